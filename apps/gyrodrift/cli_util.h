@@ -1,0 +1,26 @@
+// Helpers shared by the subcommands: loading a column, options common to several commands,
+// JSON sidecars. Kept here so every subcommand reports errors the same way.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "gyrodrift/io/csv.h"
+
+namespace gyrodrift::cli {
+
+// CLI11 validator: the value must name an existing regular file (message: "FILE: no such file").
+extern const CLI::Validator kInputFile;
+
+// The sidecar path of an output file: OUT.csv -> OUT.csv.json.
+std::string SidecarPath(const std::string& output_path);
+
+// Common metadata of every sidecar: tool name, version, command line.
+nlohmann::json SidecarHeader(const std::string& command);
+
+// True when stdout or stderr is a terminal and progress may be shown.
+bool IsTerminal();
+
+}  // namespace gyrodrift::cli

@@ -1,0 +1,57 @@
+// gyrodrift: the command line tool. Subcommands live in *_command.cc and register themselves.
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <fmt/core.h>
+
+#include "command.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/version.h"
+
+namespace gyrodrift::cli {
+std::vector<Command>& Commands() {
+  static std::vector<Command> commands;
+  return commands;
+}
+}  // namespace gyrodrift::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "gyrodrift: model and compensate the thermal drift of gyroscopes (MS-ELM, Chen & Cui 2016).",
+      "gyrodrift"};
+  app.footer(
+      "Example:\n"
+      "  gyrodrift simulate --duration 8h -o fog.csv           # a thermal-chamber log with truth\n"
+      "  gyrodrift decompose fog.csv --column rate_dph --method beemdan -o imfs.csv\n"
+      "  gyrodrift allan fog.csv --column rate_dph --rate-hz 1 -o adev.csv\n"
+      "Run 'gyrodrift SUBCOMMAND --help' for each subcommand. Exit codes: 0 ok, 2 usage,\n"
+      "3 data, 4 file I/O, 1 internal error (see docs/errors.md).");
+  app.set_version_flag("--version", std::string("gyrodrift ") + gyrodrift::kVersion);
+  app.require_subcommand(1);
+  auto& commands = gyrodrift::cli::Commands();
+  std::sort(commands.begin(), commands.end(),
+            [](const auto& a, const auto& b) { return a.order < b.order; });
+  for (auto& command : commands) command.setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
+    return gyrodrift::ExitCode(gyrodrift::ErrorKind::kUsage);
+  } catch (const gyrodrift::Error& e) {
+    fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
+    return gyrodrift::ExitCode(e.kind());
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "gyrodrift: error: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "gyrodrift: internal error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,48 @@
+// Errors: one exception family for the whole project.
+//
+// A caller's mistake (an option out of range, NaN in the input, a signal too short) throws a
+// gyrodrift::Error whose message names the option or the data, the value and what is allowed.
+// The kind tells the CLI which exit code to use (docs/errors.md). Numerical outcomes that are not
+// mistakes (an iteration cap reached, an ill-conditioned solve) are reported in result structs,
+// never thrown.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace gyrodrift {
+
+enum class ErrorKind {
+  kUsage,  // bad option or argument: exit code 2
+  kData,   // the data cannot be processed (NaN, too short, missing column): exit code 3
+  kIo,     // a file cannot be read or written: exit code 4
+};
+
+class Error : public std::runtime_error {
+ public:
+  Error(ErrorKind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
+  ErrorKind kind() const { return kind_; }
+
+ private:
+  ErrorKind kind_;
+};
+
+class UsageError : public Error {
+ public:
+  explicit UsageError(const std::string& message) : Error(ErrorKind::kUsage, message) {}
+};
+
+class DataError : public Error {
+ public:
+  explicit DataError(const std::string& message) : Error(ErrorKind::kData, message) {}
+};
+
+class IoError : public Error {
+ public:
+  explicit IoError(const std::string& message) : Error(ErrorKind::kIo, message) {}
+};
+
+// Exit code the CLI returns for an error of this kind.
+int ExitCode(ErrorKind kind);
+
+}  // namespace gyrodrift

@@ -1,0 +1,128 @@
+// The EMD family: EMD, EEMD, CEEMDAN, ICEEMDAN and BEEMDAN behind one entry point.
+//
+// Computes x = sum_k imf_k + residue. Signals are Eigen vectors on a uniform time axis t = 1..N.
+// References:
+//   EMD      Huang et al., Proc. R. Soc. A 454 (1998); Rilling, Flandrin & Goncalves, NSIP 2003
+//            (the defaults here reproduce their MATLAB emd.m).
+//   EEMD     Wu & Huang, Adv. Adapt. Data Anal. 1 (2009).
+//   CEEMDAN  Torres, Colominas, Schlotthauer & Flandrin, ICASSP 2011.
+//   ICEEMDAN Colominas, Schlotthauer & Torres, Biomed. Signal Process. Control 14 (2014).
+//   BEEMDAN  ICEEMDAN stages bounded to the noise-dominated early modes (Chen & Cui, Signal
+//            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11 (2004).
+// Cost: one sift is O(N); EMD is O(N * total sifts); the ensemble methods multiply the per-mode
+// cost by the ensemble size I and spread realisations over `threads` workers. Results are the
+// same bits for any thread count (realisation i draws from stream (seed, i), sums run in i order).
+// Units: the IMFs have the units of the input.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace gyrodrift::decomposition {
+
+enum class Method { kEmd, kEemd, kCeemdan, kIceemdan, kBeemdan };
+std::string_view ToString(Method method);
+Method MethodFromString(std::string_view name);  // "emd", "eemd", ...; throws UsageError
+
+// When to stop sifting one IMF.
+enum class StopRule {
+  kRilling,  // Rilling-Flandrin: share of |mean|/amplitude > threshold1 under tolerance, none >
+             // threshold2, and |#zero crossings - #extrema| <= 1
+  kSNumber,  // Huang 2003: extrema and zero-crossing counts unchanged (and within 1 of each
+             // other) for S consecutive sifts
+  kFixed,    // exactly fixed_sifts sifts
+  kCauchySd, // Huang 1998: sum (h_prev - h)^2 / sum h_prev^2 < sd_threshold
+};
+std::string_view ToString(StopRule rule);
+StopRule StopRuleFromString(std::string_view name);  // "rilling", "snumber", "fixed", "sd"
+
+struct SiftingOptions {
+  StopRule stop_rule = StopRule::kRilling;
+  double rilling_threshold1 = 0.05;  // |mean|/amplitude level for the "most samples" test, (0, 1)
+  double rilling_threshold2 = 0.5;   // |mean|/amplitude level no sample may exceed, >= threshold1
+  double rilling_tolerance = 0.05;   // share of samples allowed above threshold1, [0, 1)
+  int s_number = 4;                  // S of the S-number rule, >= 1
+  int fixed_sifts = 10;              // sifts per IMF for kFixed, >= 1
+  double sd_threshold = 0.2;         // Cauchy SD threshold, > 0
+  // Sift cap per IMF, >= 1. 0 selects the rule's customary cap: 2000 (Rilling), 50 (S-number,
+  // as libeemd), fixed_sifts (fixed), 2000 (SD).
+  int max_sifts = 0;
+  int EffectiveMaxSifts() const;
+  void Validate() const;  // throws UsageError naming the field
+};
+
+// How BEEMDAN decides how many stages get noise assistance.
+enum class BeemdanBound {
+  kEnergyBand,   // stop at the first mode whose energy leaves the white-noise band
+  kFixedStages,  // exactly noise_stages noise-assisted stages
+  kFull,         // every stage (then BEEMDAN equals ICEEMDAN bit for bit)
+};
+std::string_view ToString(BeemdanBound bound);
+BeemdanBound BeemdanBoundFromString(std::string_view name);  // "energy", "stages", "full"
+
+// ICEEMDAN noise scaling (the SNRFlag of the reference code).
+enum class NoiseScaling {
+  kColominas2014,  // SNRFlag 1: beta_k = eps * std(r_k), noise mode E_k(w) as is
+  kConstantSnr,    // SNRFlag 2: E_k(w) divided by its std first
+};
+std::string_view ToString(NoiseScaling scaling);
+NoiseScaling NoiseScalingFromString(std::string_view name);  // "colominas2014", "constant-snr"
+
+struct DecompositionOptions {
+  Method method = Method::kBeemdan;
+  SiftingOptions sifting;
+  int max_imfs = 0;  // cap on the IMF count (residue not counted), 0 = until the residue is
+                     // monotone; EEMD with 0 uses floor(log2 N) - 1 so all members align
+  // Noise-assisted methods.
+  int ensemble_size = 100;     // I, >= 1
+  double noise_strength = 0.2; // eps (EEMD: noise std / signal std; CEEMDAN family: eps_0)
+  std::uint64_t seed = 1;      // realisation i draws from stream (seed, i)
+  int threads = 0;             // workers, 0 = every core
+  NoiseScaling noise_scaling = NoiseScaling::kColominas2014;
+  // Supplied white noise (N x I, one realisation per column) used instead of drawing; for the
+  // CEEMDAN family in the normalised domain x / std(x), for EEMD scaled by eps * std(x).
+  std::shared_ptr<const Eigen::MatrixXd> supplied_noise;
+  // BEEMDAN.
+  BeemdanBound beemdan_bound = BeemdanBound::kEnergyBand;
+  double band_confidence = 0.99;  // 0.95 or 0.99 (the two bands Flandrin et al. 2004 fitted)
+  int noise_stages = 3;           // for kFixedStages, >= 1
+
+  void Validate() const;  // throws UsageError naming the field, value and allowed range
+};
+
+struct DecompositionReport {
+  Method method = Method::kEmd;
+  std::vector<int> sifts_per_imf;   // EMD: sifts of IMF k; ensembles: mean over realisations
+  std::vector<bool> sift_cap_hit;   // IMF k hit the sift cap (any realisation)
+  int sift_cap_hits = 0;            // total number of one-mode extractions that hit the cap
+  int ensemble_size = 0;            // 0 for plain EMD
+  std::uint64_t seed = 0;
+  bool supplied_noise = false;
+  int noise_assisted_stages = 0;    // CEEMDAN family: stages run with noise
+  std::string stop_reason;          // why the decomposition (or BEEMDAN's noise assistance) ended
+  std::vector<double> mode_log2_energy;       // BEEMDAN: log2 energy of each tested mode
+  std::vector<double> noise_band_log2_upper;  // BEEMDAN: the band's upper limit for that mode
+  std::string Summary() const;      // one line
+};
+
+struct Decomposition {
+  Eigen::MatrixXd imfs;      // N x K, one IMF per column
+  Eigen::VectorXd residue;   // N
+  DecompositionReport report;
+  int num_imfs() const { return static_cast<int>(imfs.cols()); }
+};
+
+// Decomposes x with options.method. Throws UsageError (bad options) or DataError (fewer than 4
+// samples, a non-finite sample, supplied noise of the wrong shape).
+Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
+                        const DecompositionOptions& options);
+
+// Plain EMD (the same as Decompose with Method::kEmd, without the ensemble fields).
+Decomposition Emd(const Eigen::Ref<const Eigen::VectorXd>& x, const SiftingOptions& sifting = {},
+                  int max_imfs = 0);
+
+}  // namespace gyrodrift::decomposition

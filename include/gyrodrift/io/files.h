@@ -1,0 +1,22 @@
+// Whole-file reads and atomic writes.
+//
+// An output set (a CSV and its JSON sidecar, say) is committed with one AtomicWriteSet: every file
+// is written to a temporary beside its target first, and only when all are written are they
+// renamed into place, so a failure leaves no partial output.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace gyrodrift::io {
+
+// Throws IoError naming the path when the file cannot be read.
+std::string ReadTextFile(const std::string& path);
+
+// Writes each (path, contents) atomically as a set. Throws IoError naming the path that failed;
+// then no target is created or changed.
+void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
+void WriteFileAtomically(const std::string& path, const std::string& contents);
+
+}  // namespace gyrodrift::io

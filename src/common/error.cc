@@ -1,0 +1,66 @@
+#include "gyrodrift/common/error.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "gyrodrift/common/check.h"
+
+namespace gyrodrift {
+
+int ExitCode(ErrorKind kind) {
+  switch (kind) {
+    case ErrorKind::kUsage:
+      return 2;
+    case ErrorKind::kData:
+      return 3;
+    case ErrorKind::kIo:
+      return 4;
+  }
+  return 1;
+}
+
+std::string FormatValue(double value) {
+  char buffer[64];
+  auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return ec == std::errc() ? std::string(buffer, end) : std::string("?");
+}
+
+void ThrowOption(std::string_view name, std::string_view value, std::string_view rule) {
+  throw UsageError(std::string(name) + " = " + std::string(value) + ": must be " +
+                   std::string(rule));
+}
+
+void RequireInRange(std::string_view name, double value, double lo, double hi) {
+  if (!(value >= lo && value <= hi)) {
+    ThrowOption(name, FormatValue(value),
+                "in [" + FormatValue(lo) + ", " + FormatValue(hi) + "]");
+  }
+}
+
+void RequirePositive(std::string_view name, double value) {
+  if (!(value > 0.0) || !std::isfinite(value)) {
+    ThrowOption(name, FormatValue(value), "a finite number > 0");
+  }
+}
+
+void RequireNonNegative(std::string_view name, double value) {
+  if (!(value >= 0.0) || !std::isfinite(value)) {
+    ThrowOption(name, FormatValue(value), "a finite number >= 0");
+  }
+}
+
+void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
+                         Eigen::Index min_samples) {
+  if (x.size() < min_samples) {
+    throw DataError(std::string(what) + " has " + std::to_string(x.size()) +
+                    " samples: at least " + std::to_string(min_samples) + " are needed");
+  }
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    if (!std::isfinite(x[i])) {
+      throw DataError(std::string(what) + " sample " + std::to_string(i + 1) + " is " +
+                      FormatValue(x[i]) + ": every sample must be finite");
+    }
+  }
+}
+
+}  // namespace gyrodrift

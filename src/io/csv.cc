@@ -1,0 +1,180 @@
+#include "gyrodrift/io/csv.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <string_view>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
+
+namespace gyrodrift::io {
+namespace {
+
+std::string_view Trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+std::string_view Unquote(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') return s.substr(1, s.size() - 2);
+  return s;
+}
+
+// Splits one line at commas (no quoted commas: numeric files do not need them).
+void SplitLine(std::string_view line, std::vector<std::string_view>& cells) {
+  cells.clear();
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      cells.push_back(Trim(line.substr(start)));
+      return;
+    }
+    cells.push_back(Trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+bool ParseDouble(std::string_view cell, double& value) {
+  cell = Unquote(cell);
+  if (cell.empty()) return false;
+  if (cell.front() == '+') cell.remove_prefix(1);
+  auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), value);
+  return ec == std::errc() && end == cell.data() + cell.size();
+}
+
+bool IsSkippable(std::string_view line) {
+  const std::string_view t = Trim(line);
+  return t.empty() || t.front() == '#';
+}
+
+}  // namespace
+
+CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadTextFile(path), path); }
+
+CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
+  CsvTable table;
+  table.source_ = source;
+  std::string_view rest(text);
+  if (rest.size() >= 3 && rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // BOM
+  std::vector<std::string_view> cells;
+  bool have_header = false;
+  Eigen::Index line_number = 0;
+  while (!rest.empty()) {
+    const size_t eol = rest.find('\n');
+    const std::string_view line = rest.substr(0, eol);
+    rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 1);
+    ++line_number;
+    if (IsSkippable(line)) continue;
+    SplitLine(line, cells);
+    if (!have_header) {
+      for (auto cell : cells) table.header_.emplace_back(Unquote(cell));
+      for (size_t i = 0; i < table.header_.size(); ++i) {
+        if (table.header_[i].empty()) {
+          throw DataError(source + ": header column " + std::to_string(i + 1) + " has no name");
+        }
+      }
+      table.columns_.resize(table.header_.size());
+      table.first_bad_.resize(table.header_.size());
+      have_header = true;
+      continue;
+    }
+    if (cells.size() != table.header_.size()) {
+      throw DataError(source + ": line " + std::to_string(line_number) + " has " +
+                      std::to_string(cells.size()) + " cells, the header has " +
+                      std::to_string(table.header_.size()));
+    }
+    ++table.rows_;
+    for (size_t c = 0; c < cells.size(); ++c) {
+      double value;
+      if (!ParseDouble(cells[c], value)) {
+        value = std::numeric_limits<double>::quiet_NaN();
+        if (table.first_bad_[c].row < 0) table.first_bad_[c] = {table.rows_, std::string(cells[c])};
+      } else if (!std::isfinite(value) && table.first_bad_[c].row < 0) {
+        table.first_bad_[c] = {table.rows_, std::string(cells[c])};
+      }
+      table.columns_[c].push_back(value);
+    }
+  }
+  if (!have_header) throw DataError(source + ": empty file (no header row)");
+  if (table.rows_ == 0) throw DataError(source + ": header but no data rows");
+  return table;
+}
+
+bool CsvTable::HasColumn(const std::string& name) const {
+  for (const auto& h : header_) {
+    if (h == name) return true;
+  }
+  return false;
+}
+
+int CsvTable::ResolveColumn(const std::string& spec) const {
+  for (size_t i = 0; i < header_.size(); ++i) {
+    if (header_[i] == spec) return static_cast<int>(i);
+  }
+  int index = 0;
+  auto [end, ec] = std::from_chars(spec.data(), spec.data() + spec.size(), index);
+  if (ec == std::errc() && end == spec.data() + spec.size() && index >= 1 &&
+      index <= static_cast<int>(header_.size())) {
+    return index - 1;
+  }
+  std::string names;
+  for (const auto& h : header_) names += (names.empty() ? "" : ", ") + h;
+  throw UsageError("column '" + spec + "' not found in " + source_ + " (columns: " + names +
+                   "; or a 1-based index up to " + std::to_string(header_.size()) + ")");
+}
+
+Eigen::VectorXd CsvTable::Column(const std::string& spec) const {
+  return Column(ResolveColumn(spec));
+}
+
+Eigen::VectorXd CsvTable::Column(int index) const {
+  const auto& bad = first_bad_.at(static_cast<size_t>(index));
+  if (bad.row >= 0) {
+    throw DataError(source_ + ": column '" + header_[static_cast<size_t>(index)] + "' data row " +
+                    std::to_string(bad.row) + " is '" + bad.text +
+                    "': every value must be a finite number");
+  }
+  const auto& values = columns_[static_cast<size_t>(index)];
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+std::string FormatDouble(double value) {
+  char buffer[64];
+  auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, end);
+}
+
+std::string RenderCsv(const std::vector<CsvColumn>& columns) {
+  std::string out;
+  if (columns.empty()) return out;
+  const Eigen::Index rows = columns.front().values.size();
+  for (size_t c = 0; c < columns.size(); ++c) {
+    if (columns[c].values.size() != rows) {
+      throw DataError("CSV column '" + columns[c].name + "' has " +
+                      std::to_string(columns[c].values.size()) + " rows, expected " +
+                      std::to_string(rows));
+    }
+    out += (c ? "," : "") + columns[c].name;
+  }
+  out += '\n';
+  out.reserve(out.size() + static_cast<size_t>(rows * static_cast<Eigen::Index>(columns.size()) * 24));
+  char buffer[64];
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    for (size_t c = 0; c < columns.size(); ++c) {
+      if (c) out += ',';
+      auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), columns[c].values[r]);
+      out.append(buffer, end);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+void WriteCsv(const std::string& path, const std::vector<CsvColumn>& columns) {
+  WriteFileAtomically(path, RenderCsv(columns));
+}
+
+}  // namespace gyrodrift::io

@@ -1,0 +1,82 @@
+#include "support/test_support.h"
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <stdexcept>
+
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+
+namespace gyrodrift::test {
+
+std::string TestDataPath(const std::string& relative) {
+  return std::string(GYRODRIFT_TESTDATA_DIR) + "/" + relative;
+}
+
+std::string TempDir(const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::path(GYRODRIFT_BINARY_DIR) / "test-tmp" / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+Eigen::MatrixXd ReadCsvMatrix(const std::string& path, std::vector<std::string>* header) {
+  const auto table = io::CsvTable::Read(path);
+  Eigen::MatrixXd m(table.rows(), static_cast<Eigen::Index>(table.header().size()));
+  for (int c = 0; c < static_cast<int>(table.header().size()); ++c) m.col(c) = table.Column(c);
+  if (header) *header = table.header();
+  return m;
+}
+
+Eigen::VectorXd ReadF64(const std::string& path) {
+  const std::string bytes = io::ReadTextFile(path);
+  Eigen::VectorXd v(static_cast<Eigen::Index>(bytes.size() / sizeof(double)));
+  std::memcpy(v.data(), bytes.data(), static_cast<size_t>(v.size()) * sizeof(double));
+  return v;
+}
+
+double LehmerUniform::Next() {
+  state_ = (16807 * state_) % 2147483647;
+  return static_cast<double>(state_) / 2147483647.0;
+}
+
+Eigen::VectorXd LehmerBoxMullerNormals(std::int64_t seed, Eigen::Index n) {
+  LehmerUniform uniform(seed);
+  Eigen::VectorXd z(n);
+  for (Eigen::Index j = 0; 2 * j < n; ++j) {
+    const double u1 = uniform.Next();
+    const double u2 = uniform.Next();
+    const double radius = std::sqrt(-2.0 * std::log(u1));
+    const double angle = 2.0 * std::numbers::pi * u2;
+    z[2 * j] = radius * std::cos(angle);
+    if (2 * j + 1 < n) z[2 * j + 1] = radius * std::sin(angle);
+  }
+  return z;
+}
+
+CommandResult RunCli(const std::string& args) {
+  CommandResult result;
+  const std::string dir = TempDir("cli-capture-" + std::to_string(::getpid()));
+  const std::string out_path = dir + "/stdout";
+  const std::string err_path = dir + "/stderr";
+  const std::string command =
+      std::string("'") + GYRODRIFT_CLI + "' " + args + " >'" + out_path + "' 2>'" + err_path + "' </dev/null";
+  const int status = std::system(command.c_str());
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.out = io::ReadTextFile(out_path);
+  result.err = io::ReadTextFile(err_path);
+  return result;
+}
+
+bool FileExists(const std::string& path) { return std::filesystem::exists(path); }
+
+}  // namespace gyrodrift::test

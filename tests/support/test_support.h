@@ -1,0 +1,43 @@
+// Shared test helpers: paths to the external reference data and the built CLI, CSV fixtures,
+// the portable generators the reference fixtures were made with, and running the CLI.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gyrodrift::test {
+
+// ../shared/testdata/<relative>
+std::string TestDataPath(const std::string& relative);
+// A fresh empty directory for this test (under the build tree).
+std::string TempDir(const std::string& name);
+// Matrix of every numeric column of a CSV file with a header (rows x columns).
+Eigen::MatrixXd ReadCsvMatrix(const std::string& path, std::vector<std::string>* header = nullptr);
+// Raw little-endian float64 file.
+Eigen::VectorXd ReadF64(const std::string& path);
+
+// Lehmer / Park-Miller minimal-standard LCG, s <- 16807 s mod (2^31 - 1); u = s / (2^31 - 1).
+class LehmerUniform {
+ public:
+  explicit LehmerUniform(std::int64_t seed) : state_(seed) {}
+  double Next();
+
+ private:
+  std::int64_t state_;
+};
+// First n Box-Muller normals of a Lehmer stream (cos, sin, cos, sin, ...), as the ICEEMDAN
+// fixture SOURCE.md defines them.
+Eigen::VectorXd LehmerBoxMullerNormals(std::int64_t seed, Eigen::Index n);
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+// Runs the built gyrodrift binary with the given argument string (shell-quoted by the caller).
+CommandResult RunCli(const std::string& args);
+bool FileExists(const std::string& path);
+
+}  // namespace gyrodrift::test

@@ -1,0 +1,78 @@
+#include "gyrodrift/io/csv.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::io {
+namespace {
+
+TEST(CsvTable, ParsesHeaderCommentsCrlfAndQuotedNames) {
+  const auto t = CsvTable::Parse("# comment\n\"time_s\", rate\r\n0,1.5\r\n1,-2e-3\r\n\n", "mem");
+  ASSERT_EQ(t.header().size(), 2u);
+  EXPECT_EQ(t.header()[0], "time_s");
+  EXPECT_EQ(t.rows(), 2);
+  EXPECT_EQ(t.Column("rate")[1], -2e-3);
+  EXPECT_EQ(t.Column("1")[1], 1.0);
+}
+
+TEST(CsvTable, NamesMissingColumn) {
+  const auto t = CsvTable::Parse("a,b\n1,2\n", "f.csv");
+  try {
+    t.Column("c");
+    FAIL();
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("column 'c' not found in f.csv"), std::string::npos);
+  }
+  EXPECT_THROW(t.Column("3"), UsageError);
+  EXPECT_THROW(t.Column("0"), UsageError);
+}
+
+TEST(CsvTable, NonNumericAndNonFiniteCellsNameTheRow) {
+  const auto t = CsvTable::Parse("a,b,c\n1,x,1\n2,3,nan\n3,4,inf\n", "f.csv");
+  EXPECT_EQ(t.Column("a").size(), 3);
+  try {
+    t.Column("b");
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("data row 1 is 'x'"), std::string::npos) << e.what();
+  }
+  try {
+    t.Column("c");
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("data row 2 is 'nan'"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CsvTable, RaggedRowsAndEmptyFilesAreErrors) {
+  EXPECT_THROW(CsvTable::Parse("a,b\n1\n", "f"), DataError);
+  EXPECT_THROW(CsvTable::Parse("", "f"), DataError);
+  EXPECT_THROW(CsvTable::Parse("a,b\n", "f"), DataError);
+  EXPECT_THROW(CsvTable::Read("/nonexistent/file.csv"), IoError);
+}
+
+TEST(Csv, WriteReadRoundTripIsExact) {
+  const std::string dir = test::TempDir("csv_roundtrip");
+  Eigen::VectorXd a(3), b(3);
+  a << 0.1, 1.0 / 3.0, -1e-300;
+  b << 1e300, std::nextafter(1.0, 2.0), 0.0;
+  WriteCsv(dir + "/x.csv", {{"a", a}, {"b", b}});
+  const auto t = CsvTable::Read(dir + "/x.csv");
+  EXPECT_EQ(t.Column("a"), a);
+  EXPECT_EQ(t.Column("b"), b);
+}
+
+TEST(Files, FailedSetLeavesNothingBehind) {
+  const std::string dir = test::TempDir("atomic_set");
+  EXPECT_THROW(WriteFilesAtomically({{dir + "/ok.txt", "x"}, {dir + "/missing/dir/f.txt", "y"}}),
+               IoError);
+  EXPECT_FALSE(test::FileExists(dir + "/ok.txt"));
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
