@@ -1,0 +1,205 @@
+#include "gyrodrift/decomposition/decomposition.h"
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <utility>
+
+#include "decomposition/internal.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::decomposition {
+namespace {
+
+template <class E, size_t N>
+std::string_view EnumName(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
+  for (const auto& [v, name] : names) {
+    if (v == value) return name;
+  }
+  return "?";
+}
+
+template <class E, size_t N>
+E EnumFromName(std::string_view text, std::string_view what,
+               const std::array<std::pair<E, std::string_view>, N>& names) {
+  std::string allowed;
+  for (const auto& [v, name] : names) {
+    if (name == text) return v;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
+}
+
+constexpr std::array<std::pair<Method, std::string_view>, 5> kMethods{{
+    {Method::kEmd, "emd"},
+    {Method::kEemd, "eemd"},
+    {Method::kCeemdan, "ceemdan"},
+    {Method::kIceemdan, "iceemdan"},
+    {Method::kBeemdan, "beemdan"},
+}};
+constexpr std::array<std::pair<StopRule, std::string_view>, 4> kStopRules{{
+    {StopRule::kRilling, "rilling"},
+    {StopRule::kSNumber, "snumber"},
+    {StopRule::kFixed, "fixed"},
+    {StopRule::kCauchySd, "sd"},
+}};
+constexpr std::array<std::pair<BeemdanBound, std::string_view>, 3> kBounds{{
+    {BeemdanBound::kEnergyBand, "energy"},
+    {BeemdanBound::kFixedStages, "stages"},
+    {BeemdanBound::kFull, "full"},
+}};
+constexpr std::array<std::pair<NoiseScaling, std::string_view>, 2> kScalings{{
+    {NoiseScaling::kColominas2014, "colominas2014"},
+    {NoiseScaling::kConstantSnr, "constant-snr"},
+}};
+
+}  // namespace
+
+std::string_view ToString(Method method) { return EnumName(method, kMethods); }
+Method MethodFromString(std::string_view name) { return EnumFromName(name, "method", kMethods); }
+std::string_view ToString(StopRule rule) { return EnumName(rule, kStopRules); }
+StopRule StopRuleFromString(std::string_view name) {
+  return EnumFromName(name, "stop rule", kStopRules);
+}
+std::string_view ToString(BeemdanBound bound) { return EnumName(bound, kBounds); }
+BeemdanBound BeemdanBoundFromString(std::string_view name) {
+  return EnumFromName(name, "BEEMDAN bound", kBounds);
+}
+std::string_view ToString(NoiseScaling scaling) { return EnumName(scaling, kScalings); }
+NoiseScaling NoiseScalingFromString(std::string_view name) {
+  return EnumFromName(name, "noise scaling", kScalings);
+}
+
+int SiftingOptions::EffectiveMaxSifts() const {
+  if (max_sifts > 0) return max_sifts;
+  switch (stop_rule) {
+    case StopRule::kSNumber:
+      return 50;
+    case StopRule::kFixed:
+      return fixed_sifts;
+    case StopRule::kRilling:
+    case StopRule::kCauchySd:
+      return 2000;
+  }
+  return 2000;
+}
+
+void SiftingOptions::Validate() const {
+  if (!(rilling_threshold1 > 0 && rilling_threshold1 < 1)) {
+    ThrowOption("rilling_threshold1", FormatValue(rilling_threshold1), "in (0, 1)");
+  }
+  if (!(rilling_threshold2 >= rilling_threshold1) || !std::isfinite(rilling_threshold2)) {
+    ThrowOption("rilling_threshold2", FormatValue(rilling_threshold2),
+                "finite and >= rilling_threshold1 (" + FormatValue(rilling_threshold1) + ")");
+  }
+  if (!(rilling_tolerance >= 0 && rilling_tolerance < 1)) {
+    ThrowOption("rilling_tolerance", FormatValue(rilling_tolerance), "in [0, 1)");
+  }
+  if (s_number < 1 || s_number > 1000) {
+    ThrowOption("s_number", std::to_string(s_number), "an integer in [1, 1000]");
+  }
+  if (fixed_sifts < 1 || fixed_sifts > 100000) {
+    ThrowOption("fixed_sifts", std::to_string(fixed_sifts), "an integer in [1, 100000]");
+  }
+  RequirePositive("sd_threshold", sd_threshold);
+  if (max_sifts < 0 || max_sifts > 1000000) {
+    ThrowOption("max_sifts", std::to_string(max_sifts),
+                "an integer in [1, 1000000], or 0 for the stop rule's default cap");
+  }
+}
+
+void DecompositionOptions::Validate() const {
+  sifting.Validate();
+  if (max_imfs < 0 || max_imfs > 1000) {
+    ThrowOption("max_imfs", std::to_string(max_imfs), "an integer in [0, 1000] (0 = no cap)");
+  }
+  if (method != Method::kEmd) {
+    if (!supplied_noise && (ensemble_size < 1 || ensemble_size > 1000000)) {
+      ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 1000000]");
+    }
+    if (!(noise_strength > 0 && noise_strength <= 10)) {
+      ThrowOption("noise_strength", FormatValue(noise_strength), "in (0, 10]");
+    }
+    if (threads < 0 || threads > 1024) {
+      ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
+    }
+  }
+  if (method == Method::kBeemdan) {
+    if (band_confidence != 0.95 && band_confidence != 0.99) {
+      ThrowOption("band_confidence", FormatValue(band_confidence),
+                  "0.95 or 0.99 (the bands fitted by Flandrin et al. 2004)");
+    }
+    if (noise_stages < 1 || noise_stages > 1000) {
+      ThrowOption("noise_stages", std::to_string(noise_stages), "an integer in [1, 1000]");
+    }
+  }
+}
+
+std::string DecompositionReport::Summary() const {
+  std::string s = std::string(ToString(method)) + ": " + std::to_string(sifts_per_imf.size()) +
+                  " IMFs, sifts per IMF [";
+  for (size_t k = 0; k < sifts_per_imf.size(); ++k) {
+    s += (k ? " " : "") + std::to_string(sifts_per_imf[k]);
+  }
+  s += "]";
+  if (sift_cap_hits > 0) s += ", sift cap hit " + std::to_string(sift_cap_hits) + " times";
+  if (ensemble_size > 0) {
+    s += ", ensemble " + std::to_string(ensemble_size) +
+         (supplied_noise ? " (supplied noise)" : ", seed " + std::to_string(seed));
+  }
+  if (method == Method::kCeemdan || method == Method::kIceemdan || method == Method::kBeemdan) {
+    s += ", " + std::to_string(noise_assisted_stages) + " noise-assisted stages";
+  }
+  if (!stop_reason.empty()) s += "; stop: " + stop_reason;
+  return s;
+}
+
+Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
+                        const DecompositionOptions& options) {
+  options.Validate();
+  RequireFiniteSignal("input signal", x, 4);
+  const Eigen::Index n = x.size();
+  if (options.method != Method::kEmd && options.supplied_noise) {
+    const auto& w = *options.supplied_noise;
+    if (w.rows() != n || w.cols() < 1) {
+      throw DataError("supplied noise is " + std::to_string(w.rows()) + " x " +
+                      std::to_string(w.cols()) + ": it must have one row per sample (" +
+                      std::to_string(n) + ") and at least one realisation column");
+    }
+    if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
+  }
+  // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.
+  if (internal::CountExtrema(x.data(), n).extrema() < 3) {
+    Decomposition result;
+    result.imfs.resize(n, 0);
+    result.residue = x;
+    result.report.method = options.method;
+    result.report.seed = options.seed;
+    result.report.stop_reason = "input has fewer than 3 extrema: no IMF";
+    return result;
+  }
+  switch (options.method) {
+    case Method::kEmd:
+      return internal::RunEmd(x, options);
+    case Method::kEemd:
+      return internal::RunEemd(x, options);
+    case Method::kCeemdan:
+      return internal::RunCeemdan(x, options);
+    case Method::kIceemdan:
+    case Method::kBeemdan:
+      return internal::RunIceemdan(x, options);
+  }
+  throw UsageError("unknown decomposition method");
+}
+
+Decomposition Emd(const Eigen::Ref<const Eigen::VectorXd>& x, const SiftingOptions& sifting,
+                  int max_imfs) {
+  DecompositionOptions options;
+  options.method = Method::kEmd;
+  options.sifting = sifting;
+  options.max_imfs = max_imfs;
+  return Decompose(x, options);
+}
+
+}  // namespace gyrodrift::decomposition

@@ -1,0 +1,99 @@
+// Plain EMD (Rilling & Flandrin's emd.m main loop) and the incremental noise EMD.
+#include <algorithm>
+#include <cmath>
+
+#include "decomposition/internal.h"
+
+namespace gyrodrift::decomposition::internal {
+
+double SampleStd(const double* x, Eigen::Index n) {
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) sum += x[i];
+  const double mean = sum / static_cast<double>(n);
+  double ss = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) ss += (x[i] - mean) * (x[i] - mean);
+  return std::sqrt(ss / static_cast<double>(n - 1));
+}
+
+namespace {
+double MaxAbs(const double* x, Eigen::Index n) {
+  double m = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) m = std::max(m, std::abs(x[i]));
+  return m;
+}
+}  // namespace
+
+NoiseModes::NoiseModes(Eigen::VectorXd noise)
+    : residue_(std::move(noise)), input_max_abs_(MaxAbs(residue_.data(), residue_.size())) {}
+
+bool NoiseModes::Next(Sifter& sifter, double* out) {
+  const Eigen::Index n = residue_.size();
+  if (!finished_) {
+    // emd.m stops when the residue has < 3 extrema or is negligible against the input.
+    if (MaxAbs(residue_.data(), n) < 1e-10 * input_max_abs_) {
+      finished_ = true;
+    } else {
+      const SiftOutcome outcome = sifter.ExtractImf(residue_.data(), out);
+      if (outcome.extracted) {
+        for (Eigen::Index i = 0; i < n; ++i) residue_[i] = residue_[i] - out[i];
+        return true;
+      }
+      finished_ = true;
+    }
+  }
+  if (residue_given_) return false;
+  residue_given_ = true;
+  if ((residue_.array() == 0.0).all()) return false;
+  std::copy(residue_.data(), residue_.data() + n, out);
+  return true;
+}
+
+void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen::VectorXd>& imfs,
+             DecompositionReport& report) {
+  const Eigen::Index n = r.size();
+  Eigen::VectorXd imf(n);
+  const double reference = MaxAbs(r.data(), n);
+  for (;;) {
+    if (max_imfs > 0 && static_cast<int>(imfs.size()) >= max_imfs) {
+      report.stop_reason = "IMF cap (" + std::to_string(max_imfs) + ") reached";
+      return;
+    }
+    if (CountExtrema(r.data(), n).extrema() < 3) {
+      report.stop_reason = "residue has fewer than 3 extrema";
+      return;
+    }
+    if (MaxAbs(r.data(), n) < 1e-10 * reference) {
+      report.stop_reason = "residue below 1e-10 of the input amplitude";
+      return;
+    }
+    const SiftOutcome outcome = sifter.ExtractImf(r.data(), imf.data());
+    r -= imf;
+    imfs.push_back(imf);
+    report.sifts_per_imf.push_back(outcome.sifts);
+    report.sift_cap_hit.push_back(outcome.cap_hit);
+    report.sift_cap_hits += outcome.cap_hit;
+  }
+}
+
+Decomposition AssembleResult(const std::vector<Eigen::VectorXd>& imfs, Eigen::VectorXd residue,
+                             DecompositionReport report) {
+  Decomposition result;
+  const Eigen::Index n = residue.size();
+  result.imfs.resize(n, static_cast<Eigen::Index>(imfs.size()));
+  for (size_t k = 0; k < imfs.size(); ++k) result.imfs.col(static_cast<Eigen::Index>(k)) = imfs[k];
+  result.residue = std::move(residue);
+  result.report = std::move(report);
+  return result;
+}
+
+Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o) {
+  Sifter sifter(x.size(), o.sifting);
+  DecompositionReport report;
+  report.method = Method::kEmd;
+  Eigen::VectorXd r = x;
+  std::vector<Eigen::VectorXd> imfs;
+  EmdLoop(sifter, r, o.max_imfs, imfs, report);
+  return AssembleResult(imfs, std::move(r), std::move(report));
+}
+
+}  // namespace gyrodrift::decomposition::internal

@@ -1,0 +1,45 @@
+// Private: the per-method drivers behind Decompose() and the incremental white-noise EMD.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "decomposition/sifting.h"
+#include "gyrodrift/decomposition/decomposition.h"
+
+namespace gyrodrift::decomposition::internal {
+
+// The EMD of one white-noise realisation, extracted one mode at a time on demand, so the
+// CEEMDAN family never computes a noise mode it does not use nor recomputes one from the start.
+// Rows follow emd.m: IMF 1, IMF 2, ..., then the residue (if not identically zero).
+class NoiseModes {
+ public:
+  // Takes the realisation (moved in; it becomes the running residue).
+  explicit NoiseModes(Eigen::VectorXd noise);
+  // Writes row `next` of the noise EMD into out and advances; false when there is no such row.
+  bool Next(Sifter& sifter, double* out);
+
+ private:
+  Eigen::VectorXd residue_;
+  double input_max_abs_;
+  bool finished_ = false;
+  bool residue_given_ = false;
+};
+
+// Sample standard deviation (N - 1), as MATLAB's std.
+double SampleStd(const double* x, Eigen::Index n);
+
+// emd.m's main loop on r (in place): IMFs are appended until the residue has < 3 extrema, is
+// negligible against r's initial amplitude, or max_imfs (0 = no cap) IMFs are in `imfs`.
+void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen::VectorXd>& imfs,
+             DecompositionReport& report);
+Decomposition AssembleResult(const std::vector<Eigen::VectorXd>& imfs, Eigen::VectorXd residue,
+                             DecompositionReport report);
+
+Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+// ICEEMDAN, and BEEMDAN (o.method == kBeemdan) which bounds its noise-assisted stages.
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+
+}  // namespace gyrodrift::decomposition::internal
