@@ -64,8 +64,7 @@ TEST(Sifting, DopplerFirstSiftNodesMatchReference) {
 
 TEST(Sifting, PlateausCountOnceAtTheirMiddle) {
   // Plateau maximum over samples 2..4 (0-based), a strict maximum at 8; plateau minima over 6..7
-  // and over the zeros at
-  9..10 (falling into the run, rising out of it).
+  // and over the zeros at 9..10 (falling into the run, rising out of it).
   const std::vector<double> x{0, 1, 3, 3, 3, 1, -2, -2, 1, 0, 0, 2};
   const ExtremaCounts c = CountExtrema(x.data(), static_cast<Eigen::Index>(x.size()));
   EXPECT_EQ(c.maxima, 2);
