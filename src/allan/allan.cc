@@ -1,0 +1,367 @@
+#include "gyrodrift/allan/allan.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "allan/kernels.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/parallel.h"
+
+namespace gyrodrift::allan {
+namespace {
+
+template <class E, size_t K>
+E FromName(std::string_view field, std::string_view s,
+           const std::array<std::pair<const char*, E>, K>& names) {
+  std::string allowed;
+  for (const auto& [name, value] : names) {
+    if (s == name) return value;
+    if (!allowed.empty()) allowed += "|";
+    allowed += name;
+  }
+  ThrowOption(field, s, "one of " + allowed);
+}
+
+constexpr std::array<std::pair<const char*, Deviation>, 7> kDeviationNames{{
+    {"adev", Deviation::kAdev},
+    {"oadev", Deviation::kOadev},
+    {"mdev", Deviation::kMdev},
+    {"hdev", Deviation::kHdev},
+    {"ohdev", Deviation::kOhdev},
+    {"tdev", Deviation::kTdev},
+    {"totdev", Deviation::kTotdev},
+}};
+constexpr std::array<std::pair<const char*, DataType>, 2> kDataTypeNames{{
+    {"rate", DataType::kRate},
+    {"angle", DataType::kAngle},
+}};
+constexpr std::array<std::pair<const char*, RateUnit>, 3> kUnitNames{{
+    {"dph", RateUnit::kDegPerHour},
+    {"dps", RateUnit::kDegPerSecond},
+    {"rads", RateUnit::kRadPerSecond},
+}};
+constexpr std::array<std::pair<const char*, TauGrid>, 4> kGridNames{{
+    {"all", TauGrid::kAll},
+    {"octave", TauGrid::kOctave},
+    {"decade", TauGrid::kDecade},
+    {"list", TauGrid::kList},
+}};
+
+template <class E, size_t K>
+std::string NameOf(E value, const std::array<std::pair<const char*, E>, K>& names) {
+  for (const auto& [name, v] : names)
+    if (v == value) return name;
+  return "?";
+}
+
+// Angle (phase) samples the estimators work on, in rate unit x seconds. The mean rate (or the
+// straight line through the end angles) is removed first: every estimator here is blind to a
+// constant rate, and without it the integrated angle of a biased gyro grows to values whose
+// rounding would swamp the short-tau differences.
+std::vector<double> InternalPhase(const Eigen::VectorXd& data, const AllanOptions& o) {
+  const Eigen::Index n = data.size();
+  const double tau0 = o.tau0_s();
+  std::vector<double> x;
+  if (o.data_type == DataType::kRate) {
+    x.resize(static_cast<size_t>(n + 1));
+    long double mean = 0.0L;
+    for (Eigen::Index i = 0; i < n; ++i) mean += data[i];
+    mean /= static_cast<long double>(n);
+    long double acc = 0.0L;
+    x[0] = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      acc += (static_cast<long double>(data[i]) - mean) * tau0;
+      x[static_cast<size_t>(i + 1)] = static_cast<double>(acc);
+    }
+  } else {
+    // Angle unit -> rate unit x s: degrees with deg/h become deg/h * s (x 3600).
+    const double scale = o.units == RateUnit::kDegPerHour ? 3600.0 : 1.0;
+    x.resize(static_cast<size_t>(n));
+    const long double x0 = data[0], x1 = data[n - 1];
+    const long double slope = n > 1 ? (x1 - x0) / static_cast<long double>(n - 1) : 0.0L;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const long double line = x0 + slope * static_cast<long double>(i);
+      x[static_cast<size_t>(i)] = static_cast<double>((data[i] - line) * scale);
+    }
+  }
+  return x;
+}
+
+int DifferenceOrder(Deviation d) {
+  return (d == Deviation::kHdev || d == Deviation::kOhdev) ? 3 : 2;
+}
+
+}  // namespace
+
+std::string ToString(Deviation d) { return NameOf(d, kDeviationNames); }
+Deviation DeviationFromString(std::string_view s) { return FromName("dev", s, kDeviationNames); }
+std::string ToString(DataType t) { return NameOf(t, kDataTypeNames); }
+DataType DataTypeFromString(std::string_view s) { return FromName("type", s, kDataTypeNames); }
+std::string ToString(RateUnit u) { return NameOf(u, kUnitNames); }
+RateUnit RateUnitFromString(std::string_view s) { return FromName("units", s, kUnitNames); }
+std::string ToString(TauGrid g) { return NameOf(g, kGridNames); }
+TauGrid TauGridFromString(std::string_view s) { return FromName("taus", s, kGridNames); }
+
+double ToDegPerHour(RateUnit u) {
+  switch (u) {
+    case RateUnit::kDegPerHour:
+      return 1.0;
+    case RateUnit::kDegPerSecond:
+      return 3600.0;
+    case RateUnit::kRadPerSecond:
+      return 3600.0 * 180.0 / std::numbers::pi;
+  }
+  return 1.0;
+}
+
+std::string NoiseTypeName(int alpha) {
+  switch (alpha) {
+    case 2:
+      return "white angle (quantization)";
+    case 1:
+      return "flicker angle";
+    case 0:
+      return "white rate (ARW)";
+    case -1:
+      return "flicker rate (bias instability)";
+    case -2:
+      return "random-walk rate (RRW)";
+    case -3:
+      return "flicker-walk rate";
+    case -4:
+      return "random-run rate (rate ramp)";
+    default:
+      return "unknown";
+  }
+}
+
+void AllanOptions::Validate() const {
+  RequirePositive("rate_hz", rate_hz);
+  if (!(confidence > 0.0 && confidence < 1.0))
+    ThrowOption("confidence", FormatValue(confidence), "in (0, 1)");
+  if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = all cores)");
+  if (forced_alpha && (*forced_alpha < -4 || *forced_alpha > 2))
+    ThrowOption("forced_alpha", std::to_string(*forced_alpha), "an integer in -4..2");
+  if (forced_alpha && *forced_alpha + 2 * DifferenceOrder(deviation) <= 1)
+    ThrowOption("forced_alpha", std::to_string(*forced_alpha),
+                "> " + std::to_string(1 - 2 * DifferenceOrder(deviation)) + " for " +
+                    ToString(deviation));
+  if (grid == TauGrid::kList) {
+    if (tau_list_s.empty()) ThrowOption("tau_list_s", "(empty)", "at least one tau for grid list");
+    for (double t : tau_list_s) RequirePositive("tau_list_s", t);
+  }
+}
+
+std::int64_t MaxAveragingFactor(Deviation d, Eigen::Index n_phase) {
+  const std::int64_t n = n_phase;
+  switch (d) {
+    case Deviation::kAdev:
+    case Deviation::kOadev:
+    case Deviation::kTotdev:
+      return (n - 1) / 2;
+    case Deviation::kMdev:
+    case Deviation::kTdev:
+      return n / 3;
+    case Deviation::kHdev:
+    case Deviation::kOhdev:
+      return (n - 1) / 3;
+  }
+  return 0;
+}
+
+std::int64_t TermCount(Deviation d, Eigen::Index n_phase, std::int64_t m) {
+  const std::int64_t n = n_phase;
+  switch (d) {
+    case Deviation::kAdev:
+      return (n - 1) / m - 1;
+    case Deviation::kOadev:
+      return n - 2 * m;
+    case Deviation::kMdev:
+    case Deviation::kTdev:
+      return n - 3 * m + 1;
+    case Deviation::kHdev:
+      return (n - 1) / m - 2;
+    case Deviation::kOhdev:
+      return n - 3 * m;
+    case Deviation::kTotdev:
+      return n - 2;
+  }
+  return 0;
+}
+
+std::vector<std::int64_t> AveragingFactors(const AllanOptions& o, Eigen::Index n_phase) {
+  const std::int64_t max_m = MaxAveragingFactor(o.deviation, n_phase);
+  std::vector<std::int64_t> ms;
+  switch (o.grid) {
+    case TauGrid::kAll:
+      for (std::int64_t m = 1; m <= max_m; ++m) ms.push_back(m);
+      break;
+    case TauGrid::kOctave:
+      for (std::int64_t m = 1; m <= max_m; m *= 2) ms.push_back(m);
+      break;
+    case TauGrid::kDecade:
+      for (std::int64_t decade = 1; decade <= max_m; decade *= 10)
+        for (std::int64_t f : {1, 2, 4})
+          if (decade * f <= max_m) ms.push_back(decade * f);
+      break;
+    case TauGrid::kList:
+      for (double tau : o.tau_list_s) {
+        const double mf = std::max(1.0, std::round(tau * o.rate_hz));
+        if (mf > static_cast<double>(max_m)) {
+          throw DataError("tau " + FormatValue(tau) + " s needs averaging factor " +
+                          FormatValue(mf) + " but " + ToString(o.deviation) + " of " +
+                          std::to_string(n_phase) + " points allows at most " +
+                          std::to_string(max_m) + " (tau " +
+                          FormatValue(static_cast<double>(max_m) * o.tau0_s()) + " s)");
+        }
+        ms.push_back(static_cast<std::int64_t>(mf));
+      }
+      std::sort(ms.begin(), ms.end());
+      ms.erase(std::unique(ms.begin(), ms.end()), ms.end());
+      break;
+  }
+  return ms;
+}
+
+Eigen::VectorXd AllanResult::tau_s() const {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(points.size()));
+  for (size_t i = 0; i < points.size(); ++i) v[static_cast<Eigen::Index>(i)] = points[i].tau_s;
+  return v;
+}
+
+Eigen::VectorXd AllanResult::dev() const {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(points.size()));
+  for (size_t i = 0; i < points.size(); ++i) v[static_cast<Eigen::Index>(i)] = points[i].dev;
+  return v;
+}
+
+std::string AllanResult::Summary() const {
+  std::ostringstream s;
+  s << ToString(options.deviation) << " of " << n_samples << " " << ToString(options.data_type)
+    << " samples at " << FormatValue(options.rate_hz) << " Hz: " << points.size() << " taus";
+  if (!points.empty()) {
+    const auto it = std::min_element(points.begin(), points.end(),
+                                     [](const auto& a, const auto& b) { return a.dev < b.dev; });
+    s << " " << FormatValue(points.front().tau_s) << ".." << FormatValue(points.back().tau_s)
+      << " s, min " << FormatValue(it->dev) << " " << ToString(options.units) << " at "
+      << FormatValue(it->tau_s) << " s";
+  }
+  return s.str();
+}
+
+AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options) {
+  options.Validate();
+  const Eigen::Index min_samples = options.data_type == DataType::kRate ? 2 : 3;
+  RequireFiniteSignal("input", data, min_samples);
+  AllanResult result;
+  result.options = options;
+  result.n_samples = data.size();
+  const std::vector<double> x = InternalPhase(data, options);
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  result.n_phase = n;
+  const Deviation dev = options.deviation;
+  const std::vector<std::int64_t> ms = AveragingFactors(options, n);
+  if (ms.empty()) {
+    throw DataError(ToString(dev) + " needs at least " +
+                    std::to_string(dev == Deviation::kHdev || dev == Deviation::kOhdev ? 4 : 3) +
+                    " angle points (" + std::to_string(n) + " given)");
+  }
+  const double tau0 = options.tau0_s();
+  const int count = static_cast<int>(ms.size());
+  std::vector<double> variance(ms.size());
+  std::vector<std::optional<int>> alpha(ms.size());
+  const std::vector<double> extended =
+      dev == Deviation::kTotdev ? internal::ExtendForTotdev(x.data(), n) : std::vector<double>{};
+
+  // Tasks: groups of consecutive factors for the blocked OADEV kernel, single factors otherwise.
+  std::vector<int> task_begin;
+  for (int k = 0; k < count;) {
+    task_begin.push_back(k);
+    int stop = k + 1;
+    if (dev == Deviation::kOadev)
+      while (stop < count && stop - k < 16 && ms[stop] - ms[k] <= 64) ++stop;
+    k = stop;
+  }
+  task_begin.push_back(count);
+  const int dmax = DifferenceOrder(dev);
+  const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
+  ParallelFor(static_cast<int>(task_begin.size()) - 1, options.threads, [&](int task, int) {
+    const int begin = task_begin[static_cast<size_t>(task)];
+    const int end = task_begin[static_cast<size_t>(task) + 1];
+    if (dev == Deviation::kOadev) {
+      internal::OverlappingSecondDifferenceSums(x.data(), n, ms.data() + begin, end - begin,
+                                                variance.data() + begin);
+    }
+    for (int k = begin; k < end; ++k) {
+      const std::int64_t m = ms[static_cast<size_t>(k)];
+      const double tau = static_cast<double>(m) * tau0;
+      double& v = variance[static_cast<size_t>(k)];
+      switch (dev) {
+        case Deviation::kOadev:
+          v /= 2.0 * static_cast<double>(n - 2 * m) * tau * tau;
+          break;
+        case Deviation::kAdev:
+          v = internal::AdevVariance(x.data(), n, m, tau);
+          break;
+        case Deviation::kMdev:
+        case Deviation::kTdev:
+          v = internal::MdevVariance(x.data(), n, m, tau);
+          break;
+        case Deviation::kHdev:
+          v = internal::HdevVariance(x.data(), n, m, tau);
+          break;
+        case Deviation::kOhdev:
+          v = internal::OhdevVariance(x.data(), n, m, tau);
+          break;
+        case Deviation::kTotdev:
+          v = internal::TotdevVariance(extended, n, m, tau);
+          break;
+      }
+      if (want_alpha) {
+        Eigen::Map<const Eigen::VectorXd> xm(x.data(), n);
+        alpha[static_cast<size_t>(k)] = IdentifyAlpha(xm, m, options.data_type, dmax);
+      }
+    }
+  });
+
+  // Noise type where fewer than 30 points remain: carry the last identified one forward (the
+  // curve's noise type changes slowly with tau); before any identification, white rate noise.
+  int carried = 0;
+  for (int k = 0; k < count; ++k) {
+    if (alpha[static_cast<size_t>(k)]) {
+      carried = *alpha[static_cast<size_t>(k)];
+      break;
+    }
+  }
+  result.points.resize(ms.size());
+  for (int k = 0; k < count; ++k) {
+    AllanPoint& p = result.points[static_cast<size_t>(k)];
+    const std::int64_t m = ms[static_cast<size_t>(k)];
+    p.m = m;
+    p.tau_s = static_cast<double>(m) * tau0;
+    p.dev = std::sqrt(std::max(0.0, variance[static_cast<size_t>(k)]));
+    if (dev == Deviation::kTdev) p.dev *= p.tau_s / std::sqrt(3.0);
+    p.n_terms = TermCount(dev, n, m);
+    if (!options.confidence_intervals) {
+      p.edf = p.dev_lo = p.dev_hi = std::numeric_limits<double>::quiet_NaN();
+      continue;
+    }
+    if (options.forced_alpha) {
+      p.alpha = *options.forced_alpha;
+    } else if (alpha[static_cast<size_t>(k)]) {
+      p.alpha = carried = *alpha[static_cast<size_t>(k)];
+      p.alpha_identified = true;
+    } else {
+      p.alpha = carried;
+    }
+    p.edf = EquivalentDof(dev, p.alpha, m, n);
+    ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
+  }
+  return result;
+}
+
+}  // namespace gyrodrift::allan

@@ -1,0 +1,341 @@
+// Equivalent degrees of freedom, chi-square quantiles and lag-1 autocorrelation noise
+// identification for allan.h.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::allan {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kWilsonHilfertyDof = 1e4;
+
+// ---- Greenhall & Riley 2003 ------------------------------------------------------------------
+// Generalized autocovariance of the phase increments for power-law noise alpha (their eq. 7).
+double Sw(double t, int alpha) {
+  const double a = std::abs(t);
+  switch (alpha) {
+    case 2:
+      return -a;
+    case 1:
+      return a == 0.0 ? 0.0 : t * t * std::log(a);
+    case 0:
+      return a * a * a;
+    case -1:
+      return a == 0.0 ? 0.0 : t * t * t * t * std::log(a);
+    case -2:
+      return a * a * a * a * a;
+    case -3:
+      return a == 0.0 ? 0.0 : std::pow(t, 6) * std::log(a);
+    case -4:
+      return std::pow(a, 7);
+    default:
+      return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+// Averaging by F (F = inf: the continuous limit, which raises the noise order by 2). Eq. 8.
+double Sx(double t, double f, int alpha) {
+  if (f == kInf) return Sw(t, alpha + 2);
+  return f * f * (2.0 * Sw(t, alpha) - Sw(t - 1.0 / f, alpha) - Sw(t + 1.0 / f, alpha));
+}
+
+// d-th difference: binomial weights (-1)^k C(2d, d+k). Eq. 9.
+double Sz(double t, double f, int alpha, int d) {
+  static constexpr double kW[4][4] = {
+      {1, 0, 0, 0}, {2, -1, 0, 0}, {6, -4, 1, 0}, {20, -15, 6, -1}};
+  double s = kW[d][0] * Sx(t, f, alpha);
+  for (int k = 1; k <= d; ++k) s += kW[d][k] * (Sx(t - k, f, alpha) + Sx(t + k, f, alpha));
+  return s;
+}
+
+// Eq. 10.
+double BasicSum(double j_terms, double m_terms, double s, double f, int alpha, int d) {
+  const double z0 = Sz(0.0, f, alpha, d);
+  double sum = z0 * z0;
+  const double zj = Sz(j_terms / s, f, alpha, d);
+  sum += (1.0 - j_terms / m_terms) * zj * zj;
+  for (int j = 1; j < static_cast<int>(j_terms); ++j) {
+    const double z = Sz(j / s, f, alpha, d);
+    sum += 2.0 * (1.0 - j / m_terms) * z * z;
+  }
+  return sum;
+}
+
+// Table 1 (modified variances) and 2 (unmodified) of Greenhall & Riley: (a0, a1) for
+// alpha = 2..-4 (rows) and d = 1..3 (columns); NaN where alpha + 2d <= 1.
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kTable1[7][3][2] = {
+    {{2.0 / 3, 1.0 / 3}, {7.0 / 9, 1.0 / 2}, {22.0 / 25, 2.0 / 3}},
+    {{0.840, 0.345}, {0.997, 0.616}, {1.141, 0.843}},
+    {{1.079, 0.368}, {1.033, 0.607}, {1.184, 0.848}},
+    {{kNaN, kNaN}, {1.048, 0.534}, {1.180, 0.816}},
+    {{kNaN, kNaN}, {1.302, 0.535}, {1.175, 0.777}},
+    {{kNaN, kNaN}, {kNaN, kNaN}, {1.194, 0.703}},
+    {{kNaN, kNaN}, {kNaN, kNaN}, {1.489, 0.702}},
+};
+constexpr double kTable2[7][3][2] = {
+    {{3.0 / 2, 1.0 / 2}, {35.0 / 18, 1.0}, {231.0 / 100, 3.0 / 2}},
+    {{78.6, 25.2}, {790.0, 410.0}, {9950.0, 6520.0}},
+    {{2.0 / 3, 1.0 / 6}, {2.0 / 3, 1.0 / 3}, {7.0 / 9, 1.0 / 2}},
+    {{kNaN, kNaN}, {0.852, 0.375}, {0.997, 0.617}},
+    {{kNaN, kNaN}, {1.079, 0.368}, {1.033, 0.607}},
+    {{kNaN, kNaN}, {kNaN, kNaN}, {1.053, 0.553}},
+    {{kNaN, kNaN}, {kNaN, kNaN}, {1.302, 0.535}},
+};
+// Table 3: flicker PM, unmodified: (b0, b1) by d.
+constexpr double kTable3[3][2] = {{6.0, 4.0}, {15.23, 12.0}, {47.8, 40.0}};
+
+// Greenhall & Riley's algorithm. Filter factor F = 1 for modified variances, m for unmodified;
+// stride factor S = 1 for non-overlapping, m for overlapping estimators. n: phase points.
+double GreenhallEdf(int alpha, int d, double m, bool modified, bool overlapping, double n) {
+  constexpr double kJmax = 100.0;
+  const double f = modified ? 1.0 : m;
+  const double s = overlapping ? m : 1.0;
+  const double l = m / f + m * d;
+  if (n < l) return kNaN;
+  const double big_m = 1.0 + std::floor(s * (n - l) / m);
+  const double j = std::min(big_m, (d + 1) * s);
+  const double r = big_m / s;
+  const int row = 2 - alpha;
+  auto inv_basic = [&](double jj, double mm, double ss, double ff, double scale_f) {
+    const double z0 = Sz(0.0, scale_f, alpha, d);
+    return BasicSum(jj, mm, ss, ff, alpha, d) / (z0 * z0 * mm);
+  };
+  double inv_edf = kNaN;
+  if (modified) {
+    if (j <= kJmax) {
+      inv_edf = inv_basic(j, big_m, s, 1.0, 1.0);
+    } else if (r > d + 1) {
+      const double a0 = kTable1[row][d - 1][0], a1 = kTable1[row][d - 1][1];
+      inv_edf = (a0 - a1 / r) / r;
+    } else {
+      inv_edf = inv_basic(kJmax, kJmax, kJmax / r, 1.0, 1.0);
+    }
+  } else if (alpha <= 0) {
+    if (j <= kJmax) {
+      // Large m: the continuous limit avoids the cancellation in F^2 (2 sw(t) - ...).
+      const double fm = m * (d + 1) <= kJmax ? m : kInf;
+      inv_edf = inv_basic(j, big_m, s, fm, fm);
+    } else if (r > d + 1) {
+      const double a0 = kTable2[row][d - 1][0], a1 = kTable2[row][d - 1][1];
+      inv_edf = (a0 - a1 / r) / r;
+    } else {
+      inv_edf = inv_basic(kJmax, kJmax, kJmax / r, kInf, kInf);
+    }
+  } else if (alpha == 1) {
+    if (j <= kJmax) {
+      inv_edf = inv_basic(j, big_m, s, m, m);
+    } else {
+      const double b = kTable3[d - 1][0] + kTable3[d - 1][1] * std::log(m);
+      if (r > d + 1) {
+        const double a0 = kTable2[row][d - 1][0], a1 = kTable2[row][d - 1][1];
+        inv_edf = (a0 - a1 / r) / (b * b * r);
+      } else {
+        const double mp = kJmax / r;
+        inv_edf = BasicSum(kJmax, kJmax, mp, mp, 1, d) / (b * b * kJmax);
+      }
+    }
+  } else {  // alpha == 2, unmodified
+    const double k = std::ceil(r);
+    if (k <= d) {
+      // Few terms: the exact basic sum (J = M here, at most d + 1 terms' worth).
+      inv_edf = inv_basic(j, big_m, s, m, m);
+    } else {
+      double a0 = 1.0;  // C(4d, 2d) / C(2d, d)^2
+      for (int i = 1; i <= 2 * d; ++i) a0 *= static_cast<double>(2 * d + i) / i;
+      double c = 1.0;
+      for (int i = 1; i <= d; ++i) c *= static_cast<double>(d + i) / i;
+      a0 /= c * c;
+      inv_edf = (a0 - (d / 2.0) / r) / big_m;
+    }
+  }
+  return 1.0 / inv_edf;
+}
+
+// Linear least-squares removal of a polynomial of degree `deg` (1 or 2), in place.
+void Detrend(Eigen::VectorXd& z, int deg) {
+  const Eigen::Index n = z.size();
+  const double half = 0.5 * static_cast<double>(n - 1);
+  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(deg + 1, deg + 1);
+  Eigen::VectorXd atb = Eigen::VectorXd::Zero(deg + 1);
+  double pw[5];
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = (static_cast<double>(i) - half) / std::max(half, 1.0);
+    pw[0] = 1.0;
+    for (int k = 1; k <= 2 * deg; ++k) pw[k] = pw[k - 1] * t;
+    for (int a = 0; a <= deg; ++a) {
+      atb[a] += pw[a] * z[i];
+      for (int b = 0; b <= deg; ++b) ata(a, b) += pw[a + b];
+    }
+  }
+  const Eigen::VectorXd c = ata.ldlt().solve(atb);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double t = (static_cast<double>(i) - half) / std::max(half, 1.0);
+    double p = c[deg];
+    for (int k = deg - 1; k >= 0; --k) p = p * t + c[k];
+    z[i] -= p;
+  }
+}
+
+double Lag1Autocorrelation(const Eigen::VectorXd& z) {
+  const double mean = z.mean();
+  double num = 0.0, den = 0.0;
+  for (Eigen::Index i = 0; i < z.size(); ++i) {
+    const double a = z[i] - mean;
+    den += a * a;
+    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+}  // namespace
+
+double EquivalentDof(Deviation dev, int alpha, std::int64_t m, Eigen::Index n_phase) {
+  const double md = static_cast<double>(m);
+  const double n = static_cast<double>(n_phase);
+  switch (dev) {
+    case Deviation::kAdev:
+      return GreenhallEdf(alpha, 2, md, false, false, n);
+    case Deviation::kOadev:
+      return GreenhallEdf(alpha, 2, md, false, true, n);
+    case Deviation::kMdev:
+    case Deviation::kTdev:
+      return GreenhallEdf(alpha, 2, md, true, true, n);
+    case Deviation::kHdev:
+      return GreenhallEdf(alpha, 3, md, false, false, n);
+    case Deviation::kOhdev:
+      return GreenhallEdf(alpha, 3, md, false, true, n);
+    case Deviation::kTotdev: {
+      // NIST SP 1065 table 7: edf = b (T / tau) - c, T = record length (N - 1) tau0.
+      static constexpr double kBc[3][2] = {{1.50, 0.0}, {1.17, 0.22}, {0.93, 0.36}};
+      if (alpha <= 0 && alpha >= -2)
+        return kBc[-alpha][0] * ((n - 1.0) / md) - kBc[-alpha][1];
+      // Phase noise (table 7 has no row): the simple OADEV formulas of SP 1065 table 5
+      // (Howe, Allan, Barnes 1981), which is what Stable32's intervals imply.
+      if (alpha == 2) return (n + 1.0) * (n - 2.0 * md) / (2.0 * (n - md));
+      if (alpha == 1)
+        return std::exp(std::sqrt(std::log((n - 1.0) / (2.0 * md)) *
+                                  std::log((2.0 * md + 1.0) * (n - 1.0) / 4.0)));
+      return GreenhallEdf(alpha, 2, md, false, true, n);
+    }
+  }
+  return kNaN;
+}
+
+double RegularizedGammaP(double a, double x) {
+  if (!(a > 0.0) || !(x >= 0.0)) return kNaN;
+  if (x == 0.0) return 0.0;
+  if (x == kInf) return 1.0;
+  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
+  const int max_iter = 1000 + static_cast<int>(20.0 * std::sqrt(a));
+  constexpr double kEps = 1e-16;
+  if (x < a + 1.0) {
+    // Series: P = e^-x x^a / Gamma(a+1) * sum x^n / ((a+1)...(a+n)).
+    double term = 1.0 / a, sum = term;
+    for (int n = 1; n < max_iter; ++n) {
+      term *= x / (a + n);
+      sum += term;
+      if (std::abs(term) < std::abs(sum) * kEps) break;
+    }
+    return std::min(1.0, sum * std::exp(log_prefactor));
+  }
+  // Continued fraction for Q (modified Lentz).
+  constexpr double kTiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < max_iter; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = b + an / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1.0) < kEps) break;
+  }
+  return std::max(0.0, 1.0 - std::exp(log_prefactor) * h);
+}
+
+double ChiSquareQuantile(double p, double dof) {
+  if (!(p > 0.0 && p < 1.0) || !(dof > 0.0)) return kNaN;
+  // Standard normal quantile by bisection on erfc (64 halvings of [-40, 40]: below 1e-17).
+  double zlo = -40.0, zhi = 40.0;
+  for (int i = 0; i < 64; ++i) {
+    const double mid = 0.5 * (zlo + zhi);
+    if (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p) zlo = mid; else zhi = mid;
+  }
+  const double z = 0.5 * (zlo + zhi);
+  // Wilson-Hilferty; above kWilsonHilfertyDof its relative error is below 1e-6 (unit test), and
+  // the series below would need O(sqrt(dof)) terms per step.
+  const double h = 2.0 / (9.0 * dof);
+  double x = dof * std::pow(std::max(1e-10, 1.0 - h + z * std::sqrt(h)), 3);
+  if (dof > kWilsonHilfertyDof) return x;
+  const double a = 0.5 * dof;
+  double lo = 0.0, hi = kInf;
+  for (int it = 0; it < 200; ++it) {
+    const double f = RegularizedGammaP(a, 0.5 * x) - p;
+    if (f < 0.0) lo = x; else hi = x;
+    const double log_density =
+        (a - 1.0) * std::log(0.5 * x) - 0.5 * x - std::lgamma(a) - std::log(2.0);
+    const double density = std::exp(log_density);
+    double next = density > 0.0 ? x - f / density : kNaN;
+    if (!(next > lo && next < hi)) next = hi == kInf ? 2.0 * x + 1.0 : 0.5 * (lo + hi);
+    if (std::abs(next - x) <= 1e-14 * x) return next;
+    x = next;
+  }
+  return x;
+}
+
+void ConfidenceInterval(double dev, double edf, double confidence, double* lo, double* hi) {
+  if (!(edf > 0.0) || !std::isfinite(edf)) {
+    *lo = *hi = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
+  const double tail = 0.5 * (1.0 - confidence);
+  const double chi_hi = ChiSquareQuantile(1.0 - tail, edf);
+  const double chi_lo = ChiSquareQuantile(tail, edf);
+  *lo = dev * std::sqrt(edf / chi_hi);
+  *hi = dev * std::sqrt(edf / chi_lo);
+}
+
+std::optional<int> IdentifyAlpha(const Eigen::VectorXd& phase, std::int64_t m, DataType type,
+                                 int dmax) {
+  constexpr Eigen::Index kMinPoints = 30;
+  const Eigen::Index n = phase.size();
+  Eigen::VectorXd z;
+  if (type == DataType::kRate) {
+    // m-sample averages of the rate: differences of the integrated angle.
+    const Eigen::Index k = (n - 1) / m;
+    if (k < kMinPoints) return std::nullopt;
+    z.resize(k);
+    for (Eigen::Index i = 0; i < k; ++i) z[i] = phase[(i + 1) * m] - phase[i * m];
+    Detrend(z, 1);
+  } else {
+    const Eigen::Index k = (n - 1) / m + 1;
+    if (k < kMinPoints) return std::nullopt;
+    z.resize(k);
+    for (Eigen::Index i = 0; i < k; ++i) z[i] = phase[i * m];
+    Detrend(z, 2);
+  }
+  for (int d = 0;; ++d) {
+    const double r1 = Lag1Autocorrelation(z);
+    const double rho = r1 / (1.0 + r1);
+    if (rho < 0.25 || d >= dmax) {
+      int alpha = -static_cast<int>(std::nearbyint(2.0 * rho)) - 2 * d;
+      if (type == DataType::kAngle) alpha += 2;
+      return std::clamp(alpha, dmax == 2 ? -2 : -4, 2);
+    }
+    const Eigen::VectorXd dz = z.tail(z.size() - 1) - z.head(z.size() - 1);
+    z = dz;
+  }
+}
+
+}  // namespace gyrodrift::allan
