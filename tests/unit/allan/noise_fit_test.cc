@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+
+namespace gyrodrift::allan {
+namespace {
+
+constexpr double kUradPerDeg = std::numbers::pi / 180.0 * 1e6;
+
+// Exact IEEE 952 model in deg/h with the terms in reporting units.
+double ModelAdev(double tau, double q_urad, double n_dpsh, double b_dph, double k, double r) {
+  const double q = q_urad / kUradPerDeg * 3600.0;  // deg/h * s
+  const double n = n_dpsh * 60.0;                  // deg/h * sqrt(s)
+  const double kk = k / 60.0;                      // deg/h / sqrt(s)
+  const double rr = r / 3600.0;                    // deg/h / s
+  return std::sqrt(3 * q * q / (tau * tau) + n * n / tau +
+                   2 * std::numbers::ln2 / std::numbers::pi * b_dph * b_dph + kk * kk * tau / 3 +
+                   rr * rr * tau * tau / 2);
+}
+
+// On a noise-free model curve every term comes back exactly, in the reporting units.
+TEST(NoiseFit, RecoversExactModelCurve) {
+  const double q = 0.8, n = 0.005, b = 0.01, k = 0.02, r = 0.05;
+  std::vector<double> taus;
+  for (double t = 0.01; t < 2e5; t *= 1.5) taus.push_back(t);
+  const Eigen::Index m = static_cast<Eigen::Index>(taus.size());
+  Eigen::VectorXd tau(m), adev(m), edf = Eigen::VectorXd::Constant(m, 100.0);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    tau[i] = taus[static_cast<size_t>(i)];
+    adev[i] = ModelAdev(tau[i], q, n, b, k, r);
+  }
+  const NoiseTerms t = IdentifyNoise(tau, adev, edf, {.min_share = 0.01});
+  EXPECT_NEAR(t.q_urad.value / q, 1.0, 1e-6);
+  EXPECT_NEAR(t.n_dpsh.value / n, 1.0, 1e-6);
+  EXPECT_NEAR(t.b_dph.value / b, 1.0, 1e-6);
+  EXPECT_NEAR(t.k_dphpsh.value / k, 1.0, 1e-6);
+  EXPECT_NEAR(t.r_dphph.value / r, 1.0, 1e-6);
+  EXPECT_LT(t.chi2_per_dof, 1e-12);
+  for (double tt : {0.1, 10.0, 1e4}) EXPECT_NEAR(t.ModelDevDph(tt) / ModelAdev(tt, q, n, b, k, r), 1.0, 1e-6);
+  // Bias instability slope reading: the curve minimum / 0.664 is above B (other terms add).
+  EXPECT_GT(t.b_dph.slope_reading, b);
+}
+
+// A term that never matters in the fitted range is reported as not identified.
+TEST(NoiseFit, DropsTermsThatNeverMatter) {
+  std::vector<double> taus;
+  for (double t = 1.0; t < 1e3; t *= 2) taus.push_back(t);
+  const Eigen::Index m = static_cast<Eigen::Index>(taus.size());
+  Eigen::VectorXd tau(m), adev(m), edf = Eigen::VectorXd::Constant(m, 50.0);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    tau[i] = taus[static_cast<size_t>(i)];
+    adev[i] = ModelAdev(tau[i], 0.0, 0.01, 0.0, 0.0, 0.0);
+  }
+  const NoiseTerms t = IdentifyNoise(tau, adev, edf);
+  EXPECT_TRUE(t.n_dpsh.identified);
+  EXPECT_NEAR(t.n_dpsh.value / 0.01, 1.0, 1e-9);
+  EXPECT_FALSE(t.q_urad.identified);
+  EXPECT_FALSE(t.k_dphpsh.identified);
+  EXPECT_FALSE(t.r_dphph.identified);
+  // Slope method on a pure -1/2 line reads N exactly.
+  EXPECT_NEAR(t.n_dpsh.slope_reading / 0.01, 1.0, 1e-9);
+}
+
+// Synthetic gyro: quantization (white angle noise), angle random walk (white rate) and rate
+// random walk (integrated white rate), generated with seeded streams; the fit must find the
+// generating values.
+TEST(NoiseFit, RecoversSyntheticGyroNoise) {
+  const double rate_hz = 100.0, tau0 = 1.0 / rate_hz;
+  const Eigen::Index n = 720000;  // 2 h
+  const double q_true_urad = 2.5, n_true = 0.05, k_true = 5.0;
+  const double q_raw = q_true_urad / kUradPerDeg * 3600.0;  // deg/h * s
+  const double n_raw = n_true * 60.0;
+  const double k_raw = k_true / 60.0;
+  Rng white(2026, StreamId("arw")), walk(2026, StreamId("rrw")), quant(2026, StreamId("quant"));
+  Eigen::VectorXd rate(n);
+  double bias = 0.0, prev_angle_noise = q_raw * quant.Normal();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    bias += k_raw * std::sqrt(tau0) * walk.Normal();
+    const double angle_noise = q_raw * quant.Normal();
+    rate[i] = n_raw / std::sqrt(tau0) * white.Normal() + bias +
+              (angle_noise - prev_angle_noise) / tau0;
+    prev_angle_noise = angle_noise;
+  }
+  AllanOptions o{.rate_hz = rate_hz, .grid = TauGrid::kOctave};
+  const AllanResult r = Compute(rate, o);
+  const NoiseTerms t = IdentifyNoise(r);
+  EXPECT_NEAR(t.q_urad.value / q_true_urad, 1.0, 0.1) << t.Summary();
+  EXPECT_NEAR(t.n_dpsh.value / n_true, 1.0, 0.05) << t.Summary();
+  EXPECT_NEAR(t.k_dphpsh.value / k_true, 1.0, 0.3) << t.Summary();
+  // The reported uncertainties cover the truth (4 sigma: curve points are correlated).
+  EXPECT_LT(std::abs(t.n_dpsh.value - n_true), 4 * t.n_dpsh.sigma + 1e-3 * n_true) << t.Summary();
+  EXPECT_LT(std::abs(t.k_dphpsh.value - k_true), 4 * t.k_dphpsh.sigma) << t.Summary();
+  // Slope readings agree with the fit where each slope is visible.
+  EXPECT_NEAR(t.n_dpsh.slope_reading / n_true, 1.0, 0.15) << t.n_dpsh.slope_tau_s;
+  EXPECT_NEAR(t.k_dphpsh.slope_reading / k_true, 1.0, 0.5) << t.k_dphpsh.slope_tau_s;
+}
+
+TEST(NoiseFit, RejectsNonAllanEstimatorsAndEmptyRanges) {
+  Rng rng(1, 0);
+  Eigen::VectorXd y(1000);
+  rng.FillNormal(y);
+  AllanOptions o{.deviation = Deviation::kMdev};
+  EXPECT_THROW(IdentifyNoise(Compute(y, o)), UsageError);
+  o.deviation = Deviation::kOadev;
+  EXPECT_THROW(IdentifyNoise(Compute(y, o), {.tau_min_s = 1e6, .tau_max_s = 1e7}), DataError);
+  EXPECT_THROW(IdentifyNoise(Compute(y, o), {.tau_min_s = 5.0, .tau_max_s = 1.0}), UsageError);
+}
+
+}  // namespace
+}  // namespace gyrodrift::allan
