@@ -1,0 +1,174 @@
+// Closed-form leave-one-out (PRESS) errors of ridge ELMs over a grid of (L, C).
+//
+// For candidate L, H_L = H[:, :L] (the units are nested) and H_L^T H_L = V diag(lambda) V^T is
+// the leading block of the full Gram matrix. With P = H_L V and delta = 1/C:
+//   fitted values     y_i   = sum_j P_ij z_j / (lambda_j + delta),  z = V^T H_L^T T
+//   hat diagonal      h_ii  = sum_j P_ij^2 / (lambda_j + delta)
+//   PRESS residual    e_i   = (t_i - y_i) / (1 - h_ii)
+// so one eigendecomposition and one N x L x L product per candidate L serve every C.
+// The rows are streamed in fixed blocks; each block returns its sums of e^2 and the sums are
+// added in block order, so the result does not depend on the thread count.
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "elm/internal.h"
+#include "gyrodrift/common/parallel.h"
+
+namespace gyrodrift::elm::internal {
+namespace {
+
+// Everything the row pass needs about one candidate L.
+struct CandidatePlan {
+  int hidden = 0;
+  std::vector<int> active;       // indices into the C grid that are evaluated
+  Eigen::MatrixXd vectors;       // V, L x L
+  Eigen::MatrixXd hat_weights;   // L x |active|: 1 / (lambda_j + delta_c)
+  Eigen::MatrixXd fit_weights;   // L x (|active| m): z_jk / (lambda_j + delta_c), c-major
+  std::vector<double> condition; // per C of the grid
+};
+
+}  // namespace
+
+void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts,
+             const Eigen::MatrixXd& weights, const Eigen::VectorXd& biases, const Gram& gram,
+             const std::vector<int>& hidden_grid, const std::vector<double>& ridge_grid,
+             double max_condition, const Eigen::RowVectorXd& target_scale, int threads,
+             std::vector<LooCandidate>* candidates) {
+  const Eigen::Index n = xs.rows();
+  const Eigen::Index outputs = ts.cols();
+  const int num_l = static_cast<int>(hidden_grid.size());
+  const int num_c = static_cast<int>(ridge_grid.size());
+  const int max_hidden = *std::max_element(hidden_grid.begin(), hidden_grid.end());
+
+  // One eigendecomposition per candidate, spread over the workers (each is independent).
+  std::vector<CandidatePlan> plans(static_cast<size_t>(num_l));
+  ParallelFor(num_l, threads, [&](int q, int) {
+    CandidatePlan& plan = plans[static_cast<size_t>(q)];
+    plan.hidden = hidden_grid[static_cast<size_t>(q)];
+    const Eigen::Index l = plan.hidden;
+    // Reads the lower triangle only, which is the part ComputeGram fills.
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram.hth.topLeftCorner(l, l));
+    // H^T H is positive semi-definite; rounding can leave tiny negative eigenvalues.
+    const Eigen::ArrayXd lambda = eig.eigenvalues().array().max(0.0);
+    plan.vectors = eig.eigenvectors();
+    const Eigen::MatrixXd z = plan.vectors.transpose() * gram.htt.topRows(l);
+    plan.condition.resize(static_cast<size_t>(num_c));
+    for (int c = 0; c < num_c; ++c) {
+      const double delta = 1.0 / ridge_grid[static_cast<size_t>(c)];
+      plan.condition[static_cast<size_t>(c)] = (lambda.maxCoeff() + delta) / (lambda.minCoeff() + delta);
+      if (plan.condition[static_cast<size_t>(c)] <= max_condition) plan.active.push_back(c);
+    }
+    const Eigen::Index num_active = static_cast<Eigen::Index>(plan.active.size());
+    plan.hat_weights.resize(l, num_active);
+    plan.fit_weights.resize(l, num_active * outputs);
+    for (Eigen::Index a = 0; a < num_active; ++a) {
+      const double delta = 1.0 / ridge_grid[static_cast<size_t>(plan.active[static_cast<size_t>(a)])];
+      plan.hat_weights.col(a) = (lambda + delta).inverse().matrix();
+      for (Eigen::Index k = 0; k < outputs; ++k) {
+        plan.fit_weights.col(a * outputs + k) =
+            z.col(k).cwiseProduct(plan.hat_weights.col(a));
+      }
+    }
+  });
+
+  // Offsets of each candidate's sums in the per-block result vector.
+  std::vector<Eigen::Index> offset(static_cast<size_t>(num_l) + 1, 0);
+  Eigen::Index max_active = 0;
+  for (int q = 0; q < num_l; ++q) {
+    const Eigen::Index num_active = static_cast<Eigen::Index>(plans[static_cast<size_t>(q)].active.size());
+    offset[static_cast<size_t>(q) + 1] = offset[static_cast<size_t>(q)] + num_active * outputs;
+    max_active = std::max(max_active, num_active);
+  }
+  const Eigen::Index total = offset.back();
+
+  Eigen::VectorXd sse = Eigen::VectorXd::Zero(total);
+  if (total > 0) {
+    const int blocks = NumBlocks(n);
+    const int workers = std::min(ResolveThreads(threads), blocks);
+    const Eigen::Index block_rows = std::min(n, kBlockRows);
+    struct Workspace {
+      Eigen::MatrixXd h, p, fitted, hat;
+    };
+    std::vector<Workspace> work(static_cast<size_t>(workers));
+    for (auto& w : work) {
+      w.h.resize(block_rows, max_hidden);
+      w.p.resize(block_rows, max_hidden);
+      w.fitted.resize(block_rows, max_active * outputs);
+      w.hat.resize(block_rows, max_active);
+    }
+    ParallelOrderedReduce(
+        blocks, workers,
+        [&](int block, int worker) {
+          Workspace& w = work[static_cast<size_t>(worker)];
+          const Eigen::Index r0 = block * kBlockRows;
+          const Eigen::Index rows = std::min(kBlockRows, n - r0);
+          auto h = w.h.topRows(rows);
+          ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, h);
+          const auto t = ts.middleRows(r0, rows);
+          Eigen::VectorXd sums = Eigen::VectorXd::Zero(total);
+          for (int q = 0; q < num_l; ++q) {
+            const CandidatePlan& plan = plans[static_cast<size_t>(q)];
+            const Eigen::Index num_active = static_cast<Eigen::Index>(plan.active.size());
+            if (num_active == 0) continue;
+            const Eigen::Index l = plan.hidden;
+            auto p = w.p.topLeftCorner(rows, l);
+            auto fitted = w.fitted.topLeftCorner(rows, num_active * outputs);
+            auto hat = w.hat.topLeftCorner(rows, num_active);
+            p.noalias() = h.leftCols(l) * plan.vectors;
+            fitted.noalias() = p * plan.fit_weights;
+            p = p.array().square().matrix();
+            hat.noalias() = p * plan.hat_weights;
+            for (Eigen::Index a = 0; a < num_active; ++a) {
+              for (Eigen::Index k = 0; k < outputs; ++k) {
+                double s = 0.0;
+                for (Eigen::Index i = 0; i < rows; ++i) {
+                  const double leverage_gap = 1.0 - hat(i, a);
+                  // h_ii = 1 means the row is interpolated whatever its target: its
+                  // leave-one-out error is undefined, reported as +inf.
+                  const double e = leverage_gap > 0.0
+                                       ? (t(i, k) - fitted(i, a * outputs + k)) / leverage_gap
+                                       : std::numeric_limits<double>::infinity();
+                  s += e * e;
+                }
+                sums[offset[static_cast<size_t>(q)] + a * outputs + k] = s;
+              }
+            }
+          }
+          return sums;
+        },
+        [&](int, Eigen::VectorXd&& sums) { sse += sums; });
+  }
+
+  candidates->clear();
+  const double count = static_cast<double>(n) * static_cast<double>(outputs);
+  for (int q = 0; q < num_l; ++q) {
+    const CandidatePlan& plan = plans[static_cast<size_t>(q)];
+    size_t next_active = 0;
+    for (int c = 0; c < num_c; ++c) {
+      LooCandidate cand;
+      cand.hidden_units = plan.hidden;
+      cand.ridge_c = ridge_grid[static_cast<size_t>(c)];
+      cand.condition = plan.condition[static_cast<size_t>(c)];
+      if (next_active < plan.active.size() && plan.active[next_active] == c) {
+        const Eigen::Index base =
+            offset[static_cast<size_t>(q)] + static_cast<Eigen::Index>(next_active) * outputs;
+        double sum_std = 0.0, sum_units = 0.0;
+        for (Eigen::Index k = 0; k < outputs; ++k) {
+          sum_std += sse[base + k];
+          sum_units += sse[base + k] * target_scale[k] * target_scale[k];
+        }
+        cand.loo_mse = sum_std / count;
+        cand.loo_rmse = std::sqrt(sum_units / count);
+        ++next_active;
+      } else {
+        cand.skipped = true;
+      }
+      candidates->push_back(cand);
+    }
+  }
+}
+
+}  // namespace gyrodrift::elm::internal
