@@ -1,0 +1,22 @@
+// Private helpers shared by the selection sources.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "gyrodrift/selection/distance.h"
+#include "gyrodrift/selection/kde.h"
+
+namespace gyrodrift::selection::internal {
+
+// Per-thread buffers: repeated calls of the same size allocate nothing.
+struct Scratch {
+  KdeWorkspace kde;
+  Eigen::VectorXd density;
+  Eigen::VectorXd reference;
+};
+
+// SelfSimilarityDistance with caller-owned buffers.
+double SelfSimilarity(const Eigen::Ref<const Eigen::VectorXd>& x, const KdeOptions& kde,
+                      PdfDistance distance, Scratch* scratch);
+
+}  // namespace gyrodrift::selection::internal

@@ -1,0 +1,315 @@
+#include "gyrodrift/selection/selection.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/parallel.h"
+#include "selection/internal.h"
+
+namespace gyrodrift::selection {
+
+namespace {
+
+constexpr std::array<std::pair<Criterion, std::string_view>, 3> kCriteria{{
+    {Criterion::kPdfSimilarity, "pdf"},
+    {Criterion::kKomaty, "komaty"},
+    {Criterion::kEnergyModel, "energy"},
+}};
+constexpr std::array<std::pair<GroupKind, std::string_view>, 3> kKinds{{
+    {GroupKind::kNoise, "noise"},
+    {GroupKind::kMixed, "mixed"},
+    {GroupKind::kDrift, "drift"},
+}};
+
+template <class E, size_t N>
+std::string_view EnumName(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
+  for (const auto& [v, name] : names) {
+    if (v == value) return name;
+  }
+  return "?";
+}
+
+template <class E, size_t N>
+E EnumFromName(std::string_view text, std::string_view what,
+               const std::array<std::pair<E, std::string_view>, N>& names) {
+  std::string allowed;
+  for (const auto& [v, name] : names) {
+    if (name == text) return v;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
+}
+
+// "1-4" or "5" or "" for a list of consecutive indices.
+std::string Range(const std::vector<int>& imfs) {
+  if (imfs.empty()) return "";
+  if (imfs.size() == 1) return std::to_string(imfs.front());
+  return std::to_string(imfs.front()) + "-" + std::to_string(imfs.back());
+}
+
+void AppendNote(std::string* note, const std::string& text) {
+  if (!note->empty()) *note += "; ";
+  *note += text;
+}
+
+}  // namespace
+
+std::string_view ToString(Criterion criterion) { return EnumName(criterion, kCriteria); }
+Criterion CriterionFromString(std::string_view name) {
+  return EnumFromName(name, "criterion", kCriteria);
+}
+std::string_view ToString(GroupKind kind) { return EnumName(kind, kKinds); }
+GroupKind GroupKindFromString(std::string_view name) {
+  return EnumFromName(name, "group", kKinds);
+}
+
+void SelectionOptions::Validate() const {
+  if (criterion != Criterion::kPdfSimilarity && criterion != Criterion::kKomaty &&
+      criterion != Criterion::kEnergyModel) {
+    ThrowOption("criterion", std::to_string(static_cast<int>(criterion)), "pdf, komaty or energy");
+  }
+  if (ToString(distance) == "unknown") {
+    ThrowOption("distance", std::to_string(static_cast<int>(distance)),
+                "l2, l1, hellinger, jensen-shannon or bhattacharyya");
+  }
+  kde.Validate();
+  monte_carlo.Validate();
+  if (band_confidence != 0.99 && band_confidence != 0.95) {
+    ThrowOption("band_confidence", FormatValue(band_confidence), "0.95 or 0.99");
+  }
+  if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
+}
+
+const ModeGroup* SelectionResult::Group(GroupKind kind) const {
+  for (const auto& g : groups) {
+    if (g.kind == kind) return &g;
+  }
+  return nullptr;
+}
+
+std::string SelectionResult::Summary() const {
+  std::string s = std::string(ToString(criterion)) + "/" + std::string(ToString(distance)) +
+                  ": K=" + std::to_string(num_imfs) + " k*=" + std::to_string(k_star);
+  if (criterion == Criterion::kPdfSimilarity) s += " k_N=" + std::to_string(k_noise);
+  if (criterion == Criterion::kEnergyModel) {
+    s += " band exit=" + std::to_string(energy_signal_start);
+  }
+  for (const auto& g : groups) {
+    s += " " + std::string(ToString(g.kind)) + "{" + Range(g.imfs);
+    if (g.has_residue) s += g.imfs.empty() ? "r" : "+r";
+    s += "}";
+  }
+  s += " grid=" + std::to_string(grid_points);
+  if (grid_under_resolved) s += " (under-resolved)";
+  if (!note.empty()) s += "; " + note;
+  return s;
+}
+
+SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
+                            const decomposition::Decomposition& decomposition,
+                            const SelectionOptions& options) {
+  return SelectModes(x, decomposition.imfs, decomposition.residue, options);
+}
+
+SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
+                            const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                            const Eigen::Ref<const Eigen::VectorXd>& residue,
+                            const SelectionOptions& options) {
+  options.Validate();
+  RequireFiniteSignal("x", x, 16);
+  const Eigen::Index n = x.size();
+  const int k_count = static_cast<int>(imfs.cols());
+  if (k_count < 1) throw DataError("imfs: the decomposition has no IMF, nothing to select");
+  if (imfs.rows() != n) {
+    throw DataError("imfs: " + std::to_string(imfs.rows()) + " rows for a signal of " +
+                    std::to_string(n) + " samples");
+  }
+  if (residue.size() != n) {
+    throw DataError("residue: " + std::to_string(residue.size()) + " samples for a signal of " +
+                    std::to_string(n));
+  }
+  if (!imfs.allFinite()) throw DataError("imfs: non-finite value");
+  if (!residue.allFinite()) throw DataError("residue: non-finite value");
+  if (options.criterion == Criterion::kPdfSimilarity && options.noise_level &&
+      options.noise_level->length != n) {
+    ThrowOption("noise_level", "length " + std::to_string(options.noise_level->length),
+                "a level computed for the signal's length " + std::to_string(n));
+  }
+
+  const KdeOptions& kde = options.kde;
+  SelectionResult result;
+  result.criterion = options.criterion;
+  result.distance = options.distance;
+  result.length = static_cast<int>(n);
+  result.num_imfs = k_count;
+
+  // Reconstruction check (reported, not enforced: EEMD is not complete).
+  {
+    Eigen::VectorXd sum = residue;
+    for (int k = 0; k < k_count; ++k) sum += imfs.col(k);
+    const double scale = x.cwiseAbs().maxCoeff();
+    const double err = (x - sum).cwiseAbs().maxCoeff();
+    result.reconstruction_error = scale > 0.0 ? err / scale : err;
+  }
+
+  // Bandwidths: x (centred or not, the same), then each IMF.
+  const int workers = std::min(ResolveThreads(options.threads), k_count + 1);
+  std::vector<internal::Scratch> scratch(static_cast<size_t>(workers));
+  const double h_x = kde.bandwidth_scale * SilvermanBandwidth(x, &scratch[0].kde);
+  if (!(h_x > 0.0)) throw DataError("x: constant signal, nothing to select");
+  result.signal_bandwidth = h_x;
+  std::vector<double> h(static_cast<size_t>(k_count));
+  ParallelFor(k_count, workers, [&](int k, int w) {
+    h[static_cast<size_t>(k)] =
+        kde.bandwidth_scale * SilvermanBandwidth(imfs.col(k), &scratch[static_cast<size_t>(w)].kde);
+  });
+
+  // One common grid over the centred signal and every IMF, padded by each density's own
+  // bandwidths, resolving the narrowest density.
+  const double shift = options.center_signal ? x.mean() : 0.0;
+  double lo = x.minCoeff() - shift - kde.padding_bandwidths * h_x;
+  double hi = x.maxCoeff() - shift + kde.padding_bandwidths * h_x;
+  double h_min = h_x;
+  for (int k = 0; k < k_count; ++k) {
+    const double hk = h[static_cast<size_t>(k)];
+    lo = std::min(lo, imfs.col(k).minCoeff() - kde.padding_bandwidths * hk);
+    hi = std::max(hi, imfs.col(k).maxCoeff() + kde.padding_bandwidths * hk);
+    if (hk > 0.0) h_min = std::min(h_min, hk);
+  }
+  const Grid grid = MakeGrid(lo, hi, h_min, kde);
+  result.grid_points = grid.points;
+  result.grid_under_resolved = grid.under_resolved;
+
+  Eigen::VectorXd pdf_x(grid.points);
+  EstimateDensity(x, shift, 1.0, h_x, grid, kde.method, &scratch[0].kde, pdf_x);
+  result.pdf_distance.assign(static_cast<size_t>(k_count), 0.0);
+  result.self_distance.assign(static_cast<size_t>(k_count), 0.0);
+  bool constant_imf = false;
+  ParallelFor(k_count, workers, [&](int k, int w) {
+    internal::Scratch& s = scratch[static_cast<size_t>(w)];
+    // A constant IMF (zero bandwidth) is a spike: give it one grid step of bandwidth.
+    double hk = h[static_cast<size_t>(k)];
+    if (!(hk > 0.0)) hk = grid.step;
+    s.density.resize(grid.points);
+    EstimateDensity(imfs.col(k), 0.0, 1.0, hk, grid, kde.method, &s.kde, s.density);
+    result.pdf_distance[static_cast<size_t>(k)] =
+        Distance(options.distance, pdf_x, s.density, grid.step);
+    result.self_distance[static_cast<size_t>(k)] =
+        internal::SelfSimilarity(imfs.col(k), kde, options.distance, &s);
+  });
+  for (int k = 0; k < k_count; ++k) {
+    if (!(h[static_cast<size_t>(k)] > 0.0)) constant_imf = true;
+  }
+  if (constant_imf) AppendNote(&result.note, "constant IMF (density given one grid step)");
+
+  // k* = first maximum of D_k.
+  int k_star = 1;
+  for (int k = 2; k <= k_count; ++k) {
+    if (result.pdf_distance[static_cast<size_t>(k - 1)] >
+        result.pdf_distance[static_cast<size_t>(k_star - 1)]) {
+      k_star = k;
+    }
+  }
+  result.k_star = k_star;
+
+  // Energy curve and the white-noise band (Flandrin, Goncalves & Rilling 2004).
+  {
+    const double band_a = options.band_confidence == 0.99 ? 0.46 : 0.474;
+    const double band_b = options.band_confidence == 0.99 ? -1.919 : -2.449;
+    // Robust E_1: N * (median|imf_1| / 0.6745)^2, as BEEMDAN (METHOD.md section 3).
+    std::vector<double> a(static_cast<size_t>(n));
+    for (Eigen::Index t = 0; t < n; ++t) a[static_cast<size_t>(t)] = std::abs(imfs(t, 0));
+    const size_t mid = a.size() / 2;
+    std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid), a.end());
+    double med = a[mid];
+    if (a.size() % 2 == 0) {
+      med = 0.5 * (med + *std::max_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid)));
+    }
+    const double e1 = static_cast<double>(n) * (med / 0.6745) * (med / 0.6745);
+    const double log2_e1 = std::log2(e1);
+    result.energy_signal_start = k_count + 1;
+    for (int k = 1; k <= k_count; ++k) {
+      const double e = imfs.col(k - 1).squaredNorm();
+      result.log2_energy.push_back(std::log2(e));
+      if (k == 1) {
+        result.energy_band_log2_upper.push_back(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
+      const double upper = log2_e1 - std::log2(0.719) - k * std::log2(2.01) +
+                           std::pow(2.0, band_a * k + band_b);
+      result.energy_band_log2_upper.push_back(upper);
+      // A zero mode 1 (median 0) gives log2 E_1 = -inf: every later mode is outside the band.
+      if (result.energy_signal_start == k_count + 1 && !(std::log2(e) <= upper)) {
+        result.energy_signal_start = k;
+      }
+    }
+  }
+
+  // Boundaries per criterion.
+  switch (options.criterion) {
+    case Criterion::kPdfSimilarity: {
+      std::shared_ptr<const NoiseLevel> level = options.noise_level;
+      if (!level) {
+        level = NoiseLevelCache::Global().Get(static_cast<int>(n), options.monte_carlo, kde,
+                                              options.distance, &result.noise_level_computed);
+      }
+      int k_noise = 0;
+      for (int k = 1; k <= k_count; ++k) {
+        const double lk = level->LevelFor(k);
+        result.noise_level.push_back(lk);
+        // A NaN level (the noise rarely had a mode k) or G_k above it ends the run.
+        if (k_noise == k - 1 && result.self_distance[static_cast<size_t>(k - 1)] <= lk) {
+          k_noise = k;
+        }
+      }
+      result.k_noise = k_noise;
+      result.mixed_end = std::max(k_noise, k_star);
+      if (k_noise == 0) AppendNote(&result.note, "no IMF passes the white-noise test: no noise group");
+      if (k_star <= k_noise) {
+        AppendNote(&result.note, "k* <= k_N: no mixed group, drift starts after k_N");
+      }
+      break;
+    }
+    case Criterion::kKomaty:
+      result.k_noise = k_star;
+      result.mixed_end = k_star;
+      break;
+    case Criterion::kEnergyModel:
+      result.k_noise = result.energy_signal_start - 1;
+      result.mixed_end = result.k_noise;
+      break;
+  }
+  if (result.mixed_end == k_count) AppendNote(&result.note, "drift group is the residue alone");
+
+  // Groups: noise 1..k_noise, mixed k_noise+1..mixed_end, drift mixed_end+1..K + residue.
+  auto make_group = [&](GroupKind kind, int first, int last, bool with_residue) {
+    ModeGroup g;
+    g.kind = kind;
+    g.has_residue = with_residue;
+    g.series = Eigen::VectorXd::Zero(n);
+    for (int k = first; k <= last; ++k) {
+      g.imfs.push_back(k);
+      g.series += imfs.col(k - 1);
+    }
+    if (with_residue) g.series += residue;
+    return g;
+  };
+  if (result.k_noise >= 1) {
+    result.groups.push_back(make_group(GroupKind::kNoise, 1, result.k_noise, false));
+  }
+  if (result.mixed_end > result.k_noise) {
+    result.groups.push_back(
+        make_group(GroupKind::kMixed, result.k_noise + 1, result.mixed_end, false));
+  }
+  result.groups.push_back(make_group(GroupKind::kDrift, result.mixed_end + 1, k_count, true));
+  return result;
+}
+
+}  // namespace gyrodrift::selection

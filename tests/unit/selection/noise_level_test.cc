@@ -1,0 +1,147 @@
+// The white-noise self-similarity level: seeded, independent of the thread count, cached, and
+// white-noise IMFs stay under it while a sinusoid does not.
+#include "gyrodrift/selection/noise_level.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+
+namespace gyrodrift::selection {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kLength = 2048;
+
+MonteCarloOptions SmallRun(int threads = 0, std::uint64_t seed = 1) {
+  MonteCarloOptions o;
+  o.realisations = 40;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
+
+// Bitwise equality of two level vectors (NaN entries included).
+bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+TEST(SelfSimilarity, AffineInvariantAndSmallForGaussianSamples) {
+  Eigen::VectorXd x(20000);
+  Rng(5, 0).FillNormal(x);
+  const double g = SelfSimilarityDistance(x, {}, PdfDistance::kL2);
+  EXPECT_LT(g, 0.02);
+  const Eigen::VectorXd y = (3.0 * x.array() + 100.0).matrix();
+  EXPECT_NEAR(SelfSimilarityDistance(y, {}, PdfDistance::kL2), g, 1e-9);
+  Eigen::VectorXd sine(20000);
+  for (int t = 0; t < 20000; ++t) sine[t] = std::sin(2 * kPi * t / 500.0);
+  EXPECT_GT(SelfSimilarityDistance(sine, {}, PdfDistance::kL2), 10 * g);
+  EXPECT_EQ(SelfSimilarityDistance(Eigen::VectorXd::Constant(100, 2.0), {}, PdfDistance::kL2),
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(NoiseLevel, SeededAndThreadCountIndependent) {
+  const NoiseLevel one = ComputeNoiseLevel(kLength, SmallRun(1), {}, PdfDistance::kL2);
+  const NoiseLevel two = ComputeNoiseLevel(kLength, SmallRun(2), {}, PdfDistance::kL2);
+  const NoiseLevel again = ComputeNoiseLevel(kLength, SmallRun(2), {}, PdfDistance::kL2);
+  EXPECT_TRUE(SameBits(one.level, two.level));
+  EXPECT_TRUE(SameBits(two.level, again.level));
+  EXPECT_EQ(one.realisations_with_mode, two.realisations_with_mode);
+  const NoiseLevel other = ComputeNoiseLevel(kLength, SmallRun(2, 2), {}, PdfDistance::kL2);
+  EXPECT_FALSE(SameBits(one.level, other.level));
+  ASSERT_GE(one.level.size(), 5u);
+  for (int k = 1; k <= 5; ++k) {
+    EXPECT_TRUE(std::isfinite(one.LevelFor(k))) << k;
+    EXPECT_GT(one.LevelFor(k), 0.0) << k;
+    EXPECT_EQ(one.realisations_with_mode[static_cast<size_t>(k - 1)], 40) << k;
+  }
+  EXPECT_TRUE(std::isnan(one.LevelFor(0)));
+  EXPECT_TRUE(std::isnan(one.LevelFor(100)));
+  EXPECT_NE(one.Summary().find("N=2048 R=40"), std::string::npos) << one.Summary();
+}
+
+TEST(NoiseLevel, FreshWhiteNoiseModesStayUnderTheLevelSinusoidsDoNot) {
+  const NoiseLevel level = ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2);
+  int under = 0, tested = 0;
+  for (int i = 0; i < 20; ++i) {
+    Eigen::VectorXd w(kLength);
+    Rng(999, static_cast<std::uint64_t>(i)).FillNormal(w);  // not the Monte-Carlo's streams
+    const decomposition::Decomposition d = decomposition::Emd(w);
+    for (int k = 1; k <= 4; ++k) {
+      ++tested;
+      under += SelfSimilarityDistance(d.imfs.col(k - 1), {}, PdfDistance::kL2) <= level.LevelFor(k);
+    }
+  }
+  EXPECT_GE(under, 0.85 * tested) << under << " of " << tested;
+  Eigen::VectorXd sine(kLength);
+  for (int t = 0; t < kLength; ++t) sine[t] = std::sin(2 * kPi * t / 40.0);
+  for (int k = 1; k <= 4; ++k) {
+    EXPECT_GT(SelfSimilarityDistance(sine, {}, PdfDistance::kL2), level.LevelFor(k)) << k;
+  }
+}
+
+TEST(NoiseLevelCache, SecondCallIsCachedAndIdentical) {
+  NoiseLevelCache cache;
+  bool computed = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto first = cache.Get(kLength, SmallRun(), {}, PdfDistance::kL2, &computed);
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(computed);
+  const auto second = cache.Get(kLength, SmallRun(2), {}, PdfDistance::kL2, &computed);
+  const auto t2 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(computed);  // the thread count is not part of the key
+  EXPECT_EQ(first.get(), second.get());
+  EXPECT_LT((t2 - t1).count() * 20, (t1 - t0).count());
+  EXPECT_TRUE(SameBits(first->level,
+                       ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2).level));
+  // Another seed, distance or grid is another entry.
+  cache.Get(kLength, SmallRun(0, 3), {}, PdfDistance::kL2, &computed);
+  EXPECT_TRUE(computed);
+  cache.Get(kLength, SmallRun(), {}, PdfDistance::kHellinger, &computed);
+  EXPECT_TRUE(computed);
+  cache.Get(kLength, SmallRun(), KdeOptions{.grid_points = 256}, PdfDistance::kL2, &computed);
+  EXPECT_TRUE(computed);
+  EXPECT_EQ(cache.Size(), 4u);
+  cache.Clear();
+  EXPECT_EQ(cache.Size(), 0u);
+}
+
+TEST(NoiseLevelCache, ConcurrentCallersShareOneComputation) {
+  NoiseLevelCache cache;
+  std::shared_ptr<const NoiseLevel> a, b, c;
+  bool ca = false, cb = false, cc = false;
+  std::thread ta([&] { a = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &ca); });
+  std::thread tb([&] { b = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &cb); });
+  std::thread tc([&] { c = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &cc); });
+  ta.join();
+  tb.join();
+  tc.join();
+  EXPECT_EQ(a.get(), b.get());
+  EXPECT_EQ(a.get(), c.get());
+  EXPECT_EQ(ca + cb + cc, 1);
+}
+
+TEST(NoiseLevel, RejectsBadOptions) {
+  MonteCarloOptions few = SmallRun();
+  few.realisations = 5;
+  EXPECT_THROW(ComputeNoiseLevel(kLength, few, {}, PdfDistance::kL2), UsageError);
+  MonteCarloOptions certain = SmallRun();
+  certain.confidence = 1.0;
+  EXPECT_THROW(ComputeNoiseLevel(kLength, certain, {}, PdfDistance::kL2), UsageError);
+  EXPECT_THROW(ComputeNoiseLevel(8, SmallRun(), {}, PdfDistance::kL2), UsageError);
+  EXPECT_THROW(ComputeNoiseLevel(kLength, SmallRun(), KdeOptions{.grid_points = 10},
+                                 PdfDistance::kL2),
+               UsageError);
+  NoiseLevelCache cache;
+  EXPECT_THROW(cache.Get(kLength, SmallRun(-1), {}, PdfDistance::kL2), UsageError);
+  EXPECT_EQ(cache.Size(), 0u);
+}
+
+}  // namespace
+}  // namespace gyrodrift::selection
