@@ -67,26 +67,24 @@ std::vector<double> InternalPhase(const Eigen::VectorXd& data, const AllanOption
   const double tau0 = o.tau0_s();
   std::vector<double> x;
   if (o.data_type == DataType::kRate) {
+    // Plain double running sum: with the mean removed the angle is a random walk, and its
+    // accumulated rounding stays ~N eps relative to one step, far below what any tau resolves.
     x.resize(static_cast<size_t>(n + 1));
-    long double mean = 0.0L;
-    for (Eigen::Index i = 0; i < n; ++i) mean += data[i];
-    mean /= static_cast<long double>(n);
-    long double acc = 0.0L;
+    const double mean = data.mean();
+    double acc = 0.0;
     x[0] = 0.0;
     for (Eigen::Index i = 0; i < n; ++i) {
-      acc += (static_cast<long double>(data[i]) - mean) * tau0;
-      x[static_cast<size_t>(i + 1)] = static_cast<double>(acc);
+      acc += (data[i] - mean) * tau0;
+      x[static_cast<size_t>(i + 1)] = acc;
     }
   } else {
     // Angle unit -> rate unit x s: degrees with deg/h become deg/h * s (x 3600).
     const double scale = o.units == RateUnit::kDegPerHour ? 3600.0 : 1.0;
     x.resize(static_cast<size_t>(n));
-    const long double x0 = data[0], x1 = data[n - 1];
-    const long double slope = n > 1 ? (x1 - x0) / static_cast<long double>(n - 1) : 0.0L;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const long double line = x0 + slope * static_cast<long double>(i);
-      x[static_cast<size_t>(i)] = static_cast<double>((data[i] - line) * scale);
-    }
+    const double x0 = data[0];
+    const double slope = n > 1 ? (data[n - 1] - x0) / static_cast<double>(n - 1) : 0.0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      x[static_cast<size_t>(i)] = (data[i] - (x0 + slope * static_cast<double>(i))) * scale;
   }
   return x;
 }

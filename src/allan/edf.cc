@@ -159,39 +159,58 @@ double GreenhallEdf(int alpha, int d, double m, bool modified, bool overlapping,
   return 1.0 / inv_edf;
 }
 
-// Linear least-squares removal of a polynomial of degree `deg` (1 or 2), in place.
-void Detrend(Eigen::VectorXd& z, int deg) {
-  const Eigen::Index n = z.size();
-  const double half = 0.5 * static_cast<double>(n - 1);
-  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(deg + 1, deg + 1);
-  Eigen::VectorXd atb = Eigen::VectorXd::Zero(deg + 1);
-  double pw[5];
+// Least-squares polynomial (degree 1 or 2) of z_i, i = 0..n-1, on t = (i - c) / c with
+// c = (n - 1) / 2; returns the coefficients. The moments of t are closed forms (odd ones vanish),
+// so the pass over the data only accumulates sum t^k z.
+template <class Z>
+Eigen::Vector3d PolyFit(Eigen::Index n, int deg, const Z& z) {
+  const double nd = static_cast<double>(n);
+  const double c = 0.5 * (nd - 1.0), inv_c = 1.0 / c;
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = (static_cast<double>(i) - half) / std::max(half, 1.0);
-    pw[0] = 1.0;
-    for (int k = 1; k <= 2 * deg; ++k) pw[k] = pw[k - 1] * t;
-    for (int a = 0; a <= deg; ++a) {
-      atb[a] += pw[a] * z[i];
-      for (int b = 0; b <= deg; ++b) ata(a, b) += pw[a + b];
-    }
+    const double t = static_cast<double>(i) * inv_c - 1.0, v = z(i);
+    s0 += v;
+    s1 += t * v;
+    s2 += t * t * v;
   }
-  const Eigen::VectorXd c = ata.ldlt().solve(atb);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double t = (static_cast<double>(i) - half) / std::max(half, 1.0);
-    double p = c[deg];
-    for (int k = deg - 1; k >= 0; --k) p = p * t + c[k];
-    z[i] -= p;
+  // sum (i - c)^2 = n (n^2 - 1) / 12, sum (i - c)^4 = n (n^2 - 1) (3 n^2 - 7) / 240.
+  const double t2 = nd * (nd * nd - 1.0) / 12.0 * inv_c * inv_c;
+  const double t4 = nd * (nd * nd - 1.0) * (3.0 * nd * nd - 7.0) / 240.0 * std::pow(inv_c, 4);
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  p[1] = s1 / t2;
+  if (deg == 1) {
+    p[0] = s0 / nd;
+  } else {
+    // [n t2; t2 t4] [p0; p2] = [s0; s2]
+    const double det = nd * t4 - t2 * t2;
+    p[0] = (t4 * s0 - t2 * s2) / det;
+    p[2] = (nd * s2 - t2 * s0) / det;
   }
+  return p;
 }
 
-double Lag1Autocorrelation(const Eigen::VectorXd& z) {
-  const double mean = z.mean();
-  double num = 0.0, den = 0.0;
-  for (Eigen::Index i = 0; i < z.size(); ++i) {
-    const double a = z[i] - mean;
-    den += a * a;
-    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+// Lag-1 autocorrelation of r_i = z(i) - poly(t_i), in one pass over the samples.
+template <class Z>
+double Lag1OfResidual(Eigen::Index n, const Eigen::Vector3d& p, const Z& z) {
+  const double inv_c = 2.0 / static_cast<double>(n - 1);
+  auto r = [&](Eigen::Index i) {
+    const double t = static_cast<double>(i) * inv_c - 1.0;
+    return z(i) - (p[0] + t * (p[1] + t * p[2]));
+  };
+  double s1 = 0.0, s2 = 0.0, lag = 0.0, prev = r(0);
+  const double first = prev;
+  s1 += prev;
+  s2 += prev * prev;
+  for (Eigen::Index i = 1; i < n; ++i) {
+    const double v = r(i);
+    s1 += v;
+    s2 += v * v;
+    lag += prev * v;
+    prev = v;
   }
+  const double nd = static_cast<double>(n), mean = s1 / nd;
+  const double den = s2 - nd * mean * mean;
+  const double num = lag - mean * (2.0 * s1 - first - prev) + (nd - 1.0) * mean * mean;
   return den > 0.0 ? num / den : 0.0;
 }
 
@@ -306,35 +325,42 @@ void ConfidenceInterval(double dev, double edf, double confidence, double* lo, d
   *hi = dev * std::sqrt(edf / chi_lo);
 }
 
-std::optional<int> IdentifyAlpha(const Eigen::VectorXd& phase, std::int64_t m, DataType type,
-                                 int dmax) {
+std::optional<int> IdentifyAlpha(const Eigen::Ref<const Eigen::VectorXd>& phase, std::int64_t m,
+                                 DataType type, int dmax) {
   constexpr Eigen::Index kMinPoints = 30;
   const Eigen::Index n = phase.size();
-  Eigen::VectorXd z;
-  if (type == DataType::kRate) {
-    // m-sample averages of the rate: differences of the integrated angle.
-    const Eigen::Index k = (n - 1) / m;
-    if (k < kMinPoints) return std::nullopt;
-    z.resize(k);
-    for (Eigen::Index i = 0; i < k; ++i) z[i] = phase[(i + 1) * m] - phase[i * m];
-    Detrend(z, 1);
-  } else {
-    const Eigen::Index k = (n - 1) / m + 1;
-    if (k < kMinPoints) return std::nullopt;
-    z.resize(k);
-    for (Eigen::Index i = 0; i < k; ++i) z[i] = phase[i * m];
-    Detrend(z, 2);
+  const bool rate = type == DataType::kRate;
+  // Rate data: the m-sample averages (differences of the integrated angle), linear trend removed.
+  // Angle data: the phase decimated by m, quadratic trend removed (Riley & Greenhall 2004).
+  const Eigen::Index k = rate ? (n - 1) / m : (n - 1) / m + 1;
+  if (k < kMinPoints) return std::nullopt;
+  const int deg = rate ? 1 : 2;
+  auto sample = [&](Eigen::Index i) {
+    return rate ? phase[(i + 1) * m] - phase[i * m] : phase[i * m];
+  };
+  const Eigen::Vector3d poly = PolyFit(k, deg, sample);
+  auto finish = [&](double rho, int d) {
+    int alpha = -static_cast<int>(std::nearbyint(2.0 * rho)) - 2 * d;
+    if (!rate) alpha += 2;
+    return std::clamp(alpha, dmax == 2 ? -2 : -4, 2);
+  };
+  double r1 = Lag1OfResidual(k, poly, sample);
+  double rho = r1 / (1.0 + r1);
+  if (rho < 0.25 || dmax <= 0) return finish(rho, 0);
+  // Strongly correlated: difference the detrended series until white enough (or dmax).
+  Eigen::VectorXd z(k);
+  const double inv_c = 2.0 / static_cast<double>(k - 1);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const double t = static_cast<double>(i) * inv_c - 1.0;
+    z[i] = sample(i) - (poly[0] + t * (poly[1] + t * poly[2]));
   }
-  for (int d = 0;; ++d) {
-    const double r1 = Lag1Autocorrelation(z);
-    const double rho = r1 / (1.0 + r1);
-    if (rho < 0.25 || d >= dmax) {
-      int alpha = -static_cast<int>(std::nearbyint(2.0 * rho)) - 2 * d;
-      if (type == DataType::kAngle) alpha += 2;
-      return std::clamp(alpha, dmax == 2 ? -2 : -4, 2);
-    }
-    const Eigen::VectorXd dz = z.tail(z.size() - 1) - z.head(z.size() - 1);
-    z = dz;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  for (int d = 1;; ++d) {
+    for (Eigen::Index i = 0; i + d < k; ++i) z[i] = z[i + 1] - z[i];
+    const Eigen::Index len = k - d;
+    r1 = Lag1OfResidual(len, zero, [&](Eigen::Index i) { return z[i]; });
+    rho = r1 / (1.0 + r1);
+    if (rho < 0.25 || d >= dmax) return finish(rho, d);
   }
 }
 

@@ -1,0 +1,78 @@
+// Allan-variance benchmarks: overlapping ADEV of a white-noise rate record, octave grid and every
+// averaging factor, with noise identification, EDF and confidence intervals (the defaults of
+// allan::Compute), on all cores and on one.
+//   build-*/bench/bench_allan --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <map>
+
+#include "bench_util.h"
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/common/random.h"
+
+namespace {
+
+using gyrodrift::allan::AllanOptions;
+using gyrodrift::allan::Compute;
+using gyrodrift::allan::Deviation;
+using gyrodrift::allan::TauGrid;
+
+const Eigen::VectorXd& Record(Eigen::Index n) {
+  static std::map<Eigen::Index, Eigen::VectorXd> cache;
+  auto it = cache.find(n);
+  if (it == cache.end()) {
+    Eigen::VectorXd v(n);
+    gyrodrift::Rng(42, 0).FillNormal(v);
+    it = cache.emplace(n, std::move(v)).first;
+  }
+  return it->second;
+}
+
+void Run(benchmark::State& state, TauGrid grid, Deviation dev, int threads, bool intervals) {
+  const Eigen::VectorXd& y = Record(state.range(0));
+  AllanOptions o{.rate_hz = 100.0, .deviation = dev, .grid = grid, .confidence_intervals = intervals,
+                 .threads = threads};
+  std::size_t taus = 0;
+  for (auto _ : state) {
+    const auto r = Compute(y, o);
+    taus = r.points.size();
+    benchmark::DoNotOptimize(r.points.data());
+  }
+  state.counters["taus"] = static_cast<double>(taus);
+  state.counters["samples/s"] = benchmark::Counter(
+      static_cast<double>(state.range(0)) * static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate);
+}
+
+void BM_OadevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kOadev, 0, true); }
+void BM_OadevOctave1Thread(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kOadev, 1, true); }
+void BM_OadevAll(benchmark::State& s) { Run(s, TauGrid::kAll, Deviation::kOadev, 0, true); }
+void BM_OadevAllNoIntervals(benchmark::State& s) { Run(s, TauGrid::kAll, Deviation::kOadev, 0, false); }
+void BM_MdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kMdev, 0, true); }
+void BM_TotdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kTotdev, 0, true); }
+
+void Register() {
+  const bool smoke = gyrodrift::bench::SmokeMode();
+  const std::vector<std::int64_t> octave = smoke ? std::vector<std::int64_t>{10000}
+                                                 : std::vector<std::int64_t>{1000000, 10000000};
+  for (auto n : octave) {
+    benchmark::RegisterBenchmark("BM_OadevOctave", BM_OadevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_OadevOctave1Thread", BM_OadevOctave1Thread)->Arg(n)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_MdevOctave", BM_MdevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_TotdevOctave", BM_TotdevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
+  }
+  const std::int64_t all_n = smoke ? 2000 : 1000000;
+  benchmark::RegisterBenchmark("BM_OadevAll", BM_OadevAll)->Arg(all_n)->Unit(benchmark::kSecond)->Iterations(1);
+  benchmark::RegisterBenchmark("BM_OadevAllNoIntervals", BM_OadevAllNoIntervals)->Arg(all_n)->Unit(benchmark::kSecond)->Iterations(1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Register();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
