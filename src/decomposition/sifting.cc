@@ -1,6 +1,12 @@
 #include "decomposition/sifting.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <bit>
+#include <cstring>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <cmath>
 #include <utility>
 
@@ -45,73 +51,136 @@ int ZeroRuns(const double* x, Eigen::Index n) {
   return runs;
 }
 
-// Strict extrema and zero crossings in one branch-light pass; plateaus and exact zeros flagged.
-struct StrictScan {
-  int minima = 0, maxima = 0, zero_crossings = 0;
-  bool flat = false, zero = false;
-};
+// Appends base + (index of each set bit of word), in increasing order.
+inline int AppendBits(std::uint64_t word, Eigen::Index base, int* out, int count) {
+  while (word) {
+    out[count++] = static_cast<int>(base + std::countr_zero(word));
+    word &= word - 1;
+  }
+  return count;
+}
 
-template <bool kStore>
-StrictScan ScanStrict(const double* x, Eigen::Index n, int* indmin, int* indmax) {
-  StrictScan s;
-  if (n < 2) return s;
-  double d0 = x[1] - x[0];
-  bool flat = d0 == 0.0;
-  bool zero = x[0] == 0.0 || x[1] == 0.0;
-  int zc = x[0] * x[1] < 0.0;
-  int nmin = 0, nmax = 0;
-  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+// Strict extrema of x (sign changes of the first difference) into indmin / indmax; returns true
+// when some first difference is exactly zero (plateaus to look at). Comparisons are done two
+// samples at a time and turned into bit masks, so the cost per sample is a few instructions and
+// the cost per extremum one bit scan: smooth late modes with few extrema are cheap.
+bool FindStrictExtrema(const double* x, Eigen::Index n, int* indmin, int* indmax, int* nmin,
+                       int* nmax) {
+  int count_min = 0, count_max = 0;
+  bool flat = n >= 2 && x[1] - x[0] == 0.0;
+  Eigen::Index i = 1;  // first interior sample
+#if defined(__SSE2__)
+  const __m128d zero = _mm_setzero_pd();
+  int flat_bits = 0;
+  while (i + 2 < n) {  // room for a pair (i, i+1), both interior
+    std::uint64_t min_word = 0, max_word = 0;
+    const Eigen::Index base = i;
+    for (int k = 0; k < 64 && i + 2 < n; k += 2, i += 2) {
+      const __m128d left = _mm_loadu_pd(x + i - 1);
+      const __m128d mid = _mm_loadu_pd(x + i);
+      const __m128d right = _mm_loadu_pd(x + i + 1);
+      const __m128d d0 = _mm_sub_pd(mid, left);
+      const __m128d d1 = _mm_sub_pd(right, mid);
+      const __m128d ext = _mm_cmplt_pd(_mm_mul_pd(d0, d1), zero);
+      const __m128d rising = _mm_cmpgt_pd(d0, zero);
+      max_word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_and_pd(ext, rising))) << k;
+      min_word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_andnot_pd(rising, ext))) << k;
+      flat_bits |= _mm_movemask_pd(_mm_cmpeq_pd(d1, zero));
+    }
+    count_min = AppendBits(min_word, base, indmin, count_min);
+    count_max = AppendBits(max_word, base, indmax, count_max);
+  }
+  flat |= flat_bits != 0;
+#endif
+  for (; i + 1 < n; ++i) {
+    const double d0 = x[i] - x[i - 1];
     const double d1 = x[i + 1] - x[i];
     const bool is_ext = d0 * d1 < 0.0;
-    if constexpr (kStore) {
-      indmin[nmin] = static_cast<int>(i);
-      indmax[nmax] = static_cast<int>(i);
-    }
-    nmin += is_ext & (d0 < 0.0);
-    nmax += is_ext & (d0 > 0.0);
+    indmin[count_min] = static_cast<int>(i);
+    indmax[count_max] = static_cast<int>(i);
+    count_min += is_ext & (d0 < 0.0);
+    count_max += is_ext & (d0 > 0.0);
     flat |= d1 == 0.0;
-    zero |= x[i + 1] == 0.0;
-    zc += x[i] * x[i + 1] < 0.0;
-    d0 = d1;
   }
-  s.minima = nmin;
-  s.maxima = nmax;
-  s.zero_crossings = zc;
-  s.flat = flat;
-  s.zero = zero;
-  return s;
+  *nmin = count_min;
+  *nmax = count_max;
+  return flat;
+}
+
+// emd.m's zero crossings: strict sign changes plus one per run of exact zeros.
+int CountZeroCrossings(const double* x, Eigen::Index n) {
+  std::int64_t changes = 0, zeros = 0;
+  Eigen::Index i = 0;
+#if defined(__SSE2__)
+  // Each true comparison lane is all ones (-1 as an integer): subtracting counts it.
+  __m128i change_acc = _mm_setzero_si128(), zero_acc = _mm_setzero_si128();
+  const __m128d zero = _mm_setzero_pd();
+  for (; i + 2 < n; i += 2) {
+    const __m128d a = _mm_loadu_pd(x + i);
+    const __m128d b = _mm_loadu_pd(x + i + 1);
+    change_acc = _mm_sub_epi64(change_acc, _mm_castpd_si128(_mm_cmplt_pd(_mm_mul_pd(a, b), zero)));
+    zero_acc = _mm_sub_epi64(zero_acc, _mm_castpd_si128(_mm_cmpeq_pd(a, zero)));
+  }
+  alignas(16) std::int64_t lanes[2];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), change_acc);
+  changes = lanes[0] + lanes[1];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), zero_acc);
+  zeros = lanes[0] + lanes[1];
+#endif
+  for (; i + 1 < n; ++i) {
+    changes += x[i] * x[i + 1] < 0.0;
+    zeros += x[i] == 0.0;
+  }
+  if (n > 0) zeros += x[n - 1] == 0.0;
+  return static_cast<int>(zeros ? changes + ZeroRuns(x, n) : changes);
 }
 
 }  // namespace
 
 ExtremaCounts CountExtrema(const double* x, Eigen::Index n) {
-  const StrictScan s = ScanStrict<false>(x, n, nullptr, nullptr);
-  ExtremaCounts c{s.minima, s.maxima, s.zero_crossings};
-  if (s.flat) {
+  ExtremaCounts c{0, 0, CountZeroCrossings(x, n)};
+  bool flat = false;
+  if (n >= 2) flat = x[1] - x[0] == 0.0;
+  for (Eigen::Index i = 1; i + 1 < n; ++i) {
+    const double d0 = x[i] - x[i - 1];
+    const double d1 = x[i + 1] - x[i];
+    const bool is_ext = d0 * d1 < 0.0;
+    c.minima += is_ext & (d0 < 0.0);
+    c.maxima += is_ext & (d0 > 0.0);
+    flat |= d1 == 0.0;
+  }
+  if (flat) {
     PlateauExtrema(x, n, [&](Eigen::Index, bool is_max) { ++(is_max ? c.maxima : c.minima); });
   }
-  if (s.zero) c.zero_crossings += ZeroRuns(x, n);
   return c;
 }
 
 Sifter::Sifter(Eigen::Index n, const SiftingOptions& options)
-    : n_(n), options_(options), max_sifts_(options.EffectiveMaxSifts()) {
+    : n_(n),
+      options_(options),
+      max_sifts_(options.EffectiveMaxSifts()),
+      lower_(n + 2 * kNbSym + 4),
+      upper_(n + 2 * kNbSym + 4) {
   const size_t size = static_cast<size_t>(n);
   indmin_.resize(size + 2);
   indmax_.resize(size + 2);
-  const size_t nodes = size + 2 * kNbSym + 4;
-  for (auto* v : {&tmin_, &zmin_, &tmax_, &zmax_}) v->reserve(nodes);
-  for (auto* v : {&slope_, &diag_, &rhs_}) v->resize(nodes);
   h_.resize(n);
   next_.resize(n);
-  env_min_.resize(n);
-  env_max_.resize(n);
+  env_min_.resize(n + EnvelopeSpline::kPadding);
+  env_max_.resize(n + EnvelopeSpline::kPadding);
 }
 
-ExtremaCounts Sifter::FindExtrema(const double* h) {
-  const StrictScan s = ScanStrict<true>(h, n_, indmin_.data(), indmax_.data());
-  ExtremaCounts c{s.minima, s.maxima, s.zero_crossings};
-  if (s.flat) {
+void Sifter::Envelopes() {
+  FitPair(lower_, upper_);
+  lower_.Evaluate(n_, env_min_.data());
+  upper_.Evaluate(n_, env_max_.data());
+}
+
+ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
+  ExtremaCounts c;
+  const bool flat = FindStrictExtrema(h, n_, indmin_.data(), indmax_.data(), &c.minima, &c.maxima);
+  if (count_zero_crossings) c.zero_crossings = CountZeroCrossings(h, n_);
+  if (flat) {
     // Merge the plateau extrema into the strict ones, from the back, in place.
     int extra_min = 0, extra_max = 0;
     PlateauExtrema(h, n_, [&](Eigen::Index, bool is_max) { ++(is_max ? extra_max : extra_min); });
@@ -144,7 +213,8 @@ ExtremaCounts Sifter::FindExtrema(const double* h) {
       c.maxima += extra_max;
     }
   }
-  if (s.zero) c.zero_crossings += ZeroRuns(h, n_);
+  nmin_ = c.minima;
+  nmax_ = c.maxima;
   return c;
 }
 
@@ -259,136 +329,55 @@ bool Sifter::BoundaryConditions(const double* h) {
 
   auto assemble = [&](const List& left, const int* interior, int count, const List& right,
                       std::vector<double>& t, std::vector<double>& z) {
-    t.clear();
-    z.clear();
-    for (int k = 0; k < left.size; ++k) {
-      t.push_back(mirrored(lsym, left.v[k]));
-      z.push_back(h[left.v[k]]);
+    const size_t total = static_cast<size_t>(left.size + count + right.size);
+    t.resize(total);  // within the reserved capacity: no allocation
+    z.resize(total);
+    size_t k = 0;
+    for (int j = 0; j < left.size; ++j, ++k) {
+      t[k] = mirrored(lsym, left.v[j]);
+      z[k] = h[left.v[j]];
     }
-    for (int k = 0; k < count; ++k) {
-      t.push_back(interior[k] + 1.0);
-      z.push_back(h[interior[k]]);
+    double* tk = t.data() + k;
+    double* zk = z.data() + k;
+    for (int j = 0; j < count; ++j) {
+      tk[j] = interior[j] + 1.0;
+      zk[j] = h[interior[j]];
     }
-    for (int k = 0; k < right.size; ++k) {
-      t.push_back(mirrored(rsym, right.v[k]));
-      z.push_back(h[right.v[k]]);
+    k += static_cast<size_t>(count);
+    for (int j = 0; j < right.size; ++j, ++k) {
+      t[k] = mirrored(rsym, right.v[j]);
+      z[k] = h[right.v[j]];
     }
-    if (t.size() < 2) return false;
-    for (size_t k = 1; k < t.size(); ++k) {
-      if (!(t[k] > t[k - 1])) return false;  // interp1 needs distinct increasing nodes
+    if (total < 2) return false;
+    // interp1 needs distinct increasing nodes; the interior ones are, by construction.
+    const size_t edge = static_cast<size_t>(left.size);
+    for (size_t j = 1; j <= edge && j < total; ++j) {
+      if (!(t[j] > t[j - 1])) return false;
+    }
+    for (size_t j = total - static_cast<size_t>(right.size); j < total; ++j) {
+      if (j > 0 && !(t[j] > t[j - 1])) return false;
     }
     return true;
   };
-  return assemble(lmin, imin, nmin, rmin, tmin_, zmin_) &&
-         assemble(lmax, imax, nmax, rmax, tmax_, zmax_);
-}
-
-void Sifter::EvaluateSpline(const std::vector<double>& t, const std::vector<double>& y,
-                            double* out) {
-  const size_t m = t.size();
-  const Eigen::Index n = n_;
-  if (m == 2) {  // straight line (MATLAB spline with 2 nodes)
-    const double slope = (y[1] - y[0]) / (t[1] - t[0]);
-    for (Eigen::Index i = 0; i < n; ++i) out[i] = slope * ((i + 1) - t[0]) + y[0];
-    return;
-  }
-  if (m == 3) {  // the interpolating parabola
-    const double dx0 = t[1] - t[0];
-    const double dd0 = (y[1] - y[0]) / dx0;
-    const double dd1 = (y[2] - y[1]) / (t[2] - t[1]);
-    const double c2 = (dd1 - dd0) / (t[2] - t[0]);
-    const double c1 = dd0 - c2 * dx0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double h = (i + 1) - t[0];
-      out[i] = (c2 * h + c1) * h + y[0];
-    }
-    return;
-  }
-  // Not-a-knot slopes (MATLAB spline.m), tridiagonal, solved by forward elimination and back
-  // substitution. Row j: sub * s[j-1] + diag * s[j] + sup * s[j+1] = rhs.
-  double* s = slope_.data();
-  double* diag = diag_.data();
-  double* rhs = rhs_.data();
-  auto dx = [&](size_t j) { return t[j + 1] - t[j]; };
-  auto dd = [&](size_t j) { return (y[j + 1] - y[j]) / (t[j + 1] - t[j]); };
-  const double x31 = t[2] - t[0];
-  const double xn = t[m - 1] - t[m - 3];
-  // Row 0: dx1 s0 + x31 s1.
-  diag[0] = dx(1);
-  rhs[0] = ((dx(0) + 2 * x31) * dx(1) * dd(0) + dx(0) * dx(0) * dd(1)) / x31;
-  double sup_prev = x31;
-  for (size_t j = 1; j < m; ++j) {
-    double sub, dj, sup, r;
-    if (j < m - 1) {
-      sub = dx(j);
-      dj = 2 * (dx(j) + dx(j - 1));
-      sup = dx(j - 1);
-      r = 3 * (dx(j) * dd(j - 1) + dx(j - 1) * dd(j));
-    } else {
-      sub = xn;
-      dj = dx(m - 3);
-      sup = 0.0;
-      r = (dx(m - 2) * dx(m - 2) * dd(m - 3) + (2 * xn + dx(m - 2)) * dx(m - 3) * dd(m - 2)) / xn;
-    }
-    const double w = sub / diag[j - 1];
-    diag[j] = dj - w * sup_prev;
-    rhs[j] = r - w * rhs[j - 1];
-    // Keep the super-diagonal for back substitution in s[] (overwritten below, read first).
-    s[j - 1] = sup_prev;
-    sup_prev = sup;
-  }
-  // Back substitution: s[j-1] currently holds row j-1's super-diagonal.
-  double next = rhs[m - 1] / diag[m - 1];
-  for (size_t j = m - 1; j-- > 0;) {
-    const double value = (rhs[j] - s[j] * next) / diag[j];
-    s[j + 1] = next;
-    next = value;
-  }
-  s[0] = next;
-
-  // Piecewise cubic Hermite (MATLAB pwch + ppval Horner order), interval by interval.
-  Eigen::Index i = 0;
-  for (size_t j = 0; j + 1 < m && i < n; ++j) {
-    Eigen::Index end = n;
-    if (j + 2 < m) {
-      end = std::clamp(static_cast<Eigen::Index>(std::ceil(t[j + 1])) - 1, i, n);
-    }
-    const double h_len = dx(j);
-    const double divdif = (y[j + 1] - y[j]) / h_len;
-    const double dzzdx = (divdif - s[j]) / h_len;
-    const double dzdxdx = (s[j + 1] - divdif) / h_len;
-    const double c1 = (dzdxdx - dzzdx) / h_len;
-    const double c2 = 2 * dzzdx - dzdxdx;
-    const double c3 = s[j];
-    const double c4 = y[j];
-    const double tj = t[j];
-    for (; i < end; ++i) {
-      const double h = static_cast<double>(i + 1) - tj;
-      out[i] = ((h * c1 + c2) * h + c3) * h + c4;
-    }
-  }
+  return assemble(lmin, imin, nmin, rmin, lower_.t(), lower_.y()) &&
+         assemble(lmax, imax, nmax, rmax, upper_.t(), upper_.y());
 }
 
 bool Sifter::EnvelopeNodes(const double* x, std::vector<double>* tmin, std::vector<double>* zmin,
                            std::vector<double>* tmax, std::vector<double>* zmax) {
-  const ExtremaCounts c = FindExtrema(x);
-  nmin_ = c.minima;
-  nmax_ = c.maxima;
+  FindExtrema(x, false);
   if (!BoundaryConditions(x)) return false;
-  *tmin = tmin_;
-  *zmin = zmin_;
-  *tmax = tmax_;
-  *zmax = zmax_;
+  *tmin = lower_.t();
+  *zmin = lower_.y();
+  *tmax = upper_.t();
+  *zmax = upper_.y();
   return true;
 }
 
 bool Sifter::MeanAndAmplitude(const double* x, double* mean, double* amplitude) {
-  const ExtremaCounts c = FindExtrema(x);
-  nmin_ = c.minima;
-  nmax_ = c.maxima;
+  FindExtrema(x, false);
   if (!BoundaryConditions(x)) return false;
-  EvaluateSpline(tmin_, zmin_, env_min_.data());
-  EvaluateSpline(tmax_, zmax_, env_max_.data());
+  Envelopes();
   for (Eigen::Index i = 0; i < n_; ++i) {
     mean[i] = (env_min_[i] + env_max_[i]) / 2;
     amplitude[i] = std::abs(env_max_[i] - env_min_[i]) / 2;
@@ -399,31 +388,35 @@ bool Sifter::MeanAndAmplitude(const double* x, double* mean, double* amplitude) 
 SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
   SiftOutcome outcome;
   std::copy(x, x + n_, h_.data());
-  ExtremaCounts counts = FindExtrema(h_.data());
+  const StopRule rule = options_.stop_rule;
+  const bool every_sift_zc = rule == StopRule::kSNumber;
+  ExtremaCounts counts = FindExtrema(h_.data(), every_sift_zc);
   if (counts.extrema() < 3) {
     outcome.extracted = false;
     return outcome;
   }
-  const StopRule rule = options_.stop_rule;
   const double n_double = static_cast<double>(n_);
   int stable = 0;
   ExtremaCounts previous = counts;
   for (;;) {
     if (rule == StopRule::kSNumber && outcome.sifts > 0) {
-      const bool same = counts.extrema() == previous.extrema() &&
-                        counts.zero_crossings == previous.zero_crossings;
-      const bool imf_like = std::abs(counts.extrema() - counts.zero_crossings) <= 1;
-      stable = (same && imf_like) ? stable + 1 : 0;
+      // Huang et al. (2003) as libeemd implements it: the counts of maxima, minima and zero
+      // crossings change by at most one in total from one sift to the next, S times in a row,
+      // and extrema and zero crossings then differ by at most one.
+      const int change = std::abs(counts.maxima - previous.maxima) +
+                         std::abs(counts.minima - previous.minima) +
+                         std::abs(counts.zero_crossings - previous.zero_crossings);
+      stable = change <= 1 ? stable + 1 : 0;
       previous = counts;
-      if (stable >= options_.s_number) break;
+      if (stable >= options_.s_number &&
+          std::abs(counts.extrema() - counts.zero_crossings) <= 1) {
+        break;
+      }
     }
     if (rule == StopRule::kFixed && outcome.sifts >= options_.fixed_sifts) break;
 
-    nmin_ = counts.minima;
-    nmax_ = counts.maxima;
     if (counts.extrema() < 3 || !BoundaryConditions(h_.data())) break;  // emd.m's catch: stop
-    EvaluateSpline(tmin_, zmin_, env_min_.data());
-    EvaluateSpline(tmax_, zmax_, env_max_.data());
+    Envelopes();
 
     const double* h = h_.data();
     const double* lo = env_min_.data();
@@ -444,7 +437,8 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
       }
       const bool keep_sifting = static_cast<double>(above1) / n_double > options_.rilling_tolerance ||
                                 above2;
-      stop = !keep_sifting && std::abs(counts.zero_crossings - counts.extrema()) <= 1;
+      stop = !keep_sifting &&
+             std::abs(CountZeroCrossings(h, n_) - counts.extrema()) <= 1;
       if (stop) break;
     } else if (rule == StopRule::kCauchySd) {
       double mean_energy = 0.0, energy = 0.0;
@@ -465,7 +459,7 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
     std::swap(h_, next_);
     ++outcome.sifts;
     if (stop) break;  // Cauchy SD: the sift that met the threshold is kept
-    counts = FindExtrema(h_.data());
+    counts = FindExtrema(h_.data(), every_sift_zc);
   }
   std::copy(h_.data(), h_.data() + n_, imf);
   return outcome;

@@ -12,8 +12,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
+#include "decomposition/spline.h"
 #include "gyrodrift/decomposition/decomposition.h"
 
 namespace gyrodrift::decomposition::internal {
@@ -49,20 +51,20 @@ class Sifter {
   bool MeanAndAmplitude(const double* x, double* mean, double* amplitude);
 
  private:
-  // Finds extrema indices (0-based) and counts of h; fills indmin_/indmax_.
-  ExtremaCounts FindExtrema(const double* h);
+  // Finds extrema indices (0-based) of h into indmin_/indmax_ and counts them; zero crossings
+  // are counted only when asked (the Rilling rule needs them once per IMF, not per sift).
+  ExtremaCounts FindExtrema(const double* h, bool count_zero_crossings);
   // Builds the mirrored node sets from indmin_/indmax_; false where emd.m raises an error.
   bool BoundaryConditions(const double* h);
-  // Not-a-knot spline through (t, y) evaluated at t = 1..n into out.
-  void EvaluateSpline(const std::vector<double>& t, const std::vector<double>& y, double* out);
+  // Fits both envelope splines to the current node sets and evaluates them.
+  void Envelopes();
 
   Eigen::Index n_;
   SiftingOptions options_;
   int max_sifts_;
   std::vector<int> indmin_, indmax_;
   int nmin_ = 0, nmax_ = 0;  // counts of the last FindExtrema
-  std::vector<double> tmin_, zmin_, tmax_, zmax_;
-  std::vector<double> slope_, diag_, rhs_;  // spline scratch
+  EnvelopeSpline lower_, upper_;  // node sets (t, y) and fits of the two envelopes
   Eigen::VectorXd h_, next_, env_min_, env_max_;
 };
 

@@ -12,6 +12,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <gtest/gtest.h>
+
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 
@@ -22,8 +24,16 @@ std::string TestDataPath(const std::string& relative) {
 }
 
 std::string TempDir(const std::string& name) {
+  // CTest runs tests of one executable in parallel: the directory is unique per test.
+  std::string unique = name;
+  if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
+    unique += std::string("-") + info->test_suite_name() + "-" + info->name();
+    for (char& c : unique) {
+      if (c == '/') c = '_';
+    }
+  }
   const std::filesystem::path dir =
-      std::filesystem::path(GYRODRIFT_BINARY_DIR) / "test-tmp" / name;
+      std::filesystem::path(GYRODRIFT_BINARY_DIR) / "test-tmp" / unique;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

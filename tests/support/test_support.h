@@ -11,7 +11,7 @@ namespace gyrodrift::test {
 
 // ../shared/testdata/<relative>
 std::string TestDataPath(const std::string& relative);
-// A fresh empty directory for this test (under the build tree).
+// A fresh empty directory for this test (under the build tree), unique per running test.
 std::string TempDir(const std::string& name);
 // Matrix of every numeric column of a CSV file with a header (rows x columns).
 Eigen::MatrixXd ReadCsvMatrix(const std::string& path, std::vector<std::string>* header = nullptr);

@@ -32,8 +32,8 @@ Method MethodFromString(std::string_view name);  // "emd", "eemd", ...; throws U
 enum class StopRule {
   kRilling,  // Rilling-Flandrin: share of |mean|/amplitude > threshold1 under tolerance, none >
              // threshold2, and |#zero crossings - #extrema| <= 1
-  kSNumber,  // Huang 2003: extrema and zero-crossing counts unchanged (and within 1 of each
-             // other) for S consecutive sifts
+  kSNumber,  // Huang 2003 (libeemd's reading): extrema and zero-crossing counts change by at
+             // most one for S consecutive sifts, and then differ from each other by at most one
   kFixed,    // exactly fixed_sifts sifts
   kCauchySd, // Huang 1998: sum (h_prev - h)^2 / sum h_prev^2 < sd_threshold
 };

@@ -64,6 +64,8 @@ struct Case {
   const char* sifts_file;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 class IceemdanReference : public ::testing::TestWithParam<Case> {};
 
 TEST_P(IceemdanReference, EveryModeMatches) {

@@ -1,0 +1,36 @@
+// Private: not-a-knot cubic spline interpolation on the integer time grid t = 1..n, as MATLAB's
+// spline.m / interp1(..., 'spline') computes it: a line through 2 nodes, the parabola through 3,
+// and for 4 or more nodes the C2 piecewise cubic whose first and last two pieces are one cubic
+// (slopes from a tridiagonal system solved in O(nodes)). Buffers are sized once; fitting and
+// evaluating allocate nothing. Two splines (the lower and upper envelope) are fitted together so
+// their sequential eliminations overlap in the processor.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace gyrodrift::decomposition::internal {
+
+class EnvelopeSpline {
+ public:
+  explicit EnvelopeSpline(Eigen::Index max_nodes);
+  // Node times must be integer-valued and strictly increasing, with t[0] <= 1 <= n <= t[m-1]
+  // (the sifting's mirrored boundary nodes guarantee it).
+  std::vector<double>& t() { return t_; }
+  std::vector<double>& y() { return y_; }
+  // Evaluates at t = 1..n into out, which must have room for n + kPadding values.
+  void Evaluate(Eigen::Index n, double* out) const;
+  static constexpr Eigen::Index kPadding = 8;
+
+  // Solves the slopes of both splines.
+  friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
+
+ private:
+  void Prepare();
+  std::vector<double> t_, y_;
+  std::vector<double> inv_dx_, dd_, slope_, diag_, rhs_, sub_, sup_, c1_, c2_;
+};
+
+void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
+
+}  // namespace gyrodrift::decomposition::internal
