@@ -120,8 +120,12 @@ NoiseTerm* TermAt(NoiseTerms& t, int j) {
 const NoiseTerm* TermAt(const NoiseTerms& t, int j) { return TermAt(const_cast<NoiseTerms&>(t), j); }
 
 // Slope-method readings (IEEE 952 Annex C): at the point whose local log-log slope is closest to
-// the term's slope (within 0.25), sigma = sqrt(col_j(tau)) * term.
-void SlopeReadings(const Eigen::VectorXd& tau, const Eigen::VectorXd& adev, NoiseTerms* out) {
+// the term's slope (within 0.25), sigma = sqrt(col_j(tau)) * term. Only points whose slope rests
+// on usable neighbours (EDF >= 5, about +-32 % per point) are read, so the noisy tail
+// of a curve does not produce readings.
+void SlopeReadings(const Eigen::VectorXd& tau, const Eigen::VectorXd& adev,
+                   const Eigen::VectorXd& edf, NoiseTerms* out) {
+  constexpr double kMinEdf = 5.0;
   const Eigen::Index n = tau.size();
   if (n < 2) return;
   Eigen::VectorXd slope(n);
@@ -135,6 +139,8 @@ void SlopeReadings(const Eigen::VectorXd& tau, const Eigen::VectorXd& adev, Nois
     Eigen::Index best = -1;
     double best_gap = 0.25;
     for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index a = std::max<Eigen::Index>(0, i - 1), b = std::min(n - 1, i + 1);
+      if (edf[a] < kMinEdf || edf[i] < kMinEdf || edf[b] < kMinEdf) continue;
       const double gap = std::abs(slope[i] - kSlope[static_cast<size_t>(j)]);
       if (gap <= best_gap) {
         best_gap = gap;
@@ -209,7 +215,7 @@ NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& ad
                     FormatValue(options.tau_min_s) + ", " + FormatValue(options.tau_max_s) +
                     "] s (" + std::to_string(use.size()) + " found)");
   const Eigen::Index n = static_cast<Eigen::Index>(use.size());
-  Eigen::VectorXd tau(n), dev(n);
+  Eigen::VectorXd tau(n), dev(n), point_edf(n);
   Eigen::MatrixXd a(n, kTerms);
   Eigen::VectorXd b(n);
   for (Eigen::Index r = 0; r < n; ++r) {
@@ -219,6 +225,7 @@ NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& ad
     const double var = dev[r] * dev[r];
     // Standard deviation of an AVAR estimate with `edf` degrees of freedom: var * sqrt(2 / edf).
     const double e = std::isfinite(edf[i]) && edf[i] > 0.0 ? edf[i] : 1.0;
+    point_edf[r] = e;
     const double sd = var * std::sqrt(2.0 / e);
     for (int j = 0; j < kTerms; ++j) a(r, j) = Column(j, tau[r]) / sd;
     b[r] = var / sd;
@@ -277,7 +284,7 @@ NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& ad
       }
     }
   }
-  SlopeReadings(tau, dev, &out);
+  SlopeReadings(tau, dev, point_edf, &out);
   return out;
 }
 
