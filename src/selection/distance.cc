@@ -37,7 +37,8 @@ PdfDistance PdfDistanceFromString(std::string_view name) {
   if (name == "hellinger") return PdfDistance::kHellinger;
   if (name == "jensen-shannon") return PdfDistance::kJensenShannon;
   if (name == "bhattacharyya") return PdfDistance::kBhattacharyya;
-  ThrowOption("distance", "'" + std::string(name) + "'", "one of l2, l1, hellinger, jensen-shannon, bhattacharyya");
+  ThrowOption("distance", "'" + std::string(name) + "'",
+              "one of l2, l1, hellinger, jensen-shannon, bhattacharyya");
 }
 
 double Distance(PdfDistance distance, const Eigen::Ref<const Eigen::VectorXd>& p,
@@ -52,7 +53,8 @@ double Distance(PdfDistance distance, const Eigen::Ref<const Eigen::VectorXd>& p
       }
       return std::sqrt(sum * step);
     case PdfDistance::kL1:
-      for (Eigen::Index j = 0; j < n; ++j) sum += std::abs(std::max(0.0, p[j]) - std::max(0.0, q[j]));
+      for (Eigen::Index j = 0; j < n; ++j)
+        sum += std::abs(std::max(0.0, p[j]) - std::max(0.0, q[j]));
       return sum * step;
     case PdfDistance::kHellinger:
       for (Eigen::Index j = 0; j < n; ++j) {
@@ -70,7 +72,8 @@ double Distance(PdfDistance distance, const Eigen::Ref<const Eigen::VectorXd>& p
       // Each KL term is >= 0 in exact arithmetic; round-off must not make the divergence negative.
       return std::max(0.0, 0.5 * sum * step);
     case PdfDistance::kBhattacharyya:
-      for (Eigen::Index j = 0; j < n; ++j) sum += std::sqrt(std::max(0.0, p[j]) * std::max(0.0, q[j]));
+      for (Eigen::Index j = 0; j < n; ++j)
+        sum += std::sqrt(std::max(0.0, p[j]) * std::max(0.0, q[j]));
       // BC slightly above 1 from the Riemann sum of two identical densities gives a tiny negative
       // logarithm; the distance is 0 then.
       return std::max(0.0, -std::log(std::max(sum * step, 1e-300)));

@@ -158,8 +158,8 @@ void EstimateDensity(const Eigen::Ref<const Eigen::VectorXd>& x, double shift, d
 
   auto& w = KdeAccess::Get(*workspace);
   const double ratio = h / grid.step;
-  const size_t half = static_cast<size_t>(
-      std::min<double>(m - 1, std::ceil(kKernelCutBandwidths * ratio)));
+  const size_t half =
+      static_cast<size_t>(std::min<double>(m - 1, std::ceil(kKernelCutBandwidths * ratio)));
   const size_t p = NextPowerOfTwo(static_cast<size_t>(m) + half);
   w.bins.assign(p, 0.0);
   w.kernel.assign(p, 0.0);

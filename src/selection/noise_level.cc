@@ -40,17 +40,16 @@ std::string Fmt(double v) {
 std::string CacheKey(int length, const MonteCarloOptions& mc, const KdeOptions& kde,
                      PdfDistance distance) {
   const auto& s = mc.sifting;
-  std::string key = std::to_string(length) + "|" + std::to_string(mc.realisations) + "|" +
-                    Fmt(mc.confidence) + "|" + std::to_string(mc.seed) + "|" +
-                    std::to_string(mc.max_imfs) + "|" +
-                    std::string(decomposition::ToString(s.stop_rule)) + "|" +
-                    Fmt(s.rilling_threshold1) + "|" + Fmt(s.rilling_threshold2) + "|" +
-                    Fmt(s.rilling_tolerance) + "|" + std::to_string(s.s_number) + "|" +
-                    std::to_string(s.fixed_sifts) + "|" + Fmt(s.sd_threshold) + "|" +
-                    std::to_string(s.max_sifts) + "|" + std::to_string(kde.grid_points) + "|" +
-                    Fmt(kde.points_per_bandwidth) + "|" + std::to_string(kde.max_grid_points) +
-                    "|" + Fmt(kde.bandwidth_scale) + "|" + Fmt(kde.padding_bandwidths) + "|" +
-                    std::string(ToString(kde.method)) + "|" + std::string(ToString(distance));
+  std::string key =
+      std::to_string(length) + "|" + std::to_string(mc.realisations) + "|" + Fmt(mc.confidence) +
+      "|" + std::to_string(mc.seed) + "|" + std::to_string(mc.max_imfs) + "|" +
+      std::string(decomposition::ToString(s.stop_rule)) + "|" + Fmt(s.rilling_threshold1) + "|" +
+      Fmt(s.rilling_threshold2) + "|" + Fmt(s.rilling_tolerance) + "|" +
+      std::to_string(s.s_number) + "|" + std::to_string(s.fixed_sifts) + "|" + Fmt(s.sd_threshold) +
+      "|" + std::to_string(s.max_sifts) + "|" + std::to_string(kde.grid_points) + "|" +
+      Fmt(kde.points_per_bandwidth) + "|" + std::to_string(kde.max_grid_points) + "|" +
+      Fmt(kde.bandwidth_scale) + "|" + Fmt(kde.padding_bandwidths) + "|" +
+      std::string(ToString(kde.method)) + "|" + std::string(ToString(distance));
   return key;
 }
 
@@ -111,9 +110,9 @@ double NoiseLevel::LevelFor(int k) const {
 }
 
 std::string NoiseLevel::Summary() const {
-  std::string s = "white-noise level N=" + std::to_string(length) + " R=" +
-                  std::to_string(realisations) + " q=" + FormatValue(confidence) + " seed=" +
-                  std::to_string(seed) + ":";
+  std::string s = "white-noise level N=" + std::to_string(length) +
+                  " R=" + std::to_string(realisations) + " q=" + FormatValue(confidence) +
+                  " seed=" + std::to_string(seed) + ":";
   char buf[32];
   for (double v : level) {
     std::snprintf(buf, sizeof buf, " %.4g", v);
@@ -203,8 +202,8 @@ std::shared_ptr<const NoiseLevel> NoiseLevelCache::Get(int length,
     return existing.get();
   }
   try {
-    auto level = std::make_shared<const NoiseLevel>(
-        ComputeNoiseLevel(length, monte_carlo, kde, distance));
+    auto level =
+        std::make_shared<const NoiseLevel>(ComputeNoiseLevel(length, monte_carlo, kde, distance));
     promise.set_value(level);
     if (computed != nullptr) *computed = true;
     return level;

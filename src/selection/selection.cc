@@ -66,9 +66,7 @@ Criterion CriterionFromString(std::string_view name) {
   return EnumFromName(name, "criterion", kCriteria);
 }
 std::string_view ToString(GroupKind kind) { return EnumName(kind, kKinds); }
-GroupKind GroupKindFromString(std::string_view name) {
-  return EnumFromName(name, "group", kKinds);
-}
+GroupKind GroupKindFromString(std::string_view name) { return EnumFromName(name, "group", kKinds); }
 
 void SelectionOptions::Validate() const {
   if (criterion != Criterion::kPdfSimilarity && criterion != Criterion::kKomaty &&
@@ -230,7 +228,8 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
     std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid), a.end());
     double med = a[mid];
     if (a.size() % 2 == 0) {
-      med = 0.5 * (med + *std::max_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid)));
+      med =
+          0.5 * (med + *std::max_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid)));
     }
     const double e1 = static_cast<double>(n) * (med / 0.6745) * (med / 0.6745);
     const double log2_e1 = std::log2(e1);
@@ -242,8 +241,8 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
         result.energy_band_log2_upper.push_back(std::numeric_limits<double>::quiet_NaN());
         continue;
       }
-      const double upper = log2_e1 - std::log2(0.719) - k * std::log2(2.01) +
-                           std::pow(2.0, band_a * k + band_b);
+      const double upper =
+          log2_e1 - std::log2(0.719) - k * std::log2(2.01) + std::pow(2.0, band_a * k + band_b);
       result.energy_band_log2_upper.push_back(upper);
       // A zero mode 1 (median 0) gives log2 E_1 = -inf: every later mode is outside the band.
       if (result.energy_signal_start == k_count + 1 && !(std::log2(e) <= upper)) {
@@ -271,7 +270,8 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
       }
       result.k_noise = k_noise;
       result.mixed_end = std::max(k_noise, k_star);
-      if (k_noise == 0) AppendNote(&result.note, "no IMF passes the white-noise test: no noise group");
+      if (k_noise == 0)
+        AppendNote(&result.note, "no IMF passes the white-noise test: no noise group");
       if (k_star <= k_noise) {
         AppendNote(&result.note, "k* <= k_N: no mixed group, drift starts after k_N");
       }

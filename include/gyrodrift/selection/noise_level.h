@@ -12,8 +12,8 @@
 // the realisations that have a mode k (at least kMinRealisationsPerMode of them, else NaN: no
 // level, the mode cannot be called noise). Realisations run on `threads` workers (ParallelFor);
 // each fills its own slot, so the level is the same bits for any thread count.
-// Cost: R plain EMDs of length N plus R * K KDEs, dominated by the EMDs: for N = 28,800 and
-// R = 100 about 13 s on 2 cores (0.25 s per white-noise EMD).
+// Cost: R plain EMDs of length N plus R * K KDEs, dominated by the EMDs: for N = 28,800 about
+// 0.1 s of CPU per realisation, so R = 100 costs about 10 s of CPU (bench_selection).
 // NoiseLevelCache keeps one level per (N, options) so a process pays this once.
 #pragma once
 
@@ -36,28 +36,28 @@ double SelfSimilarityDistance(const Eigen::Ref<const Eigen::VectorXd>& x, const 
                               PdfDistance distance);
 
 struct MonteCarloOptions {
-  int realisations = 100;       // white-noise realisations R, [20, 100000]
-  double confidence = 0.99;     // quantile of G_k taken as the level, [0.5, 1)
-  std::uint64_t seed = 1;       // realisation i draws from stream (seed, i)
-  int threads = 0;              // workers, >= 0 (0 = every core); does not change the result
+  int realisations = 100;    // white-noise realisations R, [20, 100000]
+  double confidence = 0.99;  // quantile of G_k taken as the level, [0.5, 1)
+  std::uint64_t seed = 1;    // realisation i draws from stream (seed, i)
+  int threads = 0;           // workers, >= 0 (0 = every core); does not change the result
   decomposition::SiftingOptions sifting;  // EMD of the noise realisations
-  int max_imfs = 0;             // EMD IMF cap, >= 0 (0 = until the residue is monotone)
-  void Validate() const;        // throws UsageError naming the field
+  int max_imfs = 0;                       // EMD IMF cap, >= 0 (0 = until the residue is monotone)
+  void Validate() const;                  // throws UsageError naming the field
 };
 
 constexpr int kMinRealisationsPerMode = 20;
 
 struct NoiseLevel {
-  int length = 0;                        // N
-  int realisations = 0;                  // R
+  int length = 0;        // N
+  int realisations = 0;  // R
   double confidence = 0.0;
   std::uint64_t seed = 0;
-  std::vector<double> level;             // level of mode k at index k - 1 (NaN: no level)
-  std::vector<double> median;            // median G_k of the white-noise mode k (diagnostic)
+  std::vector<double> level;                // level of mode k at index k - 1 (NaN: no level)
+  std::vector<double> median;               // median G_k of the white-noise mode k (diagnostic)
   std::vector<int> realisations_with_mode;  // how many realisations had a mode k
   // Level of mode k (1-based); NaN beyond the modes the noise produced.
   double LevelFor(int k) const;
-  std::string Summary() const;           // one line
+  std::string Summary() const;  // one line
 };
 
 // Runs the Monte-Carlo (no cache). length >= 16. Throws UsageError for bad options.

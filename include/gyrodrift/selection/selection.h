@@ -53,7 +53,7 @@ struct SelectionOptions {
   // Subtract mean(x) before comparing pdf(x) with the (zero-mean) IMF densities, so D_k compares
   // shapes and not the offset the residue carries [choice].
   bool center_signal = true;
-  MonteCarloOptions monte_carlo;            // the white-noise level (kPdfSimilarity only)
+  MonteCarloOptions monte_carlo;  // the white-noise level (kPdfSimilarity only)
   // A precomputed level (length must equal N); skips NoiseLevelCache::Global().
   std::shared_ptr<const NoiseLevel> noise_level;
   // kEnergyModel band: 0.99 (a = 0.46, b = -1.919) or 0.95 (a = 0.474, b = -2.449), the two
@@ -66,9 +66,9 @@ struct SelectionOptions {
 
 struct ModeGroup {
   GroupKind kind = GroupKind::kNoise;
-  std::vector<int> imfs;          // member IMF indices k (1-based), increasing
-  bool has_residue = false;       // the drift group holds the residue
-  Eigen::VectorXd series;         // N samples: sum of the members (increasing k), then residue
+  std::vector<int> imfs;     // member IMF indices k (1-based), increasing
+  bool has_residue = false;  // the drift group holds the residue
+  Eigen::VectorXd series;    // N samples: sum of the members (increasing k), then residue
 };
 
 struct SelectionResult {
@@ -77,22 +77,22 @@ struct SelectionResult {
   int length = 0;    // N
   int num_imfs = 0;  // K
   // Curves, index k - 1 for IMF k.
-  std::vector<double> pdf_distance;     // D_k = distance(pdf(x), pdf(IMF k))
-  std::vector<double> self_distance;    // G_k = distance(pdf(standardised IMF k), N(0, 1))
-  std::vector<double> noise_level;      // Monte-Carlo level of mode k (kPdfSimilarity only)
-  std::vector<double> log2_energy;      // log2 sum_t imf_k(t)^2 (-inf for a zero IMF)
+  std::vector<double> pdf_distance;            // D_k = distance(pdf(x), pdf(IMF k))
+  std::vector<double> self_distance;           // G_k = distance(pdf(standardised IMF k), N(0, 1))
+  std::vector<double> noise_level;             // Monte-Carlo level of mode k (kPdfSimilarity only)
+  std::vector<double> log2_energy;             // log2 sum_t imf_k(t)^2 (-inf for a zero IMF)
   std::vector<double> energy_band_log2_upper;  // white-noise band upper limit (NaN for k = 1)
   // Boundaries (IMF indices, 1-based; 0 = none).
-  int k_star = 0;         // argmax_k D_k (first maximum)
-  int k_noise = 0;        // last noise IMF of the chosen criterion (k_N for kPdfSimilarity)
-  int mixed_end = 0;      // last mixed IMF (kPdfSimilarity: max(k_N, k*); others: k_noise)
-  int energy_signal_start = 0;  // first IMF outside the energy band (K + 1 if none)
+  int k_star = 0;                 // argmax_k D_k (first maximum)
+  int k_noise = 0;                // last noise IMF of the chosen criterion (k_N for kPdfSimilarity)
+  int mixed_end = 0;              // last mixed IMF (kPdfSimilarity: max(k_N, k*); others: k_noise)
+  int energy_signal_start = 0;    // first IMF outside the energy band (K + 1 if none)
   std::vector<ModeGroup> groups;  // the non-empty groups, in the order noise, mixed, drift
   // Diagnostics.
-  int grid_points = 0;               // points of the common grid of x and the IMFs
-  bool grid_under_resolved = false;  // the grid cap left a density below points_per_bandwidth
-  double signal_bandwidth = 0.0;     // Silverman bandwidth of x (units of x)
-  bool noise_level_computed = false; // this call ran the Monte-Carlo (false: cache or supplied)
+  int grid_points = 0;                // points of the common grid of x and the IMFs
+  bool grid_under_resolved = false;   // the grid cap left a density below points_per_bandwidth
+  double signal_bandwidth = 0.0;      // Silverman bandwidth of x (units of x)
+  bool noise_level_computed = false;  // this call ran the Monte-Carlo (false: cache or supplied)
   // max_t |x - (sum_k imf_k + residue)| / max_t |x|: the groups add up to the decomposition's
   // reconstruction; for a non-complete decomposition (EEMD) that differs from x by this much.
   double reconstruction_error = 0.0;

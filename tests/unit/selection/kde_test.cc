@@ -51,8 +51,8 @@ TEST(Kde, BinnedFftMatchesDirectWithinBinningBound) {
     const Kde direct = EstimateKde(x, options);
     ASSERT_EQ(binned.grid.points, points);
     ASSERT_EQ(direct.grid.points, points);
-    const double bound = BinningBound(binned.grid.step, binned.bandwidth) +
-                         1e-13 * direct.density.maxCoeff();
+    const double bound =
+        BinningBound(binned.grid.step, binned.bandwidth) + 1e-13 * direct.density.maxCoeff();
     const double err = (binned.density - direct.density).cwiseAbs().maxCoeff();
     EXPECT_LE(err, bound) << points;
     // The bound is not vacuous: the coarse grid shows a real binning error of its order.

@@ -98,8 +98,8 @@ TEST(NoiseLevelCache, SecondCallIsCachedAndIdentical) {
   EXPECT_FALSE(computed);  // the thread count is not part of the key
   EXPECT_EQ(first.get(), second.get());
   EXPECT_LT((t2 - t1).count() * 20, (t1 - t0).count());
-  EXPECT_TRUE(SameBits(first->level,
-                       ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2).level));
+  EXPECT_TRUE(
+      SameBits(first->level, ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2).level));
   // Another seed, distance or grid is another entry.
   cache.Get(kLength, SmallRun(0, 3), {}, PdfDistance::kL2, &computed);
   EXPECT_TRUE(computed);
@@ -135,9 +135,9 @@ TEST(NoiseLevel, RejectsBadOptions) {
   certain.confidence = 1.0;
   EXPECT_THROW(ComputeNoiseLevel(kLength, certain, {}, PdfDistance::kL2), UsageError);
   EXPECT_THROW(ComputeNoiseLevel(8, SmallRun(), {}, PdfDistance::kL2), UsageError);
-  EXPECT_THROW(ComputeNoiseLevel(kLength, SmallRun(), KdeOptions{.grid_points = 10},
-                                 PdfDistance::kL2),
-               UsageError);
+  EXPECT_THROW(
+      ComputeNoiseLevel(kLength, SmallRun(), KdeOptions{.grid_points = 10}, PdfDistance::kL2),
+      UsageError);
   NoiseLevelCache cache;
   EXPECT_THROW(cache.Get(kLength, SmallRun(-1), {}, PdfDistance::kL2), UsageError);
   EXPECT_EQ(cache.Size(), 0u);

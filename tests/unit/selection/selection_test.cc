@@ -88,15 +88,14 @@ void ExpectValidPartition(const SelectionResult& r, const Eigen::MatrixXd& imfs,
   for (const ModeGroup& g : r.groups) {
     EXPECT_GT(static_cast<int>(g.kind), last_kind);  // noise, mixed, drift, each at most once
     last_kind = static_cast<int>(g.kind);
-    EXPECT_TRUE(!g.imfs.empty() || g.has_residue);    // no empty group
+    EXPECT_TRUE(!g.imfs.empty() || g.has_residue);  // no empty group
     EXPECT_EQ(g.has_residue, g.kind == GroupKind::kDrift);
     for (int k : g.imfs) EXPECT_EQ(k, next++);
     total += g.series;
   }
   EXPECT_EQ(next, static_cast<int>(imfs.cols()) + 1);
   const Eigen::VectorXd reference = imfs.rowwise().sum() + residue;
-  EXPECT_LE((total - reference).cwiseAbs().maxCoeff(),
-            1e-12 * reference.cwiseAbs().maxCoeff());
+  EXPECT_LE((total - reference).cwiseAbs().maxCoeff(), 1e-12 * reference.cwiseAbs().maxCoeff());
 }
 
 TEST(SelectModes, ThreeGroupsOnSyntheticModes) {
