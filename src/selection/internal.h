@@ -11,8 +11,9 @@ namespace gyrodrift::selection::internal {
 // Per-thread buffers: repeated calls of the same size allocate nothing.
 struct Scratch {
   KdeWorkspace kde;
-  Eigen::VectorXd density;
-  Eigen::VectorXd reference;
+  Eigen::VectorXd density;    // standardised-grid density (SelfSimilarity)
+  Eigen::VectorXd reference;  // N(0, 1 + h^2) on that grid
+  Eigen::VectorXd common;     // density on the common grid of x and the IMFs
 };
 
 // SelfSimilarityDistance with caller-owned buffers.

@@ -195,10 +195,10 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
     // A constant IMF (zero bandwidth) is a spike: give it one grid step of bandwidth.
     double hk = h[static_cast<size_t>(k)];
     if (!(hk > 0.0)) hk = grid.step;
-    s.density.resize(grid.points);
-    EstimateDensity(imfs.col(k), 0.0, 1.0, hk, grid, kde.method, &s.kde, s.density);
+    s.common.resize(grid.points);
+    EstimateDensity(imfs.col(k), 0.0, 1.0, hk, grid, kde.method, &s.kde, s.common);
     result.pdf_distance[static_cast<size_t>(k)] =
-        Distance(options.distance, pdf_x, s.density, grid.step);
+        Distance(options.distance, pdf_x, s.common, grid.step);
     result.self_distance[static_cast<size_t>(k)] =
         internal::SelfSimilarity(imfs.col(k), kde, options.distance, &s);
   });
