@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"
 
 namespace gyrodrift::drift {
@@ -390,6 +391,32 @@ TEST(Learner, BpStopsAtTheDesiredMseOrTheEpochCap) {
   EXPECT_EQ(q.arrays.at("layer_sizes"), (Eigen::MatrixXd(1, 4) << 2, 6, 4, 1).finished());
   EXPECT_EQ(q.arrays.at("weights_2").rows(), 4);
   EXPECT_EQ(q.arrays.at("weights_2").cols(), 7);
+}
+
+// libsvm training is serialised internally and FANN networks share no state: fits running on
+// two threads give the same bits as fits run one after the other.
+TEST(Learner, ConcurrentFitsMatchSequentialFits) {
+  const Data train = SineBowl(200, 0.05, 20);
+  const Data test = SineBowl(50, 0.0, 21);
+  const std::vector<LearnerKind> kinds{LearnerKind::kSvr, LearnerKind::kBp, LearnerKind::kSvr,
+                                       LearnerKind::kBp, LearnerKind::kPoly, LearnerKind::kElm};
+  auto fit = [&](int task) {
+    LearnerOptions o = Options(kinds[static_cast<size_t>(task)]);
+    o.seed = static_cast<std::uint64_t>(task);
+    o.threads = 1;
+    o.bp_epochs = 100;
+    return FitLearner(train.x, train.y, o)->Predict(test.x);
+  };
+  const int n = static_cast<int>(kinds.size());
+  std::vector<Eigen::VectorXd> sequential(kinds.size());
+  std::vector<Eigen::VectorXd> concurrent(kinds.size());
+  for (int task = 0; task < n; ++task) sequential[static_cast<size_t>(task)] = fit(task);
+  ParallelFor(n, 2, [&](int task, int) { concurrent[static_cast<size_t>(task)] = fit(task); });
+  for (int task = 0; task < n; ++task) {
+    EXPECT_TRUE(SameBits(sequential[static_cast<size_t>(task)],
+                         concurrent[static_cast<size_t>(task)]))
+        << "task " << task;
+  }
 }
 
 TEST(Learner, ValidateRejectsBadOptions) {
