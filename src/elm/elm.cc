@@ -140,14 +140,13 @@ void SolveQr(ElmModel* model, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& 
     report->numerical_rank = static_cast<int>(cod.rank());
     diag = cod.matrixQTZ().diagonal().head(cod.rank()).cwiseAbs();
   }
-  report->condition_estimate =
-      diag.size() > 0 && diag.minCoeff() > 0.0 ? diag.maxCoeff() / diag.minCoeff()
-                                               : std::numeric_limits<double>::infinity();
+  report->condition_estimate = diag.size() > 0 && diag.minCoeff() > 0.0
+                                   ? diag.maxCoeff() / diag.minCoeff()
+                                   : std::numeric_limits<double>::infinity();
   const Eigen::MatrixXd residual = h_copy * model->output_weights - ts;
   const Eigen::RowVectorXd sse = residual.colwise().squaredNorm();
-  report->train_rmse =
-      std::sqrt((sse.array() * model->target_scaler.scale.array().square()).sum() /
-                (static_cast<double>(n) * static_cast<double>(ts.cols())));
+  report->train_rmse = std::sqrt((sse.array() * model->target_scaler.scale.array().square()).sum() /
+                                 (static_cast<double>(n) * static_cast<double>(ts.cols())));
 }
 
 // Training RMSE in target units from the normal equations (no second pass over the rows).
@@ -347,14 +346,17 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
     const LooCandidate* best = nullptr;
     for (const auto& c : report.candidates) {
       // Ties (to the bit) go to the smaller network, then the stronger regularisation.
-      if (!c.skipped && std::isfinite(c.loo_mse) && (best == nullptr || c.loo_mse < best->loo_mse)) {
+      if (!c.skipped && std::isfinite(c.loo_mse) &&
+          (best == nullptr || c.loo_mse < best->loo_mse)) {
         best = &c;
       }
     }
     if (best == nullptr) {
-      throw DataError("ELM auto selection: every (L, C) pair has cond(H^T H + I/C) above "
-                      "max_condition = " + FormatValue(options.max_condition) +
-                      " or an undefined leave-one-out error; add smaller C candidates");
+      throw DataError(
+          "ELM auto selection: every (L, C) pair has cond(H^T H + I/C) above "
+          "max_condition = " +
+          FormatValue(options.max_condition) +
+          " or an undefined leave-one-out error; add smaller C candidates");
     }
     hidden = best->hidden_units;
     ridge_c = best->ridge_c;
@@ -379,8 +381,8 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
     gram = internal::ComputeGram(options.activation, xs, ts, model.input_weights, model.biases,
                                  options.threads);
   }
-  internal::RidgeSolution solution = internal::SolveRidgeCholesky(gram.hth, gram.htt, hidden,
-                                                                  ridge_c);
+  internal::RidgeSolution solution =
+      internal::SolveRidgeCholesky(gram.hth, gram.htt, hidden, ridge_c);
   model.output_weights = std::move(solution.beta);
   report.condition_estimate = solution.condition;
   report.ldlt_fallback = solution.ldlt_fallback;

@@ -23,7 +23,8 @@ void DrawUnits(int inputs, int hidden, std::uint64_t seed, Eigen::MatrixXd* weig
 
 void ComputeHidden(Activation activation, const Eigen::Ref<const Eigen::MatrixXd>& xs,
                    const Eigen::Ref<const Eigen::MatrixXd>& weights,
-                   const Eigen::Ref<const Eigen::VectorXd>& biases, Eigen::Ref<Eigen::MatrixXd> out) {
+                   const Eigen::Ref<const Eigen::VectorXd>& biases,
+                   Eigen::Ref<Eigen::MatrixXd> out) {
   out.noalias() = xs * weights;
   auto z = out.array();
   switch (activation) {
@@ -100,8 +101,8 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
   return gram;
 }
 
-RidgeSolution SolveRidgeCholesky(const Eigen::MatrixXd& hth, const Eigen::MatrixXd& htt,
-                                 int hidden, double ridge_c) {
+RidgeSolution SolveRidgeCholesky(const Eigen::MatrixXd& hth, const Eigen::MatrixXd& htt, int hidden,
+                                 double ridge_c) {
   Eigen::MatrixXd system = hth.topLeftCorner(hidden, hidden);
   system.diagonal().array() += 1.0 / ridge_c;
   RidgeSolution solution;

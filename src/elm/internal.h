@@ -29,7 +29,8 @@ void DrawUnits(int inputs, int hidden, std::uint64_t seed, Eigen::MatrixXd* weig
 // packing buffers and, for RBF, one vector of row norms.
 void ComputeHidden(Activation activation, const Eigen::Ref<const Eigen::MatrixXd>& xs,
                    const Eigen::Ref<const Eigen::MatrixXd>& weights,
-                   const Eigen::Ref<const Eigen::VectorXd>& biases, Eigen::Ref<Eigen::MatrixXd> out);
+                   const Eigen::Ref<const Eigen::VectorXd>& biases,
+                   Eigen::Ref<Eigen::MatrixXd> out);
 
 // H^T H (lower triangle valid) and H^T T of the hidden layer of xs, streamed over row blocks.
 struct Gram {
@@ -42,12 +43,12 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
 // beta = (G + I/C)^{-1} H^T T by LLT (LDLT if LLT breaks down) of the leading L x L block of
 // the lower triangle of `hth`.
 struct RidgeSolution {
-  Eigen::MatrixXd beta;      // L x m
-  double condition = 0.0;    // 1 / rcond of the factorisation
+  Eigen::MatrixXd beta;    // L x m
+  double condition = 0.0;  // 1 / rcond of the factorisation
   bool ldlt_fallback = false;
 };
-RidgeSolution SolveRidgeCholesky(const Eigen::MatrixXd& hth, const Eigen::MatrixXd& htt,
-                                 int hidden, double ridge_c);
+RidgeSolution SolveRidgeCholesky(const Eigen::MatrixXd& hth, const Eigen::MatrixXd& htt, int hidden,
+                                 double ridge_c);
 
 // Leave-one-out (PRESS) errors over the (L, C) grid; see elm.h. Fills `candidates` L-major.
 void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts,

@@ -23,11 +23,11 @@ namespace {
 // Everything the row pass needs about one candidate L.
 struct CandidatePlan {
   int hidden = 0;
-  std::vector<int> active;       // indices into the C grid that are evaluated
-  Eigen::MatrixXd vectors;       // V, L x L
-  Eigen::MatrixXd hat_weights;   // L x |active|: 1 / (lambda_j + delta_c)
-  Eigen::MatrixXd fit_weights;   // L x (|active| m): z_jk / (lambda_j + delta_c), c-major
-  std::vector<double> condition; // per C of the grid
+  std::vector<int> active;        // indices into the C grid that are evaluated
+  Eigen::MatrixXd vectors;        // V, L x L
+  Eigen::MatrixXd hat_weights;    // L x |active|: 1 / (lambda_j + delta_c)
+  Eigen::MatrixXd fit_weights;    // L x (|active| m): z_jk / (lambda_j + delta_c), c-major
+  std::vector<double> condition;  // per C of the grid
 };
 
 }  // namespace
@@ -58,18 +58,19 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
     plan.condition.resize(static_cast<size_t>(num_c));
     for (int c = 0; c < num_c; ++c) {
       const double delta = 1.0 / ridge_grid[static_cast<size_t>(c)];
-      plan.condition[static_cast<size_t>(c)] = (lambda.maxCoeff() + delta) / (lambda.minCoeff() + delta);
+      plan.condition[static_cast<size_t>(c)] =
+          (lambda.maxCoeff() + delta) / (lambda.minCoeff() + delta);
       if (plan.condition[static_cast<size_t>(c)] <= max_condition) plan.active.push_back(c);
     }
     const Eigen::Index num_active = static_cast<Eigen::Index>(plan.active.size());
     plan.hat_weights.resize(l, num_active);
     plan.fit_weights.resize(l, num_active * outputs);
     for (Eigen::Index a = 0; a < num_active; ++a) {
-      const double delta = 1.0 / ridge_grid[static_cast<size_t>(plan.active[static_cast<size_t>(a)])];
+      const double delta =
+          1.0 / ridge_grid[static_cast<size_t>(plan.active[static_cast<size_t>(a)])];
       plan.hat_weights.col(a) = (lambda + delta).inverse().matrix();
       for (Eigen::Index k = 0; k < outputs; ++k) {
-        plan.fit_weights.col(a * outputs + k) =
-            z.col(k).cwiseProduct(plan.hat_weights.col(a));
+        plan.fit_weights.col(a * outputs + k) = z.col(k).cwiseProduct(plan.hat_weights.col(a));
       }
     }
   });
@@ -78,7 +79,8 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
   std::vector<Eigen::Index> offset(static_cast<size_t>(num_l) + 1, 0);
   Eigen::Index max_active = 0;
   for (int q = 0; q < num_l; ++q) {
-    const Eigen::Index num_active = static_cast<Eigen::Index>(plans[static_cast<size_t>(q)].active.size());
+    const Eigen::Index num_active =
+        static_cast<Eigen::Index>(plans[static_cast<size_t>(q)].active.size());
     offset[static_cast<size_t>(q) + 1] = offset[static_cast<size_t>(q)] + num_active * outputs;
     max_active = std::max(max_active, num_active);
   }

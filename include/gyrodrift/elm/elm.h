@@ -151,7 +151,7 @@ struct ElmReport {
   std::vector<LooCandidate> candidates;  // kAuto: every (L, C) pair, L-major, C ascending
   double loo_rmse = std::numeric_limits<double>::quiet_NaN();  // kAuto: of the chosen pair
   std::uint64_t seed = 0;
-  int threads = 0;  // workers actually used
+  int threads = 0;              // workers actually used
   std::string Summary() const;  // one line
 };
 

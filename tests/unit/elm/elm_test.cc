@@ -89,9 +89,9 @@ class ElmActivation : public ::testing::TestWithParam<Activation> {};
 TEST_P(ElmActivation, FitsTheSineWithAutoSelection) {
   const Data train = NoisySine(1500, 0.1, 21);
   const Data test = NoisySine(800, 0.1, 22);
-  const ElmFit fit = Fit(train.x, train.t,
-                         {.hidden_units = 100, .activation = GetParam(),
-                          .selection = Selection::kAuto});
+  const ElmFit fit =
+      Fit(train.x, train.t,
+          {.hidden_units = 100, .activation = GetParam(), .selection = Selection::kAuto});
   const double rmse = Rmse(Predict(fit.model, test.x), test.truth);
   if (GetParam() == Activation::kLinear) {
     // A random linear projection of one input is a straight line: it cannot follow sin on
@@ -171,9 +171,9 @@ TEST(Elm, RidgeSolutionMatchesIndependentClosedForms) {
     // SVD form: beta = V diag(s / (s^2 + 1/C)) U^T T.
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(h, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const Eigen::ArrayXd s = svd.singularValues().array();
-    const Eigen::MatrixXd beta_svd =
-        svd.matrixV() * (s / (s.square() + 1.0 / c)).matrix().asDiagonal() *
-        svd.matrixU().transpose() * ts;
+    const Eigen::MatrixXd beta_svd = svd.matrixV() *
+                                     (s / (s.square() + 1.0 / c)).matrix().asDiagonal() *
+                                     svd.matrixU().transpose() * ts;
     EXPECT_LT((m.output_weights - beta_svd).norm(), 1e-12 * beta_svd.norm()) << ToString(solver);
     // Predictions map back to target units.
     const Eigen::MatrixXd y = (h * beta_lu).array().rowwise() * m.target_scaler.scale.array();
@@ -183,8 +183,10 @@ TEST(Elm, RidgeSolutionMatchesIndependentClosedForms) {
   }
   // C = inf with QR is the least-squares solution (full column rank here).
   const ElmFit ls = Fit(d.x, d.t,
-                        {.hidden_units = l, .ridge_c = std::numeric_limits<double>::infinity(),
-                         .solver = Solver::kQr, .standardize_inputs = false,
+                        {.hidden_units = l,
+                         .ridge_c = std::numeric_limits<double>::infinity(),
+                         .solver = Solver::kQr,
+                         .standardize_inputs = false,
                          .standardize_targets = false});
   const Eigen::MatrixXd h = HiddenLayer(ls.model, d.x);
   const Eigen::MatrixXd beta_svd =
@@ -243,8 +245,10 @@ TEST(Elm, LeaveOneOutErrorsEqualBruteForceRefits) {
 TEST(Elm, AutoSkipsIllConditionedPairs) {
   const Data d = Smooth(200, 2, 1, 52);
   const ElmFit fit = Fit(d.x, d.t,
-                         {.hidden_units = 200, .selection = Selection::kAuto,
-                          .hidden_unit_candidates = {200}, .ridge_c_candidates = {1.0, 1e14}});
+                         {.hidden_units = 200,
+                          .selection = Selection::kAuto,
+                          .hidden_unit_candidates = {200},
+                          .ridge_c_candidates = {1.0, 1e14}});
   ASSERT_EQ(fit.report.candidates.size(), 2u);
   EXPECT_FALSE(fit.report.candidates[0].skipped);
   EXPECT_TRUE(fit.report.candidates[1].skipped);
@@ -397,8 +401,7 @@ TEST(Elm, BadOptionsAndDataThrowClearErrors) {
   EXPECT_NE(ErrorOf<UsageError>(fit_with({.ridge_c_candidates = {1.0, -2.0}}))
                 .find("ridge_c_candidates = -2"),
             std::string::npos);
-  EXPECT_NE(ErrorOf<UsageError>(fit_with({.threads = -1})).find("threads = -1"),
-            std::string::npos);
+  EXPECT_NE(ErrorOf<UsageError>(fit_with({.threads = -1})).find("threads = -1"), std::string::npos);
   EXPECT_EQ(ErrorOf<UsageError>([] { ActivationFromString("relu"); }),
             "activation = 'relu': must be one of sigmoid, tanh, sine, rbf, linear");
   EXPECT_EQ(ActivationFromString(ToString(Activation::kRbf)), Activation::kRbf);
@@ -433,8 +436,7 @@ TEST(Elm, BadOptionsAndDataThrowClearErrors) {
 
 TEST(Elm, DefaultGrids) {
   ElmOptions o{.hidden_units = 1000};
-  EXPECT_EQ(o.HiddenUnitGrid(),
-            (std::vector<int>{1, 2, 5, 10, 20, 50, 100, 200, 500, 1000}));
+  EXPECT_EQ(o.HiddenUnitGrid(), (std::vector<int>{1, 2, 5, 10, 20, 50, 100, 200, 500, 1000}));
   o.hidden_units = 30;
   EXPECT_EQ(o.HiddenUnitGrid(), (std::vector<int>{1, 2, 5, 10, 20, 30}));
   const std::vector<double> c = o.RidgeGrid();
