@@ -384,6 +384,14 @@ TEST(Learner, BpStopsAtTheDesiredMseOrTheEpochCap) {
   const Parameters p = FitLearner(train.x, train.y, o)->Save();
   EXPECT_LT(p.scalars.at("epochs"), 5000.0);
   EXPECT_LE(p.scalars.at("train_mse"), 0.05);
+  // Our forward pass is FANN's network: its training MSE (weights before the last RPROP
+  // step, standardised units) matches the MSE of Predict on the training rows.
+  o.bp_epochs = 200;
+  o.bp_desired_mse = 0.0;
+  const Parameters r = FitLearner(train.x, train.y, o)->Save();
+  const double scale = r.arrays.at("target_scale")(0, 0);
+  const double own_mse = std::pow(r.scalars.at("train_rmse") / scale, 2);
+  EXPECT_NEAR(own_mse, r.scalars.at("train_mse"), 0.02 * r.scalars.at("train_mse"));
   // Two hidden layers: the saved layout follows the options.
   o.bp_hidden = {6, 4};
   o.bp_epochs = 50;
