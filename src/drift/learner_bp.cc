@@ -236,6 +236,12 @@ std::unique_ptr<Learner> FitBp(const Eigen::Ref<const Eigen::MatrixXd>& x,
   ForEachConnection(ann.get(), sizes, [&](int k, int t, int j, unsigned int c) {
     weights[static_cast<size_t>(k - 1)](t, j) = ann->weights[c];
   });
+  for (const auto& w : weights) {
+    if (!w.allFinite()) {
+      throw DataError("bp: RPROP training diverged after " + std::to_string(epochs) +
+                      " epochs (a weight is not finite); try fewer epochs or smaller layers");
+    }
+  }
 
   auto learner = std::make_unique<BpLearner>(std::move(sizes), std::move(weights),
                                              std::move(input_scaler), std::move(target_scaler),

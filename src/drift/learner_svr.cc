@@ -205,6 +205,9 @@ std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
     }
     rho = model->rho[0];
   }
+  if (!coefficients.allFinite() || !std::isfinite(rho)) {
+    throw DataError("svr: libsvm returned a non-finite coefficient or offset");
+  }
 
   auto learner = std::make_unique<SvrLearner>(std::move(support_t), std::move(coefficients), rho,
                                               param.gamma, std::move(input_scaler),
