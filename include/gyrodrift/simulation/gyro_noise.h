@@ -11,7 +11,8 @@
 //                         correlation times tau_j in [bias_tau_min_s, bias_tau_max_s] and equal
 //                         variances: their summed PSD approximates flicker (1/f) noise, so the
 //                         Allan curve has a flat floor sqrt(2 ln 2 / pi) B ~ 0.664 B (within about
-//                         3 %) between 10 tau_min and tau_max / 10, rolling off outside it.
+//                         3 %) between 10 tau_min and tau_max / 10, rolling off outside it;
+//                         the automatic tau_min = 0.6 dt extends the flat part down to tau = dt.
 //                         The common variance is set from the exact
 //                         Allan variance of the sampled AR(1) processes so that the floor equals
 //                         the target on average (in log) over that band; the ripple is reported.
@@ -46,9 +47,10 @@ struct NoiseParameters {
   double rrw_dphpsh = 2e-3;
   // Rate ramp R, deg/h/h, in [-1e4, 1e4]. Default 0 (thermal drift is simulated separately).
   double rate_ramp_dphph = 0.0;
-  // Correlation-time band of the bias-instability bank, s: min in [1e-6, 1e8],
-  // max in [100 min, 1e9]. Defaults 1 s and 1e6 s: a flat floor from 10 s to 1e5 s.
-  double bias_tau_min_s = 1.0;
+  // Correlation-time band of the bias-instability bank, s: min 0 (automatic: 0.6 x the sample
+  // interval dt, which keeps the floor within about 4 % from tau = dt up) or in [1e-6, 1e8];
+  // max in [100 min, 1e9]. Defaults 0 and 1e6 s: at 1 Hz a flat floor from 1 s to about 1e5 s.
+  double bias_tau_min_s = 0.0;
   double bias_tau_max_s = 1e6;
   // Gauss-Markov processes per decade of the band, in [1, 20]. Default 3 (19 processes).
   int bias_processes_per_decade = 3;
