@@ -1,0 +1,127 @@
+// The multi-scale drift model (MS-ELM, Chen & Cui, Signal Processing 128, 2016) and the single-
+// model baselines behind the same interface.
+//
+// MS-ELM: the drift record y is decomposed (BEEMDAN by default, decomposition.h), the IMFs are
+// grouped by PDF similarity into noise / mixed / drift sub-series (selection.h), one learner is
+// trained per sub-series and the model's output is the sum of the sub-models' outputs.
+// Two modes:
+//   kPredict    the paper's task: one-step-ahead prediction of y[t] from the sub-series' own
+//               lags s_g[t-1..t-p] (optionally with the thermal history at t-1).
+//   kCompensate what a navigation computer runs: each sub-series is modelled from the thermal
+//               history of the temperature channel at t only (features.h), so the model needs
+//               nothing but temperature at run time; compensated output = y - estimate.
+// Methods: kMsElm (groups), kEmdElm (one ELM per IMF and one for the residue), and the single
+// models kElm, kPoly, kSvr, kBp trained on y itself with the same features.
+// Cost: one decomposition of the training record plus one learner fit per sub-series.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/features.h"
+#include "gyrodrift/drift/learner.h"
+#include "gyrodrift/selection/selection.h"
+
+namespace gyrodrift::drift {
+
+enum class Mode { kPredict, kCompensate };
+std::string_view ToString(Mode mode);
+Mode ModeFromString(std::string_view name);  // "predict", "compensate"
+
+enum class Method { kMsElm, kElm, kEmdElm, kPoly, kSvr, kBp };
+std::string_view ToString(Method method);
+Method MethodFromString(std::string_view name);  // "ms-elm", "elm", "emd-elm", "poly", "svr", "bp"
+std::vector<Method> AllMethods();
+bool UsesDecomposition(Method method);  // kMsElm, kEmdElm
+
+struct DriftOptions {
+  Mode mode = Mode::kPredict;
+  Method method = Method::kMsElm;
+  decomposition::DecompositionOptions decomposition;  // BEEMDAN defaults
+  selection::SelectionOptions selection;              // PDF similarity, L2
+  FeatureOptions features;
+  // The learner of every sub-model. Its kind follows from `method` (ELM for kMsElm, kEmdElm and
+  // kElm); the default ELM is sigmoid with the number of hidden units (<= 50) and the ridge C
+  // chosen by leave-one-out error.
+  LearnerOptions learner;
+  // Predict mode: choose p among lag_candidates on the last validation_fraction of the training
+  // record (sub-models fitted on the rest), instead of features.lags.
+  bool auto_lags = false;
+  std::vector<int> lag_candidates{1, 2, 4, 8, 16};
+  double validation_fraction = 0.2;  // in [0.05, 0.5]
+  std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
+  int threads = 0;         // 0 = every core
+  DriftOptions();          // sets the learner defaults described above
+  void Validate() const;   // throws UsageError naming the field
+};
+
+// One sub-series and its learner.
+struct SubModel {
+  std::string name;          // "noise", "mixed", "drift", "imf3", "residue", "signal"
+  std::vector<int> imfs;     // IMF indices (1-based) of the training decomposition it sums
+  bool has_residue = false;  // it also holds the residue (and any IMF beyond the last listed)
+  // Null for the noise group in compensate mode: temperature cannot explain it, its sub-model is
+  // the zero function.
+  std::shared_ptr<const Learner> learner;
+};
+
+struct DriftModel {
+  DriftOptions options;
+  int lags = 0;            // p used (predict mode)
+  int training_imfs = 0;   // K of the training decomposition (0 for single models)
+  Eigen::Index training_samples = 0;
+  std::vector<SubModel> sub_models;
+  std::string decomposition_summary;  // report of the training decomposition
+  std::string selection_summary;      // report of the grouping (kMsElm)
+  std::vector<double> lag_validation_rmse;  // auto_lags: per candidate
+  bool uses_temperature() const;
+  int num_inputs() const;  // inputs of each sub-model
+  std::string Summary() const;  // one line
+};
+
+// Sub-series of a decomposition grouped as the model's sub-models expect: column g is the sum of
+// the IMFs (and residue) that belong to sub-model g. IMFs beyond the training count and the
+// residue go to the sub-model that holds the residue. Single models: one column, y itself.
+Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomposition& d);
+
+// Fits a model on target y (N samples) and, where the mode or options need it, temperature
+// (N samples, empty otherwise). Throws UsageError / DataError.
+DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
+                         const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                         const DriftOptions& options);
+
+// Compensate mode: the drift estimate at every sample of a temperature record.
+Eigen::VectorXd EstimateDrift(const DriftModel& model,
+                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
+
+// Predict mode from given sub-series (N x G, GroupSeries of some decomposition) and thermal
+// features (N x F, or empty): predictions for t = first .. first + count - 1 (first >= lags).
+Eigen::VectorXd PredictFromSeries(const DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index first,
+                                  Eigen::Index count);
+
+// How a predict-mode model gets its test-time sub-series.
+enum class Protocol {
+  kPaper,   // decompose the whole record once (what the literature does; sees the future)
+  kCausal,  // for each t, decompose the trailing window y[t-W .. t-1] only
+};
+std::string_view ToString(Protocol protocol);
+Protocol ProtocolFromString(std::string_view name);  // "paper", "causal"
+
+struct CausalOptions {
+  int window = 512;  // W, samples of the trailing window, in [16, 1e6]
+  int threads = 0;   // windows in parallel (each decomposition then runs on one thread)
+};
+
+// One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has
+// N - first entries). Single models need no decomposition and are causal under both protocols.
+Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
+                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               Eigen::Index first, Protocol protocol,
+                               const CausalOptions& causal = {});
+
+}  // namespace gyrodrift::drift

@@ -1,0 +1,360 @@
+#include "gyrodrift/drift/drift_model.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "drift/internal.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/parallel.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+constexpr std::array<std::pair<Mode, std::string_view>, 2> kModes{{
+    {Mode::kPredict, "predict"},
+    {Mode::kCompensate, "compensate"},
+}};
+constexpr std::array<std::pair<Method, std::string_view>, 6> kMethods{{
+    {Method::kMsElm, "ms-elm"},
+    {Method::kElm, "elm"},
+    {Method::kEmdElm, "emd-elm"},
+    {Method::kPoly, "poly"},
+    {Method::kSvr, "svr"},
+    {Method::kBp, "bp"},
+}};
+constexpr std::array<std::pair<Protocol, std::string_view>, 2> kProtocols{{
+    {Protocol::kPaper, "paper"},
+    {Protocol::kCausal, "causal"},
+}};
+
+template <class E, size_t N>
+std::string_view Name(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
+  for (const auto& [v, name] : names) {
+    if (v == value) return name;
+  }
+  return "?";
+}
+
+template <class E, size_t N>
+E Parse(std::string_view text, std::string_view what,
+        const std::array<std::pair<E, std::string_view>, N>& names) {
+  std::string allowed;
+  for (const auto& [v, name] : names) {
+    if (name == text) return v;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+  }
+  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
+}
+
+LearnerKind KindOf(Method method) {
+  switch (method) {
+    case Method::kPoly:
+      return LearnerKind::kPoly;
+    case Method::kSvr:
+      return LearnerKind::kSvr;
+    case Method::kBp:
+      return LearnerKind::kBp;
+    default:
+      return LearnerKind::kElm;
+  }
+}
+
+Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
+                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               Eigen::Index n) {
+  if (!model.uses_temperature()) return Eigen::MatrixXd(n, 0);
+  if (temperature_c.size() != n) {
+    throw DataError("temperature has " + std::to_string(temperature_c.size()) +
+                    " samples, the target " + std::to_string(n) + ": they must match");
+  }
+  return ThermalFeatures(temperature_c, model.options.features);
+}
+
+// Rows of inputs of sub-model g for t = first .. first + count - 1 (predict mode).
+Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& s,
+                            const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index first,
+                            Eigen::Index count) {
+  Eigen::MatrixXd x(count, model.lags + thermal.cols());
+  x.leftCols(model.lags) = LagRows(s, model.lags, first, count);
+  if (thermal.cols() > 0) x.rightCols(thermal.cols()) = thermal.middleRows(first - 1, count);
+  return x;
+}
+
+LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
+  LearnerOptions l = o.learner;
+  l.kind = KindOf(o.method);
+  l.seed = o.seed + g;
+  l.threads = o.threads;
+  return l;
+}
+
+}  // namespace
+
+std::string_view ToString(Mode mode) { return Name(mode, kModes); }
+Mode ModeFromString(std::string_view name) { return Parse(name, "mode", kModes); }
+std::string_view ToString(Method method) { return Name(method, kMethods); }
+Method MethodFromString(std::string_view name) { return Parse(name, "method", kMethods); }
+std::string_view ToString(Protocol protocol) { return Name(protocol, kProtocols); }
+Protocol ProtocolFromString(std::string_view name) { return Parse(name, "protocol", kProtocols); }
+
+std::vector<Method> AllMethods() {
+  std::vector<Method> all;
+  for (const auto& [m, name] : kMethods) all.push_back(m);
+  return all;
+}
+
+bool UsesDecomposition(Method method) {
+  return method == Method::kMsElm || method == Method::kEmdElm;
+}
+
+DriftOptions::DriftOptions() {
+  learner.elm.hidden_units = 50;
+  learner.elm.selection = elm::Selection::kAuto;
+}
+
+void DriftOptions::Validate() const {
+  decomposition.Validate();
+  selection.Validate();
+  features.Validate();
+  LearnerOptions l = learner;
+  l.kind = KindOf(method);
+  l.Validate();
+  for (int p : lag_candidates) {
+    if (p < 1 || p > 256) ThrowOption("lag candidate", std::to_string(p), "an integer in [1, 256]");
+  }
+  if (auto_lags && lag_candidates.empty()) {
+    ThrowOption("lag_candidates", "(empty)", "at least one candidate when lags are 'auto'");
+  }
+  RequireInRange("validation_fraction", validation_fraction, 0.05, 0.5);
+  if (threads < 0 || threads > 1024) {
+    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
+  }
+}
+
+bool DriftModel::uses_temperature() const {
+  return options.mode == Mode::kCompensate || options.features.use_temperature;
+}
+
+int DriftModel::num_inputs() const {
+  const int thermal = uses_temperature() ? options.features.NumThermalFeatures() : 0;
+  return options.mode == Mode::kCompensate ? thermal : lags + thermal;
+}
+
+std::string DriftModel::Summary() const {
+  std::string s = std::string(ToString(options.method)) + " (" + std::string(ToString(options.mode)) +
+                  "): " + std::to_string(sub_models.size()) + " sub-model" +
+                  (sub_models.size() == 1 ? "" : "s") + " [";
+  for (size_t g = 0; g < sub_models.size(); ++g) s += (g ? " " : "") + sub_models[g].name;
+  s += "], " + std::to_string(num_inputs()) + " inputs";
+  if (options.mode == Mode::kPredict) s += ", " + std::to_string(lags) + " lags";
+  s += ", trained on " + std::to_string(training_samples) + " samples";
+  return s;
+}
+
+Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomposition& d) {
+  const Eigen::Index n = d.residue.size();
+  const int k_total = d.num_imfs();
+  Eigen::MatrixXd s = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(model.sub_models.size()));
+  int highest_listed = 0;
+  for (const auto& sub : model.sub_models) {
+    for (int k : sub.imfs) highest_listed = std::max(highest_listed, k);
+  }
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    const SubModel& sub = model.sub_models[g];
+    auto col = s.col(static_cast<Eigen::Index>(g));
+    for (int k : sub.imfs) {
+      if (k <= k_total) col += d.imfs.col(k - 1);
+    }
+    if (sub.has_residue) {
+      for (int k = highest_listed + 1; k <= k_total; ++k) col += d.imfs.col(k - 1);
+      col += d.residue;
+    }
+  }
+  return s;
+}
+
+namespace internal {
+
+SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o) {
+  SubSeries out;
+  out.model.options = o;
+  if (!UsesDecomposition(o.method)) {
+    out.model.sub_models.push_back({"signal", {}, true, nullptr});
+    out.series = y;
+    return out;
+  }
+  decomposition::DecompositionOptions dopt = o.decomposition;
+  dopt.seed = o.seed;
+  dopt.threads = o.threads;
+  const decomposition::Decomposition d = decomposition::Decompose(y, dopt);
+  out.model.training_imfs = d.num_imfs();
+  out.model.decomposition_summary = d.report.Summary();
+  if (d.num_imfs() == 0) {
+    out.model.sub_models.push_back({"signal", {}, true, nullptr});
+  } else if (o.method == Method::kEmdElm) {
+    for (int k = 1; k <= d.num_imfs(); ++k) {
+      out.model.sub_models.push_back({"imf" + std::to_string(k), {k}, false, nullptr});
+    }
+    out.model.sub_models.push_back({"residue", {}, true, nullptr});
+  } else {
+    selection::SelectionOptions sopt = o.selection;
+    sopt.threads = o.threads;
+    const selection::SelectionResult sel = selection::SelectModes(y, d, sopt);
+    out.model.selection_summary = sel.Summary();
+    for (const auto& group : sel.groups) {
+      out.model.sub_models.push_back(
+          {std::string(selection::ToString(group.kind)), group.imfs, group.has_residue, nullptr});
+    }
+  }
+  out.series = GroupSeries(out.model, d);
+  return out;
+}
+
+void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
+                 const Eigen::Ref<const Eigen::VectorXd>& y,
+                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end) {
+  const DriftOptions& o = model.options;
+  model.training_samples = fit_end;
+  const size_t groups = model.sub_models.size();
+  if (o.mode == Mode::kCompensate) {
+    for (size_t g = 0; g < groups; ++g) {
+      // The selection found the noise group white-noise-like: it carries no thermal information,
+      // and a learner fitted to it from temperature only extrapolates noise into new thermal
+      // histories. Its sub-model is the zero function [choice, docs/drift.md].
+      if (model.sub_models[g].name == "noise") continue;
+      model.sub_models[g].learner =
+          FitLearner(thermal.topRows(fit_end), series.col(static_cast<Eigen::Index>(g)).head(fit_end),
+                     SubModelLearner(o, g));
+    }
+    return;
+  }
+  auto fit_with_lags = [&](int p, Eigen::Index end) {
+    model.lags = p;
+    if (end - p < 8) {
+      throw DataError("training block of " + std::to_string(end) + " samples is too short for " +
+                      std::to_string(p) + " lags (at least " + std::to_string(p + 8) + " needed)");
+    }
+    for (size_t g = 0; g < groups; ++g) {
+      const auto s = series.col(static_cast<Eigen::Index>(g));
+      model.sub_models[g].learner = FitLearner(PredictRows(model, s, thermal, p, end - p),
+                                               s.segment(p, end - p), SubModelLearner(o, g));
+    }
+  };
+  if (!o.auto_lags) {
+    fit_with_lags(o.features.lags, fit_end);
+    return;
+  }
+  const Eigen::Index validation = static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
+  const Eigen::Index inner_end = fit_end - validation;
+  double best = std::numeric_limits<double>::infinity();
+  int best_p = o.lag_candidates.front();
+  model.lag_validation_rmse.clear();
+  for (int p : o.lag_candidates) {
+    fit_with_lags(p, inner_end);
+    const Eigen::VectorXd pred = PredictFromSeries(model, series, thermal, inner_end, validation);
+    const double rmse = std::sqrt((pred - y.segment(inner_end, validation)).squaredNorm() / validation);
+    model.lag_validation_rmse.push_back(rmse);
+    if (rmse < best) {
+      best = rmse;
+      best_p = p;
+    }
+  }
+  fit_with_lags(best_p, fit_end);
+}
+
+}  // namespace internal
+
+DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
+                         const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                         const DriftOptions& options) {
+  options.Validate();
+  RequireFiniteSignal("target", y, 32);
+  internal::SubSeries prepared = internal::PrepareSubSeries(y, options);
+  const Eigen::MatrixXd thermal = ThermalOrEmpty(prepared.model, temperature_c, y.size());
+  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size());
+  return std::move(prepared.model);
+}
+
+Eigen::VectorXd EstimateDrift(const DriftModel& model,
+                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
+  if (model.options.mode != Mode::kCompensate) {
+    throw UsageError("model mode = predict: drift estimation needs a model fitted with --mode compensate");
+  }
+  const Eigen::MatrixXd f = ThermalFeatures(temperature_c, model.options.features);
+  Eigen::VectorXd estimate = Eigen::VectorXd::Zero(temperature_c.size());
+  for (const auto& sub : model.sub_models) {
+    if (sub.learner) estimate += sub.learner->Predict(f);
+  }
+  return estimate;
+}
+
+Eigen::VectorXd PredictFromSeries(const DriftModel& model,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& series,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& thermal,
+                                  Eigen::Index first, Eigen::Index count) {
+  Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    prediction += model.sub_models[g].learner->Predict(
+        PredictRows(model, series.col(static_cast<Eigen::Index>(g)), thermal, first, count));
+  }
+  return prediction;
+}
+
+Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
+                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               Eigen::Index first, Protocol protocol, const CausalOptions& causal) {
+  if (model.options.mode != Mode::kPredict) {
+    throw UsageError("model mode = compensate: one-step prediction needs a model fitted with --mode predict");
+  }
+  RequireFiniteSignal("target", y, 2);
+  const Eigen::Index n = y.size();
+  if (causal.window < 16 || causal.window > 1000000) {
+    ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
+  }
+  const Eigen::Index min_first =
+      protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
+          ? std::max<Eigen::Index>(model.lags, 16)
+          : model.lags;
+  if (first < min_first || first >= n) {
+    throw DataError("first predicted sample " + std::to_string(first + 1) + " must be in [" +
+                    std::to_string(min_first + 1) + ", " + std::to_string(n) +
+                    "] (the model needs that much history)");
+  }
+  const Eigen::MatrixXd thermal = ThermalOrEmpty(model, temperature_c, n);
+  const Eigen::Index count = n - first;
+  if (!UsesDecomposition(model.options.method)) {
+    return PredictFromSeries(model, y, thermal, first, count);
+  }
+  decomposition::DecompositionOptions dopt = model.options.decomposition;
+  dopt.seed = model.options.seed;
+  if (protocol == Protocol::kPaper) {
+    dopt.threads = model.options.threads;
+    const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
+    return PredictFromSeries(model, series, thermal, first, count);
+  }
+  // Causal: the lags at t come from decomposing y[t-W .. t-1] alone; windows run in parallel.
+  dopt.threads = 1;
+  const int p = model.lags;
+  const size_t groups = model.sub_models.size();
+  std::vector<Eigen::MatrixXd> rows(groups, Eigen::MatrixXd(count, p + thermal.cols()));
+  ParallelFor(static_cast<int>(count), causal.threads, [&](int r, int) {
+    const Eigen::Index t = first + r;
+    const Eigen::Index start = std::max<Eigen::Index>(0, t - causal.window);
+    const Eigen::Index length = t - start;
+    const Eigen::MatrixXd series =
+        GroupSeries(model, decomposition::Decompose(y.segment(start, length), dopt));
+    for (size_t g = 0; g < groups; ++g) {
+      for (int k = 0; k < p; ++k) rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
+      if (thermal.cols() > 0) rows[g].row(r).tail(thermal.cols()) = thermal.row(t - 1);
+    }
+  });
+  Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
+  for (size_t g = 0; g < groups; ++g) prediction += model.sub_models[g].learner->Predict(rows[g]);
+  return prediction;
+}
+
+}  // namespace gyrodrift::drift

@@ -1,0 +1,190 @@
+#include "gyrodrift/drift/evaluation.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "drift/internal.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+struct Trial {
+  Eigen::VectorXd estimate;  // on the test block
+  double train_s = 0.0, predict_s = 0.0;
+  std::string summary;
+};
+
+// Fits and scores one (method, protocol, seed) on the split record.
+Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
+               const Eigen::Ref<const Eigen::VectorXd>& temperature_c, const DriftOptions& o,
+               Protocol protocol, Eigen::Index split, const CausalOptions& causal) {
+  const Eigen::Index n = y.size();
+  const Eigen::Index test = n - split;
+  const bool thermal_needed = o.mode == Mode::kCompensate || o.features.use_temperature;
+  Trial trial;
+  auto start = std::chrono::steady_clock::now();
+  DriftModel model;
+  // Paper protocol: the whole record is decomposed (and grouped) before the split.
+  const bool decompose_all = protocol == Protocol::kPaper && UsesDecomposition(o.method);
+  Eigen::MatrixXd series_all;
+  Eigen::MatrixXd thermal_all;
+  if (thermal_needed) thermal_all = ThermalFeatures(temperature_c, o.features);
+  if (decompose_all) {
+    internal::SubSeries prepared = internal::PrepareSubSeries(y, o);
+    series_all = std::move(prepared.series);
+    model = std::move(prepared.model);
+    internal::FitLearners(model, series_all, y,
+                          thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0), split);
+  } else {
+    model = FitDriftModel(y.head(split), thermal_needed ? Eigen::VectorXd(temperature_c.head(split))
+                                                        : Eigen::VectorXd(),
+                          o);
+  }
+  trial.train_s = Seconds(start);
+  trial.summary = model.Summary();
+
+  start = std::chrono::steady_clock::now();
+  if (o.mode == Mode::kCompensate) {
+    // Thermal features are causal recursions: estimating on the whole record and keeping the
+    // test block gives the filter states a navigation computer would have.
+    trial.estimate = EstimateDrift(model, temperature_c).tail(test);
+  } else if (decompose_all) {
+    trial.estimate = PredictFromSeries(
+        model, series_all, thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
+        split, test);
+  } else {
+    trial.estimate = PredictOneStep(model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(),
+                                    split, Protocol::kCausal, causal);
+  }
+  trial.predict_s = Seconds(start);
+  return trial;
+}
+
+}  // namespace
+
+Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error) {
+  Metrics m;
+  if (error.size() == 0) return m;
+  m.rmse = std::sqrt(error.squaredNorm() / static_cast<double>(error.size()));
+  m.mae = error.cwiseAbs().mean();
+  m.max_abs = error.cwiseAbs().maxCoeff();
+  return m;
+}
+
+void EvaluationOptions::Validate() const {
+  RequireInRange("split", split, 0.1, 0.95);
+  if (repeats < 1 || repeats > 1000) ThrowOption("repeats", std::to_string(repeats), "an integer in [1, 1000]");
+  if (methods.empty()) ThrowOption("methods", "(empty)", "at least one method");
+  if (protocols.empty()) ThrowOption("protocols", "(empty)", "at least one protocol");
+  if (causal.window < 16 || causal.window > 1000000) {
+    ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
+  }
+}
+
+EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
+                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                          const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
+                          const EvaluationOptions& options) {
+  base.Validate();
+  options.Validate();
+  RequireFiniteSignal("target", y, 64);
+  const Eigen::Index n = y.size();
+  const bool thermal_needed = base.mode == Mode::kCompensate || base.features.use_temperature;
+  if (thermal_needed) {
+    if (temperature_c.size() != n) {
+      throw DataError(std::string(ToString(base.mode)) + " mode" +
+                      (base.features.use_temperature ? " with temperature features" : "") +
+                      " needs a temperature column of the same length as the target");
+    }
+    RequireFiniteSignal("temperature", temperature_c, n);
+  }
+  if (truth.size() != 0) {
+    if (truth.size() != n) throw DataError("truth column length differs from the target's");
+    RequireFiniteSignal("truth", truth, n);
+  }
+  EvaluationResult result;
+  result.mode = base.mode;
+  result.split_index = static_cast<Eigen::Index>(std::floor(options.split * static_cast<double>(n)));
+  const Eigen::Index split = result.split_index;
+  if (split < 32 || n - split < 16) {
+    throw DataError("split at sample " + std::to_string(split) + " of " + std::to_string(n) +
+                    " leaves too little data (at least 32 training and 16 test samples)");
+  }
+  result.against_truth = truth.size() != 0;
+  result.reference = result.against_truth ? Eigen::VectorXd(truth.tail(n - split))
+                                          : Eigen::VectorXd(y.tail(n - split));
+  const double total = static_cast<double>(options.methods.size() * options.protocols.size() *
+                                           static_cast<size_t>(options.repeats));
+  double done = 0;
+  for (Method method : options.methods) {
+    // Single models never decompose: both protocols are the same computation, run once.
+    std::vector<EvaluationRow> computed;
+    for (Protocol protocol : options.protocols) {
+      EvaluationRow row;
+      row.method = method;
+      row.protocol = protocol;
+      if (!UsesDecomposition(method) && !computed.empty()) {
+        row = computed.front();
+        row.protocol = protocol;
+        result.rows.push_back(row);
+        done += options.repeats;
+        continue;
+      }
+      std::vector<double> rmse;
+      for (int r = 0; r < options.repeats; ++r) {
+        if (options.progress) {
+          options.progress(done / total, std::string(ToString(method)) + " / " +
+                                             std::string(ToString(protocol)) + " / seed " +
+                                             std::to_string(base.seed + static_cast<std::uint64_t>(r)));
+        }
+        DriftOptions o = base;
+        o.method = method;
+        o.seed = base.seed + static_cast<std::uint64_t>(r);
+        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.causal);
+        const Metrics m = ComputeMetrics(trial.estimate - result.reference);
+        rmse.push_back(m.rmse);
+        row.mae += m.mae / options.repeats;
+        row.max_abs += m.max_abs / options.repeats;
+        row.train_s += trial.train_s / options.repeats;
+        row.predict_s += trial.predict_s / options.repeats;
+        row.estimate = trial.estimate;
+        row.model_summary = trial.summary;
+        done += 1;
+      }
+      double mean = 0;
+      for (double v : rmse) mean += v / static_cast<double>(rmse.size());
+      double var = 0;
+      for (double v : rmse) var += (v - mean) * (v - mean);
+      row.rmse = mean;
+      row.rmse_std = rmse.size() > 1 ? std::sqrt(var / static_cast<double>(rmse.size() - 1)) : 0.0;
+      computed.push_back(row);
+      result.rows.push_back(row);
+    }
+  }
+  if (options.progress) options.progress(1.0, "done");
+  return result;
+}
+
+std::string EvaluationResult::Table() const {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-8s %-7s %12s %12s %12s %12s %9s %10s\n", "method",
+                "protocol", "rmse", "rmse_std", "mae", "max_abs", "train_s", "predict_s");
+  out += line;
+  for (const auto& r : rows) {
+    std::snprintf(line, sizeof(line), "%-8s %-7s %12.6g %12.3g %12.6g %12.6g %9.3f %10.3f\n",
+                  std::string(ToString(r.method)).c_str(), std::string(ToString(r.protocol)).c_str(),
+                  r.rmse, r.rmse_std, r.mae, r.max_abs, r.train_s, r.predict_s);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace gyrodrift::drift

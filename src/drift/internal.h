@@ -1,0 +1,24 @@
+// Private: the steps FitDriftModel is made of, shared with the evaluation's paper protocol (which
+// decomposes the whole record but fits on the training rows only).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "gyrodrift/drift/drift_model.h"
+
+namespace gyrodrift::drift::internal {
+
+struct SubSeries {
+  DriftModel model;        // options and sub-model definitions, no learners yet
+  Eigen::MatrixXd series;  // N x G sub-series of the decomposed record
+};
+
+// Decomposes y (if the method needs it), groups the IMFs and defines the sub-models.
+SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o);
+
+// Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty).
+void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
+                 const Eigen::Ref<const Eigen::VectorXd>& y,
+                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end);
+
+}  // namespace gyrodrift::drift::internal

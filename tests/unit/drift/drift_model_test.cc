@@ -1,0 +1,169 @@
+// The multi-scale drift model: features, fitting in both modes, and the causal protocol's
+// guarantee that nothing after t reaches a prediction for t.
+#include "gyrodrift/drift/drift_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/drift/features.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+// A small thermal log: temperature ramps, a drift that follows a lagged temperature and its rate,
+// white noise on top.
+struct Log {
+  Eigen::VectorXd rate, temperature, drift;
+};
+
+Log MakeLog(Eigen::Index n, std::uint64_t seed) {
+  Log log{Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  Rng rng(seed, 0);
+  double lagged = 20.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const double x = static_cast<double>(t) / n;
+    log.temperature[t] = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * x);
+    const double previous = lagged;
+    lagged += (log.temperature[t] - lagged) / 120.0;
+    log.drift[t] = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    log.rate[t] = log.drift[t] + 0.02 * rng.Normal();
+  }
+  return log;
+}
+
+TEST(ThermalFeatures, FirstOrderLagsAndTheirRates) {
+  FeatureOptions o;
+  o.time_constants_s = {10.0};
+  Eigen::VectorXd step = Eigen::VectorXd::Constant(200, 5.0);
+  step.tail(100).setConstant(15.0);
+  const Eigen::MatrixXd f = ThermalFeatures(step, o);
+  ASSERT_EQ(f.cols(), 3);
+  EXPECT_EQ(f(99, 1), 5.0);  // steady state: the lag equals the input, the rate is zero
+  EXPECT_EQ(f(99, 2), 0.0);
+  // Exact first-order step response: after k samples the lag has covered 1 - exp(-k dt / tau).
+  EXPECT_NEAR(f(109, 1), 15.0 - 10.0 * std::exp(-10.0 / 10.0), 1e-12);
+  EXPECT_NEAR(f(109, 2), (15.0 - f(109, 1)) / 10.0, 1e-15);
+  // Causal: changing the future leaves every earlier row unchanged.
+  Eigen::VectorXd changed = step;
+  changed.tail(50).setConstant(-3.0);
+  const Eigen::MatrixXd g = ThermalFeatures(changed, o);
+  EXPECT_EQ(f.topRows(150), g.topRows(150));
+}
+
+TEST(ThermalFeatures, RejectsBadInput) {
+  FeatureOptions o;
+  Eigen::VectorXd t = Eigen::VectorXd::Constant(10, 1.0);
+  t[3] = std::nan("");
+  EXPECT_THROW(ThermalFeatures(t, o), DataError);
+  o.time_constants_s = {0.0};
+  EXPECT_THROW(ThermalFeatures(Eigen::VectorXd::Ones(10), o), UsageError);
+  o = FeatureOptions{};
+  o.rate_hz = 0.0;
+  EXPECT_THROW(o.Validate(), UsageError);
+}
+
+DriftOptions Fast(Mode mode, Method method) {
+  DriftOptions o;
+  o.mode = mode;
+  o.method = method;
+  o.decomposition.ensemble_size = 10;
+  o.selection.monte_carlo.realisations = 20;
+  o.threads = 2;
+  return o;
+}
+
+TEST(DriftModel, MsElmPredictModeBuildsGroupsThatSumToTheSignal) {
+  const Log log = MakeLog(1500, 1);
+  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
+  EXPECT_EQ(model.lags, 4);
+  EXPECT_GT(model.training_imfs, 3);
+  decomposition::DecompositionOptions d = model.options.decomposition;
+  d.seed = model.options.seed;
+  const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(log.rate, d));
+  EXPECT_LE((series.rowwise().sum() - log.rate).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
+  const Log log = MakeLog(900, 2);
+  for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {
+    const DriftModel model = FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, method));
+    CausalOptions causal;
+    causal.window = 128;
+    const Eigen::VectorXd base = PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    Eigen::VectorXd changed = log.rate;
+    changed.tail(150).array() += 5.0;  // samples 750.. change
+    const Eigen::VectorXd after = PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    // Predictions for t <= 750 use samples up to 749 only: unchanged to the bit.
+    EXPECT_EQ(base.head(151), after.head(151)) << ToString(method);
+    EXPECT_NE(base.tail(10), after.tail(10)) << ToString(method);
+    if (UsesDecomposition(method)) {
+      // The paper protocol decomposes the whole record: the same change leaks into earlier
+      // predictions, which is exactly the leakage the causal protocol removes.
+      const Eigen::VectorXd paper = PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kPaper);
+      const Eigen::VectorXd paper_changed = PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kPaper);
+      EXPECT_NE(paper.head(150), paper_changed.head(150)) << ToString(method);
+    }
+  }
+}
+
+TEST(DriftModel, CompensateModeNeedsOnlyTemperatureAtRunTime) {
+  const Log train = MakeLog(3000, 3);
+  for (Method method : {Method::kMsElm, Method::kElm, Method::kPoly}) {
+    const DriftModel model = FitDriftModel(train.rate, train.temperature, Fast(Mode::kCompensate, method));
+    const Log test = MakeLog(3000, 4);  // same programme, new noise
+    const Eigen::VectorXd estimate = EstimateDrift(model, test.temperature);
+    const double rms_drift = std::sqrt(test.drift.squaredNorm() / 3000);
+    const double rms_error = std::sqrt((estimate - test.drift).squaredNorm() / 3000);
+    EXPECT_LT(rms_error, 0.3 * rms_drift) << ToString(method) << ": " << model.Summary();
+  }
+}
+
+TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {
+  const Log log = MakeLog(1200, 5);
+  DriftOptions o = Fast(Mode::kPredict, Method::kElm);
+  o.auto_lags = true;
+  o.lag_candidates = {1, 3, 6};
+  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  ASSERT_EQ(model.lag_validation_rmse.size(), 3u);
+  const auto best = std::min_element(model.lag_validation_rmse.begin(), model.lag_validation_rmse.end());
+  EXPECT_EQ(model.lags, o.lag_candidates[static_cast<size_t>(best - model.lag_validation_rmse.begin())]);
+}
+
+TEST(DriftModel, BadInputIsRejected) {
+  const Log log = MakeLog(500, 6);
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kCompensate, Method::kElm)), DataError);
+  EXPECT_THROW(FitDriftModel(log.rate.head(10), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kElm)), DataError);
+  DriftOptions bad = Fast(Mode::kPredict, Method::kElm);
+  bad.features.lags = 0;
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), bad), UsageError);
+  EXPECT_THROW(MethodFromString("lstm"), UsageError);
+  EXPECT_THROW(ModeFromString("guess"), UsageError);
+}
+
+TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
+  const Log log = MakeLog(1000, 7);
+  EvaluationOptions eo;
+  eo.methods = {Method::kMsElm, Method::kPoly};
+  eo.causal.window = 128;
+  const EvaluationResult r = Evaluate(log.rate, Eigen::VectorXd(), log.drift, Fast(Mode::kPredict, Method::kMsElm), eo);
+  ASSERT_EQ(r.rows.size(), 4u);
+  EXPECT_EQ(r.split_index, 700);
+  EXPECT_TRUE(r.against_truth);
+  for (const auto& row : r.rows) {
+    EXPECT_EQ(row.estimate.size(), 300);
+    EXPECT_GT(row.rmse, 0.0);
+    EXPECT_GE(row.max_abs, row.rmse);
+  }
+  // Single models do not decompose: both protocols are the same computation.
+  EXPECT_EQ(r.rows[2].rmse, r.rows[3].rmse);
+  EXPECT_NE(r.Table().find("ms-elm"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gyrodrift::drift
