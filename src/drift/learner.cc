@@ -192,8 +192,7 @@ const Eigen::MatrixXd& ParameterReader::Array(const std::string& name, Eigen::In
   if ((rows >= 0 && a.rows() != rows) || (cols >= 0 && a.cols() != cols) ||
       (a.size() == 0 && !allow_empty)) {
     Fail("array '" + name + "' is " + std::to_string(a.rows()) + " x " + std::to_string(a.cols()) +
-         ", expected " + dim(rows) + " x " + dim(cols) +
-         (allow_empty ? "" : " (non-empty)"));
+         ", expected " + dim(rows) + " x " + dim(cols) + (allow_empty ? "" : " (non-empty)"));
   }
   if (!a.allFinite()) Fail("array '" + name + "' has a value that is not finite");
   return a;
@@ -244,8 +243,7 @@ elm::Standardizer GetScaler(const ParameterReader& reader, const std::string& pr
   return s;
 }
 
-void PutCommon(LearnerKind kind, std::uint64_t seed, int rows, double train_rmse,
-               Parameters* out) {
+void PutCommon(LearnerKind kind, std::uint64_t seed, int rows, double train_rmse, Parameters* out) {
   out->texts["kind"] = std::string(ToString(kind));
   out->texts["seed"] = std::to_string(seed);
   out->scalars["train_rows"] = rows;

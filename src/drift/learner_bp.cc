@@ -142,9 +142,9 @@ class BpLearner final : public Learner {
       if (k) count += static_cast<long>(sizes_[k]) * (sizes_[k - 1] + 1);
     }
     return "bp: " + std::to_string(num_inputs()) + " inputs, layers " + layers + " (" +
-           std::to_string(count) + " weights), RPROP " + std::to_string(epochs_) +
-           " epochs (MSE " + FormatShort(train_mse_) + "), " + std::to_string(rows_) +
-           " rows, train RMSE " + FormatShort(train_rmse_) + ", seed " + std::to_string(seed_);
+           std::to_string(count) + " weights), RPROP " + std::to_string(epochs_) + " epochs (MSE " +
+           FormatShort(train_mse_) + "), " + std::to_string(rows_) + " rows, train RMSE " +
+           FormatShort(train_rmse_) + ", seed " + std::to_string(seed_);
   }
 
   void SetTraining(int rows, double train_rmse, int epochs, double train_mse) {
@@ -155,7 +155,7 @@ class BpLearner final : public Learner {
   }
 
  private:
-  std::vector<int> sizes_;               // d, hidden..., 1
+  std::vector<int> sizes_;                // d, hidden..., 1
   std::vector<Eigen::MatrixXd> weights_;  // layer k: n_k x (n_{k-1} + 1), bias last
   elm::Standardizer input_scaler_;
   elm::Standardizer target_scaler_;
@@ -195,9 +195,8 @@ std::unique_ptr<Learner> FitBp(const Eigen::Ref<const Eigen::MatrixXd>& x,
     weights.push_back(std::move(w));
   }
 
-  std::unique_ptr<struct fann, FannDeleter> ann(
-      fann_create_standard_array(static_cast<unsigned int>(layer_sizes.size()),
-                                 layer_sizes.data()));
+  std::unique_ptr<struct fann, FannDeleter> ann(fann_create_standard_array(
+      static_cast<unsigned int>(layer_sizes.size()), layer_sizes.data()));
   if (!ann) throw DataError("bp: FANN could not create the network (out of memory?)");
   fann_set_error_log(reinterpret_cast<struct fann_error*>(ann.get()), nullptr);
   fann_set_activation_function_hidden(ann.get(), FANN_SIGMOID_SYMMETRIC);
@@ -243,9 +242,9 @@ std::unique_ptr<Learner> FitBp(const Eigen::Ref<const Eigen::MatrixXd>& x,
     }
   }
 
-  auto learner = std::make_unique<BpLearner>(std::move(sizes), std::move(weights),
-                                             std::move(input_scaler), std::move(target_scaler),
-                                             options.seed);
+  auto learner =
+      std::make_unique<BpLearner>(std::move(sizes), std::move(weights), std::move(input_scaler),
+                                  std::move(target_scaler), options.seed);
   learner->SetTraining(static_cast<int>(n), Rmse(learner->Predict(x), y), epochs, mse);
   return learner;
 }
@@ -274,13 +273,12 @@ std::unique_ptr<Learner> LoadBp(const ParameterReader& reader) {
   }
   elm::Standardizer input_scaler = GetScaler(reader, "input", sizes.front());
   elm::Standardizer target_scaler = GetScaler(reader, "target", 1);
-  auto learner = std::make_unique<BpLearner>(std::move(sizes), std::move(weights),
-                                             std::move(input_scaler), std::move(target_scaler),
-                                             reader.Seed());
-  learner->SetTraining(static_cast<int>(reader.Integer("train_rows", 0, 2147483647L)),
-                       reader.Scalar("train_rmse"),
-                       static_cast<int>(reader.Integer("epochs", 0, 100000)),
-                       reader.Scalar("train_mse"));
+  auto learner =
+      std::make_unique<BpLearner>(std::move(sizes), std::move(weights), std::move(input_scaler),
+                                  std::move(target_scaler), reader.Seed());
+  learner->SetTraining(
+      static_cast<int>(reader.Integer("train_rows", 0, 2147483647L)), reader.Scalar("train_rmse"),
+      static_cast<int>(reader.Integer("epochs", 0, 100000)), reader.Scalar("train_mse"));
   return learner;
 }
 

@@ -42,10 +42,10 @@ class ElmLearner final : public Learner {
   }
 
   std::string Summary() const override {
-    return "elm: " + std::to_string(num_inputs()) + " inputs, L=" +
-           std::to_string(model_.num_hidden()) + " " +
-           std::string(elm::ToString(model_.activation)) + " C=" +
-           FormatShort(model_.options.ridge_c) + " (" +
+    return "elm: " + std::to_string(num_inputs()) +
+           " inputs, L=" + std::to_string(model_.num_hidden()) + " " +
+           std::string(elm::ToString(model_.activation)) +
+           " C=" + FormatShort(model_.options.ridge_c) + " (" +
            std::string(elm::ToString(model_.options.selection)) + "), " + std::to_string(rows_) +
            " rows, train RMSE " + FormatShort(train_rmse_) + ", seed " +
            std::to_string(model_.options.seed);

@@ -54,8 +54,7 @@ elm::Standardizer GetScaler(const ParameterReader& reader, const std::string& pr
                             Eigen::Index columns);
 
 // Fields every learner saves: kind, seed (text, exact for 64 bits), training rows and RMSE.
-void PutCommon(LearnerKind kind, std::uint64_t seed, int rows, double train_rmse,
-               Parameters* out);
+void PutCommon(LearnerKind kind, std::uint64_t seed, int rows, double train_rmse, Parameters* out);
 
 std::unique_ptr<Learner> FitElm(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const Eigen::Ref<const Eigen::VectorXd>& y,

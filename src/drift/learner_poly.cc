@@ -55,8 +55,7 @@ Eigen::MatrixXi MakeExponents(int d, int degree) {
 // Row of monomials of one standardised input row z. `powers` (d x (degree + 1)) is scratch.
 // A template so that strided rows of column-major matrices are used in place (no copies).
 template <class Z, class Out>
-void Monomials(const Eigen::MatrixXi& exponents, const Z& z, Eigen::MatrixXd& powers,
-               Out&& out) {
+void Monomials(const Eigen::MatrixXi& exponents, const Z& z, Eigen::MatrixXd& powers, Out&& out) {
   const Eigen::Index d = exponents.cols();
   for (Eigen::Index j = 0; j < d; ++j) {
     powers(j, 0) = 1.0;
@@ -114,8 +113,7 @@ class PolyLearner final : public Learner {
 
   std::string Summary() const override {
     std::string s = "poly: " + std::to_string(num_inputs()) + " inputs, degree " +
-                    std::to_string(degree_) + ", " + std::to_string(exponents_.rows()) +
-                    " terms";
+                    std::to_string(degree_) + ", " + std::to_string(exponents_.rows()) + " terms";
     if (rank_ < exponents_.rows()) s += " (rank " + std::to_string(rank_) + ")";
     return s + ", ridge " + FormatShort(ridge_) + ", " + std::to_string(rows_) +
            " rows, train RMSE " + FormatShort(train_rmse_);
@@ -187,8 +185,8 @@ std::unique_ptr<Learner> LoadPoly(const ParameterReader& reader) {
   const Eigen::Index d = exponents_d.cols();
   if (exponents_d.rows() != CountTerms(d, degree)) {
     reader.Fail("exponents has " + std::to_string(exponents_d.rows()) + " rows, expected C(" +
-                std::to_string(d) + " + " + std::to_string(degree) + ", " +
-                std::to_string(degree) + ") = " + std::to_string(CountTerms(d, degree)));
+                std::to_string(d) + " + " + std::to_string(degree) + ", " + std::to_string(degree) +
+                ") = " + std::to_string(CountTerms(d, degree)));
   }
   const Eigen::MatrixXi expected = MakeExponents(static_cast<int>(d), degree);
   if (!(exponents_d.array() == expected.cast<double>().array()).all()) {
@@ -199,7 +197,8 @@ std::unique_ptr<Learner> LoadPoly(const ParameterReader& reader) {
   elm::Standardizer input_scaler = GetScaler(reader, "input", d);
   elm::Standardizer target_scaler = GetScaler(reader, "target", 1);
   const double ridge = reader.Scalar("ridge");
-  if (!(ridge >= 0.0 && ridge <= 1.0)) reader.Fail("ridge = " + FormatShort(ridge) + " not in [0, 1]");
+  if (!(ridge >= 0.0 && ridge <= 1.0))
+    reader.Fail("ridge = " + FormatShort(ridge) + " not in [0, 1]");
   const int rank = static_cast<int>(reader.Integer("rank", 0, expected.rows()));
   auto learner = std::make_unique<PolyLearner>(degree, expected, std::move(coefficients),
                                                std::move(input_scaler), std::move(target_scaler),

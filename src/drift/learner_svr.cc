@@ -102,8 +102,8 @@ class SvrLearner final : public Learner {
     return "svr: " + std::to_string(num_inputs()) + " inputs, " +
            std::to_string(support_t_.cols()) + " support vectors from " +
            std::to_string(rows_used_) + " of " + std::to_string(rows_) + " rows, C " +
-           FormatShort(c_) + " epsilon " + FormatShort(epsilon_) + " gamma " +
-           FormatShort(gamma_) + ", train RMSE " + FormatShort(train_rmse_);
+           FormatShort(c_) + " epsilon " + FormatShort(epsilon_) + " gamma " + FormatShort(gamma_) +
+           ", train RMSE " + FormatShort(train_rmse_);
   }
 
   void SetInfo(double c, double epsilon, int rows_used, int threads, std::uint64_t seed) {
@@ -209,9 +209,9 @@ std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
     throw DataError("svr: libsvm returned a non-finite coefficient or offset");
   }
 
-  auto learner = std::make_unique<SvrLearner>(std::move(support_t), std::move(coefficients), rho,
-                                              param.gamma, std::move(input_scaler),
-                                              std::move(target_scaler));
+  auto learner =
+      std::make_unique<SvrLearner>(std::move(support_t), std::move(coefficients), rho, param.gamma,
+                                   std::move(input_scaler), std::move(target_scaler));
   learner->SetInfo(options.svr_c, options.svr_epsilon, static_cast<int>(used), options.threads,
                    options.seed);
   learner->SetTraining(static_cast<int>(n), Rmse(learner->Predict(x), y));
@@ -229,9 +229,9 @@ std::unique_ptr<Learner> LoadSvr(const ParameterReader& reader) {
   const double gamma = reader.Scalar("gamma");
   if (!std::isfinite(rho)) reader.Fail("rho is not finite");
   if (!(gamma > 0.0) || !std::isfinite(gamma)) reader.Fail("gamma is not a finite number > 0");
-  auto learner = std::make_unique<SvrLearner>(support.transpose(), std::move(coefficients), rho,
-                                              gamma, std::move(input_scaler),
-                                              std::move(target_scaler));
+  auto learner =
+      std::make_unique<SvrLearner>(support.transpose(), std::move(coefficients), rho, gamma,
+                                   std::move(input_scaler), std::move(target_scaler));
   learner->SetInfo(reader.Scalar("c"), reader.Scalar("epsilon"),
                    static_cast<int>(reader.Integer("rows_used", 1, 2147483647L)),
                    static_cast<int>(reader.Integer("threads", 0, 1024)), reader.Seed());

@@ -61,8 +61,8 @@ LearnerOptions Options(LearnerKind kind) {
   return o;
 }
 
-const std::vector<LearnerKind> kAllKinds{LearnerKind::kElm, LearnerKind::kPoly,
-                                         LearnerKind::kSvr, LearnerKind::kBp};
+const std::vector<LearnerKind> kAllKinds{LearnerKind::kElm, LearnerKind::kPoly, LearnerKind::kSvr,
+                                         LearnerKind::kBp};
 
 class EveryKind : public ::testing::TestWithParam<LearnerKind> {};
 
@@ -406,8 +406,8 @@ TEST(Learner, BpStopsAtTheDesiredMseOrTheEpochCap) {
 TEST(Learner, ConcurrentFitsMatchSequentialFits) {
   const Data train = SineBowl(200, 0.05, 20);
   const Data test = SineBowl(50, 0.0, 21);
-  const std::vector<LearnerKind> kinds{LearnerKind::kSvr, LearnerKind::kBp, LearnerKind::kSvr,
-                                       LearnerKind::kBp, LearnerKind::kPoly, LearnerKind::kElm};
+  const std::vector<LearnerKind> kinds{LearnerKind::kSvr, LearnerKind::kBp,   LearnerKind::kSvr,
+                                       LearnerKind::kBp,  LearnerKind::kPoly, LearnerKind::kElm};
   auto fit = [&](int task) {
     LearnerOptions o = Options(kinds[static_cast<size_t>(task)]);
     o.seed = static_cast<std::uint64_t>(task);
@@ -421,8 +421,8 @@ TEST(Learner, ConcurrentFitsMatchSequentialFits) {
   for (int task = 0; task < n; ++task) sequential[static_cast<size_t>(task)] = fit(task);
   ParallelFor(n, 2, [&](int task, int) { concurrent[static_cast<size_t>(task)] = fit(task); });
   for (int task = 0; task < n; ++task) {
-    EXPECT_TRUE(SameBits(sequential[static_cast<size_t>(task)],
-                         concurrent[static_cast<size_t>(task)]))
+    EXPECT_TRUE(
+        SameBits(sequential[static_cast<size_t>(task)], concurrent[static_cast<size_t>(task)]))
         << "task " << task;
   }
 }
@@ -443,8 +443,14 @@ TEST(Learner, ValidateRejectsBadOptions) {
       {[](LearnerOptions& o) { o.svr_gamma = -1.0; }, "svr_gamma"},
       {[](LearnerOptions& o) { o.svr_max_rows = 1; }, "svr_max_rows"},
       {[](LearnerOptions& o) { o.bp_hidden = {}; }, "bp_hidden"},
-      {[](LearnerOptions& o) { o.bp_hidden = {4, 4, 4, 4}; }, "bp_hidden"},
-      {[](LearnerOptions& o) { o.bp_hidden = {10, 0}; }, "bp_hidden"},
+      {[](LearnerOptions& o) {
+         o.bp_hidden = {4, 4, 4, 4};
+       },
+       "bp_hidden"},
+      {[](LearnerOptions& o) {
+         o.bp_hidden = {10, 0};
+       },
+       "bp_hidden"},
       {[](LearnerOptions& o) { o.bp_hidden = {1001}; }, "bp_hidden"},
       {[](LearnerOptions& o) { o.bp_epochs = 0; }, "bp_epochs"},
       {[](LearnerOptions& o) { o.bp_epochs = 100001; }, "bp_epochs"},
