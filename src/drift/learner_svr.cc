@@ -221,8 +221,15 @@ std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
 std::unique_ptr<Learner> LoadSvr(const ParameterReader& reader) {
   // A target that stays within epsilon of its mean needs no support vector at all.
   const Eigen::Index d = reader.Array("input_mean", 1, -1).cols();
-  const Eigen::MatrixXd& support = reader.Array("support_vectors", -1, d, true);
-  Eigen::VectorXd coefficients = reader.Array("coefficients", support.rows(), 1, true);
+  // A model file may not keep the column count of an empty array: 0 x anything is accepted.
+  const bool none = reader.Array("support_vectors", -1, -1, true).rows() == 0;
+  const Eigen::MatrixXd support =
+      none ? Eigen::MatrixXd(0, d) : reader.Array("support_vectors", -1, d);
+  Eigen::VectorXd coefficients =
+      none ? Eigen::VectorXd(0) : Eigen::VectorXd(reader.Array("coefficients", support.rows(), 1));
+  if (none && reader.Array("coefficients", -1, -1, true).size() != 0) {
+    reader.Fail("coefficients are given but there are no support vectors");
+  }
   elm::Standardizer input_scaler = GetScaler(reader, "input", d);
   elm::Standardizer target_scaler = GetScaler(reader, "target", 1);
   const double rho = reader.Scalar("rho");

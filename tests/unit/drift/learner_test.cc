@@ -371,6 +371,12 @@ TEST(Learner, SvrConstantTargetHasNoSupportVectorsAndRoundTrips) {
   const Eigen::VectorXd a = learner->Predict(train.x);
   EXPECT_TRUE(SameBits(a, loaded->Predict(train.x)));
   EXPECT_NEAR((a.array() - 3.25).abs().maxCoeff(), 0.0, 1e-9);
+  EXPECT_EQ(p.arrays.at("support_vectors").rows(), 0);
+  // A model file that loses the column count of the empty arrays still loads.
+  Parameters flat = p;
+  flat.arrays["support_vectors"].resize(0, 0);
+  flat.arrays["coefficients"].resize(0, 0);
+  EXPECT_TRUE(SameBits(a, LoadLearner(LearnerKind::kSvr, flat)->Predict(train.x)));
 }
 
 TEST(Learner, BpStopsAtTheDesiredMseOrTheEpochCap) {
