@@ -281,7 +281,9 @@ AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options) {
     task_begin.push_back(k);
     int stop = k + 1;
     if (dev == Deviation::kOadev)
-      while (stop < count && stop - k < 16 && ms[stop] - ms[k] <= 64) ++stop;
+      while (stop < count && stop - k < internal::kOadevMaxGroup &&
+             ms[stop] - ms[k] <= internal::kOadevMaxGroupSpan)
+        ++stop;
     k = stop;
   }
   task_begin.push_back(count);

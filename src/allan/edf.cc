@@ -286,12 +286,25 @@ double RegularizedGammaP(double a, double x) {
 double ChiSquareQuantile(double p, double dof) {
   if (!(p > 0.0 && p < 1.0) || !(dof > 0.0)) return kNaN;
   // Standard normal quantile by bisection on erfc (64 halvings of [-40, 40]: below 1e-17).
-  double zlo = -40.0, zhi = 40.0;
-  for (int i = 0; i < 64; ++i) {
-    const double mid = 0.5 * (zlo + zhi);
-    if (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p) zlo = mid; else zhi = mid;
+  // Every tau of a curve asks for the same two levels, so the last two are kept per thread.
+  thread_local double cached_p[2] = {-1.0, -1.0}, cached_z[2] = {0.0, 0.0};
+  double z;
+  if (p == cached_p[0]) {
+    z = cached_z[0];
+  } else if (p == cached_p[1]) {
+    z = cached_z[1];
+  } else {
+    double zlo = -40.0, zhi = 40.0;
+    for (int i = 0; i < 64; ++i) {
+      const double mid = 0.5 * (zlo + zhi);
+      if (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p) zlo = mid; else zhi = mid;
+    }
+    z = 0.5 * (zlo + zhi);
+    cached_p[1] = cached_p[0];
+    cached_z[1] = cached_z[0];
+    cached_p[0] = p;
+    cached_z[0] = z;
   }
-  const double z = 0.5 * (zlo + zhi);
   // Wilson-Hilferty; above kWilsonHilfertyDof its relative error is below 1e-6 (unit test), and
   // the series below would need O(sqrt(dof)) terms per step.
   const double h = 2.0 / (9.0 * dof);

@@ -6,6 +6,11 @@
 
 namespace gyrodrift::allan::internal {
 
+// Grouping of consecutive averaging factors in one pass of the overlapping kernel: at most this
+// many factors, spanning at most this many samples (so their streams share cache lines).
+constexpr int kOadevMaxGroup = 32;
+constexpr std::int64_t kOadevMaxGroupSpan = 64;
+
 // Sums of squared second differences of x over the overlapping index range, for each factor in
 // ms[0..count): out[k] = sum_{i=0}^{n-2m-1} (x[i+2m] - 2 x[i+m] + x[i])^2. The summation order
 // depends only on i (fixed lanes, fixed chunk boundaries), never on how the factors are grouped,
