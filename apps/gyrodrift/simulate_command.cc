@@ -26,8 +26,8 @@ struct SimulateArgs {
   std::string duration;  // empty: the programme's own length (8 h for the built-in ones)
   double rate_hz = 1.0;
   std::uint64_t seed = 1;
-  std::string winding;            // empty: the preset's
-  double asymmetry = std::nan(""); // NaN: the preset's
+  std::string winding;              // empty: the preset's
+  double asymmetry = std::nan("");  // NaN: the preset's
   double input_rate_dph = 0.0;
   bool no_noise = false;
   std::string output;
@@ -36,13 +36,16 @@ struct SimulateArgs {
 
 // "30s", "10min", "8h", "1.5h", "3600": seconds. Anything else is a usage error.
 double ParseDuration(const std::string& text) {
-  static const std::regex kPattern(R"(^\s*([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\s*(s|min|h)?\s*$)");
+  static const std::regex kPattern(
+      R"(^\s*([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\s*(s|min|h)?\s*$)");
   std::smatch m;
   if (std::regex_match(text, m, kPattern)) {
-    const double value = std::stod(m[1].str() + m[3].str());
+    const std::string number = m[1].str() + m[3].str();
+    double value = 0.0;
+    const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
     const std::string unit = m[4].str();
     const double seconds = unit == "h" ? value * 3600.0 : unit == "min" ? value * 60.0 : value;
-    if (seconds > 0.0 && std::isfinite(seconds)) return seconds;
+    if (ec == std::errc() && seconds > 0.0 && std::isfinite(seconds)) return seconds;
   }
   ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
 }
@@ -123,7 +126,8 @@ nlohmann::json ParametersJson(const sim::FogParameters& p) {
         {"coating_expansion_per_k", s.coating_expansion_per_k},
         {"nonreciprocity", s.nonreciprocity},
         {"coefficient_dph_per_k", p.StressCoefficientDphPerK()}}},
-      {"bias", {{"reference_c", p.bias.reference_c}, {"coefficients_dph", p.bias.coefficients_dph}}},
+      {"bias",
+       {{"reference_c", p.bias.reference_c}, {"coefficients_dph", p.bias.coefficients_dph}}},
       {"noise",
        {{"quantization_urad", n.quantization_urad},
         {"arw_dpsh", n.arw_dpsh},
@@ -163,17 +167,14 @@ void Run(const SimulateArgs& a) {
   const sim::SimulationResult r = sim::Simulate(programme, params, o);
 
   const std::vector<io::CsvColumn> columns = {
-      {"time_s", r.time_s},         {"rate_dph", r.rate_dph},     {"temperature_c", r.temperature_c},
-      {"drift_dph", r.drift_dph},   {"shupe_dph", r.shupe_dph},   {"stress_dph", r.stress_dph},
-      {"bias_dph", r.bias_dph},     {"noise_dph", r.noise_dph}};
+      {"time_s", r.time_s},       {"rate_dph", r.rate_dph},   {"temperature_c", r.temperature_c},
+      {"drift_dph", r.drift_dph}, {"shupe_dph", r.shupe_dph}, {"stress_dph", r.stress_dph},
+      {"bias_dph", r.bias_dph},   {"noise_dph", r.noise_dph}};
   nlohmann::json sidecar = SidecarHeader("simulate");
-  sidecar["options"] = {{"preset", a.preset},
-                        {"profile", a.profile},
-                        {"duration_s", o.duration_s},
-                        {"rate_hz", o.rate_hz},
-                        {"seed", o.seed},
-                        {"input_rate_dph", o.input_rate_dph},
-                        {"noise", o.include_noise}};
+  sidecar["options"] = {
+      {"preset", a.preset},      {"profile", a.profile}, {"duration_s", o.duration_s},
+      {"rate_hz", o.rate_hz},    {"seed", o.seed},       {"input_rate_dph", o.input_rate_dph},
+      {"noise", o.include_noise}};
   sidecar["seed"] = o.seed;
   sidecar["programme"] = ProgrammeJson(programme);
   sidecar["parameters"] = ParametersJson(params);
@@ -208,7 +209,8 @@ const RegisterCommand kRegister("simulate", 10, [](CLI::App& app) {
       "simulate", "Simulate a FOG in a thermal chamber: logged rate, temperature, and the truth.");
   cmd->footer(
       "Example:\n"
-      "  gyrodrift simulate --preset navigation --profile chamber --duration 8h --seed 7 -o train.csv\n"
+      "  gyrodrift simulate --preset navigation --profile chamber --duration 8h --seed 7 -o "
+      "train.csv\n"
       "  gyrodrift simulate --profile chamber-b --seed 8 -o test.csv   # a different history\n"
       "writes train.csv with columns\n"
       "  time_s,rate_dph,temperature_c,drift_dph,shupe_dph,stress_dph,bias_dph,noise_dph\n"

@@ -75,8 +75,8 @@ void RadialConduction::SetUniform(double temperature_c) { t_.setConstant(tempera
 
 void RadialConduction::SetTemperatures(const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
   if (temperature_c.size() != t_.size()) {
-    throw UsageError("temperatures: " + std::to_string(temperature_c.size()) +
-                     " values for " + std::to_string(t_.size()) + " rings");
+    throw UsageError("temperatures: " + std::to_string(temperature_c.size()) + " values for " +
+                     std::to_string(t_.size()) + " rings");
   }
   t_ = temperature_c;
 }

@@ -12,13 +12,15 @@ namespace gyrodrift::simulation {
 namespace {
 
 // Unit conversions of the IEEE 952 terms to deg/h and seconds.
-constexpr double kArwToDphRootS = 60.0;          // 1 deg/sqrt(h) = 60 deg/h * sqrt(s)
+constexpr double kArwToDphRootS = 60.0;           // 1 deg/sqrt(h) = 60 deg/h * sqrt(s)
 constexpr double kRrwToDphPerRootS = 1.0 / 60.0;  // 1 deg/h/sqrt(h) = 1/60 deg/h/sqrt(s)
 constexpr double kRampToDphPerS = 1.0 / 3600.0;   // 1 deg/h/h = 1/3600 deg/h/s
 constexpr double kUradToRad = 1e-6;
 
 // Bias-instability floor factor: sigma^2 = (2 ln 2 / pi) B^2.
-double FloorVariance(double b_dph) { return 2.0 * std::numbers::ln2 / std::numbers::pi * b_dph * b_dph; }
+double FloorVariance(double b_dph) {
+  return 2.0 * std::numbers::ln2 / std::numbers::pi * b_dph * b_dph;
+}
 
 // Allan variance at factor m of a unit-variance AR(1) process x_k = phi x_{k-1} + ..., with
 // phi = exp(-dt / tau): (1/m^2) [m (1+phi)/(1-phi) - phi (1-phi^m)(3-phi^m)/(1-phi)^2].
@@ -46,10 +48,12 @@ std::vector<double> BankTaus(const NoiseParameters& p, double dt_s) {
                 ">= 100 x the shortest correlation time " + FormatValue(tau_min) + " s");
   }
   const double decades = std::log10(p.bias_tau_max_s / tau_min);
-  const int count = std::max(2, static_cast<int>(std::lround(decades * p.bias_processes_per_decade)) + 1);
+  const int count =
+      std::max(2, static_cast<int>(std::lround(decades * p.bias_processes_per_decade)) + 1);
   std::vector<double> taus(static_cast<size_t>(count));
   for (int j = 0; j < count; ++j) {
-    taus[static_cast<size_t>(j)] = tau_min * std::pow(p.bias_tau_max_s / tau_min, j / double(count - 1));
+    taus[static_cast<size_t>(j)] =
+        tau_min * std::pow(p.bias_tau_max_s / tau_min, j / double(count - 1));
   }
   return taus;
 }
@@ -94,7 +98,8 @@ BiasBank DesignBiasBank(const NoiseParameters& params, double dt_s) {
   const double variance = target / std::exp(mean_log);
   bank.sigma_dph = std::sqrt(variance);
   for (const double a : unit_avar) {
-    bank.floor_ripple = std::max(bank.floor_ripple, std::abs(std::sqrt(a / std::exp(mean_log)) - 1.0));
+    bank.floor_ripple =
+        std::max(bank.floor_ripple, std::abs(std::sqrt(a / std::exp(mean_log)) - 1.0));
   }
   return bank;
 }
@@ -202,7 +207,8 @@ Eigen::VectorXd SenseTemperature(const TemperatureSensorParameters& params,
                 : case_c[k];
     double reading = state + params.offset_k;
     if (params.noise_k > 0.0) reading += params.noise_k * rng.Normal();
-    if (params.resolution_k > 0.0) reading = std::round(reading / params.resolution_k) * params.resolution_k;
+    if (params.resolution_k > 0.0)
+      reading = std::round(reading / params.resolution_k) * params.resolution_k;
     out[k] = reading;
   }
   return out;

@@ -1,8 +1,8 @@
 #include "gyrodrift/simulation/temperature_programme.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 
@@ -81,9 +81,8 @@ TemperatureProgramme TemperatureProgramme::FromSamples(const Eigen::VectorXd& ti
   return p;
 }
 
-TemperatureProgramme TemperatureProgramme::Sine(double mean_c, double amplitude_c,
-                                                double period_s, double phase_rad,
-                                                std::string name) {
+TemperatureProgramme TemperatureProgramme::Sine(double mean_c, double amplitude_c, double period_s,
+                                                double phase_rad, std::string name) {
   RequireInRange("sine.mean_c", mean_c, kMinC, kMaxC);
   RequireNonNegative("sine.amplitude_c", amplitude_c);
   if (mean_c - amplitude_c < kMinC || mean_c + amplitude_c > kMaxC) {
@@ -122,8 +121,8 @@ double TemperatureProgramme::MaxRateKPerS() const {
   if (kind_ == Kind::kSine) return 2.0 * std::numbers::pi * amplitude_c_ / period_s_;
   double r = 0.0;
   for (size_t i = 1; i < time_s_.size(); ++i) {
-    r = std::max(r, std::abs(temperature_c_[i] - temperature_c_[i - 1]) /
-                        (time_s_[i] - time_s_[i - 1]));
+    r = std::max(
+        r, std::abs(temperature_c_[i] - temperature_c_[i - 1]) / (time_s_[i] - time_s_[i - 1]));
   }
   return r;
 }

@@ -52,9 +52,7 @@ WindingPattern WindingPatternFromString(std::string_view name) {
   ThrowOption("winding", name, "one of quadrupole, dipole, octupole, conventional, symmetric");
 }
 
-int PatternPeriod(WindingPattern pattern) {
-  return static_cast<int>(PatternRoles(pattern).size());
-}
+int PatternPeriod(WindingPattern pattern) { return static_cast<int>(PatternRoles(pattern).size()); }
 
 int WindingMap::LayerAt(double z_m) const {
   for (int l = 0; l < layers(); ++l) {
@@ -65,8 +63,8 @@ int WindingMap::LayerAt(double z_m) const {
   ThrowOption("z_m", FormatValue(z_m), "in [0, " + FormatValue(fibre_length_m) + "]");
 }
 
-WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m,
-                        double asymmetry, const Eigen::VectorXd& layer_capacity) {
+WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m, double asymmetry,
+                        const Eigen::VectorXd& layer_capacity) {
   const int period = PatternPeriod(pattern);
   if (layers < 1 || layers > 100000 || layers % period != 0) {
     ThrowOption("coil.layers", std::to_string(layers),
@@ -77,12 +75,11 @@ WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_
   if (!(std::abs(asymmetry) < 0.5)) {
     ThrowOption("coil.winding_asymmetry", FormatValue(asymmetry), "in (-0.5, 0.5)");
   }
-  Eigen::VectorXd capacity = layer_capacity.size() == 0
-                                 ? Eigen::VectorXd::Ones(layers)
-                                 : Eigen::VectorXd(layer_capacity);
+  Eigen::VectorXd capacity =
+      layer_capacity.size() == 0 ? Eigen::VectorXd::Ones(layers) : Eigen::VectorXd(layer_capacity);
   if (capacity.size() != layers) {
-    throw UsageError("layer_capacity has " + std::to_string(capacity.size()) +
-                     " entries for " + std::to_string(layers) + " layers");
+    throw UsageError("layer_capacity has " + std::to_string(capacity.size()) + " entries for " +
+                     std::to_string(layers) + " layers");
   }
   for (int l = 0; l < layers; ++l) {
     if (!(capacity[l] > 0.0) || !std::isfinite(capacity[l])) {

@@ -35,18 +35,21 @@ TEST_F(SimulateCli, WritesTheDocumentedColumnsAndSidecar) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("3600 samples"), std::string::npos) << r.out;
   const auto table = io::CsvTable::Read(out);
-  const std::vector<std::string> header = {"time_s",    "rate_dph",   "temperature_c",
-                                           "drift_dph", "shupe_dph",  "stress_dph",
-                                           "bias_dph",  "noise_dph"};
+  const std::vector<std::string> header = {"time_s",    "rate_dph",   "temperature_c", "drift_dph",
+                                           "shupe_dph", "stress_dph", "bias_dph",      "noise_dph"};
   EXPECT_EQ(table.header(), header);
   ASSERT_EQ(table.rows(), 3600);
   EXPECT_EQ(table.Column("time_s")[0], 1.0);
   EXPECT_EQ(table.Column("time_s")[3599], 3600.0);
   // The truth adds up through the text round trip.
   const Eigen::VectorXd drift = table.Column("drift_dph");
-  EXPECT_LT((drift - table.Column("shupe_dph") - table.Column("stress_dph") - table.Column("bias_dph"))
-                .cwiseAbs().maxCoeff(), 1e-12);
-  EXPECT_LT((table.Column("rate_dph") - drift - table.Column("noise_dph")).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT(
+      (drift - table.Column("shupe_dph") - table.Column("stress_dph") - table.Column("bias_dph"))
+          .cwiseAbs()
+          .maxCoeff(),
+      1e-12);
+  EXPECT_LT((table.Column("rate_dph") - drift - table.Column("noise_dph")).cwiseAbs().maxCoeff(),
+            1e-12);
   // The chamber starts its ramp at 30 min: the case sensor warms by the end of the hour.
   EXPECT_GT(table.Column("temperature_c")[3599], table.Column("temperature_c")[0] + 5.0);
   const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
@@ -72,7 +75,8 @@ TEST_F(SimulateCli, SameSeedSameBytesOtherSeedOtherNoise) {
   EXPECT_EQ(io::ReadTextFile(a + ".json"), io::ReadTextFile(b + ".json"));
   EXPECT_NE(io::ReadTextFile(a), io::ReadTextFile(c));
   const auto ta = io::CsvTable::Read(a), tc = io::CsvTable::Read(c);
-  EXPECT_EQ(ta.Column("drift_dph"), tc.Column("drift_dph"));  // the truth does not depend on the seed
+  EXPECT_EQ(ta.Column("drift_dph"),
+            tc.Column("drift_dph"));  // the truth does not depend on the seed
   EXPECT_NE(ta.Column("noise_dph"), tc.Column("noise_dph"));
 }
 
@@ -123,7 +127,8 @@ TEST_F(SimulateCli, BadProfileFilesAreDataErrors) {
   };
   ExpectFailure(write("nocol.csv", "time_s,temp\n0,20\n10,30\n"), 3, "temperature_c");
   ExpectFailure(write("notime.csv", "t,temperature_c\n0,20\n10,30\n"), 3, "time_s");
-  ExpectFailure(write("nan.csv", "time_s,temperature_c\n0,20\n10,nan\n20,30\n"), 3, "temperature_c");
+  ExpectFailure(write("nan.csv", "time_s,temperature_c\n0,20\n10,nan\n20,30\n"), 3,
+                "temperature_c");
   ExpectFailure(write("text.csv", "time_s,temperature_c\n0,20\n10,warm\n"), 3, "temperature_c");
   ExpectFailure(write("back.csv", "time_s,temperature_c\n0,20\n10,30\n5,25\n"), 3, "increase");
   ExpectFailure(write("one.csv", "time_s,temperature_c\n0,20\n"), 3, "at least 2");
@@ -139,6 +144,9 @@ TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--duration -5s", 2, "--duration");
   ExpectFailure("--duration 0", 2, "--duration = 0");
   ExpectFailure("--duration 1s", 2, "duration_s");  // a single sample
+  ExpectFailure("--duration 1e400", 2, "--duration = 1e400");
+  ExpectFailure("--duration 200d", 2, "--duration = 200d");
+  ExpectFailure("--duration 3000h", 2, "1e7 samples");
   ExpectFailure("--rate-hz 0", 2, "--rate-hz = 0");
   ExpectFailure("--rate-hz abc", 2, "rate-hz");
   ExpectFailure("--winding sextupole", 2, "winding = sextupole");
@@ -163,7 +171,8 @@ TEST_F(SimulateCli, HelpShowsAWorkedExample) {
   const auto r = test::RunCli("simulate --help");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("Example:"), std::string::npos);
-  EXPECT_NE(r.out.find("gyrodrift simulate --preset navigation --profile chamber"), std::string::npos);
+  EXPECT_NE(r.out.find("gyrodrift simulate --preset navigation --profile chamber"),
+            std::string::npos);
   EXPECT_NE(r.out.find("time_s,rate_dph,temperature_c,drift_dph"), std::string::npos);
 }
 

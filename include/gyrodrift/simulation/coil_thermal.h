@@ -25,7 +25,7 @@
 namespace gyrodrift::simulation {
 
 enum class ThermalScheme { kBackwardEuler, kCrankNicolson };
-std::string_view ToString(ThermalScheme scheme);                // "backward-euler", "crank-nicolson"
+std::string_view ToString(ThermalScheme scheme);               // "backward-euler", "crank-nicolson"
 ThermalScheme ThermalSchemeFromString(std::string_view name);  // throws UsageError
 
 // Thermal properties of the winding pack and its mounting. Defaults: navigation coil

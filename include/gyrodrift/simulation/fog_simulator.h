@@ -9,10 +9,10 @@
 //   shupe_dph  = n C / (L D) sum_l w_l dT_l/dt (winding.h; METHOD.md eq. 3 with the rate), the
 //                exact interval mean because it is linear in the layer rates.
 //   stress_dph = (c / D) eta [2 n mu / E_core + n^3 / (2 E_core) (P11 - mu P11 + P12 - 3 mu P12)]
-//                E_coat alpha_c (T_mean(t) - T_mean(0))  (paper eq. 4 with a uniform coil). Eq. 4 as
-//                printed has c/D times a dimensionless index change, which would be ~1e3 rad/s per
-//                K; the nonreciprocal share eta of the stress-induced path change is therefore an
-//                explicit parameter (docs/simulation.md, "thermal stress").
+//                E_coat alpha_c (T_mean(t) - T_mean(0))  (paper eq. 4 with a uniform coil). Eq. 4
+//                as printed has c/D times a dimensionless index change, which would be ~3.5e3 rad/s
+//                per K; the nonreciprocal share eta of the stress-induced path change is therefore
+//                an explicit parameter (docs/simulation.md, "thermal stress").
 //   bias_dph   = sum_i b_i (T_case - T_ref)^i: the static temperature dependence of the source,
 //                detector and electronics, which sit on the case.
 //   drift_dph  = shupe_dph + stress_dph + bias_dph;  noise_dph from gyro_noise.h;
@@ -43,17 +43,17 @@ namespace gyrodrift::simulation {
 inline constexpr double kSpeedOfLightM_S = 299792458.0;
 
 enum class Preset { kNavigation, kTactical };
-std::string_view ToString(Preset preset);           // "navigation", "tactical"
-Preset PresetFromString(std::string_view name);     // throws UsageError
+std::string_view ToString(Preset preset);        // "navigation", "tactical"
+Preset PresetFromString(std::string_view name);  // throws UsageError
 
 // Optics and geometry of the sensing coil. Defaults: navigation coil (METHOD.md sec. 1).
 struct CoilParameters {
-  double fibre_length_m = 1000.0;      // L, m, in [10, 1e5]
-  double coil_diameter_m = 0.1;        // D, mean winding diameter, m, in [0.005, 2]
-  double wavelength_m = 1310e-9;       // lambda, m, in [4e-7, 2e-6] (Sagnac scale factor)
-  double refractive_index = 1.468;     // n, in [1, 2]
-  double dn_dt_per_k = 1e-5;           // thermo-optic coefficient dn/dT, 1/K, in [-1e-3, 1e-3]
-  double expansion_per_k = 5.5e-7;     // alpha of the fibre (silica), 1/K, in [0, 1e-4]
+  double fibre_length_m = 1000.0;   // L, m, in [10, 1e5]
+  double coil_diameter_m = 0.1;     // D, mean winding diameter, m, in [0.005, 2]
+  double wavelength_m = 1310e-9;    // lambda, m, in [4e-7, 2e-6] (Sagnac scale factor)
+  double refractive_index = 1.468;  // n, in [1, 2]
+  double dn_dt_per_k = 1e-5;        // thermo-optic coefficient dn/dT, 1/K, in [-1e-3, 1e-3]
+  double expansion_per_k = 5.5e-7;  // alpha of the fibre (silica), 1/K, in [0, 1e-4]
   // Fibre layers = rings of the conduction grid, in [20, 2000], a multiple of the pattern period.
   // Default 32: 1 km on a 0.1 m coil is 3183 turns, about 100 turns per layer of a 25 mm tall coil.
   int layers = 32;
@@ -74,14 +74,14 @@ struct CoilParameters {
   void Validate() const;
 };
 
-// Coating thermal-stress term, paper eq. 4. Defaults: METHOD.md sec. 1 (core), acrylate coating
-// values of the fibre literature for E_coat and alpha_c [choice], eta calibrated [choice].
+// Coating thermal-stress term, paper eq. 4. Defaults: METHOD.md sec. 1 (core); the order of
+// magnitude of acrylate coatings for E_coat and alpha_c [choice]; eta calibrated [choice].
 struct StressParameters {
-  double core_modulus_pa = 72e9;        // E_core (silica), Pa, in [1e9, 1e12]
-  double poisson_ratio = 0.17;          // mu, in [0, 0.5)
-  double p11 = 0.113;                   // photoelastic P11, in [-1, 1]
-  double p12 = 0.252;                   // photoelastic P12, in [-1, 1]
-  double coating_modulus_pa = 1e9;      // E_coating, Pa, in [1e5, 1e11]
+  double core_modulus_pa = 72e9;          // E_core (silica), Pa, in [1e9, 1e12]
+  double poisson_ratio = 0.17;            // mu, in [0, 0.5)
+  double p11 = 0.113;                     // photoelastic P11, in [-1, 1]
+  double p12 = 0.252;                     // photoelastic P12, in [-1, 1]
+  double coating_modulus_pa = 1e9;        // E_coating, Pa, in [1e5, 1e11]
   double coating_expansion_per_k = 1e-4;  // alpha_c, 1/K, in [0, 1e-2]
   // eta: nonreciprocal share of the stress-induced optical path change, in [0, 1e-6].
   // Default 7e-12, which gives the navigation coil 0.005 deg/h per K of mean coil temperature.
@@ -121,7 +121,7 @@ struct FogParameters {
 FogParameters PresetParameters(Preset preset);
 
 struct SimulationOptions {
-  double duration_s = 28800.0;  // s; samples = floor(duration_s * rate_hz), in [2, 1e8]
+  double duration_s = 28800.0;  // s; samples = floor(duration_s * rate_hz), in [2, 1e7]
   double rate_hz = 1.0;         // output rate, Hz, in [1e-3, 1e4]
   std::uint64_t seed = 1;       // noise and sensor streams derive from it
   double input_rate_dph = 0.0;  // true rate on the sensitive axis, deg/h, |.| <= 1e6
@@ -146,10 +146,10 @@ struct SimulationResult {
   int layers = 0;
   double shupe_scale_dph_per_km2s = 0;  // deg/h per (K m^2 / s) of Shupe integral
   double stress_coefficient_dph_per_k = 0;
-  double coil_lag_s = 0;         // steady-ramp lag of the mean coil temperature behind the chamber
-  double bias_bank_ripple = 0;   // DesignBiasBank floor ripple (0 if B = 0)
+  double coil_lag_s = 0;        // steady-ramp lag of the mean coil temperature behind the chamber
+  double bias_bank_ripple = 0;  // DesignBiasBank floor ripple (0 if B = 0)
   double max_abs_shupe_dph = 0, rms_drift_dph = 0, rms_noise_dph = 0;
-  std::string Summary() const;   // one line
+  std::string Summary() const;  // one line
 };
 
 // Runs the simulation. Throws UsageError for bad parameters/options.

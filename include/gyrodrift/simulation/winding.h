@@ -62,19 +62,20 @@ struct WindingMap {
 // Builds the map. layer_capacity (length `layers`, all > 0) is the relative amount of fibre each
 // layer takes; empty means equal. asymmetry in (-0.5, 0.5). Throws UsageError for bad arguments
 // (including a layer count that is not a multiple of the pattern period).
-WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m,
-                        double asymmetry, const Eigen::VectorXd& layer_capacity = {});
+WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m, double asymmetry,
+                        const Eigen::VectorXd& layer_capacity = {});
 
 // sum_l w_l dT_l/dt: the Shupe integral for layer temperature rates (K/s), in K m^2 / s.
-double ShupeIntegral(const WindingMap& map, const Eigen::Ref<const Eigen::VectorXd>& layer_rate_k_s);
+double ShupeIntegral(const WindingMap& map,
+                     const Eigen::Ref<const Eigen::VectorXd>& layer_rate_k_s);
 
 // Optical constants of the Shupe scale factor.
 struct ShupeConstants {
-  double refractive_index = 1.468;      // n (effective group index of the fibre mode)
-  double dn_dt_per_k = 1e-5;            // dn/dT, 1/K
-  double expansion_per_k = 5.5e-7;      // alpha of silica, 1/K
-  double fibre_length_m = 1000.0;       // L
-  double coil_diameter_m = 0.1;         // D (mean)
+  double refractive_index = 1.468;  // n (effective group index of the fibre mode)
+  double dn_dt_per_k = 1e-5;        // dn/dT, 1/K
+  double expansion_per_k = 5.5e-7;  // alpha of silica, 1/K
+  double fibre_length_m = 1000.0;   // L
+  double coil_diameter_m = 0.1;     // D (mean)
   double C() const { return dn_dt_per_k + refractive_index * expansion_per_k; }
   // n C / (L D): rad/s per unit of the Shupe integral (K m^2 / s).
   double Scale() const;

@@ -71,8 +71,7 @@ TEST_P(SimulatedNoiseAllan, CurveAndFittedTermsMatchTheGeneratingParameters) {
   EXPECT_LT(std::abs(t.n_dpsh.value - rec.truth.arw_dpsh), 5 * t.n_dpsh.sigma) << t.Summary();
   EXPECT_LT(std::abs(t.b_dph.value - rec.truth.bias_instability_dph), 5 * t.b_dph.sigma)
       << t.Summary();
-  EXPECT_LT(std::abs(t.k_dphpsh.value - rec.truth.rrw_dphpsh), 5 * t.k_dphpsh.sigma)
-      << t.Summary();
+  EXPECT_LT(std::abs(t.k_dphpsh.value - rec.truth.rrw_dphpsh), 5 * t.k_dphpsh.sigma) << t.Summary();
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, SimulatedNoiseAllan, ::testing::Values(1u, 2u, 3u));

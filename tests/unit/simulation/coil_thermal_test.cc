@@ -63,7 +63,8 @@ TEST(RadialConduction, SteadyStateWithFixedFacesIsTheLogProfile) {
 double SlabStepResponse(double x, double t, double w, double a) {
   double sum = 0.0;
   for (int n = 1; n < 400; n += 2) {
-    sum += 4.0 / (n * kPi) * std::sin(n * kPi * x / w) * std::exp(-n * n * kPi * kPi * a * t / (w * w));
+    sum += 4.0 / (n * kPi) * std::sin(n * kPi * x / w) *
+           std::exp(-n * n * kPi * kPi * a * t / (w * w));
   }
   return sum;
 }
@@ -86,7 +87,8 @@ TEST_P(SlabTest, StepResponseMatchesTheSeries) {
     double max_error = 0.0;
     for (int i = 0; i < cells; ++i) {
       const double x = (i + 0.5) * w / cells;
-      max_error = std::max(max_error, std::abs(pack.temperature_c()[i] - SlabStepResponse(x, t, w, a)));
+      max_error =
+          std::max(max_error, std::abs(pack.temperature_c()[i] - SlabStepResponse(x, t, w, a)));
     }
     EXPECT_LT(max_error, 2e-3) << "t = " << t;
   }

@@ -109,7 +109,8 @@ TEST(FogSimulator, CoilLagsTheChamberAsDocumented) {
 TEST(FogSimulator, StressCoefficientFollowsEquationFour) {
   const FogParameters p;
   const double n = 1.468, mu = 0.17, e = 72e9;
-  const double bracket = 2 * n * mu / e + n * n * n / (2 * e) * (0.113 * (1 - mu) + 0.252 * (1 - 3 * mu));
+  const double bracket =
+      2 * n * mu / e + n * n * n / (2 * e) * (0.113 * (1 - mu) + 0.252 * (1 - 3 * mu));
   const double expected = 299792458.0 / 0.1 * 7e-12 * bracket * 1e9 * 1e-4 * 206264.806247;
   EXPECT_NEAR(p.StressCoefficientDphPerK(), expected, 1e-9 * expected);
   EXPECT_NEAR(p.StressCoefficientDphPerK(), 0.005, 0.0005);  // the documented default
@@ -138,7 +139,8 @@ TEST(FogSimulator, OutputRateDoesNotChangeTheThermalTruth) {
   // A 10 s sample is the mean of ten 1 s samples (Shupe is an exact interval mean).
   double max_error = 0.0;
   for (Eigen::Index k = 0; k < tenth.samples; ++k) {
-    max_error = std::max(max_error, std::abs(tenth.shupe_dph[k] - one.shupe_dph.segment(10 * k, 10).mean()));
+    max_error = std::max(max_error,
+                         std::abs(tenth.shupe_dph[k] - one.shupe_dph.segment(10 * k, 10).mean()));
   }
   EXPECT_LT(max_error, 0.01 * one.max_abs_shupe_dph);
 }

@@ -73,9 +73,9 @@ TEST(TemperatureProgramme, BadSamplesAreDataErrors) {
   temp << 0, 300, 2;
   EXPECT_THROW(TemperatureProgramme::FromSamples(t, temp), DataError);  // Kelvin by mistake
   EXPECT_THROW(TemperatureProgramme::FromSamples(t, Eigen::VectorXd::Zero(2)), DataError);
-  EXPECT_THROW(TemperatureProgramme::FromSamples(Eigen::VectorXd::Zero(1),
-                                                 Eigen::VectorXd::Zero(1)),
-               DataError);
+  EXPECT_THROW(
+      TemperatureProgramme::FromSamples(Eigen::VectorXd::Zero(1), Eigen::VectorXd::Zero(1)),
+      DataError);
 }
 
 TEST(TemperatureProgramme, BadSegmentsAndNamesAreUsageErrors) {

@@ -32,7 +32,8 @@ TEST(Winding, EveryPatternLaysTheWholeFibreExactlyOnce) {
       ASSERT_DOUBLE_EQ(all.front().first, 0.0) << ToString(pattern);
       ASSERT_DOUBLE_EQ(all.back().second, 1000.0) << ToString(pattern);
       for (size_t i = 1; i < all.size(); ++i) {
-        ASSERT_NEAR(all[i].first, all[i - 1].second, 1e-9) << ToString(pattern);  // no gap, no overlap
+        ASSERT_NEAR(all[i].first, all[i - 1].second, 1e-9)
+            << ToString(pattern);  // no gap, no overlap
         ASSERT_LT(all[i].first, all[i].second);
       }
       EXPECT_NEAR(map.layer_length_m.sum(), 1000.0, 1e-9);
@@ -80,8 +81,8 @@ TEST(Winding, PerfectlySymmetricWindingCancelsShupeToRoundOff) {
 // s L^2 / 6 / layers^2 (equal layers), so the sum converges to n L C s / (6 D).
 double ConventionalShupe(int layers, const Eigen::VectorXd& capacity) {
   const ShupeConstants c;  // METHOD.md values
-  const WindingMap map = BuildWinding(WindingPattern::kConventional, layers, c.fibre_length_m,
-                                      0.0, capacity);
+  const WindingMap map =
+      BuildWinding(WindingPattern::kConventional, layers, c.fibre_length_m, 0.0, capacity);
   const double spread = 1e-3;
   Eigen::VectorXd rate(layers);
   for (int l = 0; l < layers; ++l) {
