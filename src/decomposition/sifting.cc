@@ -60,47 +60,54 @@ inline int AppendBits(std::uint64_t word, Eigen::Index base, int* out, int count
   return count;
 }
 
-// Strict extrema of x (sign changes of the first difference) into indmin / indmax; returns true
-// when some first difference is exactly zero (plateaus to look at). Comparisons are done two
-// samples at a time and turned into bit masks, so the cost per sample is a few instructions and
-// the cost per extremum one bit scan: smooth late modes with few extrema are cheap.
+// Strict extrema of x into indmin / indmax; returns true when some first difference is exactly
+// zero (plateaus to look at). An interior sample i is a maximum when d[i-1] > 0 > d[i] and a
+// minimum when d[i-1] < 0 < d[i], d[i] = x[i+1] - x[i]: emd.m's test d[i-1] * d[i] < 0 without
+// the product (which could underflow to zero for differences below 1e-154; the sign test is the
+// definition). Signs of 64 differences are packed into bit masks, two per instruction, and the
+// extrema are the bit patterns "+ then -" and "- then +": a few instructions per sample and one
+// bit scan per extremum, so the smooth late modes with few extrema cost little.
 bool FindStrictExtrema(const double* x, Eigen::Index n, int* indmin, int* indmax, int* nmin,
                        int* nmax) {
   int count_min = 0, count_max = 0;
-  bool flat = n >= 2 && x[1] - x[0] == 0.0;
-  Eigen::Index i = 1;  // first interior sample
+  bool flat = false;
+  const Eigen::Index nd = n - 1;  // differences d[0..nd-1]
+  std::uint64_t carry_pos = 0, carry_neg = 0;  // sign bits of the last difference of the block
+  for (Eigen::Index base = 0; base < nd; base += 64) {
+    const int count = static_cast<int>(std::min<Eigen::Index>(64, nd - base));
+    std::uint64_t pos = 0, neg = 0;
+    int k = 0;
 #if defined(__SSE2__)
-  const __m128d zero = _mm_setzero_pd();
-  int flat_bits = 0;
-  while (i + 2 < n) {  // room for a pair (i, i+1), both interior
-    std::uint64_t min_word = 0, max_word = 0;
-    const Eigen::Index base = i;
-    for (int k = 0; k < 64 && i + 2 < n; k += 2, i += 2) {
-      const __m128d left = _mm_loadu_pd(x + i - 1);
-      const __m128d mid = _mm_loadu_pd(x + i);
-      const __m128d right = _mm_loadu_pd(x + i + 1);
-      const __m128d d0 = _mm_sub_pd(mid, left);
-      const __m128d d1 = _mm_sub_pd(right, mid);
-      const __m128d ext = _mm_cmplt_pd(_mm_mul_pd(d0, d1), zero);
-      const __m128d rising = _mm_cmpgt_pd(d0, zero);
-      max_word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_and_pd(ext, rising))) << k;
-      min_word |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_andnot_pd(rising, ext))) << k;
-      flat_bits |= _mm_movemask_pd(_mm_cmpeq_pd(d1, zero));
+    const __m128d zero = _mm_setzero_pd();
+    int zero_bits = 0;
+    for (; k + 2 <= count; k += 2) {
+      const __m128d d =
+          _mm_sub_pd(_mm_loadu_pd(x + base + k + 1), _mm_loadu_pd(x + base + k));
+      pos |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmpgt_pd(d, zero))) << k;
+      neg |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmplt_pd(d, zero))) << k;
+      zero_bits |= _mm_movemask_pd(_mm_cmpeq_pd(d, zero));
     }
-    count_min = AppendBits(min_word, base, indmin, count_min);
-    count_max = AppendBits(max_word, base, indmax, count_max);
-  }
-  flat |= flat_bits != 0;
+    flat |= zero_bits != 0;
 #endif
-  for (; i + 1 < n; ++i) {
-    const double d0 = x[i] - x[i - 1];
-    const double d1 = x[i + 1] - x[i];
-    const bool is_ext = d0 * d1 < 0.0;
-    indmin[count_min] = static_cast<int>(i);
-    indmax[count_max] = static_cast<int>(i);
-    count_min += is_ext & (d0 < 0.0);
-    count_max += is_ext & (d0 > 0.0);
-    flat |= d1 == 0.0;
+    for (; k < count; ++k) {
+      const double d = x[base + k + 1] - x[base + k];
+      pos |= static_cast<std::uint64_t>(d > 0.0) << k;
+      neg |= static_cast<std::uint64_t>(d < 0.0) << k;
+      flat |= d == 0.0;
+    }
+    // Sample base + k is interior with d[base+k-1] before it and d[base+k] after it.
+    const std::uint64_t pos_before = (pos << 1) | carry_pos;
+    const std::uint64_t neg_before = (neg << 1) | carry_neg;
+    std::uint64_t max_bits = pos_before & neg;
+    std::uint64_t min_bits = neg_before & pos;
+    if (base == 0) {  // sample 0 is not interior
+      max_bits &= ~std::uint64_t{1};
+      min_bits &= ~std::uint64_t{1};
+    }
+    count_max = AppendBits(max_bits, base, indmax, count_max);
+    count_min = AppendBits(min_bits, base, indmin, count_min);
+    carry_pos = (pos >> 63) & 1;
+    carry_neg = (neg >> 63) & 1;
   }
   *nmin = count_min;
   *nmax = count_max;
