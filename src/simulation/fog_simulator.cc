@@ -72,6 +72,7 @@ void StressParameters::Validate() const {
   RequireInRange("stress.coating_modulus_pa", coating_modulus_pa, 1e5, 1e11);
   RequireInRange("stress.coating_expansion_per_k", coating_expansion_per_k, 0.0, 1e-2);
   RequireInRange("stress.nonreciprocity", nonreciprocity, 0.0, 1e-6);
+  RequireInRange("stress.reference_c", reference_c, -100.0, 200.0);
 }
 
 double BiasParameters::At(double case_c) const {
@@ -199,6 +200,8 @@ SimulationResult Simulate(const TemperatureProgramme& programme, const FogParame
   // that start temperature, so a constant chamber leaves it at exactly zero (no round-off drift).
   double chamber = programme.TemperatureAt(0.0);
   const double start_c = chamber;
+  // Coil mean temperature relative to the coating's stress-free temperature at the start.
+  const double start_offset = start_c - params.stress.reference_c;
   double case_c = chamber;
   pack.SetUniform(0.0);
   Eigen::VectorXd previous = pack.temperature_c();
@@ -223,7 +226,7 @@ SimulationResult Simulate(const TemperatureProgramme& programme, const FogParame
     const double mean_change = pack.MeanTemperature();
     r.time_s[k] = static_cast<double>(k + 1) * dt;
     r.shupe_dph[k] = shupe_scale * integral / dt;
-    r.stress_dph[k] = stress_per_k * mean_change;
+    r.stress_dph[k] = stress_per_k * (start_offset + mean_change);
     r.bias_dph[k] = params.bias.At(case_c);
     r.chamber_c[k] = chamber;
     r.case_c[k] = case_c;

@@ -86,6 +86,10 @@ struct StressParameters {
   // eta: nonreciprocal share of the stress-induced optical path change, in [0, 1e-6].
   // Default 7e-12, which gives the navigation coil 0.005 deg/h per K of mean coil temperature.
   double nonreciprocity = 7e-12;
+  // Stress-free temperature of the coating (its cure temperature), degC, in [-100, 200]. The
+  // stress drift follows the coil's mean temperature relative to it, so two runs that start at
+  // different temperatures share one drift-versus-temperature law.
+  double reference_c = 20.0;
   // The bracket of eq. 4 times E_coat alpha_c: index change per K of the coil, 1/K.
   double IndexChangePerK(double refractive_index) const;
   void Validate() const;

@@ -61,10 +61,9 @@ TEST_P(SimulatorProperties, TruthAddsUpAndFollowsTheTemperatures) {
   const SimulationResult r = Run(p.coil.winding, /*noise=*/true);
   EXPECT_EQ(r.drift_dph, r.shupe_dph + r.stress_dph + r.bias_dph);
   EXPECT_EQ(r.rate_dph, r.drift_dph + r.noise_dph);
-  const double start = BuiltinProgramme(std::get<1>(GetParam())).TemperatureAt(0.0);
   for (Eigen::Index k = 0; k < r.samples; k += 997) {
-    EXPECT_NEAR(r.stress_dph[k], r.stress_coefficient_dph_per_k * (r.coil_mean_c[k] - start),
-                1e-12);
+    EXPECT_NEAR(r.stress_dph[k],
+                r.stress_coefficient_dph_per_k * (r.coil_mean_c[k] - p.stress.reference_c), 1e-12);
     EXPECT_DOUBLE_EQ(r.bias_dph[k], p.bias.At(r.case_c[k]));
     // The coil mean stays inside the range the case has visited.
     EXPECT_LE(r.coil_mean_c[k], r.case_c.head(k + 1).maxCoeff() + 1e-9);
