@@ -30,7 +30,10 @@ const Eigen::VectorXd& Record(Eigen::Index n) {
 
 void Run(benchmark::State& state, TauGrid grid, Deviation dev, int threads, bool intervals) {
   const Eigen::VectorXd& y = Record(state.range(0));
-  AllanOptions o{.rate_hz = 100.0, .deviation = dev, .grid = grid, .confidence_intervals = intervals,
+  AllanOptions o{.rate_hz = 100.0,
+                 .deviation = dev,
+                 .grid = grid,
+                 .confidence_intervals = intervals,
                  .threads = threads};
   std::size_t taus = 0;
   for (auto _ : state) {
@@ -45,25 +48,43 @@ void Run(benchmark::State& state, TauGrid grid, Deviation dev, int threads, bool
 }
 
 void BM_OadevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kOadev, 0, true); }
-void BM_OadevOctave1Thread(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kOadev, 1, true); }
+void BM_OadevOctave1Thread(benchmark::State& s) {
+  Run(s, TauGrid::kOctave, Deviation::kOadev, 1, true);
+}
 void BM_OadevAll(benchmark::State& s) { Run(s, TauGrid::kAll, Deviation::kOadev, 0, true); }
-void BM_OadevAllNoIntervals(benchmark::State& s) { Run(s, TauGrid::kAll, Deviation::kOadev, 0, false); }
+void BM_OadevAllNoIntervals(benchmark::State& s) {
+  Run(s, TauGrid::kAll, Deviation::kOadev, 0, false);
+}
 void BM_MdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kMdev, 0, true); }
 void BM_TotdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kTotdev, 0, true); }
 
 void Register() {
   const bool smoke = gyrodrift::bench::SmokeMode();
-  const std::vector<std::int64_t> octave = smoke ? std::vector<std::int64_t>{10000}
-                                                 : std::vector<std::int64_t>{1000000, 10000000};
+  const std::vector<std::int64_t> octave =
+      smoke ? std::vector<std::int64_t>{10000} : std::vector<std::int64_t>{1000000, 10000000};
   for (auto n : octave) {
-    benchmark::RegisterBenchmark("BM_OadevOctave", BM_OadevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark("BM_OadevOctave1Thread", BM_OadevOctave1Thread)->Arg(n)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark("BM_MdevOctave", BM_MdevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark("BM_TotdevOctave", BM_TotdevOctave)->Arg(n)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_OadevOctave", BM_OadevOctave)
+        ->Arg(n)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_OadevOctave1Thread", BM_OadevOctave1Thread)
+        ->Arg(n)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_MdevOctave", BM_MdevOctave)
+        ->Arg(n)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("BM_TotdevOctave", BM_TotdevOctave)
+        ->Arg(n)
+        ->Unit(benchmark::kMillisecond);
   }
   const std::int64_t all_n = smoke ? 2000 : 1000000;
-  benchmark::RegisterBenchmark("BM_OadevAll", BM_OadevAll)->Arg(all_n)->Unit(benchmark::kSecond)->Iterations(1);
-  benchmark::RegisterBenchmark("BM_OadevAllNoIntervals", BM_OadevAllNoIntervals)->Arg(all_n)->Unit(benchmark::kSecond)->Iterations(1);
+  benchmark::RegisterBenchmark("BM_OadevAll", BM_OadevAll)
+      ->Arg(all_n)
+      ->Unit(benchmark::kSecond)
+      ->Iterations(1);
+  benchmark::RegisterBenchmark("BM_OadevAllNoIntervals", BM_OadevAllNoIntervals)
+      ->Arg(all_n)
+      ->Unit(benchmark::kSecond)
+      ->Iterations(1);
 }
 
 }  // namespace

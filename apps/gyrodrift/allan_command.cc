@@ -48,11 +48,13 @@ void ParseTaus(const std::string& text, al::AllanOptions* o) {
   while (std::getline(s, item, ',')) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    const bool blank_tail = end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
+    const bool blank_tail =
+        end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
     if (!blank_tail || !(v > 0.0) || !std::isfinite(v)) {
-      ThrowOption("--taus", text,
-                  "all, octave, decade or a comma-separated list of positive taus in s (bad item '" +
-                      item + "')");
+      ThrowOption(
+          "--taus", text,
+          "all, octave, decade or a comma-separated list of positive taus in s (bad item '" + item +
+              "')");
     }
     o->tau_list_s.push_back(v);
   }
@@ -167,23 +169,23 @@ void Run(const AllanArgs& a) {
                       {"alpha_identified", p.alpha_identified}});
   }
   nlohmann::json sidecar = SidecarHeader("allan");
-  sidecar["options"] = {{"input", a.input},
-                        {"column", a.column},
-                        {"rate_hz", o.rate_hz},
-                        {"tau0_s", o.tau0_s()},
-                        {"type", al::ToString(o.data_type)},
-                        {"dev", al::ToString(o.deviation)},
-                        {"taus", a.taus},
-                        {"tau_grid", al::ToString(o.grid)},
-                        {"tau_list_s", o.tau_list_s},
-                        {"units", al::ToString(o.units)},
-                        {"confidence", o.confidence},
-                        {"threads", o.threads},
-                        {"fit_tau_min_s", fit_options.tau_min_s},
-                        {"fit_tau_max_s", std::isfinite(fit_options.tau_max_s)
-                                              ? nlohmann::json(fit_options.tau_max_s)
-                                              : nlohmann::json("inf")},
-                        {"seed", nullptr}};
+  sidecar["options"] = {
+      {"input", a.input},
+      {"column", a.column},
+      {"rate_hz", o.rate_hz},
+      {"tau0_s", o.tau0_s()},
+      {"type", al::ToString(o.data_type)},
+      {"dev", al::ToString(o.deviation)},
+      {"taus", a.taus},
+      {"tau_grid", al::ToString(o.grid)},
+      {"tau_list_s", o.tau_list_s},
+      {"units", al::ToString(o.units)},
+      {"confidence", o.confidence},
+      {"threads", o.threads},
+      {"fit_tau_min_s", fit_options.tau_min_s},
+      {"fit_tau_max_s", std::isfinite(fit_options.tau_max_s) ? nlohmann::json(fit_options.tau_max_s)
+                                                             : nlohmann::json("inf")},
+      {"seed", nullptr}};
   sidecar["samples"] = r.n_samples;
   sidecar["summary"] = r.Summary();
   sidecar["dev_unit"] = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
@@ -194,8 +196,9 @@ void Run(const AllanArgs& a) {
   if (terms) {
     sidecar["noise_terms"] = {
         {"source_dev", fit_source},
-        {"method", "IEEE 952 model, weighted non-negative least squares on AVAR (weights EDF / "
-                   "(2 AVAR^2)); terms below 10 % of the model at every tau dropped"},
+        {"method",
+         "IEEE 952 model, weighted non-negative least squares on AVAR (weights EDF / "
+         "(2 AVAR^2)); terms below 10 % of the model at every tau dropped"},
         {"points_used", terms->points_used},
         {"tau_min_s", terms->tau_min_s},
         {"tau_max_s", terms->tau_max_s},
@@ -239,8 +242,11 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
       "non-negative least squares on sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3\n"
       "+ R^2 tau^2/2, beside the IEEE 952 slope-method readings.\n"
       "Angle input (--type angle) is in degrees (radians with --units rads).\n"
-      "  gyrodrift allan imu.csv -c 2 --rate-hz 100 --units dps --dev mdev --taus 0.1,1,10 -o m.csv");
-  cmd->add_option("input", args->input, "CSV file with a header row")->required()->check(kInputFile);
+      "  gyrodrift allan imu.csv -c 2 --rate-hz 100 --units dps --dev mdev --taus 0.1,1,10 -o "
+      "m.csv");
+  cmd->add_option("input", args->input, "CSV file with a header row")
+      ->required()
+      ->check(kInputFile);
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
   cmd->add_option("--rate-hz", args->rate_hz, "sample rate in Hz (tau0 = 1 / rate)")->required();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")

@@ -145,9 +145,9 @@ void AllanOptions::Validate() const {
   if (forced_alpha && (*forced_alpha < -4 || *forced_alpha > 2))
     ThrowOption("forced_alpha", std::to_string(*forced_alpha), "an integer in -4..2");
   if (forced_alpha && *forced_alpha + 2 * DifferenceOrder(deviation) <= 1)
-    ThrowOption("forced_alpha", std::to_string(*forced_alpha),
-                "> " + std::to_string(1 - 2 * DifferenceOrder(deviation)) + " for " +
-                    ToString(deviation));
+    ThrowOption(
+        "forced_alpha", std::to_string(*forced_alpha),
+        "> " + std::to_string(1 - 2 * DifferenceOrder(deviation)) + " for " + ToString(deviation));
   if (grid == TauGrid::kList) {
     if (tau_list_s.empty()) ThrowOption("tau_list_s", "(empty)", "at least one tau for grid list");
     for (double t : tau_list_s) RequirePositive("tau_list_s", t);

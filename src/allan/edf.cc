@@ -48,8 +48,7 @@ double Sx(double t, double f, int alpha) {
 
 // d-th difference: binomial weights (-1)^k C(2d, d+k). Eq. 9.
 double Sz(double t, double f, int alpha, int d) {
-  static constexpr double kW[4][4] = {
-      {1, 0, 0, 0}, {2, -1, 0, 0}, {6, -4, 1, 0}, {20, -15, 6, -1}};
+  static constexpr double kW[4][4] = {{1, 0, 0, 0}, {2, -1, 0, 0}, {6, -4, 1, 0}, {20, -15, 6, -1}};
   double s = kW[d][0] * Sx(t, f, alpha);
   for (int k = 1; k <= d; ++k) s += kW[d][k] * (Sx(t - k, f, alpha) + Sx(t + k, f, alpha));
   return s;
@@ -234,8 +233,7 @@ double EquivalentDof(Deviation dev, int alpha, std::int64_t m, Eigen::Index n_ph
     case Deviation::kTotdev: {
       // NIST SP 1065 table 7: edf = b (T / tau) - c, T = record length (N - 1) tau0.
       static constexpr double kBc[3][2] = {{1.50, 0.0}, {1.17, 0.22}, {0.93, 0.36}};
-      if (alpha <= 0 && alpha >= -2)
-        return kBc[-alpha][0] * ((n - 1.0) / md) - kBc[-alpha][1];
+      if (alpha <= 0 && alpha >= -2) return kBc[-alpha][0] * ((n - 1.0) / md) - kBc[-alpha][1];
       // Phase noise (table 7 has no row): the simple OADEV formulas of SP 1065 table 5
       // (Howe, Allan, Barnes 1981), which is what Stable32's intervals imply.
       if (alpha == 2) return (n + 1.0) * (n - 2.0 * md) / (2.0 * (n - md));
@@ -297,7 +295,10 @@ double ChiSquareQuantile(double p, double dof) {
     double zlo = -40.0, zhi = 40.0;
     for (int i = 0; i < 64; ++i) {
       const double mid = 0.5 * (zlo + zhi);
-      if (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p) zlo = mid; else zhi = mid;
+      if (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p)
+        zlo = mid;
+      else
+        zhi = mid;
     }
     z = 0.5 * (zlo + zhi);
     cached_p[1] = cached_p[0];
@@ -314,7 +315,10 @@ double ChiSquareQuantile(double p, double dof) {
   double lo = 0.0, hi = kInf;
   for (int it = 0; it < 200; ++it) {
     const double f = RegularizedGammaP(a, 0.5 * x) - p;
-    if (f < 0.0) lo = x; else hi = x;
+    if (f < 0.0)
+      lo = x;
+    else
+      hi = x;
     const double log_density =
         (a - 1.0) * std::log(0.5 * x) - 0.5 * x - std::lgamma(a) - std::log(2.0);
     const double density = std::exp(log_density);

@@ -17,9 +17,11 @@ constexpr std::int64_t kChunk = 1024;
 // multiple of kLanes. Separate lanes keep the floating-point order fixed while the compiler maps
 // them onto vector registers (target_clones picks AVX2 when the CPU has it; the arithmetic is the
 // same, so the bits are too).
-__attribute__((target_clones("avx2", "default"))) void AccumulateLanes(
-    const double* __restrict x0, const double* __restrict x1, const double* __restrict x2,
-    std::int64_t count, double* __restrict acc) {
+__attribute__((target_clones("avx2", "default"))) void AccumulateLanes(const double* __restrict x0,
+                                                                       const double* __restrict x1,
+                                                                       const double* __restrict x2,
+                                                                       std::int64_t count,
+                                                                       double* __restrict acc) {
   double a[kLanes];
   for (int l = 0; l < kLanes; ++l) a[l] = acc[l];
   std::int64_t i = 0;

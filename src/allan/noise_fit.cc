@@ -13,7 +13,7 @@
 namespace gyrodrift::allan {
 namespace {
 
-constexpr int kTerms = 5;  // Q, N, B, K, R
+constexpr int kTerms = 5;                                               // Q, N, B, K, R
 const double kBiasFactor = 2.0 * std::numbers::ln2 / std::numbers::pi;  // (0.664)^2
 
 // Model column of term j at tau (s); coefficients are the squared raw terms in deg/h and s.
@@ -86,7 +86,8 @@ Fit SolveNnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, unsigned allow
       best.chi2 = chi2;
       best.ok = true;
       best.active = cols;
-      const Eigen::MatrixXd r = qr.matrixR().topLeftCorner(sub.cols(), sub.cols())
+      const Eigen::MatrixXd r = qr.matrixR()
+                                    .topLeftCorner(sub.cols(), sub.cols())
                                     .template triangularView<Eigen::Upper>();
       // (A^T A)^-1 = P R^-1 R^-T P^T, then undo the equilibration.
       const Eigen::MatrixXd rinv =
@@ -97,7 +98,8 @@ Fit SolveNnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b, unsigned allow
         for (Eigen::Index j = 0; j < cov.cols(); ++j) cov(i, j) /= scale[i] * scale[j];
       best.cov = cov;
       for (size_t c = 0; c < cols.size(); ++c)
-        best.coef[static_cast<size_t>(cols[c])] = x[static_cast<Eigen::Index>(c)] / scale[static_cast<Eigen::Index>(c)];
+        best.coef[static_cast<size_t>(cols[c])] =
+            x[static_cast<Eigen::Index>(c)] / scale[static_cast<Eigen::Index>(c)];
     }
   }
   return best;
@@ -117,7 +119,9 @@ NoiseTerm* TermAt(NoiseTerms& t, int j) {
       return &t.r_dphph;
   }
 }
-const NoiseTerm* TermAt(const NoiseTerms& t, int j) { return TermAt(const_cast<NoiseTerms&>(t), j); }
+const NoiseTerm* TermAt(const NoiseTerms& t, int j) {
+  return TermAt(const_cast<NoiseTerms&>(t), j);
+}
 
 // Slope-method readings (IEEE 952 Annex C): at the point whose local log-log slope is closest to
 // the term's slope (within 0.25), sigma = sqrt(col_j(tau)) * term. Only points whose slope rests
@@ -183,8 +187,10 @@ std::string NoiseTerms::Summary() const {
   std::ostringstream s;
   auto put = [&](const char* name, const NoiseTerm& t, const char* unit) {
     s << name << " ";
-    if (t.identified) s << FormatValue(t.value) << " +- " << FormatValue(t.sigma) << " " << unit;
-    else s << "-";
+    if (t.identified)
+      s << FormatValue(t.value) << " +- " << FormatValue(t.sigma) << " " << unit;
+    else
+      s << "-";
   };
   put("Q", q_urad, "urad");
   s << ", ";
@@ -269,7 +275,8 @@ NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& ad
   for (size_t c = 0; c < fit.active.size(); ++c) {
     const int j = fit.active[c];
     const double coef = fit.coef[static_cast<size_t>(j)];
-    const double coef_sd = std::sqrt(fit.cov(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)) * inflate);
+    const double coef_sd =
+        std::sqrt(fit.cov(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(c)) * inflate);
     const double raw = std::sqrt(coef);
     NoiseTerm* t = TermAt(out, j);
     t->identified = true;

@@ -1,11 +1,12 @@
 // gyrodrift allan: the main path and every bad-input case, on the real binary.
+#include "gyrodrift/allan/allan.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"

@@ -53,7 +53,7 @@ enum class Deviation {
   kTdev,    // time deviation, tau / sqrt(3) * MDEV, in rate unit x s
   kTotdev,  // total deviation (phase reflected at both ends, NIST SP 1065 sec. 5.2.11)
 };
-std::string ToString(Deviation d);              // "adev", "oadev", ...
+std::string ToString(Deviation d);                  // "adev", "oadev", ...
 Deviation DeviationFromString(std::string_view s);  // throws UsageError
 
 enum class DataType {
@@ -125,13 +125,14 @@ struct AllanPoint {
   std::int64_t n_terms = 0;  // number of terms in the estimator's sum (Stable32 "#")
   double edf = 0.0;          // equivalent degrees of freedom (NaN if intervals are off)
   int alpha = 0;             // noise type used for the EDF (identified or forced)
-  bool alpha_identified = false;  // false: carried over from a neighbouring tau (< 30 points) or forced
+  bool alpha_identified =
+      false;  // false: carried over from a neighbouring tau (< 30 points) or forced
 };
 
 struct AllanResult {
   AllanOptions options;
-  Eigen::Index n_samples = 0;  // input samples
-  Eigen::Index n_phase = 0;    // angle (phase) points the estimators see (rate: n_samples + 1)
+  Eigen::Index n_samples = 0;      // input samples
+  Eigen::Index n_phase = 0;        // angle (phase) points the estimators see (rate: n_samples + 1)
   std::vector<AllanPoint> points;  // increasing tau
 
   Eigen::VectorXd tau_s() const;
@@ -173,8 +174,7 @@ void ConfidenceInterval(double dev, double edf, double confidence, double* lo, d
 // Returns nullopt when fewer than 30 points remain. Cost O(N / m), no copy of the series unless
 // differencing is needed (rho >= 0.25 at d = 0).
 std::optional<int> IdentifyAlpha(const Eigen::Ref<const Eigen::VectorXd>& phase, std::int64_t m,
-                                 DataType type,
-                                 int dmax);
+                                 DataType type, int dmax);
 
 // ---- IEEE 952 noise terms --------------------------------------------------------------------
 
@@ -190,24 +190,24 @@ struct NoiseFitOptions {
 };
 
 struct NoiseTerm {
-  double value = 0.0;        // fitted value in the unit named below (0 if not identified)
-  double sigma = 0.0;        // 1-sigma uncertainty from the weighted least-squares covariance
+  double value = 0.0;  // fitted value in the unit named below (0 if not identified)
+  double sigma = 0.0;  // 1-sigma uncertainty from the weighted least-squares covariance
   double slope_reading = std::numeric_limits<double>::quiet_NaN();  // IEEE 952 slope method
   double slope_tau_s = std::numeric_limits<double>::quiet_NaN();    // tau of that reading
-  bool identified = false;   // the term matters somewhere in the fitted range
+  bool identified = false;  // the term matters somewhere in the fitted range
   double tau_lo_s = std::numeric_limits<double>::quiet_NaN();  // fitted taus where it matters
   double tau_hi_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct NoiseTerms {
-  NoiseTerm q_urad;     // quantization Q, microradians (arcsec = urad * 0.206264806)
-  NoiseTerm n_dpsh;     // angle random walk N, deg/sqrt(h)
-  NoiseTerm b_dph;      // bias instability B, deg/h
-  NoiseTerm k_dphpsh;   // rate random walk K, deg/h/sqrt(h)
-  NoiseTerm r_dphph;    // rate ramp R, deg/h/h
+  NoiseTerm q_urad;    // quantization Q, microradians (arcsec = urad * 0.206264806)
+  NoiseTerm n_dpsh;    // angle random walk N, deg/sqrt(h)
+  NoiseTerm b_dph;     // bias instability B, deg/h
+  NoiseTerm k_dphpsh;  // rate random walk K, deg/h/sqrt(h)
+  NoiseTerm r_dphph;   // rate ramp R, deg/h/h
   int points_used = 0;
-  double tau_min_s = 0.0, tau_max_s = 0.0;  // fitted range actually used
-  double chi2_per_dof = 0.0;  // weighted residual sum / (points - active terms)
+  double tau_min_s = 0.0, tau_max_s = 0.0;        // fitted range actually used
+  double chi2_per_dof = 0.0;                      // weighted residual sum / (points - active terms)
   double min_dev_dph = 0.0, min_dev_tau_s = 0.0;  // minimum of the curve (deg/h)
   std::string Summary() const;
   // Model Allan deviation in deg/h at tau from the fitted terms.

@@ -19,8 +19,8 @@ TEST(Adis16405, OverlappingAvarMatchesRPackageAvar) {
       test::TestDataPath("smac_adis16405_avar/adis_16405_imu1.csv.gz"), "allan-adis16405");
   const io::CsvTable table = io::CsvTable::Read(raw);
   ASSERT_EQ(table.rows(), 1000000);
-  const io::CsvTable ref =
-      io::CsvTable::Read(test::TestDataPath("smac_adis16405_avar/adis_16405_imu1_avar_mo_reference.csv"));
+  const io::CsvTable ref = io::CsvTable::Read(
+      test::TestDataPath("smac_adis16405_avar/adis_16405_imu1_avar_mo_reference.csv"));
   // The channel column is text; read it from the raw file alongside the numeric columns.
   std::ifstream in(test::TestDataPath("smac_adis16405_avar/adis_16405_imu1_avar_mo_reference.csv"));
   std::string line;
@@ -30,14 +30,17 @@ TEST(Adis16405, OverlappingAvarMatchesRPackageAvar) {
   ASSERT_EQ(static_cast<Eigen::Index>(channel.size()), ref.rows());
   const Eigen::VectorXd ref_tau = ref.Column("tau_s");
   const Eigen::VectorXd ref_avar = ref.Column("avar");
-  const std::map<std::string, std::string> columns = {
-      {"Gyro. X", "gyro_x"}, {"Gyro. Y", "gyro_y"}, {"Gyro. Z", "gyro_z"},
-      {"Accel. X", "acc_x"}, {"Accel. Y", "acc_y"}, {"Accel. Z", "acc_z"}};
+  const std::map<std::string, std::string> columns = {{"Gyro. X", "gyro_x"}, {"Gyro. Y", "gyro_y"},
+                                                      {"Gyro. Z", "gyro_z"}, {"Accel. X", "acc_x"},
+                                                      {"Accel. Y", "acc_y"}, {"Accel. Z", "acc_z"}};
   int checked = 0;
   double worst = 0.0;
   for (const auto& [name, column] : columns) {
-    AllanOptions o{.rate_hz = 100.0, .deviation = Deviation::kOadev, .grid = TauGrid::kList,
-                   .units = RateUnit::kDegPerSecond, .confidence_intervals = false};
+    AllanOptions o{.rate_hz = 100.0,
+                   .deviation = Deviation::kOadev,
+                   .grid = TauGrid::kList,
+                   .units = RateUnit::kDegPerSecond,
+                   .confidence_intervals = false};
     std::vector<Eigen::Index> rows;
     for (Eigen::Index i = 0; i < ref.rows(); ++i) {
       if (channel[static_cast<size_t>(i)] != name) continue;

@@ -68,9 +68,11 @@ TEST(AllanCompute, RejectsNonFiniteAndShortData) {
 TEST(AllanGrid, OctaveDecadeAllAndListFactors) {
   AllanOptions o;
   o.grid = TauGrid::kOctave;
-  EXPECT_EQ(AveragingFactors(o, 1001), (std::vector<std::int64_t>{1, 2, 4, 8, 16, 32, 64, 128, 256}));
+  EXPECT_EQ(AveragingFactors(o, 1001),
+            (std::vector<std::int64_t>{1, 2, 4, 8, 16, 32, 64, 128, 256}));
   o.grid = TauGrid::kDecade;
-  EXPECT_EQ(AveragingFactors(o, 1001), (std::vector<std::int64_t>{1, 2, 4, 10, 20, 40, 100, 200, 400}));
+  EXPECT_EQ(AveragingFactors(o, 1001),
+            (std::vector<std::int64_t>{1, 2, 4, 10, 20, 40, 100, 200, 400}));
   o.grid = TauGrid::kAll;
   EXPECT_EQ(AveragingFactors(o, 11).size(), 5u);
   o.grid = TauGrid::kList;
@@ -113,8 +115,11 @@ TEST(AllanCompute, RateAndAngleInputsAgreeInEveryUnit) {
     angle[0] = 0.0;
     for (Eigen::Index i = 0; i < y.size(); ++i) angle[i + 1] = angle[i] + y[i] * per_s / rate_hz;
     for (auto d : {Deviation::kOadev, Deviation::kMdev, Deviation::kTotdev}) {
-      AllanOptions o{.rate_hz = rate_hz, .data_type = DataType::kRate, .deviation = d,
-                     .units = unit, .confidence_intervals = false};
+      AllanOptions o{.rate_hz = rate_hz,
+                     .data_type = DataType::kRate,
+                     .deviation = d,
+                     .units = unit,
+                     .confidence_intervals = false};
       const AllanResult a = Compute(y, o);
       o.data_type = DataType::kAngle;
       const AllanResult b = Compute(angle, o);

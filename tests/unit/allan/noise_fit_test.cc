@@ -41,7 +41,8 @@ TEST(NoiseFit, RecoversExactModelCurve) {
   EXPECT_NEAR(t.k_dphpsh.value / k, 1.0, 1e-6);
   EXPECT_NEAR(t.r_dphph.value / r, 1.0, 1e-6);
   EXPECT_LT(t.chi2_per_dof, 1e-12);
-  for (double tt : {0.1, 10.0, 1e4}) EXPECT_NEAR(t.ModelDevDph(tt) / ModelAdev(tt, q, n, b, k, r), 1.0, 1e-6);
+  for (double tt : {0.1, 10.0, 1e4})
+    EXPECT_NEAR(t.ModelDevDph(tt) / ModelAdev(tt, q, n, b, k, r), 1.0, 1e-6);
   // Bias instability slope reading: the curve minimum / 0.664 is above B (other terms add).
   EXPECT_GT(t.b_dph.slope_reading, b);
 }
@@ -82,8 +83,8 @@ TEST(NoiseFit, RecoversSyntheticGyroNoise) {
   for (Eigen::Index i = 0; i < n; ++i) {
     bias += k_raw * std::sqrt(tau0) * walk.Normal();
     const double angle_noise = q_raw * quant.Normal();
-    rate[i] = n_raw / std::sqrt(tau0) * white.Normal() + bias +
-              (angle_noise - prev_angle_noise) / tau0;
+    rate[i] =
+        n_raw / std::sqrt(tau0) * white.Normal() + bias + (angle_noise - prev_angle_noise) / tau0;
     prev_angle_noise = angle_noise;
   }
   AllanOptions o{.rate_hz = rate_hz, .grid = TauGrid::kOctave};
