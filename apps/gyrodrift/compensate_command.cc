@@ -1,0 +1,107 @@
+// gyrodrift compensate: remove the drift a saved compensate-mode model estimates from temperature.
+#include <fmt/core.h>
+
+#include <cmath>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli_util.h"
+#include "command.h"
+#include "drift_cli.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+
+namespace gyrodrift::cli {
+namespace {
+
+struct CompensateArgs {
+  std::string model;
+  std::string input;
+  std::string output;
+  bool quiet = false;
+};
+
+void Run(const CompensateArgs& a) {
+  const io::LoadedModel loaded = io::ReadModelFile(a.model);
+  const drift::DriftModel& model = loaded.model;
+  if (model.options.mode != drift::Mode::kCompensate) {
+    throw UsageError(a.model +
+                     " is a predict-mode model: use 'gyrodrift predict' (compensate "
+                     "needs a model fitted with --mode compensate)");
+  }
+  const io::CsvTable table = io::CsvTable::Read(a.input);
+  RequireModelColumns(loaded, table);
+  for (const char* name : {"drift_est", "compensated"}) {
+    if (table.HasColumn(name)) {
+      throw DataError(a.input + " already has a column '" + name +
+                      "': compensate an uncompensated log");
+    }
+  }
+  const Eigen::VectorXd y = table.Column(loaded.info.target_column);
+  const Eigen::VectorXd temperature = table.Column(loaded.info.temperature_column);
+  const Eigen::VectorXd estimate = drift::EstimateDrift(model, temperature);
+
+  std::vector<io::CsvColumn> columns;
+  for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
+    columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
+  }
+  columns.push_back({"drift_est", estimate});
+  const Eigen::VectorXd compensated = y - estimate;
+  columns.push_back({"compensated", compensated});
+
+  auto rms = [](const Eigen::VectorXd& v) {
+    const Eigen::VectorXd centred = v.array() - v.mean();
+    return std::sqrt(centred.squaredNorm() / static_cast<double>(v.size()));
+  };
+  nlohmann::json sidecar = SidecarHeader("compensate");
+  sidecar["options"] = {{"model", a.model}, {"input", a.input}};
+  sidecar["model"] = {{"summary", model.Summary()},
+                      {"method", drift::ToString(model.options.method)},
+                      {"target_column", loaded.info.target_column},
+                      {"temperature_column", loaded.info.temperature_column},
+                      {"seed", model.options.seed},
+                      {"tool_version", loaded.info.tool_version}};
+  sidecar["samples"] = y.size();
+  sidecar["std_before"] = rms(y);
+  sidecar["std_after"] = rms(compensated);
+  io::WriteFilesAtomically(
+      {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
+  if (!a.quiet) {
+    fmt::print(
+        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\nwrote {} and {}\n",
+        model.Summary(), loaded.info.target_column, rms(y), rms(compensated), y.size(), a.output,
+        SidecarPath(a.output));
+  }
+}
+
+const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
+  auto args = std::make_shared<CompensateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "compensate", "Subtract the drift a saved compensate-mode model estimates from temperature.");
+  cmd->footer(
+      "Example:\n"
+      "  gyrodrift fit train.csv --target rate_dph --temperature temperature_c --mode compensate "
+      "\\\n"
+      "      -o model.json\n"
+      "  gyrodrift compensate model.json test.csv -o out.csv\n"
+      "writes out.csv: every column of test.csv, then drift_est (the model's drift estimate,\n"
+      "from the temperature history only) and compensated (= target column - drift_est), one\n"
+      "row per input row; out.csv.json records the model and the std before and after.\n"
+      "test.csv needs the columns the model was trained with (here rate_dph and temperature_c).");
+  cmd->add_option("model", args->model, "model file written by 'gyrodrift fit --mode compensate'")
+      ->required()
+      ->check(kInputFile);
+  cmd->add_option("input", args->input, "CSV log with the model's target and temperature columns")
+      ->required()
+      ->check(kInputFile);
+  cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
+      ->required();
+  cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
+  cmd->callback([args] { Run(*args); });
+});
+
+}  // namespace
+}  // namespace gyrodrift::cli

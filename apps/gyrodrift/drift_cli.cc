@@ -1,0 +1,179 @@
+#include "drift_cli.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "cli_util.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::cli {
+namespace {
+
+// "auto" or an integer in [lo, hi]; -1 for auto.
+int AutoOrInteger(const std::string& option, const std::string& text, int lo, int hi) {
+  if (text == "auto") return -1;
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || value < lo || value > hi) {
+    ThrowOption(option, "'" + text + "'",
+                "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return value;
+}
+
+std::string Columns(const io::CsvTable& table) {
+  std::string names;
+  for (const auto& h : table.header()) names += (names.empty() ? "" : ", ") + h;
+  return names;
+}
+
+}  // namespace
+
+const CLI::Validator kSeed(
+    [](std::string& text) -> std::string {
+      std::uint64_t value = 0;
+      const char* end = text.data() + text.size();
+      const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+      const bool ok = !text.empty() && ec == std::errc() && ptr == end;
+      return ok ? std::string() : text + ": must be an integer in [0, 2^64)";
+    },
+    "SEED");
+
+void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
+  cmd->add_option("input", a->input, "CSV file with a header row")->required()->check(kInputFile);
+  cmd->add_option("--target,-t", a->target, "column of the gyro output (name or 1-based index)")
+      ->required();
+  cmd->add_option("--temperature,-T", a->temperature,
+                  "temperature column, degC (needed by --mode compensate; in predict mode it adds "
+                  "the thermal history to the lags)");
+  cmd->add_option(
+         "--mode", a->mode,
+         "predict (one-step-ahead from past samples) | compensate (drift from temperature)")
+      ->required();
+  cmd->add_option("--decomposition", a->decomposition, "beemdan|iceemdan|ceemdan|eemd|emd")
+      ->capture_default_str();
+  cmd->add_option("--lags,-p", a->lags,
+                  "own lags per sub-model: auto (chosen on the last 20% of the training record "
+                  "among 1,2,4,8,16) or p in [1,256] (predict mode)")
+      ->capture_default_str();
+  cmd->add_option("--hidden", a->hidden,
+                  "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed L")
+      ->capture_default_str();
+  a->rate_option = cmd->add_option("--rate-hz", a->rate_hz,
+                                   "sample rate, Hz (default: from the median step of a time_s "
+                                   "column, else 1)");
+  cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
+      ->capture_default_str();
+  cmd->add_option("--seed", a->seed, "seed of the decomposition and the learners")
+      ->check(kSeed)
+      ->capture_default_str();
+  cmd->add_option("--threads,-j", a->threads,
+                  "worker threads (0 = all cores); results do not "
+                  "depend on it")
+      ->capture_default_str();
+  cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
+}
+
+drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
+  drift::DriftOptions o;
+  o.mode = drift::ModeFromString(a.mode);
+  o.method = method;
+  o.decomposition.method = decomposition::MethodFromString(a.decomposition);
+  o.decomposition.ensemble_size = a.ensemble;
+  o.seed = a.seed;
+  o.threads = a.threads;
+  const int p = AutoOrInteger("--lags", a.lags, 1, 256);
+  o.auto_lags = p < 0;
+  if (p > 0) o.features.lags = p;
+  const int hidden = AutoOrInteger("--hidden", a.hidden, 1, 100000);
+  if (hidden > 0) {
+    o.learner.elm.selection = elm::Selection::kFixed;
+    o.learner.elm.hidden_units = hidden;
+  }
+  if (o.mode == drift::Mode::kCompensate && a.temperature.empty()) {
+    throw UsageError(
+        "--mode compensate needs --temperature COL (the compensation model runs on temperature "
+        "alone)");
+  }
+  o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
+  if (a.rate_option != nullptr && a.rate_option->count() > 0) o.features.rate_hz = a.rate_hz;
+  o.Validate();
+  return o;
+}
+
+double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string* how) {
+  if (a.rate_option != nullptr && a.rate_option->count() > 0) {
+    *how = "given";
+    return a.rate_hz;
+  }
+  if (!table.HasColumn("time_s") || table.rows() < 2) {
+    *how = "default";
+    return 1.0;
+  }
+  const Eigen::VectorXd t = table.Column("time_s");
+  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
+  const size_t mid = steps.size() / 2;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
+  double median = steps[mid];
+  if (steps.size() % 2 == 0) {
+    const double below =
+        *std::max_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid));
+    median = 0.5 * (median + below);
+  }
+  if (!(median > 0.0)) {
+    throw DataError(table.source() + ": column 'time_s' has a median step of " +
+                    FormatValue(median) +
+                    " s: it must increase to give the sample rate (or pass --rate-hz)");
+  }
+  *how = "time_s";
+  return 1.0 / median;
+}
+
+std::string ColumnName(const io::CsvTable& table, const std::string& spec) {
+  return table.header()[static_cast<size_t>(table.ResolveColumn(spec))];
+}
+
+void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table) {
+  auto require = [&](const std::string& column, const char* option) {
+    if (table.HasColumn(column)) return;
+    throw DataError("model needs column '" + column + "' (trained with " + option + " " + column +
+                    "); " + table.source() + " has: " + Columns(table));
+  };
+  require(loaded.info.target_column, "--target");
+  if (loaded.model.uses_temperature()) require(loaded.info.temperature_column, "--temperature");
+}
+
+ProgressLine::ProgressLine(bool enabled)
+    : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
+
+void ProgressLine::Update(double fraction, const std::string& label) {
+  if (!enabled_) return;
+  constexpr int kWidth = 20;
+  fraction = std::clamp(fraction, 0.0, 1.0);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const int filled = static_cast<int>(fraction * kWidth + 0.5);
+  std::string line = "\r[" + std::string(static_cast<size_t>(filled), '#') +
+                     std::string(static_cast<size_t>(kWidth - filled), ' ') + "] " +
+                     fmt::format("{:3.0f}% {}  elapsed {:.0f}s", 100.0 * fraction, label, elapsed);
+  if (fraction > 0.0) line += fmt::format("  left {:.0f}s", elapsed * (1.0 - fraction) / fraction);
+  // Pad so a shorter line overwrites the previous one completely.
+  fmt::print(stderr, "{:<100}", line);
+  std::fflush(stderr);
+  shown_ = true;
+}
+
+void ProgressLine::Finish() {
+  if (shown_) fmt::print(stderr, "\n");
+  shown_ = false;
+}
+
+}  // namespace gyrodrift::cli

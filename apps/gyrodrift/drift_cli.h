@@ -1,0 +1,72 @@
+// Option plumbing shared by the drift-model subcommands (fit, predict, compensate, evaluate): the
+// model options fit and evaluate take, the sample-rate rule, the column checks a saved model
+// needs, and the terminal progress line.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/model_file.h"
+
+namespace gyrodrift::cli {
+
+// Options fit and evaluate share. Defaults are those of drift::DriftOptions.
+struct DriftArgs {
+  std::string input;
+  std::string target;
+  std::string temperature;  // "" = none
+  std::string mode;
+  std::string decomposition = "beemdan";
+  std::string lags = "4";       // "auto" or p
+  std::string hidden = "auto";  // "auto" or L
+  double rate_hz = 1.0;
+  CLI::Option* rate_option = nullptr;  // to tell "--rate-hz given" from the default
+  int ensemble = 100;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  bool quiet = false;
+};
+
+// CLI11 validator for 64-bit seeds (CLI11 2.1 would wrap "-1" to 2^64 - 1 silently).
+extern const CLI::Validator kSeed;
+
+// Adds input, --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
+// --ensemble, --seed, --threads and --quiet to cmd.
+void AddDriftOptions(CLI::App* cmd, DriftArgs* args);
+
+// DriftOptions from the arguments (method = `method`), before any file is read; the sample rate
+// is settled later by ResolveRateHz. Throws UsageError naming the option.
+drift::DriftOptions MakeDriftOptions(const DriftArgs& args, drift::Method method);
+
+// --rate-hz if given; else 1 / (median step of a `time_s` column) if the file has one; else 1.
+// `how` receives "given", "time_s" or "default". Throws DataError on a time_s column whose
+// median step is not positive.
+double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::string* how);
+
+// Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
+std::string ColumnName(const io::CsvTable& table, const std::string& spec);
+
+// Throws DataError "model needs column 'X' (trained with --target X); IN.csv has: a, b" unless
+// the table has the model's target column and, when the model uses it, its temperature column.
+void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);
+
+// The one-line progress display on stderr, shown only when stderr is a terminal and the command
+// is not quiet: "\r[####      ] 40% label  elapsed 12s  left 18s".
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled);
+  void Update(double fraction, const std::string& label);
+  void Finish();  // ends the line (if anything was shown)
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace gyrodrift::cli

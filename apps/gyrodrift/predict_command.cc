@@ -1,0 +1,131 @@
+// gyrodrift predict: one-step-ahead predictions of a saved predict-mode model on a CSV log.
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cli_util.h"
+#include "command.h"
+#include "drift_cli.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+
+namespace gyrodrift::cli {
+namespace {
+
+struct PredictArgs {
+  std::string model;
+  std::string input;
+  std::string output;
+  std::string protocol = "causal";
+  int window = 512;
+  int threads = 0;
+  bool quiet = false;
+};
+
+void Run(const PredictArgs& a) {
+  const drift::Protocol protocol = drift::ProtocolFromString(a.protocol);
+  if (a.window < 16 || a.window > 1000000) {
+    ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
+  }
+  if (a.threads < 0 || a.threads > 1024) {
+    ThrowOption("--threads", std::to_string(a.threads), "an integer in [0, 1024] (0 = all cores)");
+  }
+  io::LoadedModel loaded = io::ReadModelFile(a.model);
+  drift::DriftModel& model = loaded.model;
+  if (model.options.mode != drift::Mode::kPredict) {
+    throw UsageError(a.model +
+                     " is a compensate-mode model: use 'gyrodrift compensate' (predict "
+                     "needs a model fitted with --mode predict)");
+  }
+  model.options.threads = a.threads;  // the thread count never changes the result
+
+  const io::CsvTable table = io::CsvTable::Read(a.input);
+  RequireModelColumns(loaded, table);
+  const Eigen::VectorXd y = table.Column(loaded.info.target_column);
+  Eigen::VectorXd temperature;
+  if (model.uses_temperature()) temperature = table.Column(loaded.info.temperature_column);
+  // The first sample with enough history: p lags, and under the causal protocol a window long
+  // enough to decompose.
+  const bool decomposes = drift::UsesDecomposition(model.options.method);
+  const Eigen::Index first = protocol == drift::Protocol::kCausal && decomposes
+                                 ? std::max<Eigen::Index>(model.lags, 16)
+                                 : model.lags;
+  if (y.size() <= first) {
+    throw DataError(a.input + " has " + std::to_string(y.size()) +
+                    " samples: the model needs more than " + std::to_string(first) +
+                    " (its history) to predict any");
+  }
+  const Eigen::VectorXd prediction = drift::PredictOneStep(
+      model, y, temperature, first, protocol, drift::CausalOptions{a.window, a.threads});
+
+  const Eigen::Index count = y.size() - first;
+  std::vector<io::CsvColumn> columns;
+  columns.push_back({"sample", Eigen::VectorXd::LinSpaced(count, static_cast<double>(first + 1),
+                                                          static_cast<double>(y.size()))});
+  if (table.HasColumn("time_s")) columns.push_back({"time_s", table.Column("time_s").tail(count)});
+  columns.push_back({"prediction", prediction});
+
+  nlohmann::json sidecar = SidecarHeader("predict");
+  sidecar["options"] = {{"model", a.model},
+                        {"input", a.input},
+                        {"protocol", a.protocol},
+                        {"window", a.window},
+                        {"threads", a.threads}};
+  sidecar["model"] = {{"summary", model.Summary()},
+                      {"method", drift::ToString(model.options.method)},
+                      {"target_column", loaded.info.target_column},
+                      {"temperature_column", loaded.info.temperature_column},
+                      {"lags", model.lags},
+                      {"seed", model.options.seed},
+                      {"tool_version", loaded.info.tool_version}};
+  sidecar["samples"] = y.size();
+  sidecar["first_predicted_sample"] = first + 1;
+  sidecar["predicted"] = count;
+  io::WriteFilesAtomically(
+      {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
+  if (!a.quiet) {
+    fmt::print("{}\npredicted samples {}..{} ({} protocol)\nwrote {} and {}\n", model.Summary(),
+               first + 1, y.size(), a.protocol, a.output, SidecarPath(a.output));
+  }
+}
+
+const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
+  auto args = std::make_shared<PredictArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "predict", "One-step-ahead predictions of a saved predict-mode model on a log.");
+  cmd->footer(
+      "Example:\n"
+      "  gyrodrift fit train.csv --target rate_dph --mode predict --lags 4 -o model.json\n"
+      "  gyrodrift predict model.json test.csv --protocol causal --window 512 -o pred.csv\n"
+      "writes pred.csv with columns sample (1-based row of test.csv), time_s (if test.csv has\n"
+      "it) and prediction, one row per predicted sample: rows before the model has its p lags\n"
+      "of history (and, for ms-elm/emd-elm under the causal protocol, 16 samples to decompose)\n"
+      "are left out. causal (default): the sub-series at t come from decomposing only the\n"
+      "trailing window y[t-W..t-1], what a running system can do. paper: the whole file is\n"
+      "decomposed once, so predictions see future samples (the literature's protocol, for\n"
+      "comparison only). pred.csv.json records the options and the model.");
+  cmd->add_option("model", args->model, "model file written by 'gyrodrift fit'")
+      ->required()
+      ->check(kInputFile);
+  cmd->add_option("input", args->input, "CSV log with the model's target (and temperature) column")
+      ->required()
+      ->check(kInputFile);
+  cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
+      ->required();
+  cmd->add_option("--protocol", args->protocol, "causal|paper")->capture_default_str();
+  cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
+      ->capture_default_str();
+  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+      ->capture_default_str();
+  cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
+  cmd->callback([args] { Run(*args); });
+});
+
+}  // namespace
+}  // namespace gyrodrift::cli

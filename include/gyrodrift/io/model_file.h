@@ -1,0 +1,72 @@
+// Model files: a fitted drift::DriftModel saved as JSON and read back with predictions identical
+// to the bit.
+//
+// Layout (format "gyrodrift-model", format_version 1; every field required on reading):
+//   format, format_version, tool_version
+//   training   target_column, temperature_column ("" if none), samples, source (informative)
+//   options    every field of drift::DriftOptions (mode, method, decomposition with its sifting
+//              rule, selection with its KDE and Monte-Carlo settings, features with the thermal
+//              time constants and rate_hz, learner, lag candidates, seed, threads); enums as the
+//              strings their ToString() gives
+//   model      lags, training_imfs, training_samples, the training reports, lag validation RMSE,
+//              and sub_models: name, imfs, has_residue, learner (null for the zero sub-model of
+//              the noise group in compensate mode) = {kind, arrays, scalars, texts}, each array
+//              {rows, cols, data} with data column-major
+//   checksum   "fnv1a64:<16 hex digits>" of the compact dump of everything else
+// Doubles: nlohmann/json prints the shortest decimal that reads back to the same double and parses
+// with correct rounding, so finite values survive exactly; NaN and +-infinity, which JSON lacks,
+// are written as the strings "nan", "inf", "-inf". Seeds are unsigned 64-bit integers.
+// The checksum is FNV-1a 64 (Fowler, Noll & Vo), over the compact, key-sorted dump, so a damaged
+// or hand-edited number is caught before anything is used; it guards against accidents, not
+// against forgery.
+// Errors: an unreadable or unwritable file -> IoError; anything wrong inside (not JSON, another
+// format or version, checksum mismatch, a missing field, a wrong type or shape, options out of
+// range, learner parameters that do not rebuild) -> DataError naming the file and the field.
+// Cost: linear in the number of stored parameters.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+
+#include "gyrodrift/drift/drift_model.h"
+
+namespace gyrodrift::io {
+
+inline constexpr std::string_view kModelFormat = "gyrodrift-model";
+inline constexpr int kModelFormatVersion = 1;
+
+// What the model was trained on, beside the model itself.
+struct ModelFileInfo {
+  std::string target_column;       // CSV column of the gyro output the model was fitted on
+  std::string temperature_column;  // CSV column of the temperature, "" when the model has none
+  std::string source;              // training file, informative only
+  std::string tool_version;        // ignored on writing (the running version is written)
+};
+
+struct LoadedModel {
+  drift::DriftModel model;
+  ModelFileInfo info;
+};
+
+// Renders / writes a model file. Throws UsageError when the model cannot be stored (options that
+// hold supplied decomposition noise, a predict-mode sub-model without a learner), IoError when the
+// file cannot be written (atomically: nothing partial is left).
+std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info);
+void WriteModelFile(const std::string& path, const drift::DriftModel& model,
+                    const ModelFileInfo& info);
+
+// Parses / reads a model file; `source` names it in messages. Throws DataError / IoError.
+LoadedModel ParseModelFile(const std::string& text, const std::string& source);
+LoadedModel ReadModelFile(const std::string& path);
+
+// Every option of a DriftOptions as JSON (the "options" object of a model file); used by the CLI
+// sidecars too. DriftOptionsFromJson reads it back (DataError naming a missing or bad field).
+nlohmann::json DriftOptionsToJson(const drift::DriftOptions& options);
+drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::string& source);
+
+// FNV-1a 64 of the bytes of text.
+std::uint64_t Fnv1a64(std::string_view text);
+
+}  // namespace gyrodrift::io

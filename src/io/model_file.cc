@@ -1,0 +1,573 @@
+#include "gyrodrift/io/model_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/version.h"
+#include "gyrodrift/io/files.h"
+
+namespace gyrodrift::io {
+namespace {
+
+using nlohmann::json;
+namespace dec = gyrodrift::decomposition;
+namespace sel = gyrodrift::selection;
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+json Number(double v) {
+  if (std::isfinite(v)) return v;
+  if (std::isnan(v)) return "nan";
+  return v > 0 ? "inf" : "-inf";
+}
+
+json Numbers(const std::vector<double>& values) {
+  json out = json::array();
+  for (double v : values) out.push_back(Number(v));
+  return out;
+}
+
+json Array(const Eigen::MatrixXd& m) {
+  json data = json::array();
+  // Eigen's default storage is column-major, so data() walks the documented order.
+  for (Eigen::Index i = 0; i < m.size(); ++i) data.push_back(Number(m.data()[i]));
+  return {{"rows", m.rows()}, {"cols", m.cols()}, {"data", std::move(data)}};
+}
+
+json SiftingJson(const dec::SiftingOptions& s) {
+  return {{"stop_rule", dec::ToString(s.stop_rule)},
+          {"rilling_threshold1", Number(s.rilling_threshold1)},
+          {"rilling_threshold2", Number(s.rilling_threshold2)},
+          {"rilling_tolerance", Number(s.rilling_tolerance)},
+          {"s_number", s.s_number},
+          {"fixed_sifts", s.fixed_sifts},
+          {"sd_threshold", Number(s.sd_threshold)},
+          {"max_sifts", s.max_sifts}};
+}
+
+json DecompositionJson(const dec::DecompositionOptions& o) {
+  return {{"method", dec::ToString(o.method)},
+          {"sifting", SiftingJson(o.sifting)},
+          {"max_imfs", o.max_imfs},
+          {"ensemble_size", o.ensemble_size},
+          {"noise_strength", Number(o.noise_strength)},
+          {"seed", o.seed},
+          {"threads", o.threads},
+          {"noise_scaling", dec::ToString(o.noise_scaling)},
+          {"beemdan_bound", dec::ToString(o.beemdan_bound)},
+          {"band_confidence", Number(o.band_confidence)},
+          {"noise_stages", o.noise_stages}};
+}
+
+json SelectionJson(const sel::SelectionOptions& o) {
+  const sel::KdeOptions& k = o.kde;
+  const sel::MonteCarloOptions& m = o.monte_carlo;
+  return {{"criterion", sel::ToString(o.criterion)},
+          {"distance", sel::ToString(o.distance)},
+          {"kde",
+           {{"grid_points", k.grid_points},
+            {"points_per_bandwidth", Number(k.points_per_bandwidth)},
+            {"max_grid_points", k.max_grid_points},
+            {"bandwidth_scale", Number(k.bandwidth_scale)},
+            {"padding_bandwidths", Number(k.padding_bandwidths)},
+            {"method", sel::ToString(k.method)}}},
+          {"center_signal", o.center_signal},
+          {"monte_carlo",
+           {{"realisations", m.realisations},
+            {"confidence", Number(m.confidence)},
+            {"seed", m.seed},
+            {"threads", m.threads},
+            {"sifting", SiftingJson(m.sifting)},
+            {"max_imfs", m.max_imfs}}},
+          // A precomputed level only shortens the fit; the model does not need it afterwards.
+          {"precomputed_noise_level", o.noise_level != nullptr},
+          {"band_confidence", Number(o.band_confidence)},
+          {"threads", o.threads}};
+}
+
+json LearnerOptionsJson(const drift::LearnerOptions& l) {
+  const elm::ElmOptions& e = l.elm;
+  return {{"kind", drift::ToString(l.kind)},
+          {"elm",
+           {{"hidden_units", e.hidden_units},
+            {"activation", elm::ToString(e.activation)},
+            {"ridge_c", Number(e.ridge_c)},
+            {"solver", elm::ToString(e.solver)},
+            {"selection", elm::ToString(e.selection)},
+            {"hidden_unit_candidates", e.hidden_unit_candidates},
+            {"ridge_c_candidates", Numbers(e.ridge_c_candidates)},
+            {"max_condition", Number(e.max_condition)},
+            {"standardize_inputs", e.standardize_inputs},
+            {"standardize_targets", e.standardize_targets},
+            {"seed", e.seed},
+            {"threads", e.threads}}},
+          {"poly_degree", l.poly_degree},
+          {"poly_ridge", Number(l.poly_ridge)},
+          {"svr_c", Number(l.svr_c)},
+          {"svr_epsilon", Number(l.svr_epsilon)},
+          {"svr_gamma", Number(l.svr_gamma)},
+          {"svr_max_rows", l.svr_max_rows},
+          {"bp_hidden", l.bp_hidden},
+          {"bp_epochs", l.bp_epochs},
+          {"bp_desired_mse", Number(l.bp_desired_mse)},
+          {"seed", l.seed},
+          {"threads", l.threads}};
+}
+
+json LearnerJson(const drift::Learner& learner) {
+  const drift::Parameters p = learner.Save();
+  json arrays = json::object(), scalars = json::object(), texts = json::object();
+  for (const auto& [name, m] : p.arrays) arrays[name] = Array(m);
+  for (const auto& [name, v] : p.scalars) scalars[name] = Number(v);
+  for (const auto& [name, t] : p.texts) texts[name] = t;
+  return {{"kind", drift::ToString(learner.kind())},
+          {"arrays", std::move(arrays)},
+          {"scalars", std::move(scalars)},
+          {"texts", std::move(texts)}};
+}
+
+json ModelJson(const drift::DriftModel& model) {
+  json subs = json::array();
+  for (const auto& sub : model.sub_models) {
+    if (!sub.learner && model.options.mode == drift::Mode::kPredict) {
+      throw UsageError("sub-model '" + sub.name +
+                       "' has no learner: a predict-mode model needs one per sub-model");
+    }
+    subs.push_back({{"name", sub.name},
+                    {"imfs", sub.imfs},
+                    {"has_residue", sub.has_residue},
+                    {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)}});
+  }
+  return {{"lags", model.lags},
+          {"training_imfs", model.training_imfs},
+          {"training_samples", model.training_samples},
+          {"decomposition_summary", model.decomposition_summary},
+          {"selection_summary", model.selection_summary},
+          {"lag_validation_rmse", Numbers(model.lag_validation_rmse)},
+          {"sub_models", std::move(subs)}};
+}
+
+std::string Hex64(std::uint64_t v) {
+  char buffer[17];
+  std::snprintf(buffer, sizeof(buffer), "%016llx", static_cast<unsigned long long>(v));
+  return buffer;
+}
+
+// The text the checksum covers: compact, keys sorted (nlohmann objects are ordered maps), and
+// invalid UTF-8 in names replaced the same way on writing and reading.
+std::string Canonical(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+std::string ChecksumText(const json& without_checksum) {
+  return "fnv1a64:" + Hex64(Fnv1a64(Canonical(without_checksum)));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading: every access names the file and the dotted path of the field.
+
+class Node {
+ public:
+  Node(const json& j, std::string path, const std::string& source)
+      : j_(j), path_(std::move(path)), source_(source) {}
+
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw DataError(source_ + ": field '" + path_ + "' " + what);
+  }
+
+  Node operator[](const std::string& key) const {
+    if (!j_.is_object()) Fail("must be an object (found " + std::string(j_.type_name()) + ")");
+    const auto it = j_.find(key);
+    const std::string path = path_.empty() ? key : path_ + "." + key;
+    if (it == j_.end()) throw DataError(source_ + ": field '" + path + "' is missing");
+    return Node(*it, path, source_);
+  }
+
+  bool IsNull() const { return j_.is_null(); }
+  const json& raw() const { return j_; }
+
+  double Double() const {
+    if (j_.is_number()) return j_.get<double>();
+    if (j_.is_string()) {
+      const std::string& s = j_.get_ref<const std::string&>();
+      if (s == "nan") return std::numeric_limits<double>::quiet_NaN();
+      if (s == "inf") return std::numeric_limits<double>::infinity();
+      if (s == "-inf") return -std::numeric_limits<double>::infinity();
+    }
+    Fail("must be a number (found " + Found() + ")");
+  }
+
+  long long Int(long long lo, long long hi) const {
+    if (!j_.is_number_integer()) Fail("must be an integer (found " + Found() + ")");
+    if (j_.is_number_unsigned() && j_.get<std::uint64_t>() > static_cast<std::uint64_t>(hi)) {
+      Fail("= " + j_.dump() + ": must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+           "]");
+    }
+    const long long v = j_.get<long long>();
+    if (v < lo || v > hi) {
+      Fail("= " + std::to_string(v) + ": must be in [" + std::to_string(lo) + ", " +
+           std::to_string(hi) + "]");
+    }
+    return v;
+  }
+  int Int() const {
+    return static_cast<int>(Int(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+  }
+
+  std::uint64_t U64() const {
+    if (!j_.is_number_unsigned()) Fail("must be an unsigned integer (found " + Found() + ")");
+    return j_.get<std::uint64_t>();
+  }
+
+  bool Bool() const {
+    if (!j_.is_boolean()) Fail("must be true or false (found " + Found() + ")");
+    return j_.get<bool>();
+  }
+
+  std::string String() const {
+    if (!j_.is_string()) Fail("must be a string (found " + Found() + ")");
+    return j_.get<std::string>();
+  }
+
+  std::vector<Node> Items() const {
+    if (!j_.is_array()) Fail("must be an array (found " + Found() + ")");
+    std::vector<Node> items;
+    for (size_t i = 0; i < j_.size(); ++i) {
+      items.emplace_back(j_[i], path_ + "[" + std::to_string(i) + "]", source_);
+    }
+    return items;
+  }
+
+  std::vector<int> Ints() const {
+    std::vector<int> out;
+    for (const Node& n : Items()) out.push_back(n.Int());
+    return out;
+  }
+  std::vector<double> Doubles() const {
+    std::vector<double> out;
+    for (const Node& n : Items()) out.push_back(n.Double());
+    return out;
+  }
+
+  // An enum through its FromString, whose UsageError becomes a DataError naming the field.
+  template <class F>
+  auto Enum(F from_string) const -> decltype(from_string(std::string_view())) {
+    const std::string text = String();
+    try {
+      return from_string(text);
+    } catch (const UsageError& e) {
+      Fail("= '" + text + "' is not understood (" + e.what() + ")");
+    }
+  }
+
+  Eigen::MatrixXd Matrix() const {
+    const long long max_size = 1LL << 31;
+    const long long rows = (*this)["rows"].Int(0, max_size);
+    const long long cols = (*this)["cols"].Int(0, max_size);
+    const std::vector<Node> data = (*this)["data"].Items();
+    if (static_cast<long long>(data.size()) != rows * cols) {
+      Fail("has " + std::to_string(data.size()) + " values for a " + std::to_string(rows) + " x " +
+           std::to_string(cols) + " array (rows * cols expected)");
+    }
+    Eigen::MatrixXd m(rows, cols);
+    for (size_t i = 0; i < data.size(); ++i) m.data()[i] = data[i].Double();
+    return m;
+  }
+
+ private:
+  std::string Found() const {
+    if (j_.is_string()) return "\"" + j_.get<std::string>() + "\"";
+    if (j_.is_number() || j_.is_boolean() || j_.is_null()) return j_.dump();
+    return j_.type_name();
+  }
+
+  const json& j_;
+  std::string path_;
+  const std::string& source_;
+};
+
+dec::SiftingOptions ReadSifting(const Node& n) {
+  dec::SiftingOptions s;
+  s.stop_rule = n["stop_rule"].Enum(dec::StopRuleFromString);
+  s.rilling_threshold1 = n["rilling_threshold1"].Double();
+  s.rilling_threshold2 = n["rilling_threshold2"].Double();
+  s.rilling_tolerance = n["rilling_tolerance"].Double();
+  s.s_number = n["s_number"].Int();
+  s.fixed_sifts = n["fixed_sifts"].Int();
+  s.sd_threshold = n["sd_threshold"].Double();
+  s.max_sifts = n["max_sifts"].Int();
+  return s;
+}
+
+dec::DecompositionOptions ReadDecomposition(const Node& n) {
+  dec::DecompositionOptions o;
+  o.method = n["method"].Enum(dec::MethodFromString);
+  o.sifting = ReadSifting(n["sifting"]);
+  o.max_imfs = n["max_imfs"].Int();
+  o.ensemble_size = n["ensemble_size"].Int();
+  o.noise_strength = n["noise_strength"].Double();
+  o.seed = n["seed"].U64();
+  o.threads = n["threads"].Int();
+  o.noise_scaling = n["noise_scaling"].Enum(dec::NoiseScalingFromString);
+  o.beemdan_bound = n["beemdan_bound"].Enum(dec::BeemdanBoundFromString);
+  o.band_confidence = n["band_confidence"].Double();
+  o.noise_stages = n["noise_stages"].Int();
+  return o;
+}
+
+sel::SelectionOptions ReadSelection(const Node& n) {
+  sel::SelectionOptions o;
+  o.criterion = n["criterion"].Enum(sel::CriterionFromString);
+  o.distance = n["distance"].Enum(sel::PdfDistanceFromString);
+  const Node k = n["kde"];
+  o.kde.grid_points = k["grid_points"].Int();
+  o.kde.points_per_bandwidth = k["points_per_bandwidth"].Double();
+  o.kde.max_grid_points = k["max_grid_points"].Int();
+  o.kde.bandwidth_scale = k["bandwidth_scale"].Double();
+  o.kde.padding_bandwidths = k["padding_bandwidths"].Double();
+  o.kde.method = k["method"].Enum(sel::KdeMethodFromString);
+  o.center_signal = n["center_signal"].Bool();
+  const Node m = n["monte_carlo"];
+  o.monte_carlo.realisations = m["realisations"].Int();
+  o.monte_carlo.confidence = m["confidence"].Double();
+  o.monte_carlo.seed = m["seed"].U64();
+  o.monte_carlo.threads = m["threads"].Int();
+  o.monte_carlo.sifting = ReadSifting(m["sifting"]);
+  o.monte_carlo.max_imfs = m["max_imfs"].Int();
+  n["precomputed_noise_level"].Bool();  // provenance only; the level is not stored
+  o.band_confidence = n["band_confidence"].Double();
+  o.threads = n["threads"].Int();
+  return o;
+}
+
+drift::LearnerOptions ReadLearnerOptions(const Node& n) {
+  drift::LearnerOptions l;
+  l.kind = n["kind"].Enum(drift::LearnerKindFromString);
+  const Node e = n["elm"];
+  l.elm.hidden_units = e["hidden_units"].Int();
+  l.elm.activation = e["activation"].Enum(elm::ActivationFromString);
+  l.elm.ridge_c = e["ridge_c"].Double();
+  l.elm.solver = e["solver"].Enum(elm::SolverFromString);
+  l.elm.selection = e["selection"].Enum(elm::SelectionFromString);
+  l.elm.hidden_unit_candidates = e["hidden_unit_candidates"].Ints();
+  l.elm.ridge_c_candidates = e["ridge_c_candidates"].Doubles();
+  l.elm.max_condition = e["max_condition"].Double();
+  l.elm.standardize_inputs = e["standardize_inputs"].Bool();
+  l.elm.standardize_targets = e["standardize_targets"].Bool();
+  l.elm.seed = e["seed"].U64();
+  l.elm.threads = e["threads"].Int();
+  l.poly_degree = n["poly_degree"].Int();
+  l.poly_ridge = n["poly_ridge"].Double();
+  l.svr_c = n["svr_c"].Double();
+  l.svr_epsilon = n["svr_epsilon"].Double();
+  l.svr_gamma = n["svr_gamma"].Double();
+  l.svr_max_rows = n["svr_max_rows"].Int();
+  l.bp_hidden = n["bp_hidden"].Ints();
+  l.bp_epochs = n["bp_epochs"].Int();
+  l.bp_desired_mse = n["bp_desired_mse"].Double();
+  l.seed = n["seed"].U64();
+  l.threads = n["threads"].Int();
+  return l;
+}
+
+drift::DriftOptions ReadOptions(const Node& n) {
+  drift::DriftOptions o;
+  o.mode = n["mode"].Enum(drift::ModeFromString);
+  o.method = n["method"].Enum(drift::MethodFromString);
+  o.decomposition = ReadDecomposition(n["decomposition"]);
+  o.selection = ReadSelection(n["selection"]);
+  const Node f = n["features"];
+  o.features.lags = f["lags"].Int();
+  o.features.use_temperature = f["use_temperature"].Bool();
+  o.features.time_constants_s = f["time_constants_s"].Doubles();
+  o.features.rate_hz = f["rate_hz"].Double();
+  o.learner = ReadLearnerOptions(n["learner"]);
+  o.auto_lags = n["auto_lags"].Bool();
+  o.lag_candidates = n["lag_candidates"].Ints();
+  o.validation_fraction = n["validation_fraction"].Double();
+  o.seed = n["seed"].U64();
+  o.threads = n["threads"].Int();
+  try {
+    o.Validate();
+  } catch (const UsageError& e) {
+    n.Fail("holds an invalid option: " + std::string(e.what()));
+  }
+  return o;
+}
+
+std::shared_ptr<const drift::Learner> ReadLearner(const Node& n, const std::string& sub_name) {
+  const drift::LearnerKind kind = n["kind"].Enum(drift::LearnerKindFromString);
+  for (const char* key : {"arrays", "scalars", "texts"}) {
+    if (!n[key].raw().is_object()) n[key].Fail("must be an object");
+  }
+  drift::Parameters p;
+  for (const auto& [name, value] : n["arrays"].raw().items()) {
+    p.arrays[name] = n["arrays"][name].Matrix();
+  }
+  for (const auto& [name, value] : n["scalars"].raw().items()) {
+    p.scalars[name] = n["scalars"][name].Double();
+  }
+  for (const auto& [name, value] : n["texts"].raw().items()) {
+    p.texts[name] = n["texts"][name].String();
+  }
+  try {
+    return drift::LoadLearner(kind, p);
+  } catch (const Error& e) {
+    n.Fail("(learner of sub-model '" + sub_name + "') does not rebuild: " + e.what());
+  }
+}
+
+drift::DriftModel ReadModel(const Node& root) {
+  drift::DriftModel model;
+  model.options = ReadOptions(root["options"]);
+  const Node m = root["model"];
+  model.lags = m["lags"].Int();
+  model.training_imfs = m["training_imfs"].Int();
+  model.training_samples = static_cast<Eigen::Index>(m["training_samples"].Int(0, 1LL << 40));
+  model.decomposition_summary = m["decomposition_summary"].String();
+  model.selection_summary = m["selection_summary"].String();
+  model.lag_validation_rmse = m["lag_validation_rmse"].Doubles();
+  const bool predict = model.options.mode == drift::Mode::kPredict;
+  if (predict && (model.lags < 1 || model.lags > 256)) {
+    m["lags"].Fail("= " + std::to_string(model.lags) +
+                   ": a predict-mode model needs 1 to 256 lags");
+  }
+  const std::vector<Node> subs = m["sub_models"].Items();
+  if (subs.empty()) m["sub_models"].Fail("is empty: a model needs at least one sub-model");
+  for (const Node& s : subs) {
+    drift::SubModel sub;
+    sub.name = s["name"].String();
+    sub.imfs = s["imfs"].Ints();
+    for (int k : sub.imfs) {
+      if (k < 1) s["imfs"].Fail("holds IMF " + std::to_string(k) + ": IMF indices start at 1");
+    }
+    sub.has_residue = s["has_residue"].Bool();
+    const Node learner = s["learner"];
+    if (learner.IsNull()) {
+      if (predict) learner.Fail("is null: a predict-mode sub-model needs a learner");
+    } else {
+      sub.learner = ReadLearner(learner, sub.name);
+      if (sub.learner->num_inputs() != model.num_inputs()) {
+        learner.Fail("takes " + std::to_string(sub.learner->num_inputs()) +
+                     " inputs, the model's options give " + std::to_string(model.num_inputs()));
+      }
+    }
+    model.sub_models.push_back(std::move(sub));
+  }
+  return model;
+}
+
+}  // namespace
+
+std::uint64_t Fnv1a64(std::string_view text) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
+  const drift::FeatureOptions& f = o.features;
+  return {{"mode", drift::ToString(o.mode)},
+          {"method", drift::ToString(o.method)},
+          {"decomposition", DecompositionJson(o.decomposition)},
+          {"selection", SelectionJson(o.selection)},
+          {"features",
+           {{"lags", f.lags},
+            {"use_temperature", f.use_temperature},
+            {"time_constants_s", Numbers(f.time_constants_s)},
+            {"rate_hz", Number(f.rate_hz)}}},
+          {"learner", LearnerOptionsJson(o.learner)},
+          {"auto_lags", o.auto_lags},
+          {"lag_candidates", o.lag_candidates},
+          {"validation_fraction", Number(o.validation_fraction)},
+          {"seed", o.seed},
+          {"threads", o.threads}};
+}
+
+drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::string& source) {
+  return ReadOptions(Node(json, "options", source));
+}
+
+std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info) {
+  if (model.options.decomposition.supplied_noise) {
+    throw UsageError(
+        "model options hold supplied decomposition noise, which a model file cannot store; fit "
+        "with drawn noise (a seed) to save the model");
+  }
+  json j = {{"format", kModelFormat},
+            {"format_version", kModelFormatVersion},
+            {"tool_version", kVersion},
+            {"training",
+             {{"target_column", info.target_column},
+              {"temperature_column", info.temperature_column},
+              {"samples", model.training_samples},
+              {"source", info.source}}},
+            {"options", DriftOptionsToJson(model.options)},
+            {"model", ModelJson(model)}};
+  j["checksum"] = ChecksumText(j);
+  return j.dump(1, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+void WriteModelFile(const std::string& path, const drift::DriftModel& model,
+                    const ModelFileInfo& info) {
+  WriteFileAtomically(path, RenderModelFile(model, info));
+}
+
+LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw DataError(source + ": not a gyrodrift model file (not valid JSON: byte " +
+                    std::to_string(e.byte) + ")");
+  }
+  if (!j.is_object() || !j.contains("format") || !j["format"].is_string() ||
+      j["format"].get<std::string>() != kModelFormat) {
+    throw DataError(source + ": not a gyrodrift model file (\"format\" must be \"" +
+                    std::string(kModelFormat) + "\")");
+  }
+  const Node root(j, "", source);
+  const long long version = root["format_version"].Int(0, std::numeric_limits<int>::max());
+  if (version != kModelFormatVersion) {
+    throw DataError(source + ": model format_version " + std::to_string(version) +
+                    " is not supported (this gyrodrift reads version " +
+                    std::to_string(kModelFormatVersion) + ")");
+  }
+  const std::string stored = root["checksum"].String();
+  json body = j;
+  body.erase("checksum");
+  const std::string computed = ChecksumText(body);
+  if (stored != computed) {
+    throw DataError(source + ": checksum mismatch (file says " + stored + ", content gives " +
+                    computed + "): the model file is damaged or was edited");
+  }
+  LoadedModel out;
+  out.info.tool_version = root["tool_version"].String();
+  const Node training = root["training"];
+  out.info.target_column = training["target_column"].String();
+  out.info.temperature_column = training["temperature_column"].String();
+  out.info.source = training["source"].String();
+  out.model = ReadModel(root);
+  if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
+    training["samples"].Fail("differs from model.training_samples");
+  }
+  if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
+    training["temperature_column"].Fail("is empty but the model uses temperature");
+  }
+  return out;
+}
+
+LoadedModel ReadModelFile(const std::string& path) {
+  return ParseModelFile(ReadTextFile(path), path);
+}
+
+}  // namespace gyrodrift::io

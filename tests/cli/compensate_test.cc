@@ -1,0 +1,153 @@
+// gyrodrift compensate, run as a user would: the output columns, identity with the library, that
+// compensation removes drift on a new log, and every bad-input case.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+#include "support/test_support.h"
+
+namespace gyrodrift {
+namespace {
+
+// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
+std::string LogCsv(int n, std::uint64_t seed) {
+  Rng rng(seed, 0);
+  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
+  double lagged = 20.0;
+  for (int t = 0; t < n; ++t) {
+    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
+    const double previous = lagged;
+    lagged += (temperature - lagged) / 40.0;
+    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
+           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
+  }
+  return csv;
+}
+
+double Rms(const Eigen::VectorXd& v) {
+  return std::sqrt(v.squaredNorm() / static_cast<double>(v.size()));
+}
+
+class CompensateCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(test::TempDir("cli_compensate"));
+    io::WriteFileAtomically(Dir() + "/train.csv", LogCsv(600, 1));
+    io::WriteFileAtomically(Dir() + "/test.csv", LogCsv(600, 2));  // same programme, new noise
+    const std::string fit = "fit '" + Dir() + "/train.csv' -t rate_dph -T temperature_c -I 10 -q ";
+    ASSERT_EQ(test::RunCli(fit + "--mode compensate -o '" + Dir() + "/ms.json'").exit_code, 0);
+    ASSERT_EQ(test::RunCli(fit + "--mode predict -m elm -o '" + Dir() + "/pred.json'").exit_code,
+              0);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static const std::string& Dir() { return *dir_; }
+  static std::string* dir_;
+};
+std::string* CompensateCli::dir_ = nullptr;
+
+TEST_F(CompensateCli, AddsTheEstimateAndTheCompensatedOutput) {
+  const std::string out = Dir() + "/out.csv";
+  const auto r =
+      test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() + "/test.csv' -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("ms-elm (compensate)"), std::string::npos) << r.out;
+  const auto table = io::CsvTable::Read(out);
+  EXPECT_EQ(table.header(), (std::vector<std::string>{"time_s", "rate_dph", "temperature_c",
+                                                      "drift_dph", "drift_est", "compensated"}));
+  ASSERT_EQ(table.rows(), 600);
+  const auto input = io::CsvTable::Read(Dir() + "/test.csv");
+  for (const char* c : {"time_s", "rate_dph", "temperature_c", "drift_dph"}) {
+    EXPECT_EQ(table.Column(c), input.Column(c)) << c;
+  }
+  const Eigen::VectorXd estimate = table.Column("drift_est");
+  EXPECT_EQ(table.Column("compensated"), (input.Column("rate_dph") - estimate).eval());
+  const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
+  EXPECT_EQ(estimate, drift::EstimateDrift(loaded.model, input.Column("temperature_c")));
+  // On a log it never saw, the estimate tracks the true drift far better than zero does.
+  const Eigen::VectorXd truth = input.Column("drift_dph");
+  EXPECT_LT(Rms(estimate - truth), 0.5 * Rms(truth.array() - truth.mean()));
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["command"], "compensate");
+  EXPECT_EQ(json["model"]["temperature_column"], "temperature_c");
+  EXPECT_LT(json["std_after"].get<double>(), json["std_before"].get<double>());
+}
+
+TEST_F(CompensateCli, RunsOnALogWithOnlyTheModelsColumns) {
+  const auto input = io::CsvTable::Read(Dir() + "/test.csv");
+  io::WriteCsv(Dir() + "/minimal.csv", {{"temperature_c", input.Column("temperature_c")},
+                                        {"rate_dph", input.Column("rate_dph")}});
+  const std::string out = Dir() + "/minimal_out.csv";
+  ASSERT_EQ(test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() + "/minimal.csv' -q -o '" +
+                         out + "'")
+                .exit_code,
+            0);
+  const auto table = io::CsvTable::Read(out);
+  EXPECT_EQ(table.header().size(), 4u);
+  const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
+  EXPECT_EQ(table.Column("drift_est"),
+            drift::EstimateDrift(loaded.model, input.Column("temperature_c")));
+}
+
+struct BadCase {
+  const char* name;
+  std::string args;  // %DIR% is substituted
+  int exit_code;
+  const char* message;
+};
+
+TEST_F(CompensateCli, BadInputGivesOneLineErrorAndNoOutput) {
+  io::WriteFileAtomically(Dir() + "/no_temp.csv", "time_s,rate_dph\n0,1\n1,2\n");
+  io::WriteFileAtomically(Dir() + "/no_rate.csv", "temperature_c\n20\n21\n");
+  io::WriteFileAtomically(Dir() + "/nan.csv", "rate_dph,temperature_c\n1,20\n2,nan\n3,22\n");
+  io::WriteFileAtomically(Dir() + "/twice.csv",
+                          "rate_dph,temperature_c,drift_est\n1,20,0\n2,21,0\n");
+  std::string damaged = io::ReadTextFile(Dir() + "/ms.json");
+  const size_t p = damaged.find("\"format_version\"");
+  damaged.replace(p, 16, "\"format_versions\"");
+  io::WriteFileAtomically(Dir() + "/damaged.json", damaged);
+  const std::vector<BadCase> cases = {
+      {"missing model", "compensate %DIR%/nope.json %DIR%/test.csv", 2, "no such file"},
+      {"missing input", "compensate %DIR%/ms.json %DIR%/nope.csv", 2, "no such file"},
+      {"predict model", "compensate %DIR%/pred.json %DIR%/test.csv", 2, "use 'gyrodrift predict'"},
+      {"not a model", "compensate %DIR%/test.csv %DIR%/test.csv", 3, "not a gyrodrift model file"},
+      {"edited model", "compensate %DIR%/damaged.json %DIR%/test.csv", 3, "format_version"},
+      {"temperature missing", "compensate %DIR%/ms.json %DIR%/no_temp.csv", 3,
+       "model needs column 'temperature_c' (trained with --temperature temperature_c); "},
+      {"target missing", "compensate %DIR%/ms.json %DIR%/no_rate.csv", 3,
+       "model needs column 'rate_dph' (trained with --target rate_dph); "},
+      {"nan temperature", "compensate %DIR%/ms.json %DIR%/nan.csv", 3, "data row 2"},
+      {"already compensated", "compensate %DIR%/ms.json %DIR%/twice.csv", 3,
+       "already has a column 'drift_est'"},
+  };
+  for (const auto& c : cases) {
+    std::string args = c.args;
+    for (size_t q; (q = args.find("%DIR%")) != std::string::npos;) args.replace(q, 5, Dir());
+    const std::string out = Dir() + "/bad.csv";
+    const auto r = test::RunCli(args + " -o " + out);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    EXPECT_FALSE(test::FileExists(out)) << c.name;
+    EXPECT_FALSE(test::FileExists(out + ".json")) << c.name;
+  }
+  const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() + "/test.csv' -o '" +
+                              Dir() + "/no/dir/c.csv'");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+}
+
+TEST(CompensateHelp, ShowsAWorkedExample) {
+  const auto r = test::RunCli("compensate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("gyrodrift compensate model.json test.csv"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gyrodrift

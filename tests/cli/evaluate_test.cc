@@ -1,0 +1,163 @@
+// gyrodrift evaluate, run as a user would: the table, its sidecar, repeats, and every bad-input
+// case.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift {
+namespace {
+
+// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
+std::string LogCsv(int n, std::uint64_t seed) {
+  Rng rng(seed, 0);
+  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
+  double lagged = 20.0;
+  for (int t = 0; t < n; ++t) {
+    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
+    const double previous = lagged;
+    lagged += (temperature - lagged) / 40.0;
+    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
+           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
+  }
+  return csv;
+}
+
+class EvaluateCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::TempDir("cli_evaluate");
+    input_ = dir_ + "/log.csv";
+    io::WriteFileAtomically(input_, LogCsv(400, 1));
+  }
+  std::string dir_, input_;
+};
+
+TEST_F(EvaluateCli, CompensateTableAgainstTruth) {
+  const std::string out = dir_ + "/table.csv";
+  const auto r = test::RunCli("evaluate '" + input_ +
+                              "' -t rate_dph -T temperature_c --truth drift_dph --mode compensate "
+                              "--methods ms-elm,poly -I 10 --seed 3 -o '" +
+                              out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;  // no progress line: stderr is not a terminal
+  EXPECT_NE(r.out.find("against drift_dph"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("method   protocol"), std::string::npos) << r.out;
+  const std::string text = io::ReadTextFile(out);
+  EXPECT_EQ(text.substr(0, text.find('\n')),
+            "method,protocol,rmse,rmse_std,mae,max_abs,train_s,predict_s");
+  const auto table = io::CsvTable::Parse(text, out);
+  ASSERT_EQ(table.rows(), 4);  // 2 methods x 2 protocols
+  EXPECT_NE(text.find("\nms-elm,paper,"), std::string::npos);
+  EXPECT_NE(text.find("\nms-elm,causal,"), std::string::npos);
+  EXPECT_NE(text.find("\npoly,paper,"), std::string::npos);
+  const Eigen::VectorXd rmse = table.Column("rmse"), mae = table.Column("mae"),
+                        max_abs = table.Column("max_abs");
+  for (Eigen::Index i = 0; i < 4; ++i) {
+    EXPECT_GT(rmse[i], 0.0);
+    EXPECT_LE(mae[i], rmse[i]);
+    EXPECT_LE(rmse[i], max_abs[i]);
+  }
+  EXPECT_EQ(table.Column("rmse_std"), Eigen::VectorXd::Zero(4));  // one repeat
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["command"], "evaluate");
+  EXPECT_EQ(json["options"]["methods"], nlohmann::json({"ms-elm", "poly"}));
+  EXPECT_EQ(json["options"]["protocols"], nlohmann::json({"paper", "causal"}));
+  EXPECT_EQ(json["options"]["split"], 0.7);
+  EXPECT_EQ(json["options"]["truth_column"], "drift_dph");
+  EXPECT_EQ(json["options"]["drift"]["seed"], 3);
+  EXPECT_EQ(json["options"]["drift"]["decomposition"]["ensemble_size"], 10);
+  EXPECT_EQ(json["result"]["first_test_sample"], 281);
+  EXPECT_EQ(json["result"]["rows"].size(), 4u);
+  EXPECT_EQ(json["result"]["rows"][0]["rmse"].get<double>(), rmse[0]);
+}
+
+TEST_F(EvaluateCli, RepeatsGiveASpreadOnlyWhereTheSeedMatters) {
+  const std::string out = dir_ + "/t.csv";
+  const auto r = test::RunCli("evaluate '" + input_ +
+                              "' -t rate_dph --mode predict --protocol causal --methods elm,poly "
+                              "--repeats 3 --split 0.6 -q -o '" +
+                              out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const auto table = io::CsvTable::Read(out);
+  ASSERT_EQ(table.rows(), 2);
+  const Eigen::VectorXd spread = table.Column("rmse_std");
+  EXPECT_GT(spread[0], 0.0);  // elm: random hidden layer per seed
+  EXPECT_EQ(spread[1], 0.0);  // poly: no randomness
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["result"]["first_test_sample"], 241);
+  EXPECT_EQ(json["result"]["scored_against"], "rate_dph");
+}
+
+struct BadCase {
+  const char* name;
+  std::string args;  // %IN% and %DIR% are substituted
+  int exit_code;
+  const char* message;
+};
+
+TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
+  io::WriteFileAtomically(dir_ + "/short.csv", LogCsv(50, 2));
+  io::WriteFileAtomically(dir_ + "/seventy.csv", LogCsv(70, 2));
+  std::string nan_truth = LogCsv(200, 3);
+  nan_truth.replace(nan_truth.rfind(',') + 1, std::string::npos, "nan\n");
+  io::WriteFileAtomically(dir_ + "/nan_truth.csv", nan_truth);
+  const std::string p = "evaluate %IN% -t rate_dph --mode predict -I 10 ";
+  const std::vector<BadCase> cases = {
+      {"missing file", "evaluate %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
+      {"unknown method", p + "--methods elm,lstm", 2, "method = 'lstm'"},
+      {"repeated method", p + "--methods elm,elm", 2, "without repeats"},
+      {"empty methods", p + "--methods ,", 2, "--methods"},
+      {"bad protocol", p + "--protocol future", 2, "--protocol = 'future'"},
+      {"bad split", p + "--split 0.99", 2, "split = 0.99"},
+      {"zero repeats", p + "--repeats 0", 2, "repeats = 0"},
+      {"small window", p + "--window 4", 2, "window = 4"},
+      {"compensate without temperature", "evaluate %IN% -t rate_dph --mode compensate", 2,
+       "needs --temperature"},
+      {"missing truth", p + "--truth drift", 2, "column 'drift' not found"},
+      {"truth is target", p + "--truth rate_dph", 2, "must differ from --target"},
+      {"too short", "evaluate %DIR%/short.csv -t rate_dph --mode predict --methods poly", 3,
+       "at least 64"},
+      {"test block too small",
+       "evaluate %DIR%/seventy.csv -t rate_dph --mode predict --methods poly --split 0.9", 3,
+       "too little data"},
+      {"nan truth",
+       "evaluate %DIR%/nan_truth.csv -t rate_dph --truth drift_dph --mode predict --methods poly",
+       3, "data row 200"},
+  };
+  for (const auto& c : cases) {
+    std::string args = c.args;
+    for (auto [key, value] :
+         {std::pair<std::string, std::string>{"%IN%", input_}, {"%DIR%", dir_}}) {
+      for (size_t q; (q = args.find(key)) != std::string::npos;) args.replace(q, key.size(), value);
+    }
+    const std::string out = dir_ + "/bad.csv";
+    const auto r = test::RunCli(args + " -o " + out);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    EXPECT_FALSE(test::FileExists(out)) << c.name;
+    EXPECT_FALSE(test::FileExists(out + ".json")) << c.name;
+  }
+  const auto r =
+      test::RunCli("evaluate '" + input_ + "' -t rate_dph --mode predict --methods poly -o '" +
+                   dir_ + "/no/dir/t.csv'");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+}
+
+TEST(EvaluateHelp, ShowsAWorkedExample) {
+  const auto r = test::RunCli("evaluate --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("gyrodrift evaluate fog.csv --target rate_dph"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gyrodrift

@@ -1,0 +1,204 @@
+// gyrodrift fit, run as a user would: the model file, what it records, and every bad-input case.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+#include "support/test_support.h"
+
+namespace gyrodrift {
+namespace {
+
+// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
+std::string LogCsv(int n, std::uint64_t seed, double step_s = 1.0) {
+  Rng rng(seed, 0);
+  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
+  double lagged = 20.0;
+  for (int t = 0; t < n; ++t) {
+    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
+    const double previous = lagged;
+    lagged += (temperature - lagged) / 40.0;
+    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    csv += io::FormatDouble(t * step_s) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) +
+           "," + io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
+  }
+  return csv;
+}
+
+// Removes every "threads" entry (options and learner scalars), which records but never changes
+// the result.
+void DropThreads(nlohmann::json& j) {
+  if (j.is_object()) {
+    j.erase("threads");
+    for (auto& [key, value] : j.items()) DropThreads(value);
+  } else if (j.is_array()) {
+    for (auto& value : j) DropThreads(value);
+  }
+}
+
+class FitCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::TempDir("cli_fit");
+    input_ = dir_ + "/train.csv";
+    io::WriteFileAtomically(input_, LogCsv(400, 1));
+  }
+  test::CommandResult Fit(const std::string& args, const std::string& model) {
+    return test::RunCli("fit '" + input_ + "' " + args + " -o '" + model + "'");
+  }
+  std::string dir_, input_;
+};
+
+TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
+  const std::string model = dir_ + "/m.json";
+  const auto r =
+      Fit("--target rate_dph --temperature temperature_c --mode compensate -I 10 --seed 4", model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_NE(r.out.find("ms-elm (compensate)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("decomposition: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("selection: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("wrote " + model), std::string::npos) << r.out;
+  const auto json = nlohmann::json::parse(io::ReadTextFile(model));
+  EXPECT_EQ(json["format"], "gyrodrift-model");
+  EXPECT_EQ(json["format_version"], 1);
+  EXPECT_EQ(json["training"]["target_column"], "rate_dph");
+  EXPECT_EQ(json["training"]["temperature_column"], "temperature_c");
+  EXPECT_EQ(json["training"]["samples"], 400);
+  EXPECT_EQ(json["options"]["mode"], "compensate");
+  EXPECT_EQ(json["options"]["method"], "ms-elm");
+  EXPECT_EQ(json["options"]["decomposition"]["method"], "beemdan");
+  EXPECT_EQ(json["options"]["decomposition"]["ensemble_size"], 10);
+  EXPECT_EQ(json["options"]["seed"], 4);
+  EXPECT_EQ(json["options"]["features"]["rate_hz"], 1.0);  // from time_s
+  EXPECT_EQ(json["options"]["learner"]["elm"]["selection"], "auto");
+  EXPECT_EQ(json["options"]["learner"]["elm"]["hidden_units"], 50);
+  const io::LoadedModel loaded = io::ReadModelFile(model);
+  EXPECT_GE(loaded.model.sub_models.size(), 2u);
+  EXPECT_EQ(loaded.model.options.mode, drift::Mode::kCompensate);
+}
+
+TEST_F(FitCli, SameSeedSameBytesForAnyThreadCount) {
+  const std::string a = dir_ + "/a.json", b = dir_ + "/b.json";
+  ASSERT_EQ(Fit("-t rate_dph --mode predict -m emd-elm -I 10 --seed 9 -q", a).exit_code, 0);
+  const auto r = Fit("-t 2 --mode predict -m emd-elm -I 10 --seed 9 -j 1 -q", b);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  auto ja = nlohmann::json::parse(io::ReadTextFile(a));
+  auto jb = nlohmann::json::parse(io::ReadTextFile(b));
+  EXPECT_EQ(jb["options"]["threads"], 1);
+  // Only the thread settings differ; the fitted model is the same to the bit.
+  DropThreads(ja);
+  DropThreads(jb);
+  EXPECT_TRUE(ja["model"] == jb["model"]);
+  EXPECT_EQ(jb["training"]["target_column"], "rate_dph");  // resolved from the index
+}
+
+TEST_F(FitCli, LagsHiddenAndRateOptions) {
+  const std::string model = dir_ + "/m.json";
+  auto r =
+      Fit("-t rate_dph -T temperature_c --mode predict -m elm --lags auto --hidden 7 --rate-hz 4",
+          model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("chosen by validation RMSE"), std::string::npos) << r.out;
+  auto json = nlohmann::json::parse(io::ReadTextFile(model));
+  EXPECT_EQ(json["options"]["auto_lags"], true);
+  EXPECT_EQ(json["options"]["features"]["use_temperature"], true);
+  EXPECT_EQ(json["options"]["features"]["rate_hz"], 4.0);
+  EXPECT_EQ(json["options"]["learner"]["elm"]["selection"], "fixed");
+  EXPECT_EQ(json["options"]["learner"]["elm"]["hidden_units"], 7);
+  EXPECT_EQ(json["model"]["sub_models"][0]["learner"]["scalars"]["hidden_units"], 7.0);
+  EXPECT_EQ(json["model"]["lag_validation_rmse"].size(), 5u);
+
+  // A time_s column sampled at 0.5 s gives 2 Hz.
+  io::WriteFileAtomically(dir_ + "/fast.csv", LogCsv(300, 2, 0.5));
+  r = test::RunCli("fit '" + dir_ + "/fast.csv' -t rate_dph --mode predict -m poly --lags 3 -o '" +
+                   model + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  json = nlohmann::json::parse(io::ReadTextFile(model));
+  EXPECT_EQ(json["options"]["features"]["rate_hz"], 2.0);
+  EXPECT_EQ(json["model"]["lags"], 3);
+  EXPECT_EQ(json["model"]["sub_models"][0]["learner"]["kind"], "poly");
+}
+
+TEST_F(FitCli, EveryBaselineFits) {
+  for (const char* method : {"elm", "poly", "svr", "bp"}) {
+    const std::string model = dir_ + "/" + method + ".json";
+    const auto r =
+        Fit(std::string("-t rate_dph -T temperature_c --mode compensate -q -m ") + method, model);
+    ASSERT_EQ(r.exit_code, 0) << method << ": " << r.err;
+    EXPECT_EQ(io::ReadModelFile(model).model.sub_models.size(), 1u) << method;
+  }
+}
+
+struct BadCase {
+  const char* name;
+  std::string args;  // %IN% and %DIR% are substituted
+  int exit_code;
+  const char* message;
+};
+
+TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
+  io::WriteFileAtomically(dir_ + "/nan.csv", "rate_dph,temperature_c\n1,2\n2,3\nnan,4\n");
+  io::WriteFileAtomically(dir_ + "/short.csv", LogCsv(20, 3));
+  io::WriteFileAtomically(dir_ + "/backwards.csv", "time_s,rate_dph\n5,1\n4,2\n3,3\n2,4\n");
+  const std::string ok = "-t rate_dph -T temperature_c --mode compensate -I 10";
+  const std::vector<BadCase> cases = {
+      {"missing file", "fit %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
+      {"missing mode", "fit %IN% -t rate_dph", 2, "--mode is required"},
+      {"missing target", "fit %IN% --mode predict", 2, "--target is required"},
+      {"unknown column", "fit %IN% -t gyro --mode predict", 2, "column 'gyro' not found"},
+      {"unknown temperature", "fit %IN% -t rate_dph -T temp --mode compensate", 2,
+       "column 'temp' not found"},
+      {"unknown mode", "fit %IN% -t rate_dph --mode guess", 2, "mode = 'guess'"},
+      {"unknown method", "fit %IN% -t rate_dph --mode predict -m lstm", 2, "method = 'lstm'"},
+      {"unknown decomposition", "fit %IN% -t rate_dph --mode predict --decomposition wavelet", 2,
+       "'wavelet'"},
+      {"compensate without temperature", "fit %IN% -t rate_dph --mode compensate", 2,
+       "needs --temperature"},
+      {"temperature is target", "fit %IN% -t rate_dph -T rate_dph --mode compensate", 2,
+       "must differ from --target"},
+      {"zero lags", "fit %IN% -t rate_dph --mode predict --lags 0", 2, "--lags = '0'"},
+      {"text lags", "fit %IN% -t rate_dph --mode predict --lags many", 2, "--lags = 'many'"},
+      {"zero hidden", "fit %IN% -t rate_dph --mode predict --hidden 0", 2, "--hidden = '0'"},
+      {"hidden for poly", "fit %IN% -t rate_dph --mode predict -m poly --hidden 5", 2,
+       "applies to the ELM methods"},
+      {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "ensemble_size = 0"},
+      {"negative rate", "fit %IN% -t rate_dph --mode predict --rate-hz -1", 2, "rate_hz"},
+      {"negative seed", "fit %IN% -t rate_dph --mode predict --seed -1", 2, "seed"},
+      {"negative threads", "fit %IN% -t rate_dph --mode predict -j -2", 2, "threads"},
+      {"nan target", "fit %DIR%/nan.csv -t rate_dph --mode predict", 3, "data row 3"},
+      {"too short", "fit %DIR%/short.csv -t rate_dph --mode predict -m elm", 3, "at least 32"},
+      {"time runs backwards", "fit %DIR%/backwards.csv -t rate_dph --mode predict", 3, "time_s"},
+  };
+  for (const auto& c : cases) {
+    std::string args = c.args;
+    for (auto [key, value] :
+         {std::pair<std::string, std::string>{"%IN%", input_}, {"%DIR%", dir_}}) {
+      for (size_t p; (p = args.find(key)) != std::string::npos;) args.replace(p, key.size(), value);
+    }
+    const std::string out = dir_ + "/bad.json";
+    const auto r = test::RunCli(args + " -o " + out);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    EXPECT_FALSE(test::FileExists(out)) << c.name;
+  }
+  const auto r = Fit(ok, dir_ + "/no/such/dir/m.json");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(FitHelp, ShowsAWorkedExample) {
+  const auto r = test::RunCli("fit --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("gyrodrift fit train.csv --target rate_dph"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gyrodrift

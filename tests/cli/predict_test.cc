@@ -1,0 +1,176 @@
+// gyrodrift predict, run as a user would: rows and columns of both protocols, identity with the
+// library's predictions, and every bad-input case.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+#include "support/test_support.h"
+
+namespace gyrodrift {
+namespace {
+
+// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
+std::string LogCsv(int n, std::uint64_t seed) {
+  Rng rng(seed, 0);
+  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
+  double lagged = 20.0;
+  for (int t = 0; t < n; ++t) {
+    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
+    const double previous = lagged;
+    lagged += (temperature - lagged) / 40.0;
+    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
+           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
+  }
+  return csv;
+}
+
+// Models are fitted once for the suite (through the CLI, as a user would).
+class PredictCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(test::TempDir("cli_predict"));
+    io::WriteFileAtomically(Dir() + "/train.csv", LogCsv(300, 1));
+    io::WriteFileAtomically(Dir() + "/test.csv", LogCsv(120, 2));
+    const std::string fit = "fit '" + Dir() + "/train.csv' -t rate_dph -I 10 -q ";
+    ASSERT_EQ(test::RunCli(fit + "--mode predict -m ms-elm --lags 3 -o '" + Dir() + "/ms.json'")
+                  .exit_code,
+              0);
+    ASSERT_EQ(
+        test::RunCli(fit + "--mode predict -m elm -T temperature_c -o '" + Dir() + "/elm.json'")
+            .exit_code,
+        0);
+    ASSERT_EQ(test::RunCli(fit + "--mode compensate -m poly -T temperature_c -o '" + Dir() +
+                           "/comp.json'")
+                  .exit_code,
+              0);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static const std::string& Dir() { return *dir_; }
+  static std::string* dir_;
+};
+std::string* PredictCli::dir_ = nullptr;
+
+TEST_F(PredictCli, CausalMsElmStartsWhenAWindowCanBeDecomposed) {
+  const std::string out = Dir() + "/causal.csv";
+  const auto r = test::RunCli("predict '" + Dir() + "/ms.json' '" + Dir() +
+                              "/test.csv' -W 64 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("predicted samples 17..120 (causal protocol)"), std::string::npos) << r.out;
+  const auto table = io::CsvTable::Read(out);
+  EXPECT_EQ(table.header(), (std::vector<std::string>{"sample", "time_s", "prediction"}));
+  ASSERT_EQ(table.rows(), 120 - 16);
+  EXPECT_EQ(table.Column("sample")[0], 17.0);
+  EXPECT_EQ(table.Column("time_s")[0], 16.0);
+  EXPECT_EQ(table.Column("sample")[table.rows() - 1], 120.0);
+  EXPECT_TRUE(table.Column("prediction").allFinite());
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["command"], "predict");
+  EXPECT_EQ(json["options"]["protocol"], "causal");
+  EXPECT_EQ(json["options"]["window"], 64);
+  EXPECT_EQ(json["first_predicted_sample"], 17);
+  EXPECT_EQ(json["model"]["lags"], 3);
+
+  // Same bytes with one thread.
+  const std::string one = Dir() + "/causal1.csv";
+  ASSERT_EQ(test::RunCli("predict '" + Dir() + "/ms.json' '" + Dir() +
+                         "/test.csv' -W 64 -j 1 -q -o '" + one + "'")
+                .exit_code,
+            0);
+  EXPECT_EQ(io::ReadTextFile(one), io::ReadTextFile(out));
+}
+
+TEST_F(PredictCli, PaperProtocolMatchesTheLibraryToTheBit) {
+  const std::string out = Dir() + "/paper.csv";
+  const auto r = test::RunCli("predict '" + Dir() + "/ms.json' '" + Dir() +
+                              "/test.csv' --protocol paper -q -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const auto table = io::CsvTable::Read(out);
+  ASSERT_EQ(table.rows(), 120 - 3);  // from sample p + 1 = 4
+  EXPECT_EQ(table.Column("sample")[0], 4.0);
+  const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
+  const Eigen::VectorXd y = io::CsvTable::Read(Dir() + "/test.csv").Column("rate_dph");
+  const Eigen::VectorXd expected =
+      drift::PredictOneStep(loaded.model, y, Eigen::VectorXd(), 3, drift::Protocol::kPaper);
+  EXPECT_EQ(table.Column("prediction"), expected);
+}
+
+TEST_F(PredictCli, SingleModelsAreCausalUnderBothProtocols) {
+  const std::string a = Dir() + "/a.csv", b = Dir() + "/b.csv";
+  const std::string base = "predict '" + Dir() + "/elm.json' '" + Dir() + "/test.csv' -q ";
+  ASSERT_EQ(test::RunCli(base + "--protocol paper -o '" + a + "'").exit_code, 0);
+  ASSERT_EQ(test::RunCli(base + "--protocol causal -o '" + b + "'").exit_code, 0);
+  EXPECT_EQ(io::ReadTextFile(a), io::ReadTextFile(b));
+  EXPECT_EQ(io::CsvTable::Read(a).rows(), 120 - 4);  // default p = 4
+}
+
+struct BadCase {
+  const char* name;
+  std::string args;  // %DIR% is substituted
+  int exit_code;
+  const char* message;
+};
+
+TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
+  io::WriteFileAtomically(Dir() + "/no_rate.csv",
+                          "time_s,gyro,temperature_c\n0,1,20\n1,2,21\n2,3,22\n");
+  std::string no_temp = LogCsv(60, 3);
+  no_temp.replace(0, no_temp.find('\n') + 1, "time_s,rate_dph,temp_c,drift_dph\n");
+  io::WriteFileAtomically(Dir() + "/no_temp.csv", no_temp);
+  io::WriteFileAtomically(Dir() + "/short.csv", LogCsv(12, 4));
+  io::WriteFileAtomically(Dir() + "/nan.csv", "rate_dph\n1\n2\n3\n4\n5\nnan\n7\n8\n");
+  std::string damaged = io::ReadTextFile(Dir() + "/ms.json");
+  const size_t digit = damaged.find_first_of("123456789", damaged.find("\"output_weights\""));
+  damaged[digit] = damaged[digit] == '9' ? '8' : static_cast<char>(damaged[digit] + 1);
+  io::WriteFileAtomically(Dir() + "/damaged.json", damaged);
+  const std::vector<BadCase> cases = {
+      {"missing model", "predict %DIR%/nope.json %DIR%/test.csv", 2, "no such file"},
+      {"missing input", "predict %DIR%/ms.json %DIR%/nope.csv", 2, "no such file"},
+      {"compensate model", "predict %DIR%/comp.json %DIR%/test.csv", 2,
+       "use 'gyrodrift compensate'"},
+      {"bad protocol", "predict %DIR%/ms.json %DIR%/test.csv --protocol future", 2,
+       "protocol = 'future'"},
+      {"small window", "predict %DIR%/ms.json %DIR%/test.csv -W 8", 2, "--window = 8"},
+      {"not a model", "predict %DIR%/test.csv %DIR%/test.csv", 3, "not a gyrodrift model file"},
+      {"damaged model", "predict %DIR%/damaged.json %DIR%/test.csv", 3, "checksum mismatch"},
+      {"target column missing", "predict %DIR%/ms.json %DIR%/no_rate.csv", 3,
+       "model needs column 'rate_dph' (trained with --target rate_dph); "},
+      {"temperature column missing", "predict %DIR%/elm.json %DIR%/no_temp.csv", 3,
+       "model needs column 'temperature_c' (trained with --temperature temperature_c); "},
+      {"too short", "predict %DIR%/ms.json %DIR%/short.csv", 3, "needs more than 16"},
+      {"file without temperature", "predict %DIR%/elm.json %DIR%/nan.csv", 3,
+       "model needs column 'temperature_c'"},
+      {"nan target", "predict %DIR%/ms.json %DIR%/nan.csv", 3, "data row 6"},
+  };
+  for (const auto& c : cases) {
+    std::string args = c.args;
+    for (size_t p; (p = args.find("%DIR%")) != std::string::npos;) args.replace(p, 5, Dir());
+    const std::string out = Dir() + "/bad.csv";
+    const auto r = test::RunCli(args + " -o " + out);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    EXPECT_FALSE(test::FileExists(out)) << c.name;
+    EXPECT_FALSE(test::FileExists(out + ".json")) << c.name;
+  }
+  const auto r = test::RunCli("predict '" + Dir() + "/elm.json' '" + Dir() + "/test.csv' -o '" +
+                              Dir() + "/no/dir/p.csv'");
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+}
+
+TEST(PredictHelp, ShowsAWorkedExample) {
+  const auto r = test::RunCli("predict --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("gyrodrift predict model.json test.csv"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace gyrodrift

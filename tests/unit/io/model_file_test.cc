@@ -1,0 +1,335 @@
+// Model files: every method in both modes survives a save/load round trip with predictions equal
+// to the bit; options and awkward doubles come back exactly; damaged, foreign, incomplete or
+// mis-shaped files are refused with a message naming the problem.
+#include "gyrodrift/io/model_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <numbers>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::io {
+namespace {
+
+using drift::Method;
+using drift::Mode;
+using nlohmann::json;
+
+struct Log {
+  Eigen::VectorXd rate, temperature;
+};
+
+// Temperature swings, a drift following a lagged temperature and its rate, white noise.
+Log MakeLog(Eigen::Index n, std::uint64_t seed) {
+  Log log{Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  Rng rng(seed, 0);
+  double lagged = 20.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const double x = static_cast<double>(t) / static_cast<double>(n);
+    log.temperature[t] = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * x);
+    const double previous = lagged;
+    lagged += (log.temperature[t] - lagged) / 40.0;
+    log.rate[t] = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous) + 0.02 * rng.Normal();
+  }
+  return log;
+}
+
+drift::DriftOptions Small(Mode mode, Method method) {
+  drift::DriftOptions o;
+  o.mode = mode;
+  o.method = method;
+  o.decomposition.ensemble_size = 10;
+  o.selection.monte_carlo.realisations = 20;
+  o.features.time_constants_s = {30.0, 120.0};
+  o.learner.bp_epochs = 50;
+  o.seed = 5;
+  return o;
+}
+
+ModelFileInfo Info() { return {"rate_dph", "temperature_c", "train.csv", ""}; }
+
+// Recomputes the checksum after a deliberate edit, so the test reaches the field checks.
+std::string Reseal(json j) {
+  j.erase("checksum");
+  char hex[17];
+  std::snprintf(hex, sizeof(hex), "%016llx",
+                static_cast<unsigned long long>(
+                    Fnv1a64(j.dump(-1, ' ', false, json::error_handler_t::replace))));
+  j["checksum"] = std::string("fnv1a64:") + hex;
+  return j.dump(1);
+}
+
+void ExpectRefused(const std::string& text, const std::string& message) {
+  try {
+    ParseModelFile(text, "m.json");
+    ADD_FAILURE() << "accepted; expected: " << message;
+  } catch (const DataError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(message), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("m.json: ", 0), 0u) << what;
+  }
+}
+
+class EveryMethod : public ::testing::TestWithParam<std::tuple<Mode, Method>> {};
+
+TEST_P(EveryMethod, RoundTripGivesIdenticalPredictions) {
+  const auto [mode, method] = GetParam();
+  const Log log = MakeLog(260, 11);
+  drift::DriftOptions o = Small(mode, method);
+  // Predict mode with the thermal history too, so every input path is exercised.
+  if (mode == Mode::kPredict && method == Method::kElm) o.features.use_temperature = true;
+  const drift::DriftModel model = drift::FitDriftModel(log.rate, log.temperature, o);
+  const std::string text = RenderModelFile(model, Info());
+  const LoadedModel loaded = ParseModelFile(text, "m.json");
+
+  EXPECT_EQ(loaded.info.target_column, "rate_dph");
+  EXPECT_EQ(loaded.info.temperature_column, "temperature_c");
+  EXPECT_EQ(loaded.info.source, "train.csv");
+  EXPECT_FALSE(loaded.info.tool_version.empty());
+  ASSERT_EQ(loaded.model.sub_models.size(), model.sub_models.size());
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    EXPECT_EQ(loaded.model.sub_models[g].name, model.sub_models[g].name);
+    EXPECT_EQ(loaded.model.sub_models[g].imfs, model.sub_models[g].imfs);
+    EXPECT_EQ(loaded.model.sub_models[g].has_residue, model.sub_models[g].has_residue);
+    EXPECT_EQ(loaded.model.sub_models[g].learner == nullptr,
+              model.sub_models[g].learner == nullptr);
+  }
+  EXPECT_EQ(loaded.model.lags, model.lags);
+  EXPECT_EQ(loaded.model.training_imfs, model.training_imfs);
+  EXPECT_EQ(loaded.model.training_samples, model.training_samples);
+  EXPECT_EQ(loaded.model.Summary(), model.Summary());
+  // Everything that was written comes back: the loaded model renders to the same bytes.
+  EXPECT_EQ(RenderModelFile(loaded.model, loaded.info), text);
+
+  const Log test = MakeLog(200, 12);
+  if (mode == Mode::kCompensate) {
+    const Eigen::VectorXd a = drift::EstimateDrift(model, test.temperature);
+    const Eigen::VectorXd b = drift::EstimateDrift(loaded.model, test.temperature);
+    EXPECT_TRUE(a.allFinite());
+    EXPECT_EQ(a, b);  // bit for bit
+  } else {
+    const Eigen::VectorXd t = model.uses_temperature() ? test.temperature : Eigen::VectorXd();
+    const Eigen::VectorXd a =
+        drift::PredictOneStep(model, test.rate, t, 20, drift::Protocol::kPaper);
+    const Eigen::VectorXd b =
+        drift::PredictOneStep(loaded.model, test.rate, t, 20, drift::Protocol::kPaper);
+    EXPECT_TRUE(a.allFinite());
+    EXPECT_EQ(a, b);
+    drift::CausalOptions causal{.window = 64, .threads = 0};
+    const Eigen::VectorXd c =
+        drift::PredictOneStep(model, test.rate, t, 190, drift::Protocol::kCausal, causal);
+    const Eigen::VectorXd d =
+        drift::PredictOneStep(loaded.model, test.rate, t, 190, drift::Protocol::kCausal, causal);
+    EXPECT_EQ(c, d);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(ModelFile, EveryMethod,
+                         ::testing::Combine(::testing::Values(Mode::kPredict, Mode::kCompensate),
+                                            ::testing::Values(Method::kMsElm, Method::kElm,
+                                                              Method::kEmdElm, Method::kPoly,
+                                                              Method::kSvr, Method::kBp)),
+                         [](const auto& info) {
+                           std::string name =
+                               std::string(drift::ToString(std::get<0>(info.param))) + "_" +
+                               std::string(drift::ToString(std::get<1>(info.param)));
+                           for (char& c : name) {
+                             if (c == '-') c = '_';
+                           }
+                           return name;
+                         });
+
+TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
+  drift::DriftOptions o;
+  o.mode = Mode::kCompensate;
+  o.method = Method::kEmdElm;
+  o.decomposition.method = decomposition::Method::kIceemdan;
+  o.decomposition.sifting.stop_rule = decomposition::StopRule::kSNumber;
+  o.decomposition.sifting.rilling_threshold1 = 0.1 + 0.2;  // 0.30000000000000004
+  o.decomposition.sifting.rilling_threshold2 = 0.7;
+  o.decomposition.sifting.s_number = 6;
+  o.decomposition.sifting.max_sifts = 77;
+  o.decomposition.max_imfs = 9;
+  o.decomposition.ensemble_size = 33;
+  o.decomposition.noise_strength = 1.0 / 3.0;
+  o.decomposition.seed = std::numeric_limits<std::uint64_t>::max();
+  o.decomposition.noise_scaling = decomposition::NoiseScaling::kConstantSnr;
+  o.decomposition.beemdan_bound = decomposition::BeemdanBound::kFixedStages;
+  o.decomposition.band_confidence = 0.95;
+  o.decomposition.noise_stages = 2;
+  o.selection.criterion = selection::Criterion::kKomaty;
+  o.selection.distance = selection::PdfDistance::kHellinger;
+  o.selection.kde.grid_points = 1000;
+  o.selection.kde.bandwidth_scale = std::nextafter(1.0, 2.0);
+  o.selection.kde.method = selection::KdeMethod::kDirect;
+  o.selection.center_signal = false;
+  o.selection.monte_carlo.realisations = 21;
+  o.selection.monte_carlo.seed = 1ULL << 63;
+  o.selection.monte_carlo.sifting.stop_rule = decomposition::StopRule::kFixed;
+  o.features.lags = 7;
+  o.features.time_constants_s = {std::nextafter(60.0, 0.0), 1e6, 1.0};
+  o.features.rate_hz = 1.0 / 7.0;
+  o.learner.elm.hidden_units = 12;
+  o.learner.elm.activation = elm::Activation::kTanh;
+  o.learner.elm.solver = elm::Solver::kQr;
+  o.learner.elm.selection = elm::Selection::kFixed;
+  o.learner.elm.ridge_c = std::numeric_limits<double>::infinity();  // no ridge: QR
+  o.learner.elm.hidden_unit_candidates = {3, 12};
+  o.learner.elm.ridge_c_candidates = {4.9406564584124654e-300, 1e10};
+  o.learner.elm.standardize_targets = false;
+  o.learner.poly_degree = 3;
+  o.learner.svr_gamma = 0.125;
+  o.learner.bp_hidden = {4, 3};
+  o.auto_lags = true;
+  o.lag_candidates = {2, 3};
+  o.validation_fraction = 0.25;
+  o.seed = 123456789012345ULL;
+  o.threads = 3;
+  const json j = DriftOptionsToJson(o);
+  const json reparsed = json::parse(j.dump());
+  const drift::DriftOptions r = DriftOptionsFromJson(reparsed, "x");
+  EXPECT_EQ(DriftOptionsToJson(r), j);
+  EXPECT_EQ(r.decomposition.sifting.rilling_threshold1, 0.1 + 0.2);
+  EXPECT_EQ(r.decomposition.noise_strength, 1.0 / 3.0);
+  EXPECT_EQ(r.decomposition.seed, std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(r.selection.kde.bandwidth_scale, std::nextafter(1.0, 2.0));
+  EXPECT_EQ(r.selection.monte_carlo.seed, 1ULL << 63);
+  EXPECT_EQ(r.features.time_constants_s, o.features.time_constants_s);
+  EXPECT_EQ(r.features.rate_hz, 1.0 / 7.0);
+  EXPECT_TRUE(std::isinf(r.learner.elm.ridge_c));
+  EXPECT_EQ(r.learner.elm.ridge_c_candidates, o.learner.elm.ridge_c_candidates);
+  EXPECT_EQ(r.learner.bp_hidden, o.learner.bp_hidden);
+  EXPECT_EQ(r.learner.elm.activation, elm::Activation::kTanh);
+  EXPECT_EQ(r.selection.distance, selection::PdfDistance::kHellinger);
+  EXPECT_EQ(r.lag_candidates, o.lag_candidates);
+  EXPECT_EQ(r.seed, o.seed);
+  EXPECT_EQ(j["learner"]["elm"]["ridge_c"], "inf");
+}
+
+TEST(ModelFile, RandomDoublesSurviveTheJsonText) {
+  Rng rng(3, 0);
+  for (int i = 0; i < 20000; ++i) {
+    double v;
+    const std::uint64_t bits = rng.NextU64();
+    std::memcpy(&v, &bits, sizeof(v));
+    if (!std::isfinite(v)) continue;
+    const json j = json::parse(json(v).dump());
+    ASSERT_EQ(j.get<double>(), v) << json(v).dump();
+  }
+}
+
+TEST(ModelFile, Fnv1a64KnownVectors) {
+  EXPECT_EQ(Fnv1a64(""), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(Fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(Fnv1a64("foobar"), 0x85944171f73967e8ULL);
+}
+
+class Refusal : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const Log log = MakeLog(200, 21);
+    const drift::DriftModel model =
+        drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kElm));
+    text_ = new std::string(RenderModelFile(model, {"rate_dph", "", "in.csv", ""}));
+  }
+  static void TearDownTestSuite() { delete text_; }
+  static json Json() { return json::parse(*text_); }
+  static std::string* text_;
+};
+std::string* Refusal::text_ = nullptr;
+
+TEST_F(Refusal, ValidFileLoads) { EXPECT_NO_THROW(ParseModelFile(*text_, "m.json")); }
+
+TEST_F(Refusal, DamagedNumberFailsTheChecksum) {
+  std::string damaged = *text_;
+  const size_t p = damaged.find("\"output_weights\"");
+  ASSERT_NE(p, std::string::npos);
+  const size_t digit = damaged.find_first_of("123456789", damaged.find("\"data\"", p));
+  damaged[digit] = damaged[digit] == '9' ? '8' : static_cast<char>(damaged[digit] + 1);
+  ExpectRefused(damaged, "checksum mismatch");
+}
+
+TEST_F(Refusal, TruncatedFileIsNotJson) {
+  ExpectRefused(text_->substr(0, text_->size() / 2), "not valid JSON");
+}
+
+TEST_F(Refusal, OtherFormatsAndVersions) {
+  ExpectRefused("{\"tool\": \"gyrodrift\"}", "not a gyrodrift model file");
+  ExpectRefused("[1, 2]", "not a gyrodrift model file");
+  json j = Json();
+  j["format"] = "gyrodrift-imfs";
+  ExpectRefused(Reseal(j), "not a gyrodrift model file");
+  j = Json();
+  j["format_version"] = 2;
+  ExpectRefused(Reseal(j), "format_version 2 is not supported");
+}
+
+TEST_F(Refusal, MissingFieldsAreNamed) {
+  json j = Json();
+  j.erase("checksum");
+  ExpectRefused(j.dump(), "field 'checksum' is missing");
+  j = Json();
+  j["options"].erase("seed");
+  ExpectRefused(Reseal(j), "field 'options.seed' is missing");
+  j = Json();
+  j["options"]["decomposition"]["sifting"].erase("s_number");
+  ExpectRefused(Reseal(j), "field 'options.decomposition.sifting.s_number' is missing");
+  j = Json();
+  j["model"]["sub_models"][0]["learner"]["arrays"].erase("output_weights");
+  ExpectRefused(Reseal(j), "output_weights");
+}
+
+TEST_F(Refusal, WrongTypesShapesAndValuesAreNamed) {
+  json j = Json();
+  j["options"]["seed"] = -3;
+  ExpectRefused(Reseal(j), "field 'options.seed' must be an unsigned integer");
+  j = Json();
+  j["options"]["method"] = "wavelet";
+  ExpectRefused(Reseal(j), "field 'options.method' = 'wavelet' is not understood");
+  j = Json();
+  j["options"]["features"]["rate_hz"] = -1.0;
+  ExpectRefused(Reseal(j), "holds an invalid option: rate_hz");
+  j = Json();
+  auto& array = j["model"]["sub_models"][0]["learner"]["arrays"]["output_weights"];
+  array["rows"] = array["rows"].get<int>() + 1;
+  ExpectRefused(Reseal(j), "values for a");
+  j = Json();
+  j["model"]["sub_models"][0]["learner"]["arrays"]["biases"]["data"][0] = "many";
+  ExpectRefused(Reseal(j),
+                "field 'model.sub_models[0].learner.arrays.biases.data[0]' must be a number");
+  j = Json();
+  j["model"]["sub_models"][0]["learner"] = nullptr;
+  ExpectRefused(Reseal(j), "a predict-mode sub-model needs a learner");
+  j = Json();
+  j["model"]["lags"] = 6;  // the learner was trained on 4 lags
+  ExpectRefused(Reseal(j), "takes 4 inputs, the model's options give 6");
+  j = Json();
+  j["model"]["sub_models"] = json::array();
+  ExpectRefused(Reseal(j), "at least one sub-model");
+}
+
+TEST(ModelFile, FilesOnDisk) {
+  const std::string dir = test::TempDir("model_file");
+  const Log log = MakeLog(200, 31);
+  const drift::DriftModel model =
+      drift::FitDriftModel(log.rate, log.temperature, Small(Mode::kCompensate, Method::kPoly));
+  WriteModelFile(dir + "/m.json", model, Info());
+  const LoadedModel loaded = ReadModelFile(dir + "/m.json");
+  EXPECT_EQ(drift::EstimateDrift(loaded.model, log.temperature),
+            drift::EstimateDrift(model, log.temperature));
+  EXPECT_THROW(ReadModelFile(dir + "/missing.json"), IoError);
+  EXPECT_THROW(WriteModelFile(dir + "/no/such/dir/m.json", model, Info()), IoError);
+  EXPECT_FALSE(test::FileExists(dir + "/no/such/dir/m.json"));
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
