@@ -38,6 +38,42 @@ __attribute__((target_clones("avx2", "default"))) void AccumulateLanes(const dou
   for (int l = 0; l < kLanes; ++l) acc[l] = a[l];
 }
 
+// Four consecutive factors m, m+1, m+2, m+3 over a full chunk: x[i] is loaded once for all four
+// (a quarter of the loads saved). Each factor's terms and lanes are exactly those of
+// AccumulateLanes, so the sums are the same bits.
+__attribute__((target_clones("avx2", "default"))) void AccumulateLanes4(
+    const double* __restrict x0, const double* __restrict x1, const double* __restrict x2,
+    std::int64_t count, double* __restrict acc0, double* __restrict acc1, double* __restrict acc2,
+    double* __restrict acc3) {
+  double a0[kLanes], a1[kLanes], a2[kLanes], a3[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    a0[l] = acc0[l];
+    a1[l] = acc1[l];
+    a2[l] = acc2[l];
+    a3[l] = acc3[l];
+  }
+  // x1 + j and x2 + 2j are the streams of factor m + j.
+  for (std::int64_t i = 0; i + kLanes <= count; i += kLanes) {
+    for (int l = 0; l < kLanes; ++l) {
+      const double base = x0[i + l];
+      const double d0 = x2[i + l] - 2.0 * x1[i + l] + base;
+      const double d1 = x2[i + l + 2] - 2.0 * x1[i + l + 1] + base;
+      const double d2 = x2[i + l + 4] - 2.0 * x1[i + l + 2] + base;
+      const double d3 = x2[i + l + 6] - 2.0 * x1[i + l + 3] + base;
+      a0[l] += d0 * d0;
+      a1[l] += d1 * d1;
+      a2[l] += d2 * d2;
+      a3[l] += d3 * d3;
+    }
+  }
+  for (int l = 0; l < kLanes; ++l) {
+    acc0[l] = a0[l];
+    acc1[l] = a1[l];
+    acc2[l] = a2[l];
+    acc3[l] = a3[l];
+  }
+}
+
 double ReduceLanes(const double* acc) {
   return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
 }
@@ -57,11 +93,18 @@ void OverlappingSecondDifferenceSums(const double* x, std::int64_t n, const std:
     double acc[kOadevMaxGroup][kLanes] = {};
     const std::int64_t longest = n - 2 * ms[start];
     for (std::int64_t c = 0; c < longest; c += kChunk) {
-      for (int k = 0; k < group; ++k) {
+      for (int k = 0; k < group;) {
         const std::int64_t m = ms[start + k];
+        // Four consecutive factors whose chunk is complete: one shared pass.
+        if (k + 4 <= group && ms[start + k + 3] == m + 3 && c + kChunk <= n - 2 * (m + 3)) {
+          AccumulateLanes4(x + c, x + c + m, x + c + 2 * m, kChunk, acc[k], acc[k + 1], acc[k + 2],
+                           acc[k + 3]);
+          k += 4;
+          continue;
+        }
         const std::int64_t end = std::min(c + kChunk, n - 2 * m);
-        if (end <= c) continue;
-        AccumulateLanes(x + c, x + c + m, x + c + 2 * m, end - c, acc[k]);
+        if (end > c) AccumulateLanes(x + c, x + c + m, x + c + 2 * m, end - c, acc[k]);
+        ++k;
       }
     }
     for (int k = 0; k < group; ++k) out[start + k] = ReduceLanes(acc[k]);
