@@ -71,6 +71,9 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
                                    "column, else 1)");
   cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
       ->capture_default_str();
+  cmd->add_option("--realisations", a->realisations,
+                  "white-noise realisations of the ms-elm grouping's Monte-Carlo level, >= 20")
+      ->capture_default_str();
   cmd->add_option("--seed", a->seed, "seed of the decomposition and the learners")
       ->check(kSeed)
       ->capture_default_str();
@@ -87,6 +90,7 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
   o.method = method;
   o.decomposition.method = decomposition::MethodFromString(a.decomposition);
   o.decomposition.ensemble_size = a.ensemble;
+  o.selection.monte_carlo.realisations = a.realisations;
   o.seed = a.seed;
   o.threads = a.threads;
   const int p = AutoOrInteger("--lags", a.lags, 1, 256);

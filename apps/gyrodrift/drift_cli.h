@@ -27,6 +27,7 @@ struct DriftArgs {
   double rate_hz = 1.0;
   CLI::Option* rate_option = nullptr;  // to tell "--rate-hz given" from the default
   int ensemble = 100;
+  int realisations = 100;  // white-noise realisations of the selection's Monte-Carlo level
   std::uint64_t seed = 1;
   int threads = 0;
   bool quiet = false;
@@ -36,7 +37,7 @@ struct DriftArgs {
 extern const CLI::Validator kSeed;
 
 // Adds input, --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
-// --ensemble, --seed, --threads and --quiet to cmd.
+// --ensemble, --realisations, --seed, --threads and --quiet to cmd.
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args);
 
 // DriftOptions from the arguments (method = `method`), before any file is read; the sample rate

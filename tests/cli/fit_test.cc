@@ -57,7 +57,9 @@ class FitCli : public ::testing::Test {
 TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   const std::string model = dir_ + "/m.json";
   const auto r =
-      Fit("--target rate_dph --temperature temperature_c --mode compensate -I 10 --seed 4", model);
+      Fit("--target rate_dph --temperature temperature_c --mode compensate -I 10 --realisations 20 "
+          "--seed 4",
+          model);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_NE(r.out.find("ms-elm (compensate)"), std::string::npos) << r.out;
@@ -75,6 +77,7 @@ TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   EXPECT_EQ(json["options"]["decomposition"]["method"], "beemdan");
   EXPECT_EQ(json["options"]["decomposition"]["ensemble_size"], 10);
   EXPECT_EQ(json["options"]["seed"], 4);
+  EXPECT_EQ(json["options"]["selection"]["monte_carlo"]["realisations"], 20);
   EXPECT_EQ(json["options"]["features"]["rate_hz"], 1.0);  // from time_s
   EXPECT_EQ(json["options"]["learner"]["elm"]["selection"], "auto");
   EXPECT_EQ(json["options"]["learner"]["elm"]["hidden_units"], 50);
@@ -169,6 +172,8 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"hidden for poly", "fit %IN% -t rate_dph --mode predict -m poly --hidden 5", 2,
        "applies to the ELM methods"},
       {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "ensemble_size = 0"},
+      {"few realisations", "fit %IN% -t rate_dph --mode predict --realisations 5", 2,
+       "realisations = 5"},
       {"negative rate", "fit %IN% -t rate_dph --mode predict --rate-hz -1", 2, "rate_hz"},
       {"negative seed", "fit %IN% -t rate_dph --mode predict --seed -1", 2, "seed"},
       {"negative threads", "fit %IN% -t rate_dph --mode predict -j -2", 2, "threads"},
