@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "gyrodrift/common/error.h"
@@ -315,6 +316,17 @@ TEST_F(Refusal, WrongTypesShapesAndValuesAreNamed) {
   j = Json();
   j["model"]["sub_models"] = json::array();
   ExpectRefused(Reseal(j), "at least one sub-model");
+}
+
+TEST(ModelFile, RefusesToStoreWhatItCannotRebuild) {
+  const Log log = MakeLog(200, 41);
+  drift::DriftModel model =
+      drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kPoly));
+  drift::DriftModel with_noise = model;
+  with_noise.options.decomposition.supplied_noise = std::make_shared<Eigen::MatrixXd>(200, 2);
+  EXPECT_THROW(RenderModelFile(with_noise, Info()), UsageError);
+  model.sub_models[0].learner = nullptr;  // predict mode cannot run a zero sub-model
+  EXPECT_THROW(RenderModelFile(model, Info()), UsageError);
 }
 
 TEST(ModelFile, FilesOnDisk) {
