@@ -1,0 +1,567 @@
+#include "gyrodrift/io/report.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::io {
+namespace {
+
+std::string Escape(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// JSON string literal that is also safe inside a <script> block ("</" cannot close it).
+std::string JsonString(std::string_view text) {
+  std::string s = nlohmann::json(std::string(text)).dump();
+  std::string out;
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '<') {
+      out += "\\u003c";
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+// Plotting precision; the CSV files keep every digit.
+void AppendNumber(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.7g", v);
+  out += buffer;
+}
+
+void AppendArray(std::string& out, const Eigen::Ref<const Eigen::VectorXd>& v) {
+  out += '[';
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i) out += ',';
+    AppendNumber(out, v[i]);
+  }
+  out += ']';
+}
+
+std::string ReadAsset(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw IoError(path + ": cannot read (the HTML report inlines dygraphs from the Debian package "
+                         "libjs-dygraphs: apt-get install libjs-dygraphs, or run scripts/setup-deps.sh)");
+  }
+  std::ostringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  // The source-map comment would make a browser's developer tools look for a file beside the
+  // report; nothing else refers outside the file.
+  const size_t map = text.rfind("sourceMappingURL");
+  if (map != std::string::npos) {
+    const size_t line = text.rfind('\n', map);
+    text.erase(line == std::string::npos ? 0 : line + 1);
+  }
+  return text;
+}
+
+// Builds every plot from the JSON blocks. Dygraphs wants rows [x, y1, y2, ...]; with a band the
+// cells are [lo, y, hi] (customBars).
+constexpr std::string_view kPlotScript = R"JS(
+(function () {
+  var blocks = document.querySelectorAll('script.fig-data');
+  for (var b = 0; b < blocks.length; ++b) {
+    var f = JSON.parse(blocks[b].textContent);
+    var bars = f.series.some(function (s) { return s.lo !== undefined; });
+    var rows = [];
+    for (var i = 0; i < f.x.length; ++i) {
+      var row = [f.x[i]];
+      for (var k = 0; k < f.series.length; ++k) {
+        var s = f.series[k], v = s.y[i];
+        if (!bars) { row.push(v); continue; }
+        if (v === null) { row.push(null); continue; }
+        var lo = s.lo !== undefined ? s.lo[i] : v, hi = s.hi !== undefined ? s.hi[i] : v;
+        row.push([lo === null ? v : lo, v, hi === null ? v : hi]);
+      }
+      rows.push(row);
+    }
+    var seriesOptions = {};
+    f.series.forEach(function (s) {
+      seriesOptions[s.name] = s.dashed ? { strokePattern: [6, 4] } : {};
+    });
+    var shades = f.shades;
+    var colours = ['rgba(255,200,0,0.15)', 'rgba(0,150,255,0.12)', 'rgba(0,200,100,0.12)',
+                   'rgba(200,0,200,0.10)'];
+    new Dygraph(document.getElementById(blocks[b].dataset.target), rows, {
+      labels: [f.xlabel].concat(f.series.map(function (s) { return s.name; })),
+      xlabel: f.xlabel, ylabel: f.ylabel,
+      customBars: bars, logscale: f.logy,
+      axes: { x: { logscale: f.logx } },
+      drawPoints: f.points, pointSize: 2.5,
+      series: seriesOptions,
+      legend: 'always', labelsSeparateLines: false,
+      labelsDiv: document.getElementById(blocks[b].dataset.target + '-legend'),
+      connectSeparatedPoints: false,
+      strokeWidth: 1.2,
+      underlayCallback: function (ctx, area, g) {
+        shades.forEach(function (s, n) {
+          var l = g.toDomXCoord(s[0]), r = g.toDomXCoord(s[1]);
+          ctx.fillStyle = colours[n % colours.length];
+          ctx.fillRect(l, area.y, r - l, area.h);
+          ctx.fillStyle = '#555';
+          ctx.font = '11px sans-serif';
+          ctx.fillText(s[2], Math.max(l, area.x) + 3, area.y + 12);
+        });
+      }
+    });
+  }
+})();
+)JS";
+
+constexpr std::string_view kPageStyle = R"CSS(
+body { font-family: sans-serif; max-width: 1200px; margin: 1em auto; padding: 0 1em; color: #222; }
+h1 { font-size: 1.6em; } h2 { margin-top: 1.6em; border-bottom: 1px solid #ccc; }
+.fig { margin: 1.2em 0 2em 0; }
+.fig h3 { font-size: 1.05em; margin-bottom: 0.2em; }
+.plot { width: 100%; }
+.legend { font-size: 0.85em; min-height: 1.3em; }
+.caption { font-size: 0.9em; color: #444; margin-top: 0.3em; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
+th, td { border: 1px solid #bbb; padding: 2px 8px; text-align: right; }
+th { background: #eee; } td:first-child, th:first-child { text-align: left; }
+pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 0.85em; }
+)CSS";
+
+}  // namespace
+
+DygraphsAssets LoadDygraphs(const std::string& dir) {
+  DygraphsAssets assets;
+  assets.js = ReadAsset(dir + "/dygraph.min.js");
+  assets.css = ReadAsset(dir + "/dygraph.min.css");
+  return assets;
+}
+
+Decimated DecimateMinMax(const Eigen::Ref<const Eigen::VectorXd>& x,
+                         const Eigen::Ref<const Eigen::MatrixXd>& values,
+                         const Eigen::Ref<const Eigen::MatrixXd>& lower,
+                         const Eigen::Ref<const Eigen::MatrixXd>& upper, int max_points) {
+  const Eigen::Index n = x.size();
+  const Eigen::Index cols = values.cols();
+  const bool bands = lower.size() > 0;
+  Decimated out;
+  if (n <= max_points) {
+    out.x = x;
+    out.values = values;
+    if (bands) {
+      out.lower = lower;
+      out.upper = upper;
+    }
+    return out;
+  }
+  const Eigen::Index buckets = std::max<Eigen::Index>(1, max_points / 2);
+  out.x.resize(2 * buckets);
+  out.values.resize(2 * buckets, cols);
+  if (bands) {
+    out.lower.resize(2 * buckets, cols);
+    out.upper.resize(2 * buckets, cols);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (Eigen::Index b = 0; b < buckets; ++b) {
+    const Eigen::Index i0 = b * n / buckets;
+    const Eigen::Index i1 = (b + 1) * n / buckets - 1;
+    out.x[2 * b] = x[i0];
+    out.x[2 * b + 1] = x[i1];
+    for (Eigen::Index c = 0; c < cols; ++c) {
+      Eigen::Index arg_min = -1, arg_max = -1;
+      for (Eigen::Index i = i0; i <= i1; ++i) {
+        const double v = values(i, c);
+        if (!std::isfinite(v)) continue;
+        if (arg_min < 0 || v < values(arg_min, c)) arg_min = i;
+        if (arg_max < 0 || v > values(arg_max, c)) arg_max = i;
+      }
+      if (arg_min < 0) {
+        out.values(2 * b, c) = out.values(2 * b + 1, c) = nan;
+      } else {
+        // The extreme that occurs first goes first, so the drawn line follows the signal.
+        const bool min_first = arg_min <= arg_max;
+        out.values(2 * b, c) = values(min_first ? arg_min : arg_max, c);
+        out.values(2 * b + 1, c) = values(min_first ? arg_max : arg_min, c);
+      }
+      if (bands) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (Eigen::Index i = i0; i <= i1; ++i) {
+          if (std::isfinite(lower(i, c))) lo = std::min(lo, lower(i, c));
+          if (std::isfinite(upper(i, c))) hi = std::max(hi, upper(i, c));
+        }
+        out.lower(2 * b, c) = out.lower(2 * b + 1, c) = std::isfinite(lo) ? lo : nan;
+        out.upper(2 * b, c) = out.upper(2 * b + 1, c) = std::isfinite(hi) ? hi : nan;
+      }
+    }
+  }
+  return out;
+}
+
+HtmlReport::HtmlReport(std::string title) : title_(std::move(title)) {}
+
+void HtmlReport::AddHeading(const std::string& text) { body_ += "<h2>" + Escape(text) + "</h2>\n"; }
+
+void HtmlReport::AddParagraph(const std::string& text) { body_ += "<p>" + Escape(text) + "</p>\n"; }
+
+void HtmlReport::AddPreformatted(const std::string& text) {
+  body_ += "<pre>" + Escape(text) + "</pre>\n";
+}
+
+void HtmlReport::AddFigure(const ReportFigure& f) {
+  if (f.max_points < 16 || f.max_points > 1000000) {
+    ThrowOption("max_points", std::to_string(f.max_points), "an integer in [16, 1000000]");
+  }
+  if (f.height_px < 100 || f.height_px > 2000) {
+    ThrowOption("height_px", std::to_string(f.height_px), "an integer in [100, 2000]");
+  }
+  const std::string where = "figure '" + f.title + "'";
+  const Eigen::Index n = f.x.size();
+  if (n == 0 || f.series.empty()) throw DataError(where + ": no samples or no series");
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!std::isfinite(f.x[i]) || (i > 0 && f.x[i] < f.x[i - 1])) {
+      throw DataError(where + ": x must be finite and non-decreasing (sample " +
+                      std::to_string(i + 1) + ")");
+    }
+  }
+  const Eigen::Index cols = static_cast<Eigen::Index>(f.series.size());
+  bool bands = false;
+  for (const auto& s : f.series) {
+    if (s.values.size() != n) {
+      throw DataError(where + ": series '" + s.name + "' has " + std::to_string(s.values.size()) +
+                      " values for " + std::to_string(n) + " x");
+    }
+    if ((s.lower.size() == 0) != (s.upper.size() == 0) ||
+        (s.lower.size() != 0 && (s.lower.size() != n || s.upper.size() != n))) {
+      throw DataError(where + ": series '" + s.name + "' needs both band limits, one per x");
+    }
+    bands = bands || s.lower.size() != 0;
+  }
+  Eigen::MatrixXd values(n, cols), lower, upper;
+  if (bands) {
+    lower.resize(n, cols);
+    upper.resize(n, cols);
+  }
+  for (Eigen::Index c = 0; c < cols; ++c) {
+    const auto& s = f.series[static_cast<size_t>(c)];
+    values.col(c) = s.values;
+    if (bands) {
+      lower.col(c) = s.lower.size() ? s.lower : s.values;
+      upper.col(c) = s.upper.size() ? s.upper : s.values;
+    }
+  }
+  const Decimated d = DecimateMinMax(f.x, values, lower, upper, f.max_points);
+
+  const std::string id = "fig" + std::to_string(++figures_);
+  std::string json = "{\"title\":" + JsonString(f.title) + ",\"xlabel\":" + JsonString(f.x_label) +
+                     ",\"ylabel\":" + JsonString(f.y_label) + ",\"logx\":" +
+                     (f.log_x ? "true" : "false") + ",\"logy\":" + (f.log_y ? "true" : "false") +
+                     ",\"points\":" + (f.draw_points ? "true" : "false") + ",\"x\":";
+  AppendArray(json, d.x);
+  json += ",\"series\":[";
+  for (Eigen::Index c = 0; c < cols; ++c) {
+    const auto& s = f.series[static_cast<size_t>(c)];
+    if (c) json += ',';
+    json += "{\"name\":" + JsonString(s.name) + ",\"dashed\":" + (s.dashed ? "true" : "false") +
+            ",\"y\":";
+    AppendArray(json, d.values.col(c));
+    if (s.lower.size()) {
+      json += ",\"lo\":";
+      AppendArray(json, d.lower.col(c));
+      json += ",\"hi\":";
+      AppendArray(json, d.upper.col(c));
+    }
+    json += '}';
+  }
+  json += "],\"shades\":[";
+  for (size_t i = 0; i < f.shades.size(); ++i) {
+    if (i) json += ',';
+    json += '[';
+    AppendNumber(json, f.shades[i].x0);
+    json += ',';
+    AppendNumber(json, f.shades[i].x1);
+    json += ',' + JsonString(f.shades[i].label) + ']';
+  }
+  json += "]}";
+
+  body_ += "<div class=\"fig\">\n<h3>" + Escape(f.title) + "</h3>\n";
+  body_ += "<div id=\"" + id + "\" class=\"plot\" style=\"height:" + std::to_string(f.height_px) +
+           "px\"></div>\n";
+  body_ += "<div id=\"" + id + "-legend\" class=\"legend\"></div>\n";
+  body_ += "<p class=\"caption\">" + Escape(f.caption) + "</p>\n";
+  body_ += "<script type=\"application/json\" class=\"fig-data\" data-target=\"" + id + "\">" +
+           json + "</script>\n</div>\n";
+}
+
+void HtmlReport::AddTable(const ReportTable& t) {
+  for (size_t r = 0; r < t.rows.size(); ++r) {
+    if (t.rows[r].size() != t.header.size()) {
+      throw DataError("table '" + t.title + "': row " + std::to_string(r + 1) + " has " +
+                      std::to_string(t.rows[r].size()) + " cells for " +
+                      std::to_string(t.header.size()) + " columns");
+    }
+  }
+  body_ += "<div class=\"table\">\n<h3>" + Escape(t.title) + "</h3>\n<table>\n<tr>";
+  for (const auto& h : t.header) body_ += "<th>" + Escape(h) + "</th>";
+  body_ += "</tr>\n";
+  for (const auto& row : t.rows) {
+    body_ += "<tr>";
+    for (const auto& cell : row) body_ += "<td>" + Escape(cell) + "</td>";
+    body_ += "</tr>\n";
+  }
+  body_ += "</table>\n";
+  if (!t.caption.empty()) body_ += "<p class=\"caption\">" + Escape(t.caption) + "</p>\n";
+  body_ += "</div>\n";
+}
+
+std::string HtmlReport::Render(const DygraphsAssets& assets) const {
+  std::string html;
+  html.reserve(body_.size() + assets.js.size() + assets.css.size() + 8192);
+  html += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n";
+  html += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"/>\n";
+  html += "<title>" + Escape(title_) + "</title>\n";
+  html += "<style>\n" + assets.css + "\n" + std::string(kPageStyle) + "</style>\n";
+  html += "<script>\n" + assets.js + "\n</script>\n</head>\n<body>\n";
+  html += "<h1>" + Escape(title_) + "</h1>\n";
+  html += "<p class=\"caption\">Plots: drag to zoom, shift-drag to pan, double-click to reset.</p>\n";
+  html += body_;
+  html += "<script>\n" + std::string(kPlotScript) + "</script>\n</body>\n</html>\n";
+  return html;
+}
+
+// ---- CheckReportHtml ---------------------------------------------------------------------------
+
+namespace {
+
+bool IsVoid(const std::string& tag) {
+  static const char* kVoid[] = {"area", "base", "br", "col", "embed", "hr", "img",
+                                "input", "link", "meta", "source", "track", "wbr"};
+  for (const char* v : kVoid) {
+    if (tag == v) return true;
+  }
+  return false;
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+struct Attribute {
+  std::string name, value;
+};
+
+// Parses the attributes of a start tag; returns false on an unquoted or unterminated value.
+bool ParseAttributes(std::string_view text, std::vector<Attribute>& out) {
+  size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    if (i >= text.size() || text[i] == '/') break;
+    size_t start = i;
+    while (i < text.size() && text[i] != '=' && !std::isspace(static_cast<unsigned char>(text[i])) &&
+           text[i] != '/') {
+      ++i;
+    }
+    Attribute a{Lower(std::string(text.substr(start, i - start))), ""};
+    if (i < text.size() && text[i] == '=') {
+      ++i;
+      if (i >= text.size() || (text[i] != '"' && text[i] != '\'')) return false;
+      const char quote = text[i++];
+      const size_t end = text.find(quote, i);
+      if (end == std::string_view::npos) return false;
+      a.value = std::string(text.substr(i, end - i));
+      i = end + 1;
+    }
+    out.push_back(std::move(a));
+  }
+  return true;
+}
+
+bool External(const std::string& url) {
+  const std::string u = Lower(url);
+  return !(u.empty() || u[0] == '#' || u.rfind("data:", 0) == 0);
+}
+
+void CheckFigureData(const std::string& text, int index, ReportCheck& check) {
+  const std::string where = "figure data block " + std::to_string(index);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    check.problems.push_back(where + ": not JSON (" + e.what() + ")");
+    return;
+  }
+  if (!j.contains("x") || !j["x"].is_array() || j["x"].empty()) {
+    check.problems.push_back(where + ": empty or missing x array");
+    return;
+  }
+  if (!j.contains("series") || !j["series"].is_array() || j["series"].empty()) {
+    check.problems.push_back(where + ": no series");
+    return;
+  }
+  const size_t n = j["x"].size();
+  for (const auto& s : j["series"]) {
+    const std::string name = s.value("name", std::string("?"));
+    if (!s.contains("y") || !s["y"].is_array() || s["y"].size() != n) {
+      check.problems.push_back(where + ": series '" + name + "' does not have one value per x");
+      continue;
+    }
+    bool any = false;
+    for (const auto& v : s["y"]) any = any || v.is_number();
+    if (!any) check.problems.push_back(where + ": series '" + name + "' has no finite value");
+  }
+}
+
+}  // namespace
+
+ReportCheck CheckReportHtml(const std::string& html) {
+  ReportCheck check;
+  check.bytes = html.size();
+  std::vector<std::string> open;
+  bool dygraphs_inlined = false;
+  bool saw_html = false;
+  size_t i = 0;
+  auto line_of = [&](size_t pos) {
+    return std::to_string(std::count(html.begin(), html.begin() + static_cast<long>(pos), '\n') + 1);
+  };
+  while (i < html.size()) {
+    const size_t lt = html.find('<', i);
+    // Text between tags: no URL may point outside the file.
+    const std::string_view text(html.data() + i, (lt == std::string::npos ? html.size() : lt) - i);
+    if (text.find("http://") != std::string_view::npos || text.find("https://") != std::string_view::npos) {
+      check.problems.push_back("line " + line_of(i) + ": URL in the text");
+    }
+    if (lt == std::string::npos) break;
+    if (html.compare(lt, 4, "<!--") == 0) {
+      const size_t end = html.find("-->", lt + 4);
+      if (end == std::string::npos) {
+        check.problems.push_back("line " + line_of(lt) + ": unterminated comment");
+        break;
+      }
+      i = end + 3;
+      continue;
+    }
+    if (html.compare(lt, 2, "<!") == 0) {
+      const size_t end = html.find('>', lt);
+      if (end == std::string::npos) break;
+      i = end + 1;
+      continue;
+    }
+    const size_t gt = html.find('>', lt);
+    if (gt == std::string::npos) {
+      check.problems.push_back("line " + line_of(lt) + ": unterminated tag");
+      break;
+    }
+    const bool closing = lt + 1 < html.size() && html[lt + 1] == '/';
+    const size_t name_start = lt + (closing ? 2 : 1);
+    size_t name_end = name_start;
+    while (name_end < gt && (std::isalnum(static_cast<unsigned char>(html[name_end])) || html[name_end] == '-')) {
+      ++name_end;
+    }
+    const std::string name = Lower(html.substr(name_start, name_end - name_start));
+    if (name.empty()) {
+      check.problems.push_back("line " + line_of(lt) + ": '<' that starts no tag (unescaped text)");
+      i = lt + 1;
+      continue;
+    }
+    if (closing) {
+      if (open.empty() || open.back() != name) {
+        check.problems.push_back("line " + line_of(lt) + ": </" + name + "> closes " +
+                                 (open.empty() ? std::string("nothing") : "<" + open.back() + ">"));
+        // Recover: pop to the matching tag if it is open at all.
+        auto it = std::find(open.rbegin(), open.rend(), name);
+        if (it != open.rend()) open.erase(std::next(it).base(), open.end());
+      } else {
+        open.pop_back();
+      }
+      i = gt + 1;
+      continue;
+    }
+    const bool self_closing = html[gt - 1] == '/';
+    std::vector<Attribute> attributes;
+    const std::string_view attr_text(html.data() + name_end, gt - name_end - (self_closing ? 1 : 0));
+    if (!ParseAttributes(attr_text, attributes)) {
+      check.problems.push_back("line " + line_of(lt) + ": <" + name + "> has an unquoted attribute");
+    }
+    for (const auto& a : attributes) {
+      if ((a.name == "src" || a.name == "href" || a.name == "action") && External(a.value)) {
+        check.problems.push_back("line " + line_of(lt) + ": <" + name + " " + a.name + "=\"" +
+                                 a.value + "\"> refers outside the file");
+      }
+    }
+    if (name == "html") saw_html = true;
+    if (name == "link") check.problems.push_back("line " + line_of(lt) + ": <link> (external resource)");
+    if (name == "table") ++check.tables;
+    if (name == "script" || name == "style") {
+      const std::string close = "</" + name;
+      size_t end = gt + 1;
+      for (;;) {
+        end = html.find("</", end);
+        if (end == std::string::npos || Lower(html.substr(end, close.size())) == close) break;
+        end += 2;
+      }
+      if (end == std::string::npos) {
+        check.problems.push_back("line " + line_of(lt) + ": <" + name + "> never closed");
+        break;
+      }
+      const std::string content = html.substr(gt + 1, end - gt - 1);
+      if (name == "style" && Lower(content).find("url(http") != std::string::npos) {
+        check.problems.push_back("line " + line_of(lt) + ": CSS url() outside the file");
+      }
+      if (name == "script") {
+        bool data_block = false;
+        for (const auto& a : attributes) {
+          if (a.name == "class" && a.value == "fig-data") data_block = true;
+        }
+        if (data_block) {
+          ++check.figures;
+          CheckFigureData(content, check.figures, check);
+        } else if (content.size() > 50000 && content.find("Dygraph") != std::string::npos) {
+          dygraphs_inlined = true;
+        }
+      }
+      const size_t close_gt = html.find('>', end);
+      i = close_gt == std::string::npos ? html.size() : close_gt + 1;
+      continue;
+    }
+    if (!self_closing && !IsVoid(name)) open.push_back(name);
+    i = gt + 1;
+  }
+  if (!saw_html) check.problems.push_back("no <html> element");
+  for (auto it = open.rbegin(); it != open.rend(); ++it) {
+    check.problems.push_back("<" + *it + "> never closed");
+  }
+  if (!dygraphs_inlined) check.problems.push_back("the dygraphs library is not inlined");
+  return check;
+}
+
+std::string ReportCheck::Summary() const {
+  return std::string(ok() ? "report ok" : "report has " + std::to_string(problems.size()) + " problem(s)") +
+         ": " + std::to_string(figures) + " figures, " + std::to_string(tables) + " tables, " +
+         std::to_string(bytes) + " bytes" + (ok() ? "" : "; first: " + problems.front());
+}
+
+}  // namespace gyrodrift::io

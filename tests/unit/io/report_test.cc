@@ -1,0 +1,158 @@
+// The HTML report writer: a small report renders and passes the structural check; the check
+// itself catches each kind of broken report; the min/max decimation keeps the envelope.
+#include "gyrodrift/io/report.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::io {
+namespace {
+
+bool HaveDygraphs() {
+  return std::filesystem::exists(std::string(kDygraphsDir) + "/dygraph.min.js");
+}
+
+// Stand-in assets for the checks that must not depend on the package: a large script that
+// mentions Dygraph (the check only needs "inlined and big").
+DygraphsAssets FakeAssets() {
+  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
+}
+
+HtmlReport SmallReport() {
+  HtmlReport report("Small <report> & test");
+  report.AddHeading("Section with a < sign");
+  report.AddParagraph("Text with \"quotes\" and </script> inside.");
+  ReportFigure f;
+  f.title = "sine";
+  f.caption = "look at the peaks";
+  f.x_label = "t (s)";
+  f.y_label = "y";
+  f.x = Eigen::VectorXd::LinSpaced(100, 0.0, 9.9);
+  f.series.push_back({"sin", f.x.array().sin().matrix(), {}, {}, false});
+  f.series.push_back({"cos", f.x.array().cos().matrix(), {}, {}, true});
+  f.shades.push_back({2.0, 3.0, "a shade"});
+  report.AddFigure(f);
+  ReportFigure allan;
+  allan.title = "log-log with bands";
+  allan.caption = "bands";
+  allan.log_x = allan.log_y = true;
+  allan.x = Eigen::VectorXd::LinSpaced(8, 1.0, 8.0);
+  ReportSeries s{"adev", allan.x.cwiseInverse(), {}, {}, false};
+  s.lower = s.values * 0.8;
+  s.upper = s.values * 1.2;
+  s.values[3] = std::nan("");  // a gap
+  allan.series.push_back(s);
+  report.AddFigure(allan);
+  report.AddTable({"t", "cap", {"method", "rmse"}, {{"ms-elm", "0.1"}, {"elm<", "0.2"}}});
+  return report;
+}
+
+TEST(Report, SmallReportRendersAndPassesTheCheck) {
+  const std::string html = SmallReport().Render(FakeAssets());
+  const ReportCheck check = CheckReportHtml(html);
+  EXPECT_TRUE(check.ok()) << check.Summary();
+  EXPECT_EQ(check.figures, 2);
+  EXPECT_EQ(check.tables, 1);
+  // Caller text is escaped, never markup.
+  EXPECT_NE(html.find("Small &lt;report&gt; &amp; test"), std::string::npos);
+  EXPECT_EQ(html.find("</script> inside"), std::string::npos);
+  EXPECT_NE(html.find("\"logx\":true"), std::string::npos);
+  EXPECT_NE(html.find("null"), std::string::npos);  // the NaN became a gap
+}
+
+TEST(Report, RealDygraphsIsInlinedWithoutItsSourceMap) {
+  if (!HaveDygraphs()) GTEST_SKIP() << "libjs-dygraphs not installed";
+  const DygraphsAssets assets = LoadDygraphs();
+  EXPECT_GT(assets.js.size(), 100000u);
+  EXPECT_EQ(assets.js.find("sourceMappingURL"), std::string::npos);
+  const std::string html = SmallReport().Render(assets);
+  const ReportCheck check = CheckReportHtml(html);
+  EXPECT_TRUE(check.ok()) << check.Summary();
+  const std::string out = test::TempDir("report_small") + "/small.html";
+  WriteFileAtomically(out, html);  // for a look in a browser
+}
+
+TEST(Report, MissingDygraphsNamesThePackage) {
+  try {
+    LoadDygraphs("/nonexistent/dygraphs");
+    FAIL() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("libjs-dygraphs"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Report, CheckCatchesBrokenReports) {
+  const std::string good = SmallReport().Render(FakeAssets());
+  ASSERT_TRUE(CheckReportHtml(good).ok());
+  auto broken = [&](std::string from, std::string to) {
+    std::string html = good;
+    const size_t at = html.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    html.replace(at, from.size(), to);
+    return CheckReportHtml(html);
+  };
+  EXPECT_FALSE(broken("</table>", "").ok());                                    // unclosed
+  EXPECT_FALSE(broken("<h1>", "<h1><b>").ok());                                 // stray open tag
+  EXPECT_FALSE(broken("</h1>", "</h1><img src=\"https://x.org/a.png\"/>").ok());  // external
+  EXPECT_FALSE(broken("</h1>", "</h1><link rel=\"stylesheet\" href=\"a.css\"/>").ok());
+  EXPECT_FALSE(broken("</h1>", "</h1>see http://example.org").ok());            // URL in text
+  EXPECT_FALSE(broken("\"y\":[", "\"y\":[1,").ok());                            // length mismatch
+  EXPECT_FALSE(broken("\"x\":[", "\"x\":[],\"old\":[").ok());                   // empty x
+  EXPECT_FALSE(broken("var Dygraph", "var Other").ok());                        // not inlined
+  EXPECT_FALSE(broken("<div class=\"fig\">", "<div class=fig>").ok());          // unquoted
+  EXPECT_FALSE(CheckReportHtml("<p>no html element</p>").ok());
+}
+
+TEST(Report, FigureErrorsAreDataErrors) {
+  HtmlReport report("r");
+  ReportFigure f;
+  f.title = "bad";
+  f.x = Eigen::VectorXd::LinSpaced(10, 0.0, 1.0);
+  f.series.push_back({"short", Eigen::VectorXd::Zero(9), {}, {}, false});
+  EXPECT_THROW(report.AddFigure(f), DataError);
+  f.series[0].values = Eigen::VectorXd::Zero(10);
+  f.x[5] = -1.0;  // decreasing
+  EXPECT_THROW(report.AddFigure(f), DataError);
+  f.x = Eigen::VectorXd::LinSpaced(10, 0.0, 1.0);
+  f.series[0].lower = Eigen::VectorXd::Zero(10);  // half a band
+  EXPECT_THROW(report.AddFigure(f), DataError);
+  f.series[0].lower.resize(0);
+  f.max_points = 4;
+  EXPECT_THROW(report.AddFigure(f), UsageError);
+  EXPECT_THROW(report.AddTable({"t", "", {"a", "b"}, {{"1"}}}), DataError);
+  EXPECT_EQ(report.figures(), 0);
+}
+
+TEST(Report, DecimationKeepsTheEnvelopeAndOrder) {
+  const Eigen::Index n = 100000;
+  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(n, 0.0, 1.0);
+  Eigen::MatrixXd v(n, 2);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    v(i, 0) = std::sin(0.01 * static_cast<double>(i));
+    v(i, 1) = 0.0;
+  }
+  v(54321, 1) = 7.0;  // one spike: a stride would miss it
+  v(12345, 1) = -3.0;
+  const Decimated d = DecimateMinMax(x, v, Eigen::MatrixXd(), Eigen::MatrixXd(), 4000);
+  ASSERT_EQ(d.x.size(), 4000);
+  EXPECT_EQ(d.values.col(1).maxCoeff(), 7.0);
+  EXPECT_EQ(d.values.col(1).minCoeff(), -3.0);
+  EXPECT_DOUBLE_EQ(d.values.col(0).maxCoeff(), v.col(0).maxCoeff());
+  EXPECT_DOUBLE_EQ(d.values.col(0).minCoeff(), v.col(0).minCoeff());
+  for (Eigen::Index i = 1; i < d.x.size(); ++i) ASSERT_GE(d.x[i], d.x[i - 1]);
+  EXPECT_EQ(d.x[0], 0.0);
+  EXPECT_EQ(d.x[d.x.size() - 1], 1.0);
+  // Short input comes back unchanged.
+  const Decimated same = DecimateMinMax(x.head(100), v.topRows(100), Eigen::MatrixXd(), Eigen::MatrixXd(), 4000);
+  EXPECT_EQ(same.values, v.topRows(100));
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
