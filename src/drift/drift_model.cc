@@ -71,7 +71,7 @@ Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
     throw DataError("temperature has " + std::to_string(temperature_c.size()) +
                     " samples, the target " + std::to_string(n) + ": they must match");
   }
-  return ThermalFeatures(temperature_c, model.options.features);
+  return ThermalFeatures(temperature_c, EffectiveFeatures(model.options));
 }
 
 // Rows of inputs of sub-model g for t = first .. first + count - 1 (predict mode).
@@ -84,9 +84,16 @@ Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eige
   return x;
 }
 
-LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
+LearnerOptions SubModelLearner(const DriftOptions& o, size_t g, int inputs) {
   LearnerOptions l = o.learner;
   l.kind = KindOf(o.method);
+  if (o.mode == Mode::kCompensate && o.linear_compensation && UsesDecomposition(o.method)) {
+    l.elm.activation = elm::Activation::kLinear;
+    l.elm.selection = elm::Selection::kFixed;
+    l.elm.hidden_units = inputs + 1;  // spans the inputs and the constant
+    l.elm.ridge_c = 1e6;
+    l.elm.solver = elm::Solver::kCholesky;
+  }
   l.seed = o.seed + g;
   l.threads = o.threads;
   return l;
@@ -107,6 +114,14 @@ std::vector<Method> AllMethods() {
   return all;
 }
 
+FeatureOptions EffectiveFeatures(const DriftOptions& options) {
+  FeatureOptions f = options.features;
+  if (f.thermal_set == ThermalSet::kAuto) {
+    f.thermal_set = options.method == Method::kPoly ? ThermalSet::kClassic : ThermalSet::kLadder;
+  }
+  return f;
+}
+
 bool UsesDecomposition(Method method) {
   return method == Method::kMsElm || method == Method::kEmdElm;
 }
@@ -119,7 +134,8 @@ DriftOptions::DriftOptions() {
 void DriftOptions::Validate() const {
   decomposition.Validate();
   selection.Validate();
-  features.Validate();
+  EffectiveFeatures(*this).Validate();
+  if (!std::isnan(reference_c)) RequireInRange("reference_c", reference_c, -100.0, 200.0);
   LearnerOptions l = learner;
   l.kind = KindOf(method);
   l.Validate();
@@ -140,14 +156,14 @@ bool DriftModel::uses_temperature() const {
 }
 
 int DriftModel::num_inputs() const {
-  const int thermal = uses_temperature() ? options.features.NumThermalFeatures() : 0;
+  const int thermal = uses_temperature() ? EffectiveFeatures(options).NumThermalFeatures() : 0;
   return options.mode == Mode::kCompensate ? thermal : lags + thermal;
 }
 
 std::string DriftModel::Summary() const {
-  std::string s = std::string(ToString(options.method)) + " (" + std::string(ToString(options.mode)) +
-                  "): " + std::to_string(sub_models.size()) + " sub-model" +
-                  (sub_models.size() == 1 ? "" : "s") + " [";
+  std::string s = std::string(ToString(options.method)) + " (" +
+                  std::string(ToString(options.mode)) + "): " + std::to_string(sub_models.size()) +
+                  " sub-model" + (sub_models.size() == 1 ? "" : "s") + " [";
   for (size_t g = 0; g < sub_models.size(); ++g) s += (g ? " " : "") + sub_models[g].name;
   s += "], " + std::to_string(num_inputs()) + " inputs";
   if (options.mode == Mode::kPredict) s += ", " + std::to_string(lags) + " lags";
@@ -226,9 +242,9 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       // and a learner fitted to it from temperature only extrapolates noise into new thermal
       // histories. Its sub-model is the zero function [choice, docs/drift.md].
       if (model.sub_models[g].name == "noise") continue;
-      model.sub_models[g].learner =
-          FitLearner(thermal.topRows(fit_end), series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-                     SubModelLearner(o, g));
+      model.sub_models[g].learner = FitLearner(
+          thermal.topRows(fit_end), series.col(static_cast<Eigen::Index>(g)).head(fit_end),
+          SubModelLearner(o, g, static_cast<int>(thermal.cols())));
     }
     return;
   }
@@ -240,15 +256,17 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
     }
     for (size_t g = 0; g < groups; ++g) {
       const auto s = series.col(static_cast<Eigen::Index>(g));
-      model.sub_models[g].learner = FitLearner(PredictRows(model, s, thermal, p, end - p),
-                                               s.segment(p, end - p), SubModelLearner(o, g));
+      model.sub_models[g].learner =
+          FitLearner(PredictRows(model, s, thermal, p, end - p), s.segment(p, end - p),
+                     SubModelLearner(o, g, p + static_cast<int>(thermal.cols())));
     }
   };
   if (!o.auto_lags) {
     fit_with_lags(o.features.lags, fit_end);
     return;
   }
-  const Eigen::Index validation = static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
+  const Eigen::Index validation =
+      static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
   const Eigen::Index inner_end = fit_end - validation;
   double best = std::numeric_limits<double>::infinity();
   int best_p = o.lag_candidates.front();
@@ -256,7 +274,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
   for (int p : o.lag_candidates) {
     fit_with_lags(p, inner_end);
     const Eigen::VectorXd pred = PredictFromSeries(model, series, thermal, inner_end, validation);
-    const double rmse = std::sqrt((pred - y.segment(inner_end, validation)).squaredNorm() / validation);
+    const double rmse =
+        std::sqrt((pred - y.segment(inner_end, validation)).squaredNorm() / validation);
     model.lag_validation_rmse.push_back(rmse);
     if (rmse < best) {
       best = rmse;
@@ -282,12 +301,22 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
   if (model.options.mode != Mode::kCompensate) {
-    throw UsageError("model mode = predict: drift estimation needs a model fitted with --mode compensate");
+    throw UsageError(
+        "model mode = predict: drift estimation needs a model fitted with --mode compensate");
   }
-  const Eigen::MatrixXd f = ThermalFeatures(temperature_c, model.options.features);
+  const FeatureOptions features = EffectiveFeatures(model.options);
+  const Eigen::MatrixXd f = ThermalFeatures(temperature_c, features);
+  // Equilibrium at the reference: a one-sample record starts (and stays) in equilibrium.
+  const bool referenced = !std::isnan(model.options.reference_c);
+  const Eigen::MatrixXd f_ref =
+      referenced
+          ? ThermalFeatures(Eigen::VectorXd::Constant(1, model.options.reference_c), features)
+          : Eigen::MatrixXd();
   Eigen::VectorXd estimate = Eigen::VectorXd::Zero(temperature_c.size());
   for (const auto& sub : model.sub_models) {
-    if (sub.learner) estimate += sub.learner->Predict(f);
+    if (!sub.learner) continue;
+    estimate += sub.learner->Predict(f);
+    if (referenced) estimate.array() -= sub.learner->Predict(f_ref)[0];
   }
   return estimate;
 }
@@ -308,7 +337,8 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
                                const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                Eigen::Index first, Protocol protocol, const CausalOptions& causal) {
   if (model.options.mode != Mode::kPredict) {
-    throw UsageError("model mode = compensate: one-step prediction needs a model fitted with --mode predict");
+    throw UsageError(
+        "model mode = compensate: one-step prediction needs a model fitted with --mode predict");
   }
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();
@@ -348,7 +378,8 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
     const Eigen::MatrixXd series =
         GroupSeries(model, decomposition::Decompose(y.segment(start, length), dopt));
     for (size_t g = 0; g < groups; ++g) {
-      for (int k = 0; k < p; ++k) rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
+      for (int k = 0; k < p; ++k)
+        rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
       if (thermal.cols() > 0) rows[g].row(r).tail(thermal.cols()) = thermal.row(t - 1);
     }
   });

@@ -35,17 +35,18 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decompose_all = protocol == Protocol::kPaper && UsesDecomposition(o.method);
   Eigen::MatrixXd series_all;
   Eigen::MatrixXd thermal_all;
-  if (thermal_needed) thermal_all = ThermalFeatures(temperature_c, o.features);
+  if (thermal_needed) thermal_all = ThermalFeatures(temperature_c, EffectiveFeatures(o));
   if (decompose_all) {
     internal::SubSeries prepared = internal::PrepareSubSeries(y, o);
     series_all = std::move(prepared.series);
     model = std::move(prepared.model);
     internal::FitLearners(model, series_all, y,
-                          thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0), split);
+                          thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
+                          split);
   } else {
-    model = FitDriftModel(y.head(split), thermal_needed ? Eigen::VectorXd(temperature_c.head(split))
-                                                        : Eigen::VectorXd(),
-                          o);
+    model = FitDriftModel(
+        y.head(split),
+        thermal_needed ? Eigen::VectorXd(temperature_c.head(split)) : Eigen::VectorXd(), o);
   }
   trial.train_s = Seconds(start);
   trial.summary = model.Summary();
@@ -60,8 +61,9 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
         model, series_all, thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
         split, test);
   } else {
-    trial.estimate = PredictOneStep(model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(),
-                                    split, Protocol::kCausal, causal);
+    trial.estimate = PredictOneStep(
+        model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(), split,
+        Protocol::kCausal, causal);
   }
   trial.predict_s = Seconds(start);
   return trial;
@@ -80,7 +82,8 @@ Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error) {
 
 void EvaluationOptions::Validate() const {
   RequireInRange("split", split, 0.1, 0.95);
-  if (repeats < 1 || repeats > 1000) ThrowOption("repeats", std::to_string(repeats), "an integer in [1, 1000]");
+  if (repeats < 1 || repeats > 1000)
+    ThrowOption("repeats", std::to_string(repeats), "an integer in [1, 1000]");
   if (methods.empty()) ThrowOption("methods", "(empty)", "at least one method");
   if (protocols.empty()) ThrowOption("protocols", "(empty)", "at least one protocol");
   if (causal.window < 16 || causal.window > 1000000) {
@@ -111,7 +114,8 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   }
   EvaluationResult result;
   result.mode = base.mode;
-  result.split_index = static_cast<Eigen::Index>(std::floor(options.split * static_cast<double>(n)));
+  result.split_index =
+      static_cast<Eigen::Index>(std::floor(options.split * static_cast<double>(n)));
   const Eigen::Index split = result.split_index;
   if (split < 32 || n - split < 16) {
     throw DataError("split at sample " + std::to_string(split) + " of " + std::to_string(n) +
@@ -140,9 +144,10 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
       std::vector<double> rmse;
       for (int r = 0; r < options.repeats; ++r) {
         if (options.progress) {
-          options.progress(done / total, std::string(ToString(method)) + " / " +
-                                             std::string(ToString(protocol)) + " / seed " +
-                                             std::to_string(base.seed + static_cast<std::uint64_t>(r)));
+          options.progress(done / total,
+                           std::string(ToString(method)) + " / " + std::string(ToString(protocol)) +
+                               " / seed " +
+                               std::to_string(base.seed + static_cast<std::uint64_t>(r)));
         }
         DriftOptions o = base;
         o.method = method;
@@ -180,8 +185,9 @@ std::string EvaluationResult::Table() const {
   out += line;
   for (const auto& r : rows) {
     std::snprintf(line, sizeof(line), "%-8s %-7s %12.6g %12.3g %12.6g %12.6g %9.3f %10.3f\n",
-                  std::string(ToString(r.method)).c_str(), std::string(ToString(r.protocol)).c_str(),
-                  r.rmse, r.rmse_std, r.mae, r.max_abs, r.train_s, r.predict_s);
+                  std::string(ToString(r.method)).c_str(),
+                  std::string(ToString(r.protocol)).c_str(), r.rmse, r.rmse_std, r.mae, r.max_abs,
+                  r.train_s, r.predict_s);
     out += line;
   }
   return out;

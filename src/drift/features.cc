@@ -1,12 +1,69 @@
 #include "gyrodrift/drift/features.h"
 
+#include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::drift {
+
+namespace {
+
+constexpr std::array<std::pair<ThermalSet, std::string_view>, 4> kSets{{
+    {ThermalSet::kAuto, "auto"},
+    {ThermalSet::kLadder, "ladder"},
+    {ThermalSet::kClassic, "classic"},
+    {ThermalSet::kLagBank, "lag-bank"},
+}};
+
+// Centre of the quadratic column: keeps (T - c)^2 well scaled for chamber temperatures; any
+// centre spans the same space together with T and the constant.
+constexpr double kQuadraticCentreC = 20.0;
+
+// The first-order lag of temperature_c with time constant tau_s, into out (N).
+void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
+                   double dt_s, Eigen::Ref<Eigen::VectorXd> out) {
+  // Exact step response of a first-order lag over one sample (stable for any dt / tau).
+  const double gain = -std::expm1(-dt_s / tau_s);
+  double state = temperature_c[0];
+  for (Eigen::Index t = 0; t < temperature_c.size(); ++t) {
+    state += gain * (temperature_c[t] - state);
+    out[t] = state;
+  }
+}
+
+}  // namespace
+
+std::string_view ToString(ThermalSet set) {
+  for (const auto& [v, name] : kSets) {
+    if (v == set) return name;
+  }
+  return "?";
+}
+
+ThermalSet ThermalSetFromString(std::string_view name) {
+  std::string allowed;
+  for (const auto& [v, n] : kSets) {
+    if (n == name) return v;
+    allowed += (allowed.empty() ? "" : ", ") + std::string(n);
+  }
+  ThrowOption("thermal_set", "'" + std::string(name) + "'", "one of " + allowed);
+}
+
+int FeatureOptions::NumThermalFeatures() const {
+  const int taus = static_cast<int>(time_constants_s.size());
+  switch (thermal_set) {
+    case ThermalSet::kClassic:
+      return 2;
+    case ThermalSet::kLagBank:
+      return 1 + 2 * taus;
+    default:
+      return 2 + taus;
+  }
+}
 
 void FeatureOptions::Validate() const {
   if (lags < 1 || lags > 256) ThrowOption("lags", std::to_string(lags), "an integer in [1, 256]");
@@ -15,6 +72,10 @@ void FeatureOptions::Validate() const {
     ThrowOption("time constants", std::to_string(time_constants_s.size()), "at most 32 values");
   }
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
+  if (thermal_set == ThermalSet::kClassic && time_constants_s.empty()) {
+    ThrowOption("time constants", "(empty)",
+                "at least one value with thermal_set = classic (the first smooths the rate)");
+  }
 }
 
 Eigen::MatrixXd ThermalFeatures(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
@@ -23,18 +84,38 @@ Eigen::MatrixXd ThermalFeatures(const Eigen::Ref<const Eigen::VectorXd>& tempera
   RequireFiniteSignal("temperature", temperature_c, 1);
   const Eigen::Index n = temperature_c.size();
   const int taus = static_cast<int>(options.time_constants_s.size());
-  Eigen::MatrixXd f(n, options.NumThermalFeatures());
-  f.col(0) = temperature_c;
   const double dt = 1.0 / options.rate_hz;
-  for (int k = 0; k < taus; ++k) {
-    const double tau = options.time_constants_s[static_cast<size_t>(k)];
-    // Exact step response of a first-order lag over one sample (stable for any dt / tau).
-    const double gain = -std::expm1(-dt / tau);
-    double state = temperature_c[0];
-    for (Eigen::Index t = 0; t < n; ++t) {
-      state += gain * (temperature_c[t] - state);
-      f(t, 1 + 2 * k) = state;
-      f(t, 2 + 2 * k) = (temperature_c[t] - state) / tau;
+  Eigen::MatrixXd f(n, options.NumThermalFeatures());
+  Eigen::VectorXd lag(n);
+  switch (options.thermal_set) {
+    case ThermalSet::kClassic: {
+      const double tau = options.time_constants_s.front();
+      FirstOrderLag(temperature_c, tau, dt, lag);
+      f.col(0) = temperature_c;
+      f.col(1) = (temperature_c - lag) / tau;
+      break;
+    }
+    case ThermalSet::kLagBank:
+      f.col(0) = temperature_c;
+      for (int k = 0; k < taus; ++k) {
+        const double tau = options.time_constants_s[static_cast<size_t>(k)];
+        FirstOrderLag(temperature_c, tau, dt, lag);
+        f.col(1 + 2 * k) = lag;
+        f.col(2 + 2 * k) = (temperature_c - lag) / tau;
+      }
+      break;
+    default: {
+      // Ladder rung k: the band of thermal history between two neighbouring depths (K). The rungs
+      // and the slowest lag add up to T, so T itself would be a redundant column.
+      Eigen::VectorXd previous = temperature_c;
+      for (int k = 0; k < taus; ++k) {
+        FirstOrderLag(temperature_c, options.time_constants_s[static_cast<size_t>(k)], dt, lag);
+        f.col(k) = previous - lag;
+        previous = lag;
+      }
+      f.col(taus) = previous;
+      f.col(f.cols() - 1) = (temperature_c.array() - kQuadraticCentreC).square().matrix();
+      break;
     }
   }
   return f;

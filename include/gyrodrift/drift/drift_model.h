@@ -53,6 +53,18 @@ struct DriftOptions {
   bool auto_lags = false;
   std::vector<int> lag_candidates{1, 2, 4, 8, 16};
   double validation_fraction = 0.2;  // in [0.05, 0.5]
+  // Compensate mode, kMsElm and kEmdElm: each sub-model is an ELM of linear neurons (hpelm's
+  // 'lin' type: activation linear, L = inputs + 1, C = 1e6, i.e. ridge-free linear regression on
+  // the thermal features) instead of `learner`. Measured in docs/drift.md: fitted on one chamber
+  // programme, sigmoid sub-models extrapolate badly to another; linear ones in the ladder
+  // features generalise. false = use `learner` as given.
+  bool linear_compensation = true;
+  // Compensate mode: the estimate is referenced to thermal equilibrium at this temperature
+  // (degC, in [-100, 200]): the model's output there is subtracted, so the estimate is the
+  // thermal change of the bias relative to its value at the calibration temperature, and the
+  // training run's turn-on bias and mean noise do not pass into it as a constant. NaN = keep the
+  // fitted intercept. Default 20 degC (the usual bias-calibration temperature).
+  double reference_c = 20.0;
   std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
   int threads = 0;         // 0 = every core
   DriftOptions();          // sets the learner defaults described above
@@ -71,17 +83,21 @@ struct SubModel {
 
 struct DriftModel {
   DriftOptions options;
-  int lags = 0;            // p used (predict mode)
-  int training_imfs = 0;   // K of the training decomposition (0 for single models)
+  int lags = 0;           // p used (predict mode)
+  int training_imfs = 0;  // K of the training decomposition (0 for single models)
   Eigen::Index training_samples = 0;
   std::vector<SubModel> sub_models;
-  std::string decomposition_summary;  // report of the training decomposition
-  std::string selection_summary;      // report of the grouping (kMsElm)
+  std::string decomposition_summary;        // report of the training decomposition
+  std::string selection_summary;            // report of the grouping (kMsElm)
   std::vector<double> lag_validation_rmse;  // auto_lags: per candidate
   bool uses_temperature() const;
-  int num_inputs() const;  // inputs of each sub-model
+  int num_inputs() const;       // inputs of each sub-model
   std::string Summary() const;  // one line
 };
+
+// The feature options a model of these options uses: thermal_set kAuto resolved (kClassic for
+// Method::kPoly, kLadder otherwise).
+FeatureOptions EffectiveFeatures(const DriftOptions& options);
 
 // Sub-series of a decomposition grouped as the model's sub-models expect: column g is the sum of
 // the IMFs (and residue) that belong to sub-model g. IMFs beyond the training count and the
@@ -94,15 +110,17 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                          const DriftOptions& options);
 
-// Compensate mode: the drift estimate at every sample of a temperature record.
+// Compensate mode: the drift estimate at every sample of a temperature record (relative to
+// equilibrium at options.reference_c unless that is NaN).
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
 
 // Predict mode from given sub-series (N x G, GroupSeries of some decomposition) and thermal
 // features (N x F, or empty): predictions for t = first .. first + count - 1 (first >= lags).
-Eigen::VectorXd PredictFromSeries(const DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
-                                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index first,
-                                  Eigen::Index count);
+Eigen::VectorXd PredictFromSeries(const DriftModel& model,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& series,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& thermal,
+                                  Eigen::Index first, Eigen::Index count);
 
 // How a predict-mode model gets its test-time sub-series.
 enum class Protocol {

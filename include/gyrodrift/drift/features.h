@@ -1,21 +1,36 @@
 // Model inputs built from a gyro log: own lags of a series, and the thermal history of the
 // temperature channel.
 //
-// Thermal history [choice, documented in docs/drift.md]: the coil's temperature lags the case
-// sensor by minutes to an hour, and the Shupe drift follows temperature *rates* inside the coil
-// (METHOD.md section 1). A bank of first-order lags of the measured temperature, one per time
+// Thermal history [choice, measured in docs/drift.md]: the coil's temperature lags the case
+// sensor by minutes to an hour, the Shupe drift follows temperature *rates* inside the coil, the
+// stress drift the coil's mean temperature and the static bias the case temperature
+// (METHOD.md section 1). A bank of first-order lags of the measured temperature T, one per time
 // constant tau, stands in for the temperature at different depths of the winding pack:
-//   T_tau[t] = T_tau[t-1] + (1 - exp(-dt/tau)) (T[t] - T_tau[t-1]),   T_tau[0] = T[0],
-// and (T - T_tau) / tau is the rate of T_tau (K/s), a smoothed rate at that depth. Features at
-// sample t: T[t], then for each tau: T_tau[t] and (T[t] - T_tau[t]) / tau. Every feature at t
-// uses T[0..t] only (causal), and the recursion is what a navigation computer would run.
-// Cost: O(N * number of time constants).
+//   T_tau[t] = T_tau[t-1] + (1 - exp(-dt/tau)) (T[t] - T_tau[t-1]),   T_tau[0] = T[0].
+// Feature sets (ThermalSet):
+//   kLadder   (default for every method but poly) the band-pass ladder T - T_tau1,
+//             T_tau1 - T_tau2, ..., T_tau(K-1) - T_tauK (K columns in K, each a smoothed rate
+//             times its time scale); the slowest lag T_tauK; and (T - 20 degC)^2 (static-bias
+//             curvature). K + 2 columns (T and (T - 20)^2 when K = 0). Rungs plus the slowest lag
+//             add up to T, so the ladder spans the same space as {T, T_tau} (and every lag rate
+//             (T - T_tau)/tau), but its columns are far less correlated, which a sigmoid network
+//             needs (the raw lags of one temperature are correlated above 0.99).
+//   kClassic  (poly's default) the classic thermal-drift regression inputs: T and the smoothed
+//             rate (T - T_tau1) / tau1 in K/s (tau1 = first time constant, 60 s by default).
+//   kLagBank  the original bank: T, then per tau T_tau and (T - T_tau) / tau (1 + 2K columns).
+// Every feature at t uses T[0..t] only (causal), and the recursion is what a navigation computer
+// would run. Cost: O(N * number of time constants).
 #pragma once
 
 #include <Eigen/Core>
+#include <string_view>
 #include <vector>
 
 namespace gyrodrift::drift {
+
+enum class ThermalSet { kAuto, kLadder, kClassic, kLagBank };
+std::string_view ToString(ThermalSet set);
+ThermalSet ThermalSetFromString(std::string_view name);  // "auto", "ladder", "classic", "lag-bank"
 
 struct FeatureOptions {
   // Own lags p of each series in predict mode, in [1, 256].
@@ -26,8 +41,13 @@ struct FeatureOptions {
   // only T itself is a feature).
   std::vector<double> time_constants_s{60.0, 300.0, 900.0, 1800.0, 3600.0};
   double rate_hz = 1.0;  // sample rate of the log, Hz, in (0, 1e6]
+  // Which thermal features; kAuto = kClassic for the poly method, kLadder otherwise (the drift
+  // model resolves it; ThermalFeatures itself treats kAuto as kLadder). kClassic needs at least
+  // one time constant.
+  ThermalSet thermal_set = ThermalSet::kAuto;
   void Validate() const;  // throws UsageError naming the field
-  int NumThermalFeatures() const { return 1 + 2 * static_cast<int>(time_constants_s.size()); }
+  // Columns of ThermalFeatures for thermal_set (kAuto counted as kLadder).
+  int NumThermalFeatures() const;
 };
 
 // N x NumThermalFeatures() matrix of the thermal history of temperature_c (degC). Throws

@@ -38,6 +38,7 @@ Log MakeLog(Eigen::Index n, std::uint64_t seed) {
 
 TEST(ThermalFeatures, FirstOrderLagsAndTheirRates) {
   FeatureOptions o;
+  o.thermal_set = ThermalSet::kLagBank;
   o.time_constants_s = {10.0};
   Eigen::VectorXd step = Eigen::VectorXd::Constant(200, 5.0);
   step.tail(100).setConstant(15.0);
@@ -53,6 +54,36 @@ TEST(ThermalFeatures, FirstOrderLagsAndTheirRates) {
   changed.tail(50).setConstant(-3.0);
   const Eigen::MatrixXd g = ThermalFeatures(changed, o);
   EXPECT_EQ(f.topRows(150), g.topRows(150));
+}
+
+TEST(ThermalFeatures, LadderRungsAddUpToTheTemperatureAndClassicIsTemperatureAndRate) {
+  const Log log = MakeLog(2000, 11);
+  FeatureOptions o;  // kAuto counts as the ladder here
+  const Eigen::MatrixXd ladder = ThermalFeatures(log.temperature, o);
+  ASSERT_EQ(ladder.cols(), 7);
+  EXPECT_EQ(o.NumThermalFeatures(), 7);
+  // Rungs plus the slowest lag telescope back to T (to rounding).
+  EXPECT_LE((ladder.leftCols(6).rowwise().sum() - log.temperature).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(ladder(100, 6), std::pow(log.temperature[100] - 20.0, 2), 1e-12);
+  o.thermal_set = ThermalSet::kLagBank;
+  const Eigen::MatrixXd bank = ThermalFeatures(log.temperature, o);
+  ASSERT_EQ(bank.cols(), 11);
+  EXPECT_NEAR((ladder.col(0) - (log.temperature - bank.col(1))).cwiseAbs().maxCoeff(), 0.0, 1e-12);
+  o.thermal_set = ThermalSet::kClassic;
+  const Eigen::MatrixXd classic = ThermalFeatures(log.temperature, o);
+  ASSERT_EQ(classic.cols(), 2);
+  EXPECT_EQ(classic.col(0), log.temperature);
+  EXPECT_EQ(classic.col(1), bank.col(2));  // (T - T_60) / 60, K/s
+  // The drift model resolves auto: classic for poly, ladder for the rest.
+  DriftOptions d;
+  d.method = Method::kPoly;
+  EXPECT_EQ(EffectiveFeatures(d).thermal_set, ThermalSet::kClassic);
+  d.method = Method::kMsElm;
+  EXPECT_EQ(EffectiveFeatures(d).thermal_set, ThermalSet::kLadder);
+  EXPECT_EQ(ThermalSetFromString("lag-bank"), ThermalSet::kLagBank);
+  EXPECT_THROW(ThermalSetFromString("cubic"), UsageError);
+  o.time_constants_s.clear();
+  EXPECT_THROW(o.Validate(), UsageError);  // classic needs a smoothing time constant
 }
 
 TEST(ThermalFeatures, RejectsBadInput) {
@@ -79,7 +110,8 @@ DriftOptions Fast(Mode mode, Method method) {
 
 TEST(DriftModel, MsElmPredictModeBuildsGroupsThatSumToTheSignal) {
   const Log log = MakeLog(1500, 1);
-  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  const DriftModel model =
+      FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
   ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
   EXPECT_EQ(model.lags, 4);
   EXPECT_GT(model.training_imfs, 3);
@@ -92,21 +124,26 @@ TEST(DriftModel, MsElmPredictModeBuildsGroupsThatSumToTheSignal) {
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   const Log log = MakeLog(900, 2);
   for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {
-    const DriftModel model = FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, method));
+    const DriftModel model =
+        FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, method));
     CausalOptions causal;
     causal.window = 128;
-    const Eigen::VectorXd base = PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    const Eigen::VectorXd base =
+        PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
     Eigen::VectorXd changed = log.rate;
     changed.tail(150).array() += 5.0;  // samples 750.. change
-    const Eigen::VectorXd after = PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    const Eigen::VectorXd after =
+        PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
     // Predictions for t <= 750 use samples up to 749 only: unchanged to the bit.
     EXPECT_EQ(base.head(151), after.head(151)) << ToString(method);
     EXPECT_NE(base.tail(10), after.tail(10)) << ToString(method);
     if (UsesDecomposition(method)) {
       // The paper protocol decomposes the whole record: the same change leaks into earlier
       // predictions, which is exactly the leakage the causal protocol removes.
-      const Eigen::VectorXd paper = PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kPaper);
-      const Eigen::VectorXd paper_changed = PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kPaper);
+      const Eigen::VectorXd paper =
+          PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kPaper);
+      const Eigen::VectorXd paper_changed =
+          PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kPaper);
       EXPECT_NE(paper.head(150), paper_changed.head(150)) << ToString(method);
     }
   }
@@ -115,7 +152,8 @@ TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
 TEST(DriftModel, CompensateModeNeedsOnlyTemperatureAtRunTime) {
   const Log train = MakeLog(3000, 3);
   for (Method method : {Method::kMsElm, Method::kElm, Method::kPoly}) {
-    const DriftModel model = FitDriftModel(train.rate, train.temperature, Fast(Mode::kCompensate, method));
+    const DriftModel model =
+        FitDriftModel(train.rate, train.temperature, Fast(Mode::kCompensate, method));
     const Log test = MakeLog(3000, 4);  // same programme, new noise
     const Eigen::VectorXd estimate = EstimateDrift(model, test.temperature);
     const double rms_drift = std::sqrt(test.drift.squaredNorm() / 3000);
@@ -131,14 +169,19 @@ TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {
   o.lag_candidates = {1, 3, 6};
   const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), o);
   ASSERT_EQ(model.lag_validation_rmse.size(), 3u);
-  const auto best = std::min_element(model.lag_validation_rmse.begin(), model.lag_validation_rmse.end());
-  EXPECT_EQ(model.lags, o.lag_candidates[static_cast<size_t>(best - model.lag_validation_rmse.begin())]);
+  const auto best =
+      std::min_element(model.lag_validation_rmse.begin(), model.lag_validation_rmse.end());
+  EXPECT_EQ(model.lags,
+            o.lag_candidates[static_cast<size_t>(best - model.lag_validation_rmse.begin())]);
 }
 
 TEST(DriftModel, BadInputIsRejected) {
   const Log log = MakeLog(500, 6);
-  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kCompensate, Method::kElm)), DataError);
-  EXPECT_THROW(FitDriftModel(log.rate.head(10), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kElm)), DataError);
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kCompensate, Method::kElm)),
+               DataError);
+  EXPECT_THROW(
+      FitDriftModel(log.rate.head(10), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kElm)),
+      DataError);
   DriftOptions bad = Fast(Mode::kPredict, Method::kElm);
   bad.features.lags = 0;
   EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), bad), UsageError);
@@ -151,7 +194,8 @@ TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
   EvaluationOptions eo;
   eo.methods = {Method::kMsElm, Method::kPoly};
   eo.causal.window = 128;
-  const EvaluationResult r = Evaluate(log.rate, Eigen::VectorXd(), log.drift, Fast(Mode::kPredict, Method::kMsElm), eo);
+  const EvaluationResult r =
+      Evaluate(log.rate, Eigen::VectorXd(), log.drift, Fast(Mode::kPredict, Method::kMsElm), eo);
   ASSERT_EQ(r.rows.size(), 4u);
   EXPECT_EQ(r.split_index, 700);
   EXPECT_TRUE(r.against_truth);
