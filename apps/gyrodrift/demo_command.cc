@@ -188,10 +188,10 @@ struct Study {
   Eigen::VectorXd comp_reference, comp_time_h, comp_raw;  // test record: reference, x, raw output
   std::vector<std::pair<std::string, std::string>> model_files;  // (file name, JSON)
   // Allan.
-  allan::AllanResult allan_raw, allan_comp, allan_noise;
-  std::optional<allan::NoiseTerms> terms_raw, terms_comp, terms_noise;
+  allan::AllanResult allan_raw, allan_comp, allan_best, allan_noise;
+  std::optional<allan::NoiseTerms> terms_raw, terms_comp, terms_best, terms_noise;
   std::string terms_note;
-  std::string compensated_by;
+  std::string compensated_by, best_by;  // MS-ELM, and the lowest-RMSE method if another
   Table predict_table, compensate_table, terms_table, settings_table, timing_table;
   std::vector<std::pair<std::string, double>> stage_s;
 };
@@ -327,12 +327,19 @@ void AllanStep(const DemoArgs& a, Study& s) {
   }
   if (!best && !s.compensate.empty()) best = &s.compensate.front();
   s.compensated_by = best ? std::string(drift::ToString(best->method)) + " (" + best->protocol + ")" : "";
+  const Study::CompensateRow* lowest = nullptr;
+  for (const auto& r : s.compensate) {
+    if (r.protocol != "paper" && (!lowest || r.metrics.rmse < lowest->metrics.rmse)) lowest = &r;
+  }
+  if (lowest == best) lowest = nullptr;
+  if (lowest) s.best_by = std::string(drift::ToString(lowest->method)) + " (" + lowest->protocol + ")";
   allan::AllanOptions o;
   o.rate_hz = s.rate_hz;
   o.units = allan::RateUnitFromString(a.units);
   o.threads = a.threads;
   s.allan_raw = allan::Compute(s.comp_raw, o);
   if (best) s.allan_comp = allan::Compute(Eigen::VectorXd(s.comp_raw - best->estimate), o);
+  if (lowest) s.allan_best = allan::Compute(Eigen::VectorXd(s.comp_raw - lowest->estimate), o);
   if (s.simulated) s.allan_noise = allan::Compute(s.b.noise_dph, o);
   // The noise terms are in deg/h; a curve too short to fit is reported, not fatal.
   auto fit = [&](const allan::AllanResult& r, std::optional<allan::NoiseTerms>& out) {
@@ -353,15 +360,17 @@ void AllanStep(const DemoArgs& a, Study& s) {
   };
   fit(s.allan_raw, s.terms_raw);
   fit(s.allan_comp, s.terms_comp);
+  fit(s.allan_best, s.terms_best);
   if (s.simulated) fit(s.allan_noise, s.terms_noise);
 
   Table& t = s.terms_table;
   t.title = "IEEE 952 noise terms of " + std::string(s.simulated ? "run B" : "the test block") +
-            ": raw vs compensated by " + s.compensated_by;
+            ": raw vs compensated";
   t.caption = "Fitted to the overlapping Allan deviation (octave grid, 68.3 % bands); 0 = the term "
               "carries < 10 % of the model variance at every tau. Units: Q urad, N deg/sqrt(h), "
               "B deg/h, K deg/h/sqrt(h), R deg/h/h.";
-  t.header = {"term", "unit", "raw", "compensated"};
+  t.header = {"term", "unit", "raw", "compensated: " + s.compensated_by};
+  if (!s.best_by.empty()) t.header.push_back("compensated: " + s.best_by);
   if (s.simulated) {
     t.header.push_back("noise only (truth)");
     t.header.push_back("simulator setting");
@@ -384,6 +393,7 @@ void AllanStep(const DemoArgs& a, Study& s) {
   };
   for (const Row& r : rows) {
     std::vector<Table::Cell> cells{r.name, r.unit, value(s.terms_raw, r.term), value(s.terms_comp, r.term)};
+    if (!s.best_by.empty()) cells.emplace_back(value(s.terms_best, r.term));
     if (s.simulated) {
       cells.emplace_back(value(s.terms_noise, r.term));
       cells.emplace_back(r.setting);
@@ -394,6 +404,7 @@ void AllanStep(const DemoArgs& a, Study& s) {
     return n ? n->min_dev_dph : std::numeric_limits<double>::quiet_NaN();
   };
   std::vector<Table::Cell> cells{"minimum ADEV", "deg/h", min_dev(s.terms_raw), min_dev(s.terms_comp)};
+  if (!s.best_by.empty()) cells.emplace_back(min_dev(s.terms_best));
   if (s.simulated) {
     cells.emplace_back(min_dev(s.terms_noise));
     cells.emplace_back(std::numeric_limits<double>::quiet_NaN());
@@ -441,6 +452,7 @@ std::string AllanCsv(const Study& s) {
   };
   add("raw", s.allan_raw);
   add("compensated", s.allan_comp);
+  if (!s.best_by.empty()) add("compensated_best", s.allan_best);
   if (s.simulated) add("noise_truth", s.allan_noise);
   return io::RenderCsv(c);
 }
@@ -455,6 +467,25 @@ io::ReportSeries Series(std::string name, Eigen::VectorXd v, bool dashed = false
   return s;
 }
 
+io::ReportSeries Reference(std::string name, Eigen::VectorXd v) {
+  io::ReportSeries s = Series(std::move(name), std::move(v));
+  s.emphasis = true;
+  return s;
+}
+
+// Trailing mean over w samples (the first w - 1 use what exists): shows the slow structure of a
+// residual that sample-to-sample noise hides.
+Eigen::VectorXd TrailingMean(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Index w) {
+  Eigen::VectorXd out(v.size());
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    sum += v[i];
+    if (i >= w) sum -= v[i - w];
+    out[i] = sum / static_cast<double>(std::min<Eigen::Index>(i + 1, w));
+  }
+  return out;
+}
+
 void AllanFigure(io::HtmlReport& report, const Study& s) {
   if (s.allan_raw.points.empty()) return;
   io::ReportFigure f;
@@ -466,9 +497,10 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
   f.draw_points = true;
   f.height_px = 420;
   f.x = s.allan_raw.tau_s();
-  auto add = [&](const std::string& name, const allan::AllanResult& r) {
+  auto add = [&](const std::string& name, const allan::AllanResult& r, const char* colour) {
     if (r.points.size() != s.allan_raw.points.size()) return;
     io::ReportSeries series = Series(name, r.dev());
+    series.color = colour;
     series.lower.resize(f.x.size());
     series.upper.resize(f.x.size());
     for (size_t i = 0; i < r.points.size(); ++i) {
@@ -477,18 +509,25 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
     }
     f.series.push_back(std::move(series));
   };
-  add("raw output", s.allan_raw);
-  add("compensated (" + s.compensated_by + ")", s.allan_comp);
-  if (s.simulated) add("noise only (truth)", s.allan_noise);
+  // A curve and its fitted model share a colour.
+  constexpr const char* kRaw = "#c0392b";
+  constexpr const char* kMsElm = "#1f5fbf";
+  constexpr const char* kBest = "#1e9e4a";
+  add("raw output", s.allan_raw, kRaw);
+  add("compensated: " + s.compensated_by, s.allan_comp, kMsElm);
+  if (!s.best_by.empty()) add("compensated: " + s.best_by, s.allan_best, kBest);
+  if (s.simulated) add("noise only (truth)", s.allan_noise, "#7f7f7f");
   const double from_dph = 1.0 / allan::ToDegPerHour(allan::RateUnitFromString(s.unit == "rad/s" ? "rads" : s.unit == "deg/s" ? "dps" : "dph"));
-  auto model = [&](const std::string& name, const std::optional<allan::NoiseTerms>& t) {
+  auto model = [&](const std::string& name, const std::optional<allan::NoiseTerms>& t, const char* colour) {
     if (!t) return;
     Eigen::VectorXd v(f.x.size());
     for (Eigen::Index i = 0; i < f.x.size(); ++i) v[i] = t->ModelDevDph(f.x[i]) * from_dph;
     f.series.push_back(Series(name, v, true));
+    f.series.back().color = colour;
   };
-  model("IEEE 952 fit, raw", s.terms_raw);
-  model("IEEE 952 fit, compensated", s.terms_comp);
+  model("IEEE 952 fit, raw", s.terms_raw, kRaw);
+  model("IEEE 952 fit, compensated: " + s.compensated_by, s.terms_comp, kMsElm);
+  if (!s.best_by.empty()) model("IEEE 952 fit, compensated: " + s.best_by, s.terms_best, kBest);
   if (s.simulated) {
     const sim::NoiseParameters np = sim::PresetParameters(sim::Preset::kNavigation).noise;
     Eigen::VectorXd v(f.x.size());
@@ -496,6 +535,7 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
       v[i] = std::sqrt(sim::NoiseAllanVariance(np, 1.0 / s.rate_hz, s.allan_raw.points[static_cast<size_t>(i)].m));
     }
     f.series.push_back(Series("simulator noise model (exact)", v, true));
+    f.series.back().color = "#000000";
   }
   f.caption = std::string("Log-log; shaded: 68.3 % chi-square confidence bands; dashed: the fitted IEEE 952 "
               "models (table below)") +
@@ -536,7 +576,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.y_label = s.target_name + " (" + s.unit + ")";
     f.x = s.time_h;
     f.series.push_back(Series("output", s.y));
-    if (s.simulated) f.series.push_back(Series("true drift", s.truth));
+    if (s.simulated) f.series.push_back(Reference("true drift", s.truth));
     f.shades.push_back({split_h, end_h, "predict-mode test block (last 30 %)"});
     f.caption = s.simulated
                     ? "The output is the drift plus white and bias-instability noise. The drift follows "
@@ -568,19 +608,21 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     io::ReportFigure f;
     f.title = "Run B: gyro output, true drift and temperature (test run for compensation)";
     f.x_label = "time (h)";
-    f.y_label = "deg/h and degC";
+    f.y_label = "deg/h";
+    f.y2_label = "case sensor (degC)";
     f.x = s.b.time_s / 3600.0;
-    f.series.push_back(Series("output (deg/h)", s.b.rate_dph));
-    f.series.push_back(Series("true drift (deg/h)", s.b.drift_dph));
-    f.series.push_back(Series("case sensor / 100 (degC / 100)", s.b.temperature_c / 100.0));
+    f.series.push_back(Series("output", s.b.rate_dph));
+    f.series.push_back(Reference("true drift", s.b.drift_dph));
+    io::ReportSeries t = Series("case sensor (right axis)", s.b.temperature_c);
+    t.right_axis = true;
+    f.series.push_back(t);
     f.caption = "Run B uses a different programme (slower ramps, other levels), so a compensation "
                 "model trained on run A meets a thermal history it has not seen.";
     report.AddFigure(f);
   }
 
   report.AddHeading("2. BEEMDAN decomposition and mode selection");
-  report.AddParagraph(s.decomposition.report.Summary() + ". " + s.selection.Summary() +
-                      (s.selection.note.empty() ? "" : " Note: " + s.selection.note));
+  report.AddParagraph(s.decomposition.report.Summary() + ". " + s.selection.Summary() + ".");
   const int k_count = s.decomposition.num_imfs();
   {
     io::ReportFigure f;
@@ -598,8 +640,10 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
       return out;
     };
     f.series.push_back(Series("D_k: PDF(IMF k) vs PDF(signal)", vec(s.selection.pdf_distance)));
-    f.series.push_back(Series("G_k: standardised IMF k vs N(0,1)", vec(s.selection.self_distance)));
-    f.series.push_back(Series("white-noise 99 % level of G_k", vec(s.selection.noise_level), true));
+    f.y2_label = "G_k (right axis)";
+    f.series.push_back(Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
+    f.series.push_back(Series("white-noise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
+    f.series[1].right_axis = f.series[2].right_axis = true;
     for (const auto& g : s.selection.groups) {
       if (g.imfs.empty()) continue;
       f.shades.push_back({g.imfs.front() - 0.45, g.imfs.back() + 0.45, std::string(sel::ToString(g.kind))});
@@ -679,31 +723,42 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = test_h;
-    f.series.push_back(Series(s.simulated ? "true drift" : "measured output", s.predict.reference));
+    // MS-ELM under both protocols and the best single model; every row is in predict_estimates.csv.
+    const drift::EvaluationRow* best = nullptr;
     for (const auto& r : s.predict.rows) {
-      if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
-      f.series.push_back(Series(std::string(drift::ToString(r.method)) + " " + std::string(drift::ToString(r.protocol)),
-                                r.estimate));
+      if (r.method == drift::Method::kMsElm) {
+        f.series.push_back(Series("ms-elm " + std::string(drift::ToString(r.protocol)), r.estimate));
+      } else if (!drift::UsesDecomposition(r.method) && (!best || r.rmse < best->rmse)) {
+        best = &r;
+      }
     }
-    f.caption = "Each model predicts the next output sample from the previous ones. Compare the paper and "
-                "causal protocols of MS-ELM: under the paper protocol the sub-series were decomposed with "
-                "the future in view. Zoom in: every model that lags the output by one sample scores about "
-                "the noise level.";
+    if (best) f.series.push_back(Series(std::string(drift::ToString(best->method)) + " (best single model)", best->estimate));
+    f.series.push_back(Reference(s.simulated ? "true drift" : "measured output", s.predict.reference));
+    f.caption = "Each model predicts the next output sample from the previous ones (MS-ELM under both "
+                "protocols and the best single model; every method is in predict_estimates.csv). Under the "
+                "paper protocol the sub-series were decomposed with the future in view. Predictions of a "
+                "noisy output are noisy: zoom into a few minutes to compare them with the thick black "
+                "reference.";
     report.AddFigure(f);
   }
   {
     io::ReportFigure f;
-    f.title = "Predict mode: residuals (reference - prediction)";
+    const Eigen::Index w = std::clamp<Eigen::Index>(
+        static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1, std::max<Eigen::Index>(1, test_h.size() / 20));
+    f.title = "Predict mode: residuals (reference - prediction), trailing mean over " + std::to_string(w) + " samples";
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = test_h;
     for (const auto& r : s.predict.rows) {
       if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
-      f.series.push_back(Series(std::string(drift::ToString(r.method)) + " " + std::string(drift::ToString(r.protocol)),
-                                s.predict.reference - r.estimate));
+      std::string name = std::string(drift::ToString(r.method));
+      if (drift::UsesDecomposition(r.method)) name += " " + std::string(drift::ToString(r.protocol));
+      f.series.push_back(Series(name, TrailingMean(s.predict.reference - r.estimate, w)));
     }
-    f.caption = "A residual that looks like white noise of the sensor's level is the best one-step "
-                "prediction can do; structure in it is drift the model missed.";
+    f.caption = "Averaged over " + Fmt(static_cast<double>(w) / s.rate_hz) +
+                " s so that the sample-to-sample noise drops out: what remains is drift the model "
+                "missed or a bias it added. Near zero is good; single models are one curve (the same "
+                "under both protocols).";
     report.AddFigure(f);
   }
 
@@ -717,11 +772,11 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = s.comp_time_h;
-    f.series.push_back(Series(s.simulated ? "true drift (run B)" : "measured output", s.comp_reference));
     for (const auto& r : s.compensate) {
       f.series.push_back(Series(std::string(drift::ToString(r.method)) +
                                     (s.simulated ? "" : " " + r.protocol), r.estimate));
     }
+    f.series.push_back(Reference(s.simulated ? "true drift (run B)" : "measured output", s.comp_reference));
     f.caption = "Only the temperature channel reaches these models, as on a navigation computer. A good "
                 "model tracks the drift through ramps it was not trained on.";
     report.AddFigure(f);
@@ -902,7 +957,10 @@ void Run(const DemoArgs& a) {
   settings.header = {"setting", "value"};
   const drift::DriftOptions base = BaseOptions(a, s.rate_hz);
   settings.Add({"source", s.simulated ? "simulation: navigation preset, programmes chamber (A) and chamber-b (B)" : s.source});
-  if (s.simulated) settings.Add({"duration, rate", Fmt(duration_s) + " s at 1 Hz"});
+  if (s.simulated) {
+    settings.Add({"duration, rate", Fmt(duration_s / 3600.0) + " h per run at 1 Hz (" +
+                                        std::to_string(s.a.samples) + " samples)"});
+  }
   settings.Add({"seed", std::to_string(a.seed) + (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)" : "")});
   settings.Add({"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) + ", noise 0.2, energy-band bound"});
   settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " + std::to_string(a.realisations) +
@@ -917,6 +975,7 @@ void Run(const DemoArgs& a) {
   timing.title = "Wall time of each stage";
   timing.header = {"stage", "seconds"};
   for (const auto& [name, sec] : s.stage_s) timing.Add({name, {sec, 3}});
+  timing.Add({"total until the report (files written after)", {Seconds(wall_start), 3}});
 
   std::vector<std::pair<std::string, std::string>> files;
   const std::string dir = a.output;

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -66,6 +67,14 @@ void AppendArray(std::string& out, const Eigen::Ref<const Eigen::VectorXd>& v) {
   out += ']';
 }
 
+bool LooksNumeric(const std::string& cell) {
+  if (cell.empty()) return false;
+  if (cell == "nan" || cell == "inf" || cell == "-inf") return true;
+  char* end = nullptr;
+  std::strtod(cell.c_str(), &end);
+  return end == cell.c_str() + cell.size();
+}
+
 std::string ReadAsset(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
@@ -107,8 +116,13 @@ constexpr std::string_view kPlotScript = R"JS(
     }
     var seriesOptions = {};
     f.series.forEach(function (s) {
-      seriesOptions[s.name] = s.dashed ? { strokePattern: [6, 4] } : {};
+      var o = { axis: s.right ? 'y2' : 'y' };
+      if (s.dashed) o.strokePattern = [6, 4];
+      if (s.color) o.color = s.color;
+      if (s.bold) { o.strokeWidth = 2.2; o.color = s.color || '#000000'; }
+      seriesOptions[s.name] = o;
     });
+    var right = f.series.some(function (s) { return s.right; });
     var shades = f.shades;
     var colours = ['rgba(255,200,0,0.15)', 'rgba(0,150,255,0.12)', 'rgba(0,200,100,0.12)',
                    'rgba(200,0,200,0.10)'];
@@ -116,7 +130,9 @@ constexpr std::string_view kPlotScript = R"JS(
       labels: [f.xlabel].concat(f.series.map(function (s) { return s.name; })),
       xlabel: f.xlabel, ylabel: f.ylabel,
       customBars: bars, logscale: f.logy,
-      axes: { x: { logscale: f.logx } },
+      axes: right ? { x: { logscale: f.logx }, y2: { independentTicks: true } }
+                  : { x: { logscale: f.logx } },
+      y2label: right ? f.y2label : undefined,
       drawPoints: f.points, pointSize: 2.5,
       series: seriesOptions,
       legend: 'always', labelsSeparateLines: false,
@@ -147,8 +163,8 @@ h1 { font-size: 1.6em; } h2 { margin-top: 1.6em; border-bottom: 1px solid #ccc; 
 .legend { font-size: 0.85em; min-height: 1.3em; }
 .caption { font-size: 0.9em; color: #444; margin-top: 0.3em; }
 table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0; }
-th, td { border: 1px solid #bbb; padding: 2px 8px; text-align: right; }
-th { background: #eee; } td:first-child, th:first-child { text-align: left; }
+th, td { border: 1px solid #bbb; padding: 2px 8px; text-align: left; }
+th { background: #eee; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
 pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 0.85em; }
 )CSS";
 
@@ -277,7 +293,7 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
 
   const std::string id = "fig" + std::to_string(++figures_);
   std::string json = "{\"title\":" + JsonString(f.title) + ",\"xlabel\":" + JsonString(f.x_label) +
-                     ",\"ylabel\":" + JsonString(f.y_label) + ",\"logx\":" +
+                     ",\"ylabel\":" + JsonString(f.y_label) + ",\"y2label\":" + JsonString(f.y2_label) + ",\"logx\":" +
                      (f.log_x ? "true" : "false") + ",\"logy\":" + (f.log_y ? "true" : "false") +
                      ",\"points\":" + (f.draw_points ? "true" : "false") + ",\"x\":";
   AppendArray(json, d.x);
@@ -286,7 +302,9 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
     const auto& s = f.series[static_cast<size_t>(c)];
     if (c) json += ',';
     json += "{\"name\":" + JsonString(s.name) + ",\"dashed\":" + (s.dashed ? "true" : "false") +
-            ",\"y\":";
+            ",\"bold\":" + (s.emphasis ? "true" : "false") +
+            (s.color.empty() ? std::string() : ",\"color\":" + JsonString(s.color)) + ",\"right\":" +
+            (s.right_axis ? "true" : "false") + ",\"y\":";
     AppendArray(json, d.values.col(c));
     if (s.lower.size()) {
       json += ",\"lo\":";
@@ -329,7 +347,9 @@ void HtmlReport::AddTable(const ReportTable& t) {
   body_ += "</tr>\n";
   for (const auto& row : t.rows) {
     body_ += "<tr>";
-    for (const auto& cell : row) body_ += "<td>" + Escape(cell) + "</td>";
+    for (const auto& cell : row) {
+      body_ += (LooksNumeric(cell) ? "<td class=\"num\">" : "<td>") + Escape(cell) + "</td>";
+    }
     body_ += "</tr>\n";
   }
   body_ += "</table>\n";

@@ -42,7 +42,10 @@ struct ReportSeries {
   Eigen::VectorXd values;  // one per x; NaN = gap
   // Optional confidence band (both empty, or both of the length of values); drawn shaded.
   Eigen::VectorXd lower, upper;
-  bool dashed = false;  // e.g. a fitted model curve
+  bool dashed = false;      // e.g. a fitted model curve
+  bool emphasis = false;    // drawn thick and black (the reference the others are judged by)
+  bool right_axis = false;  // plotted against the right-hand y axis (y2_label)
+  std::string color;        // CSS colour such as "#1f77b4"; empty = dygraphs' palette
 };
 
 // A shaded x interval with a label (the test block, a group of IMFs).
@@ -55,6 +58,7 @@ struct ReportFigure {
   std::string title;
   std::string caption;  // what to look at (plain text)
   std::string x_label, y_label;
+  std::string y2_label;  // right-hand axis, for series with right_axis
   Eigen::VectorXd x;  // non-decreasing, finite
   std::vector<ReportSeries> series;
   bool log_x = false, log_y = false;

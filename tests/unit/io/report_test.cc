@@ -25,6 +25,14 @@ DygraphsAssets FakeAssets() {
   return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
 }
 
+ReportSeries S(std::string name, Eigen::VectorXd values, bool dashed = false) {
+  ReportSeries s;
+  s.name = std::move(name);
+  s.values = std::move(values);
+  s.dashed = dashed;
+  return s;
+}
+
 HtmlReport SmallReport() {
   HtmlReport report("Small <report> & test");
   report.AddHeading("Section with a < sign");
@@ -35,8 +43,11 @@ HtmlReport SmallReport() {
   f.x_label = "t (s)";
   f.y_label = "y";
   f.x = Eigen::VectorXd::LinSpaced(100, 0.0, 9.9);
-  f.series.push_back({"sin", f.x.array().sin().matrix(), {}, {}, false});
-  f.series.push_back({"cos", f.x.array().cos().matrix(), {}, {}, true});
+  f.series.push_back(S("sin", f.x.array().sin().matrix()));
+  f.series.push_back(S("cos", f.x.array().cos().matrix(), true));
+  f.series.back().right_axis = true;
+  f.series.back().color = "#ff0000";
+  f.y2_label = "right";
   f.shades.push_back({2.0, 3.0, "a shade"});
   report.AddFigure(f);
   ReportFigure allan;
@@ -44,7 +55,7 @@ HtmlReport SmallReport() {
   allan.caption = "bands";
   allan.log_x = allan.log_y = true;
   allan.x = Eigen::VectorXd::LinSpaced(8, 1.0, 8.0);
-  ReportSeries s{"adev", allan.x.cwiseInverse(), {}, {}, false};
+  ReportSeries s = S("adev", allan.x.cwiseInverse());
   s.lower = s.values * 0.8;
   s.upper = s.values * 1.2;
   s.values[3] = std::nan("");  // a gap
@@ -64,6 +75,8 @@ TEST(Report, SmallReportRendersAndPassesTheCheck) {
   EXPECT_NE(html.find("Small &lt;report&gt; &amp; test"), std::string::npos);
   EXPECT_EQ(html.find("</script> inside"), std::string::npos);
   EXPECT_NE(html.find("\"logx\":true"), std::string::npos);
+  EXPECT_NE(html.find("\"right\":true"), std::string::npos);
+  EXPECT_NE(html.find("\"color\":\"#ff0000\""), std::string::npos);
   EXPECT_NE(html.find("null"), std::string::npos);  // the NaN became a gap
 }
 
@@ -115,7 +128,7 @@ TEST(Report, FigureErrorsAreDataErrors) {
   ReportFigure f;
   f.title = "bad";
   f.x = Eigen::VectorXd::LinSpaced(10, 0.0, 1.0);
-  f.series.push_back({"short", Eigen::VectorXd::Zero(9), {}, {}, false});
+  f.series.push_back(S("short", Eigen::VectorXd::Zero(9)));
   EXPECT_THROW(report.AddFigure(f), DataError);
   f.series[0].values = Eigen::VectorXd::Zero(10);
   f.x[5] = -1.0;  // decreasing
