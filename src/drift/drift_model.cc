@@ -237,11 +237,14 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
   model.training_samples = fit_end;
   const size_t groups = model.sub_models.size();
   if (o.mode == Mode::kCompensate) {
+    const bool linear = o.linear_compensation && UsesDecomposition(o.method);
     for (size_t g = 0; g < groups; ++g) {
-      // The selection found the noise group white-noise-like: it carries no thermal information,
-      // and a learner fitted to it from temperature only extrapolates noise into new thermal
-      // histories. Its sub-model is the zero function [choice, docs/drift.md].
-      if (model.sub_models[g].name == "noise") continue;
+      // A nonlinear learner fitted to the noise group from temperature only extrapolates noise
+      // into new thermal histories, so with nonlinear sub-models the noise group is the zero
+      // function. Linear sub-models keep it: at 1 Hz the white-noise test puts IMFs with periods
+      // up to tens of minutes in the noise group, and those carry the Shupe and bias response
+      // (docs/drift.md: zeroing it cost most of the removal on chamber-b -> chamber).
+      if (model.sub_models[g].name == "noise" && !linear) continue;
       model.sub_models[g].learner = FitLearner(
           thermal.topRows(fit_end), series.col(static_cast<Eigen::Index>(g)).head(fit_end),
           SubModelLearner(o, g, static_cast<int>(thermal.cols())));
@@ -345,6 +348,10 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
   if (causal.window < 16 || causal.window > 1000000) {
     ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
   }
+  if (causal.ensemble_size < 0 || causal.ensemble_size > 100000) {
+    ThrowOption("causal ensemble_size", std::to_string(causal.ensemble_size),
+                "an integer in [0, 100000] (0 = the model's)");
+  }
   const Eigen::Index min_first =
       protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
           ? std::max<Eigen::Index>(model.lags, 16)
@@ -368,6 +375,7 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
   }
   // Causal: the lags at t come from decomposing y[t-W .. t-1] alone; windows run in parallel.
   dopt.threads = 1;
+  if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
   std::vector<Eigen::MatrixXd> rows(groups, Eigen::MatrixXd(count, p + thermal.cols()));

@@ -1,0 +1,98 @@
+// Cost of the drift model on the issue-4 record: MS-ELM fitted on an 8-hour 1 Hz simulator log
+// (navigation preset, builtin programme "chamber", seed 1; 28,800 samples; BEEMDAN defaults:
+// 100 realisations, energy-band bound; 2 threads), in both modes, and the causal evaluation of
+// that record (fit on the first 70 %, then one BEEMDAN of the trailing 512-sample window per test
+// sample, 8,640 windows). Targets: fit < 2 s, causal evaluation < 2 min.
+// Wall time is the figure (UseRealTime); `process_cpu_s` is the CPU time of every thread of the
+// process per iteration (Google Benchmark's CPU column counts the main thread only).
+// Smoke mode (CTest): a 30-minute record and 10 realisations.
+#include <benchmark/benchmark.h>
+
+#include <ctime>
+
+#include "bench_util.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/simulation/fog_simulator.h"
+
+namespace {
+
+namespace drift = gyrodrift::drift;
+namespace simulation = gyrodrift::simulation;
+
+double ProcessCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+const simulation::SimulationResult& Record() {
+  static const simulation::SimulationResult record = [] {
+    simulation::SimulationOptions o;
+    o.seed = 1;
+    if (gyrodrift::bench::SmokeMode()) o.duration_s = 1800.0;
+    return simulation::Simulate(simulation::BuiltinProgramme("chamber"),
+                                simulation::PresetParameters(simulation::Preset::kNavigation), o);
+  }();
+  return record;
+}
+
+drift::DriftOptions Options(drift::Mode mode, int threads) {
+  drift::DriftOptions o;
+  o.mode = mode;
+  o.threads = threads;
+  if (gyrodrift::bench::SmokeMode()) o.decomposition.ensemble_size = 10;
+  return o;
+}
+
+void BM_MsElmFit(benchmark::State& state) {
+  const auto& r = Record();
+  const drift::DriftOptions o =
+      Options(static_cast<drift::Mode>(state.range(0)), static_cast<int>(state.range(1)));
+  double cpu = 0.0;
+  for (auto _ : state) {
+    const double start = ProcessCpuSeconds();
+    const drift::DriftModel model = drift::FitDriftModel(r.rate_dph, r.temperature_c, o);
+    cpu += ProcessCpuSeconds() - start;
+    benchmark::DoNotOptimize(model.sub_models.data());
+  }
+  state.counters["process_cpu_s"] =
+      benchmark::Counter(cpu / static_cast<double>(state.iterations()));
+  state.counters["samples"] = static_cast<double>(r.rate_dph.size());
+  state.SetLabel(drift::ToString(o.mode).data());
+}
+
+void BM_CausalEvaluation(benchmark::State& state) {
+  const auto& r = Record();
+  const drift::DriftOptions o = Options(drift::Mode::kPredict, static_cast<int>(state.range(0)));
+  drift::EvaluationOptions eo;
+  eo.methods = {drift::Method::kMsElm};
+  eo.protocols = {drift::Protocol::kCausal};
+  eo.causal.threads = static_cast<int>(state.range(0));
+  if (gyrodrift::bench::SmokeMode()) eo.causal.window = 64;
+  double cpu = 0.0;
+  double rmse = 0.0;
+  for (auto _ : state) {
+    const double start = ProcessCpuSeconds();
+    const drift::EvaluationResult result =
+        drift::Evaluate(r.rate_dph, Eigen::VectorXd(), r.drift_dph, o, eo);
+    cpu += ProcessCpuSeconds() - start;
+    rmse = result.rows.front().rmse;
+  }
+  state.counters["process_cpu_s"] =
+      benchmark::Counter(cpu / static_cast<double>(state.iterations()));
+  state.counters["rmse_dph"] = rmse;
+}
+
+BENCHMARK(BM_MsElmFit)
+    ->ArgsProduct({{static_cast<int>(drift::Mode::kPredict),
+                    static_cast<int>(drift::Mode::kCompensate)},
+                   {2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK(BM_CausalEvaluation)->Arg(2)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
