@@ -138,7 +138,7 @@ constexpr std::string_view kPlotScript = R"JS(
       legend: 'always', labelsSeparateLines: false,
       labelsDiv: document.getElementById(blocks[b].dataset.target + '-legend'),
       connectSeparatedPoints: false,
-      strokeWidth: 1.2,
+      strokeWidth: 1.2, digitsAfterDecimal: 5, maxNumberWidth: 8,
       underlayCallback: function (ctx, area, g) {
         shades.forEach(function (s, n) {
           var l = g.toDomXCoord(s[0]), r = g.toDomXCoord(s[1]);
