@@ -229,6 +229,10 @@ drift::DriftOptions BaseOptions(const DemoArgs& a, double rate_hz) {
   o.features.rate_hz = rate_hz;
   o.seed = a.seed;
   o.threads = a.threads;
+  // A user's log is scored against its measured output, turn-on bias included, and its
+  // temperature need not be in degC: the compensate-mode estimate keeps the fitted intercept
+  // instead of being referenced to equilibrium at 20 degC.
+  if (!a.input.empty()) o.reference_c = std::numeric_limits<double>::quiet_NaN();
   return o;
 }
 
@@ -318,6 +322,7 @@ void CompensateSplit(const DemoArgs& a, const std::vector<drift::Method>& method
   e.methods = methods;
   e.causal.window = a.window;
   e.causal.threads = a.threads;
+  e.causal.ensemble_size = a.ensemble;
   e.progress = TrialProgress(bar, methods, drift::Mode::kCompensate, "compensate: ");
   s.compensate_split = drift::Evaluate(s.y, s.temperature, Eigen::VectorXd(), base, e);
   const Eigen::Index split = s.compensate_split.split_index;
@@ -950,6 +955,7 @@ void Run(const DemoArgs& a) {
     e.methods = methods;
     e.causal.window = a.window;
     e.causal.threads = a.threads;
+    e.causal.ensemble_size = a.ensemble;
     e.progress = TrialProgress(bar, methods, drift::Mode::kPredict, "predict: ");
     s.predict = drift::Evaluate(s.y, s.temperature, s.truth, o, e);
   }
@@ -989,14 +995,18 @@ void Run(const DemoArgs& a) {
                                         std::to_string(s.a.samples) + " samples)"});
   }
   settings.Add({"seed", std::to_string(a.seed) + (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)" : "")});
-  settings.Add({"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) + ", noise 0.2, energy-band bound"});
+  settings.Add({"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) +
+                                     " (also in each causal window), noise 0.2, energy-band bound"});
   settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " + std::to_string(a.realisations) +
                                  " white-noise realisations"});
   settings.Add({"learner", "ELM sigmoid, hidden units <= " + std::to_string(base.learner.elm.hidden_units) +
                                " and ridge by leave-one-out; SVR/BP/poly library defaults"});
   settings.Add({"predict mode", std::to_string(base.features.lags) + " lags, split 70/30, causal window " +
                                     std::to_string(a.window) + " samples"});
-  settings.Add({"compensate features", "temperature and a bank of first-order lags (60, 300, 900, 1800, 3600 s)"});
+  settings.Add({"compensate mode", std::string(base.linear_compensation ? "linear ELM sub-models" : "learner as given") +
+                                       ", estimate referenced to " +
+                                       (std::isnan(base.reference_c) ? std::string("the fitted intercept (user log)")
+                                                                     : "equilibrium at " + Fmt(base.reference_c) + " degC")});
   settings.Add({"threads", a.threads == 0 ? "all cores" : std::to_string(a.threads)});
   Table& timing = s.timing_table;
   timing.title = "Wall time of each stage";
