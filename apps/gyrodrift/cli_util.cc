@@ -1,6 +1,8 @@
 #include "cli_util.h"
 
 #include <sys/stat.h>
+#include <charconv>
+#include <cstdint>
 #include <unistd.h>
 
 #include "gyrodrift/common/version.h"
@@ -15,6 +17,16 @@ const CLI::Validator kInputFile(
       return {};
     },
     "FILE");
+
+const CLI::Validator kSeed(
+    [](std::string& text) -> std::string {
+      std::uint64_t value = 0;
+      const char* end = text.data() + text.size();
+      const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+      const bool ok = !text.empty() && ec == std::errc() && ptr == end;
+      return ok ? std::string() : text + ": must be an integer in [0, 2^64)";
+    },
+    "SEED");
 
 std::string SidecarPath(const std::string& output_path) { return output_path + ".json"; }
 

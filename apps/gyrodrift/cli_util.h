@@ -14,10 +14,14 @@ namespace gyrodrift::cli {
 // CLI11 validator: the value must name an existing regular file (message: "FILE: no such file").
 extern const CLI::Validator kInputFile;
 
+// CLI11 validator for --seed: an integer in [0, 2^64). CLI11 2.1 would silently wrap "-1" to
+// 2^64 - 1 and clamp values that overflow.
+extern const CLI::Validator kSeed;
+
 // The sidecar path of an output file: OUT.csv -> OUT.csv.json.
 std::string SidecarPath(const std::string& output_path);
 
-// Common metadata of every sidecar: tool name, version, command line.
+// Common metadata of every sidecar: tool name, version and subcommand.
 nlohmann::json SidecarHeader(const std::string& command);
 
 // True when stdout or stderr is a terminal and progress may be shown.

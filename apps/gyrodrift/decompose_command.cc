@@ -160,6 +160,7 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--noise", args->noise, "noise strength eps (relative to the signal's std)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed; realisation i uses stream (seed, i)")
+      ->check(kSeed)
       ->capture_default_str();
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();

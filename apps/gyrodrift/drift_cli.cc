@@ -36,15 +36,6 @@ std::string Columns(const io::CsvTable& table) {
 
 }  // namespace
 
-const CLI::Validator kSeed(
-    [](std::string& text) -> std::string {
-      std::uint64_t value = 0;
-      const char* end = text.data() + text.size();
-      const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-      const bool ok = !text.empty() && ec == std::errc() && ptr == end;
-      return ok ? std::string() : text + ": must be an integer in [0, 2^64)";
-    },
-    "SEED");
 
 void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
   cmd->add_option("input", a->input, "CSV file with a header row")->required()->check(kInputFile);

@@ -33,8 +33,6 @@ struct DriftArgs {
   bool quiet = false;
 };
 
-// CLI11 validator for 64-bit seeds (CLI11 2.1 would wrap "-1" to 2^64 - 1 silently).
-extern const CLI::Validator kSeed;
 
 // Adds input, --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
 // --ensemble, --realisations, --seed, --threads and --quiet to cmd.

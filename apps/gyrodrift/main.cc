@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
       "  gyrodrift simulate --duration 8h -o fog.csv           # a thermal-chamber log with truth\n"
       "  gyrodrift decompose fog.csv --column rate_dph --method beemdan -o imfs.csv\n"
       "  gyrodrift allan fog.csv --column rate_dph --rate-hz 1 -o adev.csv\n"
+      "  gyrodrift fit fog.csv --target rate_dph --temperature temperature_c --mode compensate \\\n"
+      "      -o model.json && gyrodrift compensate model.json other_run.csv -o compensated.csv\n"
+      "  gyrodrift demo                                        # everything, with an HTML report\n"
       "Run 'gyrodrift SUBCOMMAND --help' for each subcommand. Exit codes: 0 ok, 2 usage,\n"
       "3 data, 4 file I/O, 1 internal error (see docs/errors.md).");
   app.set_version_flag("--version", std::string("gyrodrift ") + gyrodrift::kVersion);

@@ -228,17 +228,8 @@ const RegisterCommand kRegister("simulate", 10, [](CLI::App& app) {
   cmd->add_option("--duration", args->duration,
                   "length, e.g. 30s, 10min, 8h, 3600 (default: the profile's, 8 h)");
   cmd->add_option("--rate-hz", args->rate_hz, "output rate, Hz")->capture_default_str();
-  // CLI11 2.1 would wrap "-1" to 2^64 - 1 silently.
   cmd->add_option("--seed", args->seed, "seed of the noise and sensor streams")
-      ->check(CLI::Validator(
-          [](std::string& text) -> std::string {
-            std::uint64_t value = 0;
-            const char* end = text.data() + text.size();
-            const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-            const bool ok = !text.empty() && ec == std::errc() && ptr == end;
-            return ok ? std::string() : text + ": must be an integer in [0, 2^64)";
-          },
-          "UINT"))
+      ->check(kSeed)
       ->capture_default_str();
   cmd->add_option("--winding", args->winding,
                   "override the preset: quadrupole|dipole|octupole|conventional|symmetric");

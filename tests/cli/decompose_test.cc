@@ -94,6 +94,7 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"bad band", "decompose %IN% -c 2 --band 0.5", 2, "band_confidence"},
       {"negative imfs", "decompose %IN% -c 2 --max-imfs -2", 2, "max_imfs"},
       {"not a number", "decompose %IN% -c 2 --seed many", 2, "seed"},
+      {"negative seed", "decompose %IN% -c 2 --seed -1", 2, "[0, 2^64)"},
       {"noise rows", "decompose %IN% -c 2 --noise-file %DIR%/w_short.csv", 3, "supplied noise"},
       {"noise with emd", "decompose %IN% -c 2 -m emd --noise-file %DIR%/w_short.csv", 2, "--noise-file"},
   };
