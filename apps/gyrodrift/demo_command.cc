@@ -362,7 +362,9 @@ void AllanStep(const DemoArgs& a, Study& s) {
   for (const auto& r : s.compensate) {
     if (r.protocol != "paper" && (!lowest || r.metrics.rmse < lowest->metrics.rmse)) lowest = &r;
   }
-  if (lowest == best) lowest = nullptr;
+  // Another method only when it is clearly better (linear sub-models of MS-ELM and EMD-ELM can sum
+  // to the same estimate).
+  if (lowest == best || (best && lowest && lowest->metrics.rmse > 0.99 * best->metrics.rmse)) lowest = nullptr;
   if (lowest) s.best_by = std::string(drift::ToString(lowest->method)) + " (" + lowest->protocol + ")";
   allan::AllanOptions o;
   o.rate_hz = s.rate_hz;
