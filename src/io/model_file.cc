@@ -391,6 +391,8 @@ drift::DriftOptions ReadOptions(const Node& n) {
   o.auto_lags = n["auto_lags"].Bool();
   o.lag_candidates = n["lag_candidates"].Ints();
   o.validation_fraction = n["validation_fraction"].Double();
+  o.linear_compensation = n["linear_compensation"].Bool();
+  o.reference_c = n["reference_c"].Double();  // NaN is allowed: keep the fitted intercept
   o.seed = n["seed"].U64();
   o.threads = n["threads"].Int();
   try {
@@ -489,6 +491,8 @@ nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
           {"auto_lags", o.auto_lags},
           {"lag_candidates", o.lag_candidates},
           {"validation_fraction", Number(o.validation_fraction)},
+          {"linear_compensation", o.linear_compensation},
+          {"reference_c", Number(o.reference_c)},
           {"seed", o.seed},
           {"threads", o.threads}};
 }

@@ -193,6 +193,8 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.auto_lags = true;
   o.lag_candidates = {2, 3};
   o.validation_fraction = 0.25;
+  o.linear_compensation = false;
+  o.reference_c = std::numeric_limits<double>::quiet_NaN();  // keep the fitted intercept
   o.seed = 123456789012345ULL;
   o.threads = 3;
   const json j = DriftOptionsToJson(o);
@@ -213,6 +215,8 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   EXPECT_EQ(r.selection.distance, selection::PdfDistance::kHellinger);
   EXPECT_EQ(r.lag_candidates, o.lag_candidates);
   EXPECT_EQ(r.seed, o.seed);
+  EXPECT_FALSE(r.linear_compensation);
+  EXPECT_TRUE(std::isnan(r.reference_c));
   EXPECT_EQ(j["learner"]["elm"]["ridge_c"], "inf");
 }
 
