@@ -146,29 +146,4 @@ void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& tabl
   if (loaded.model.uses_temperature()) require(loaded.info.temperature_column, "--temperature");
 }
 
-ProgressLine::ProgressLine(bool enabled)
-    : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
-
-void ProgressLine::Update(double fraction, const std::string& label) {
-  if (!enabled_) return;
-  constexpr int kWidth = 20;
-  fraction = std::clamp(fraction, 0.0, 1.0);
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  const int filled = static_cast<int>(fraction * kWidth + 0.5);
-  std::string line = "\r[" + std::string(static_cast<size_t>(filled), '#') +
-                     std::string(static_cast<size_t>(kWidth - filled), ' ') + "] " +
-                     fmt::format("{:3.0f}% {}  elapsed {:.0f}s", 100.0 * fraction, label, elapsed);
-  if (fraction > 0.0) line += fmt::format("  left {:.0f}s", elapsed * (1.0 - fraction) / fraction);
-  // Pad so a shorter line overwrites the previous one completely.
-  fmt::print(stderr, "{:<100}", line);
-  std::fflush(stderr);
-  shown_ = true;
-}
-
-void ProgressLine::Finish() {
-  if (shown_) fmt::print(stderr, "\n");
-  shown_ = false;
-}
-
 }  // namespace gyrodrift::cli

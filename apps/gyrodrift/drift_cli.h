@@ -54,18 +54,4 @@ std::string ColumnName(const io::CsvTable& table, const std::string& spec);
 // the table has the model's target column and, when the model uses it, its temperature column.
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);
 
-// The one-line progress display on stderr, shown only when stderr is a terminal and the command
-// is not quiet: "\r[####      ] 40% label  elapsed 12s  left 18s".
-class ProgressLine {
- public:
-  explicit ProgressLine(bool enabled);
-  void Update(double fraction, const std::string& label);
-  void Finish();  // ends the line (if anything was shown)
-
- private:
-  bool enabled_;
-  bool shown_ = false;
-  std::chrono::steady_clock::time_point start_;
-};
-
 }  // namespace gyrodrift::cli

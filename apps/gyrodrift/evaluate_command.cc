@@ -9,6 +9,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "drift_cli.h"
+#include "progress.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/evaluation.h"
@@ -100,18 +101,15 @@ void Run(const EvaluateArgs& a) {
     truth = table.Column(a.truth);
   }
 
-  ProgressLine progress(IsTerminal() && !a.quiet);
-  e.progress = [&progress](double fraction, const std::string& label) {
-    progress.Update(fraction, label);
-  };
   drift::EvaluationResult result;
-  try {
+  {
+    ProgressBar progress({1.0}, IsTerminal() && !a.quiet);  // Finish() on every exit path
+    progress.BeginStage(0, "evaluate");
+    e.progress = [&progress](double fraction, const std::string& label) {
+      progress.Update(fraction, label);
+    };
     result = drift::Evaluate(y, temperature, truth, base, e);
-  } catch (...) {
-    progress.Finish();
-    throw;
   }
-  progress.Finish();
 
   nlohmann::json methods = nlohmann::json::array(), protocols = nlohmann::json::array();
   for (auto m : e.methods) methods.push_back(drift::ToString(m));
