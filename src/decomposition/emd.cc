@@ -75,12 +75,15 @@ void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen
   }
 }
 
-Decomposition AssembleResult(const std::vector<Eigen::VectorXd>& imfs, Eigen::VectorXd residue,
+Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd residue,
                              DecompositionReport report) {
   Decomposition result;
   const Eigen::Index n = residue.size();
   result.imfs.resize(n, static_cast<Eigen::Index>(imfs.size()));
-  for (size_t k = 0; k < imfs.size(); ++k) result.imfs.col(static_cast<Eigen::Index>(k)) = imfs[k];
+  for (size_t k = 0; k < imfs.size(); ++k) {
+    result.imfs.col(static_cast<Eigen::Index>(k)) = imfs[k];
+    Eigen::VectorXd().swap(imfs[k]);  // free as we go: the peak holds one copy of the modes
+  }
   result.residue = std::move(residue);
   result.report = std::move(report);
   return result;
@@ -93,7 +96,7 @@ Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decomposi
   Eigen::VectorXd r = x;
   std::vector<Eigen::VectorXd> imfs;
   EmdLoop(sifter, r, o.max_imfs, imfs, report);
-  return AssembleResult(imfs, std::move(r), std::move(report));
+  return AssembleResult(std::move(imfs), std::move(r), std::move(report));
 }
 
 }  // namespace gyrodrift::decomposition::internal

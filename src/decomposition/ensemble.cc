@@ -191,8 +191,10 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
     modes.push_back(std::move(mode));
     ++report.noise_assisted_stages;
   }
+  // The realisations' noise state (one N-vector each) is the bulk of the memory: free it first.
+  std::vector<std::optional<NoiseModes>>().swap(noise);
   Scale(modes, r, sx);
-  return AssembleResult(modes, std::move(r), std::move(report));
+  return AssembleResult(std::move(modes), std::move(r), std::move(report));
 }
 
 Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
@@ -329,8 +331,10 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
     r = std::move(next);
     ++report.noise_assisted_stages;
   }
+  // The realisations' noise state (one N-vector each) is the bulk of the memory: free it first.
+  std::vector<std::optional<NoiseModes>>().swap(noise);
   Scale(modes, r, sx);
-  return AssembleResult(modes, std::move(r), std::move(report));
+  return AssembleResult(std::move(modes), std::move(r), std::move(report));
 }
 
 }  // namespace gyrodrift::decomposition::internal

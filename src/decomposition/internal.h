@@ -33,7 +33,7 @@ double SampleStd(const double* x, Eigen::Index n);
 // negligible against r's initial amplitude, or max_imfs (0 = no cap) IMFs are in `imfs`.
 void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen::VectorXd>& imfs,
              DecompositionReport& report);
-Decomposition AssembleResult(const std::vector<Eigen::VectorXd>& imfs, Eigen::VectorXd residue,
+Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd residue,
                              DecompositionReport report);
 
 Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
