@@ -11,7 +11,9 @@
 //               history of the temperature channel at t only (features.h), so the model needs
 //               nothing but temperature at run time; compensated output = y - estimate.
 // Methods: kMsElm (groups), kEmdElm (one ELM per IMF and one for the residue), and the single
-// models kElm, kPoly, kSvr, kBp trained on y itself with the same features.
+// models kElm, kPoly, kSvr, kBp trained on y itself (thermal features: features.h; poly uses the
+// classic T and dT/dt). Compensate mode fits linear ELM sub-models and references the estimate
+// to equilibrium at 20 degC by default (docs/drift.md, with the measurements behind both).
 // Cost: one decomposition of the training record plus one learner fit per sub-series.
 #pragma once
 
@@ -76,8 +78,8 @@ struct SubModel {
   std::string name;          // "noise", "mixed", "drift", "imf3", "residue", "signal"
   std::vector<int> imfs;     // IMF indices (1-based) of the training decomposition it sums
   bool has_residue = false;  // it also holds the residue (and any IMF beyond the last listed)
-  // Null for the noise group in compensate mode: temperature cannot explain it, its sub-model is
-  // the zero function.
+  // Null = the zero function: the noise group in compensate mode with nonlinear sub-models
+  // (linear_compensation = false); with the default linear sub-models every group has a learner.
   std::shared_ptr<const Learner> learner;
 };
 
