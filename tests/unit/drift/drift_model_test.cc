@@ -162,6 +162,40 @@ TEST(DriftModel, CompensateModeNeedsOnlyTemperatureAtRunTime) {
   }
 }
 
+TEST(DriftModel, CompensateModeIsLinearPerGroupReferencedAndThreadCountFree) {
+  const Log train = MakeLog(3000, 8);
+  DriftOptions o = Fast(Mode::kCompensate, Method::kMsElm);
+  const DriftModel model = FitDriftModel(train.rate, train.temperature, o);
+  ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
+  EXPECT_EQ(model.num_inputs(), 7);  // the ladder: 5 rungs, the slowest lag, (T - 20)^2
+  for (const SubModel& sub : model.sub_models) {
+    ASSERT_TRUE(sub.learner) << sub.name << ": every group is modelled with linear sub-models";
+    EXPECT_EQ(sub.learner->Save().texts.at("activation"), "linear") << sub.name;
+  }
+  // Referenced: a record in equilibrium at 20 degC has no thermal drift.
+  const Eigen::VectorXd at_reference = EstimateDrift(model, Eigen::VectorXd::Constant(500, 20.0));
+  EXPECT_LE(at_reference.cwiseAbs().maxCoeff(), 1e-12);
+  const Eigen::VectorXd estimate = EstimateDrift(model, train.temperature);
+  o.reference_c = std::nan("");
+  const DriftModel unreferenced = FitDriftModel(train.rate, train.temperature, o);
+  const Eigen::VectorXd raw = EstimateDrift(unreferenced, train.temperature);
+  // Referencing only shifts the estimate by a constant.
+  EXPECT_LE(((raw - estimate).array() - (raw - estimate).mean()).abs().maxCoeff(), 1e-10);
+  // One thread or two: the same bits.
+  o.reference_c = 20.0;
+  o.threads = 1;
+  EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o), train.temperature),
+            estimate);
+  // Nonlinear sub-models: the noise group is the zero function.
+  o.linear_compensation = false;
+  const DriftModel sigmoid = FitDriftModel(train.rate, train.temperature, o);
+  for (const SubModel& sub : sigmoid.sub_models) {
+    EXPECT_EQ(sub.learner == nullptr, sub.name == "noise") << sub.name;
+  }
+  o.reference_c = 300.0;
+  EXPECT_THROW(o.Validate(), UsageError);
+}
+
 TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {
   const Log log = MakeLog(1200, 5);
   DriftOptions o = Fast(Mode::kPredict, Method::kElm);
