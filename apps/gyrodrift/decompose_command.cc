@@ -7,6 +7,7 @@
 
 #include "cli_util.h"
 #include "command.h"
+#include "progress.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/io/csv.h"
@@ -97,7 +98,13 @@ void Run(const DecomposeArgs& a) {
     o.supplied_noise = w;
     o.ensemble_size = static_cast<int>(w->cols());
   }
-  const dec::Decomposition d = dec::Decompose(x, o);
+  dec::Decomposition d;
+  {
+    ProgressBar progress({1.0}, IsTerminal() && !a.quiet && o.method != dec::Method::kEmd);
+    progress.BeginStage(0, std::string(dec::ToString(o.method)));
+    o.progress = [&progress](double fraction) { progress.Update(fraction); };
+    d = dec::Decompose(x, o);
+  }
 
   std::vector<io::CsvColumn> columns;
   for (int k = 0; k < d.num_imfs(); ++k) {

@@ -1120,7 +1120,8 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   cmd->add_option("--units", args->units, "unit of the --input target for the Allan noise terms: dph|dps|rads")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the simulation (run B uses seed + 1), decomposition and learners")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(kSeed);
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
   cmd->add_option("--duration", args->duration, "advanced: length of each simulated run (30s, 10min, 8h)")

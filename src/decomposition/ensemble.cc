@@ -75,6 +75,18 @@ void Scale(std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& residue, double
 
 double Log2Energy(const Eigen::VectorXd& v) { return std::log2(v.squaredNorm()); }
 
+// Stage-wise methods do not know their stage count in advance: EMD of noise gives about
+// log2(N) modes, so that is the estimate (never reaching 1 before the end).
+// `reported` keeps the display monotone when the estimate grows.
+void ReportProgress(const DecompositionOptions& o, int stage, int realisation, int ensemble,
+                    Eigen::Index n, double& reported) {
+  if (!o.progress) return;
+  const double expected = std::max<double>(stage + 2, std::floor(std::log2(static_cast<double>(n))) - 1);
+  const double estimate = std::min(0.99, (stage + static_cast<double>(realisation + 1) / ensemble) / expected);
+  reported = std::max(reported, estimate);
+  o.progress(reported);
+}
+
 }  // namespace
 
 Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o) {
@@ -103,7 +115,8 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
         EmdLoop(workers[static_cast<size_t>(w)].sifter, m.residue, max_imfs, m.imfs, m.report);
         return m;
       },
-      [&](int, Member m) {
+      [&](int i, Member m) {
+        if (o.progress) o.progress(static_cast<double>(i + 1) / ensemble);
         for (size_t k = 0; k < m.imfs.size(); ++k) {
           mean_imfs.col(static_cast<Eigen::Index>(k)) += m.imfs[k] * inv;
           SiftOutcome s;
@@ -147,6 +160,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
 
   std::vector<Eigen::VectorXd> modes;
   Eigen::VectorXd r = xn;
+  double reported = 0.0;  // progress shown so far
   for (int stage = 0;; ++stage) {
     if (o.max_imfs > 0 && static_cast<int>(modes.size()) >= o.max_imfs) {
       report.stop_reason = "IMF cap (" + std::to_string(o.max_imfs) + ") reached";
@@ -182,9 +196,10 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
           term.value = term.outcome.extracted ? wk.imf : Eigen::VectorXd::Zero(n);
           return term;
         },
-        [&](int, StageTerm term) {
+        [&](int i, StageTerm term) {
           for (Eigen::Index j = 0; j < n; ++j) mode[j] = mode[j] + term.value[j] * inv;
           stats.Add(term.outcome);
+          ReportProgress(o, stage, i, ensemble, n, reported);
         });
     stats.Report(report, ensemble);
     r -= mode;
@@ -222,6 +237,7 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
 
   std::vector<Eigen::VectorXd> modes;
   Eigen::VectorXd r = xn;
+  double reported = 0.0;  // progress shown so far
   bool plain_rest = false;
   for (int stage = 0;; ++stage) {
     if (o.max_imfs > 0 && static_cast<int>(modes.size()) >= o.max_imfs) {
@@ -312,9 +328,10 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
           }
           return term;
         },
-        [&](int, StageTerm term) {
+        [&](int i, StageTerm term) {
           for (Eigen::Index j = 0; j < n; ++j) next[j] = next[j] + term.value[j] / nr;
           stats.Add(term.outcome);
+          ReportProgress(o, stage, i, ensemble, n, reported);
         });
     stats.Report(report, ensemble);
     Eigen::VectorXd mode = r - next;

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -90,6 +91,11 @@ struct DecompositionOptions {
   BeemdanBound beemdan_bound = BeemdanBound::kEnergyBand;
   double band_confidence = 0.99;  // 0.95 or 0.99 (the two bands Flandrin et al. 2004 fitted)
   int noise_stages = 3;           // for kFixedStages, >= 1
+
+  // Noise-assisted methods: called with the estimated fraction done, in order and never
+  // concurrently (from the thread that accumulates the ensemble); may be empty. For progress
+  // displays only: it does not change the result.
+  std::function<void(double fraction)> progress;
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range
 };

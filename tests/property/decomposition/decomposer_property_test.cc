@@ -2,6 +2,7 @@
 // Every property is one that a broken decomposer would fail.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -174,6 +175,22 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
     bad.supplied_noise = std::make_shared<Eigen::MatrixXd>(Eigen::MatrixXd::Zero(63, 4));
     EXPECT_THROW(Decompose(Noisy(64, 5), bad), DataError);
   }
+}
+
+TEST_P(Decomposer, ProgressIsMonotoneAndDoesNotChangeTheResult) {
+  if (GetParam() == Method::kEmd) GTEST_SKIP() << "plain EMD reports no progress";
+  const Eigen::VectorXd x = Noisy(512, 7);
+  DecompositionOptions o = Options(GetParam());
+  o.threads = 2;
+  const Decomposition plain = Decompose(x, o);
+  std::vector<double> seen;
+  o.progress = [&seen](double f) { seen.push_back(f); };
+  const Decomposition with_progress = Decompose(x, o);
+  EXPECT_EQ(plain.imfs, with_progress.imfs);
+  ASSERT_GE(seen.size(), static_cast<size_t>(o.ensemble_size));
+  EXPECT_GT(seen.front(), 0.0);
+  EXPECT_LE(seen.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
 }
 
 TEST_P(Decomposer, EveryStopRuleTerminatesWithinItsCap) {
