@@ -1,3 +1,4 @@
+#include "common/enum_names.h"
 #include "gyrodrift/decomposition/decomposition.h"
 
 #include <array>
@@ -12,24 +13,8 @@
 namespace gyrodrift::decomposition {
 namespace {
 
-template <class E, size_t N>
-std::string_view EnumName(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
-  for (const auto& [v, name] : names) {
-    if (v == value) return name;
-  }
-  return "?";
-}
-
-template <class E, size_t N>
-E EnumFromName(std::string_view text, std::string_view what,
-               const std::array<std::pair<E, std::string_view>, N>& names) {
-  std::string allowed;
-  for (const auto& [v, name] : names) {
-    if (name == text) return v;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
-  }
-  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
-}
+using gyrodrift::internal::EnumFromName;
+using gyrodrift::internal::EnumName;
 
 constexpr std::array<std::pair<Method, std::string_view>, 5> kMethods{{
     {Method::kEmd, "emd"},

@@ -1,3 +1,4 @@
+#include "common/enum_names.h"
 #include "gyrodrift/drift/drift_model.h"
 
 #include <algorithm>
@@ -31,24 +32,8 @@ constexpr std::array<std::pair<Protocol, std::string_view>, 2> kProtocols{{
     {Protocol::kCausal, "causal"},
 }};
 
-template <class E, size_t N>
-std::string_view Name(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
-  for (const auto& [v, name] : names) {
-    if (v == value) return name;
-  }
-  return "?";
-}
-
-template <class E, size_t N>
-E Parse(std::string_view text, std::string_view what,
-        const std::array<std::pair<E, std::string_view>, N>& names) {
-  std::string allowed;
-  for (const auto& [v, name] : names) {
-    if (name == text) return v;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
-  }
-  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
-}
+using gyrodrift::internal::EnumFromName;
+using gyrodrift::internal::EnumName;
 
 LearnerKind KindOf(Method method) {
   switch (method) {
@@ -101,12 +86,12 @@ LearnerOptions SubModelLearner(const DriftOptions& o, size_t g, int inputs) {
 
 }  // namespace
 
-std::string_view ToString(Mode mode) { return Name(mode, kModes); }
-Mode ModeFromString(std::string_view name) { return Parse(name, "mode", kModes); }
-std::string_view ToString(Method method) { return Name(method, kMethods); }
-Method MethodFromString(std::string_view name) { return Parse(name, "method", kMethods); }
-std::string_view ToString(Protocol protocol) { return Name(protocol, kProtocols); }
-Protocol ProtocolFromString(std::string_view name) { return Parse(name, "protocol", kProtocols); }
+std::string_view ToString(Mode mode) { return EnumName(mode, kModes); }
+Mode ModeFromString(std::string_view name) { return EnumFromName(name, "mode", kModes); }
+std::string_view ToString(Method method) { return EnumName(method, kMethods); }
+Method MethodFromString(std::string_view name) { return EnumFromName(name, "method", kMethods); }
+std::string_view ToString(Protocol protocol) { return EnumName(protocol, kProtocols); }
+Protocol ProtocolFromString(std::string_view name) { return EnumFromName(name, "protocol", kProtocols); }
 
 std::vector<Method> AllMethods() {
   std::vector<Method> all;

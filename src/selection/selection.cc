@@ -1,3 +1,4 @@
+#include "common/enum_names.h"
 #include "gyrodrift/selection/selection.h"
 
 #include <algorithm>
@@ -28,24 +29,8 @@ constexpr std::array<std::pair<GroupKind, std::string_view>, 3> kKinds{{
     {GroupKind::kDrift, "drift"},
 }};
 
-template <class E, size_t N>
-std::string_view EnumName(E value, const std::array<std::pair<E, std::string_view>, N>& names) {
-  for (const auto& [v, name] : names) {
-    if (v == value) return name;
-  }
-  return "?";
-}
-
-template <class E, size_t N>
-E EnumFromName(std::string_view text, std::string_view what,
-               const std::array<std::pair<E, std::string_view>, N>& names) {
-  std::string allowed;
-  for (const auto& [v, name] : names) {
-    if (name == text) return v;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(name);
-  }
-  ThrowOption(what, "'" + std::string(text) + "'", "one of " + allowed);
-}
+using gyrodrift::internal::EnumFromName;
+using gyrodrift::internal::EnumName;
 
 // "1-4" or "5" or "" for a list of consecutive indices.
 std::string Range(const std::vector<int>& imfs) {
