@@ -375,14 +375,25 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   return fit;
 }
 
-Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x) {
+namespace {
+
+// The model and the inputs checked (shape, finite values), then standardised with the model's
+// training-time scaler: what Predict and HiddenLayer both start from.
+Eigen::MatrixXd CheckedScaledInputs(const ElmModel& model,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& x) {
   model.Validate();
   if (x.cols() != model.num_inputs()) {
     throw DataError("inputs have " + std::to_string(x.cols()) + " columns but the ELM model has " +
                     std::to_string(model.num_inputs()) + " inputs");
   }
   RequireFiniteMatrix("inputs", x);
-  const Eigen::MatrixXd xs = model.input_scaler.Apply(x);
+  return model.input_scaler.Apply(x);
+}
+
+}  // namespace
+
+Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x) {
+  const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd h(x.rows(), model.num_hidden());
   ForEachHiddenBlock(model, xs, [&](Eigen::Index r0, Eigen::Index rows, const auto& block) {
     h.middleRows(r0, rows) = block;
@@ -391,13 +402,7 @@ Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen:
 }
 
 Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x) {
-  model.Validate();
-  if (x.cols() != model.num_inputs()) {
-    throw DataError("inputs have " + std::to_string(x.cols()) + " columns but the ELM model has " +
-                    std::to_string(model.num_inputs()) + " inputs");
-  }
-  RequireFiniteMatrix("inputs", x);
-  const Eigen::MatrixXd xs = model.input_scaler.Apply(x);
+  const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd y(x.rows(), model.num_outputs());
   ForEachHiddenBlock(model, xs, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
     y.middleRows(r0, rows).noalias() = h * model.output_weights;

@@ -150,16 +150,10 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
        "model needs column 'temperature_c'"},
       {"nan target", "predict %DIR%/ms.json %DIR%/nan.csv", 3, "data row 6"},
   };
+  const std::string out = Dir() + "/bad.csv";
   for (const auto& c : cases) {
-    std::string args = c.args;
-    for (size_t p; (p = args.find("%DIR%")) != std::string::npos;) args.replace(p, 5, Dir());
-    const std::string out = Dir() + "/bad.csv";
-    const auto r = test::RunCli(args + " -o " + out);
-    EXPECT_EQ(r.exit_code, c.exit_code) << c.name << ": " << r.err;
-    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ": " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
-    EXPECT_FALSE(test::FileExists(out)) << c.name;
-    EXPECT_FALSE(test::FileExists(out + ".json")) << c.name;
+    const auto r = test::RunCli(test::Substitute(c.args, {{"%DIR%", Dir()}}) + " -o " + out);
+    test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
   const auto r = test::RunCli("predict '" + Dir() + "/elm.json' '" + Dir() + "/test.csv' -o '" +
                               Dir() + "/no/dir/p.csv'");

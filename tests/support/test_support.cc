@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -88,5 +89,25 @@ CommandResult RunCli(const std::string& args) {
 }
 
 bool FileExists(const std::string& path) { return std::filesystem::exists(path); }
+
+std::string Substitute(std::string text,
+                       const std::vector<std::pair<std::string, std::string>>& placeholders) {
+  for (const auto& [key, value] : placeholders) {
+    for (size_t p = 0; (p = text.find(key, p)) != std::string::npos; p += value.size()) {
+      text.replace(p, key.size(), value);
+    }
+  }
+  return text;
+}
+
+void ExpectCleanFailure(const CommandResult& result, int exit_code, const std::string& message,
+                        const std::string& output, const std::string& label) {
+  EXPECT_EQ(result.exit_code, exit_code) << label << ": " << result.err;
+  EXPECT_EQ(result.err.rfind("gyrodrift: error: ", 0), 0u) << label << ": " << result.err;
+  EXPECT_NE(result.err.find(message), std::string::npos) << label << ": " << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << label << ": " << result.err;
+  EXPECT_FALSE(FileExists(output)) << label;
+  EXPECT_FALSE(FileExists(output + ".json")) << label;
+}
 
 }  // namespace gyrodrift::test

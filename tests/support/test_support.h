@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace gyrodrift::test {
@@ -39,5 +40,14 @@ struct CommandResult {
 // Runs the built gyrodrift binary with the given argument string (shell-quoted by the caller).
 CommandResult RunCli(const std::string& args);
 bool FileExists(const std::string& path);
+
+// `text` with every occurrence of each placeholder key replaced by its value.
+std::string Substitute(std::string text,
+                       const std::vector<std::pair<std::string, std::string>>& placeholders);
+// Asserts that a CLI run failed cleanly: the exit code, exactly one stderr line
+// "gyrodrift: error: ..." containing `message`, and neither `output` nor `output`.json left
+// behind. `label` names the case in failure messages.
+void ExpectCleanFailure(const CommandResult& result, int exit_code, const std::string& message,
+                        const std::string& output, const std::string& label);
 
 }  // namespace gyrodrift::test
