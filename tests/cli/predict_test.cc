@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -52,7 +53,10 @@ class PredictCli : public ::testing::Test {
                   .exit_code,
               0);
   }
-  static void TearDownTestSuite() { delete dir_; }
+  static void TearDownTestSuite() {
+    std::filesystem::remove_all(*dir_);
+    delete dir_;
+  }
   static const std::string& Dir() { return *dir_; }
   static std::string* dir_;
 };

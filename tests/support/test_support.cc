@@ -26,12 +26,16 @@ std::string TestDataPath(const std::string& relative) {
 
 std::string TempDir(const std::string& name) {
   // CTest runs tests of one executable in parallel: the directory is unique per test.
+  // Outside a test (SetUpTestSuite) every process runs the same suite set-up, so the process
+  // id keeps concurrent processes apart.
   std::string unique = name;
   if (const auto* info = ::testing::UnitTest::GetInstance()->current_test_info()) {
     unique += std::string("-") + info->test_suite_name() + "-" + info->name();
     for (char& c : unique) {
       if (c == '/') c = '_';
     }
+  } else {
+    unique += "-pid" + std::to_string(::getpid());
   }
   const std::filesystem::path dir =
       std::filesystem::path(GYRODRIFT_BINARY_DIR) / "test-tmp" / unique;
@@ -76,7 +80,7 @@ Eigen::VectorXd LehmerBoxMullerNormals(std::int64_t seed, Eigen::Index n) {
 
 CommandResult RunCli(const std::string& args) {
   CommandResult result;
-  const std::string dir = TempDir("cli-capture-" + std::to_string(::getpid()));
+  const std::string dir = TempDir("cli-capture");
   const std::string out_path = dir + "/stdout";
   const std::string err_path = dir + "/stderr";
   const std::string command =
@@ -85,6 +89,7 @@ CommandResult RunCli(const std::string& args) {
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = io::ReadTextFile(out_path);
   result.err = io::ReadTextFile(err_path);
+  std::filesystem::remove_all(dir);
   return result;
 }
 
