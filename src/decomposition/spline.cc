@@ -54,58 +54,104 @@ void EnvelopeSpline::Prepare() {
 
 namespace {
 
-// Forward elimination of rows [1, m) of one system; diag becomes the inverse pivots.
-inline void EliminateRow(double* diag, double* rhs, const double* sub, const double* sup, size_t j) {
-  const double w = sub[j] * diag[j - 1];
-  diag[j] = 1.0 / (diag[j] - w * sup[j - 1]);
-  rhs[j] -= w * rhs[j - 1];
-}
+// Forward elimination of rows [from, to) of two systems at once; diag becomes the inverse pivots.
+// The pivot and right-hand side of the previous row stay in registers: the recurrence is one
+// division chain per system, and the two chains overlap in the processor.
+struct Chain {
+  double* diag;
+  double* rhs;
+  const double* sub;
+  const double* sup;
+  double inv_prev, rhs_prev;
+  explicit Chain(EnvelopeSpline::Rows rows)
+      : diag(rows.diag), rhs(rows.rhs), sub(rows.sub), sup(rows.sup) {
+    inv_prev = diag[0] = 1.0 / diag[0];
+    rhs_prev = rhs[0];
+  }
+  inline void Step(size_t j) {
+    const double w = sub[j] * inv_prev;
+    inv_prev = 1.0 / (diag[j] - w * sup[j - 1]);
+    rhs_prev = rhs[j] - w * rhs_prev;
+    diag[j] = inv_prev;
+    rhs[j] = rhs_prev;
+  }
+};
 
-void BackSubstitute(size_t m, const double* inv_diag, const double* rhs, const double* sup,
-                    double* s) {
-  s[m - 1] = rhs[m - 1] * inv_diag[m - 1];
-  for (size_t j = m - 1; j-- > 0;) s[j] = (rhs[j] - sup[j] * s[j + 1]) * inv_diag[j];
-}
+// Back substitution, s[j] = (rhs[j] - sup[j] s[j+1]) inv_diag[j], for rows m-1 down to 0.
+struct Back {
+  const double* inv_diag;
+  const double* rhs;
+  const double* sup;
+  double* s;
+  double next;
+  Back(EnvelopeSpline::Rows rows, double* slope, size_t m)
+      : inv_diag(rows.diag), rhs(rows.rhs), sup(rows.sup), s(slope) {
+    next = s[m - 1] = rhs[m - 1] * inv_diag[m - 1];
+  }
+  inline void Step(size_t j) {
+    next = (rhs[j] - sup[j] * next) * inv_diag[j];
+    s[j] = next;
+  }
+};
 
 }  // namespace
+
+EnvelopeSpline::Rows EnvelopeSpline::rows() {
+  return {diag_.data(), rhs_.data(), sub_.data(), sup_.data()};
+}
+
+void EnvelopeSpline::Coefficients() {
+  // Cubic coefficients per piece (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y.
+  const size_t m = t_.size();
+  const double* inv_dx = inv_dx_.data();
+  const double* dd = dd_.data();
+  const double* slope = slope_.data();
+  double* c1 = c1_.data();
+  double* c2 = c2_.data();
+  for (size_t k = 0; k + 1 < m; ++k) {
+    const double dzzdx = (dd[k] - slope[k]) * inv_dx[k];
+    const double dzdxdx = (slope[k + 1] - dd[k]) * inv_dx[k];
+    c1[k] = (dzdxdx - dzzdx) * inv_dx[k];
+    c2[k] = 2 * dzzdx - dzdxdx;
+  }
+}
 
 void FitPair(EnvelopeSpline& a, EnvelopeSpline& b) {
   a.Prepare();
   b.Prepare();
   const size_t ma = a.t_.size() >= 4 ? a.t_.size() : 0;
   const size_t mb = b.t_.size() >= 4 ? b.t_.size() : 0;
-  if (ma) a.diag_[0] = 1.0 / a.diag_[0];
-  if (mb) b.diag_[0] = 1.0 / b.diag_[0];
-  // Two independent division chains in one loop: the processor overlaps them.
-  const size_t common = std::min(ma, mb);
-  size_t j = 1;
-  for (; j < common; ++j) {
-    EliminateRow(a.diag_.data(), a.rhs_.data(), a.sub_.data(), a.sup_.data(), j);
-    EliminateRow(b.diag_.data(), b.rhs_.data(), b.sub_.data(), b.sup_.data(), j);
-  }
-  for (size_t k = j; k < ma; ++k) {
-    EliminateRow(a.diag_.data(), a.rhs_.data(), a.sub_.data(), a.sup_.data(), k);
-  }
-  for (size_t k = j; k < mb; ++k) {
-    EliminateRow(b.diag_.data(), b.rhs_.data(), b.sub_.data(), b.sup_.data(), k);
-  }
-  for (EnvelopeSpline* s : {&a, &b}) {
-    const size_t m = s->t_.size();
-    if (m < 4) continue;
-    BackSubstitute(m, s->diag_.data(), s->rhs_.data(), s->sup_.data(), s->slope_.data());
-    // Cubic coefficients per piece (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y.
-    const double* inv_dx = s->inv_dx_.data();
-    const double* dd = s->dd_.data();
-    const double* slope = s->slope_.data();
-    double* c1 = s->c1_.data();
-    double* c2 = s->c2_.data();
-    for (size_t k = 0; k + 1 < m; ++k) {
-      const double dzzdx = (dd[k] - slope[k]) * inv_dx[k];
-      const double dzdxdx = (slope[k + 1] - dd[k]) * inv_dx[k];
-      c1[k] = (dzdxdx - dzzdx) * inv_dx[k];
-      c2[k] = 2 * dzzdx - dzdxdx;
+  if (ma && mb) {
+    // Both systems in one loop: two independent division chains.
+    Chain ca(a.rows()), cb(b.rows());
+    const size_t common = std::min(ma, mb);
+    size_t j = 1;
+    for (; j < common; ++j) {
+      ca.Step(j);
+      cb.Step(j);
+    }
+    for (size_t k = j; k < ma; ++k) ca.Step(k);
+    for (size_t k = j; k < mb; ++k) cb.Step(k);
+    Back ba(a.rows(), a.slope_.data(), ma), bb(b.rows(), b.slope_.data(), mb);
+    size_t ja = ma - 1, jb = mb - 1;
+    while (ja > 0 && jb > 0) {
+      ba.Step(--ja);
+      bb.Step(--jb);
+    }
+    while (ja > 0) ba.Step(--ja);
+    while (jb > 0) bb.Step(--jb);
+  } else {
+    for (EnvelopeSpline* s : {&a, &b}) {
+      const size_t m = s->t_.size();
+      if (m < 4) continue;
+      Chain c(s->rows());
+      for (size_t j = 1; j < m; ++j) c.Step(j);
+      Back back(s->rows(), s->slope_.data(), m);
+      for (size_t j = m - 1; j-- > 0;) back.Step(j);
     }
   }
+  if (ma) a.Coefficients();
+  if (mb) b.Coefficients();
 }
 
 void EnvelopeSpline::Evaluate(Eigen::Index n, double* out) const {

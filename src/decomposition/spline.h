@@ -25,8 +25,18 @@ class EnvelopeSpline {
   // Solves the slopes of both splines.
   friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
 
+  // The tridiagonal system's arrays (row j: sub[j] s[j-1] + diag[j] s[j] + sup[j] s[j+1] = rhs[j]).
+  struct Rows {
+    double* diag;
+    double* rhs;
+    const double* sub;
+    const double* sup;
+  };
+
  private:
   void Prepare();
+  Rows rows();
+  void Coefficients();
   std::vector<double> t_, y_;
   std::vector<double> inv_dx_, dd_, slope_, diag_, rhs_, sub_, sup_, c1_, c2_;
 };
