@@ -1,6 +1,6 @@
 // Allan-variance benchmarks: overlapping ADEV of a white-noise rate record, octave grid and every
 // averaging factor, with noise identification, EDF and confidence intervals (the defaults of
-// allan::Compute), on all cores and on one.
+// allan::Compute), on all cores and on one; and the IEEE 952 noise fit of an octave curve.
 //   build-*/bench/bench_allan --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -58,6 +58,17 @@ void BM_OadevAllNoIntervals(benchmark::State& s) {
 void BM_MdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kMdev, 0, true); }
 void BM_TotdevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::kTotdev, 0, true); }
 
+// IEEE 952 noise fit (with the correlation of the points) of the octave OADEV curve of a record:
+// the cost does not depend on the record length, only on the number of fitted points.
+void BM_NoiseFit(benchmark::State& state) {
+  const auto curve = Compute(Record(state.range(0)), AllanOptions{.rate_hz = 100.0});
+  for (auto _ : state) {
+    const auto terms = gyrodrift::allan::IdentifyNoise(curve);
+    benchmark::DoNotOptimize(terms.n_dpsh.value);
+  }
+  state.counters["points"] = static_cast<double>(curve.points.size());
+}
+
 void Register() {
   const bool smoke = gyrodrift::bench::SmokeMode();
   const std::vector<std::int64_t> octave =
@@ -76,6 +87,9 @@ void Register() {
         ->Arg(n)
         ->Unit(benchmark::kMillisecond);
   }
+  benchmark::RegisterBenchmark("BM_NoiseFit", BM_NoiseFit)
+      ->Arg(smoke ? 10000 : 1000000)
+      ->Unit(benchmark::kMillisecond);
   const std::int64_t all_n = smoke ? 2000 : 1000000;
   benchmark::RegisterBenchmark("BM_OadevAll", BM_OadevAll)
       ->Arg(all_n)

@@ -77,7 +77,7 @@ std::string Num(double v) { return std::isfinite(v) ? fmt::format("{:.4g}", v) :
 // Aligned noise-term table for the terminal.
 std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
   std::string s = fmt::format(
-      "IEEE 952 noise terms ({} curve, weighted NNLS on the variance, {} points {}..{} s, "
+      "IEEE 952 noise terms ({} curve, fit in log variance, {} points {}..{} s, "
       "chi2/dof {}):\n",
       source, t.points_used, Num(t.tau_min_s), Num(t.tau_max_s), Num(t.chi2_per_dof));
   s += fmt::format("  {:<34} {:>24}   {:>12} {:>12}\n", "term", "fitted", "slope method",

@@ -186,12 +186,15 @@ struct NoiseFitOptions {
   // model variance ("the taus where it matters"); terms below are set to 0 and refitted without.
   // Range [0, 1). Default 0.1.
   double min_share = 0.1;
+  // Sample period tau0 (s) of a bare curve, used for the correlation between its points; 0 takes
+  // the smallest fitted tau. IdentifyNoise(AllanResult) uses the result's own. Finite, >= 0.
+  double sample_period_s = 0.0;
   void Validate() const;
 };
 
 struct NoiseTerm {
   double value = 0.0;  // fitted value in the unit named below (0 if not identified)
-  double sigma = 0.0;  // 1-sigma uncertainty from the weighted least-squares covariance
+  double sigma = 0.0;  // 1-sigma uncertainty (correlated points, see IdentifyNoise)
   double slope_reading = std::numeric_limits<double>::quiet_NaN();  // IEEE 952 slope method
   double slope_tau_s = std::numeric_limits<double>::quiet_NaN();    // tau of that reading
   bool identified = false;  // the term matters somewhere in the fitted range
@@ -215,8 +218,12 @@ struct NoiseTerms {
 };
 
 // Fits the IEEE 952 model sigma^2 = 3Q^2/tau^2 + N^2/tau + (2 ln2/pi) B^2 + K^2 tau/3 + R^2 tau^2/2
-// to an ADEV, OADEV or TOTDEV curve (UsageError for other estimators). Weights: the variance of
-// each point's AVAR estimate, 2 AVAR^2 / EDF (from the result when available, else n_terms).
+// to an ADEV, OADEV or TOTDEV curve (UsageError for other estimators), by non-negative weighted
+// least squares on the variance: each point's AVAR estimate has variance 2 AVAR^2 / EDF (EDF from
+// the result when available, else n_terms). The uncertainties account for the correlation of neighbouring points, as overlapping
+// estimates of the fitted noise are correlated (avar_correlation.h in src/allan; exact for OADEV
+// in long records, an approximation for ADEV and TOTDEV). Points closer than a factor sqrt(2)
+// in tau are thinned to the first. Cost: about 4e4 x T^2 for T fitted points.
 NoiseTerms IdentifyNoise(const AllanResult& result, const NoiseFitOptions& options = {});
 // Same from a bare curve: tau (s), Allan deviation in deg/h and EDF per point.
 NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& adev_dph,

@@ -2,7 +2,9 @@
 // built from: the end-to-end check that the simulator's noise means what its parameters say.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/simulation/fog_simulator.h"
@@ -56,11 +58,8 @@ TEST_P(SimulatedNoiseAllan, CurveAndFittedTermsMatchTheGeneratingParameters) {
   EXPECT_GE(points, 18);
   EXPECT_GE(covered, points - 3) << rec.curve.Summary();
 
-  // 2. The IEEE 952 fit finds N, B and K. Tolerances: the fit's own 1-sigma values (about 0.2 %,
-  //    0.6 % and 5-10 % here) assume independent points, while overlapping estimates at
-  //    neighbouring taus are correlated; over 8 seeds the generator matched its exact curve to
-  //    0.2 % (ratio of mean AVAR) while the fitted N, B and K scattered by up to 0.5 %, 1.4 % and
-  //    30 %, i.e. up to 4.5 reported sigmas. The bounds below are those of that spread.
+  // 2. The IEEE 952 fit finds N, B and K within 3 of their reported standard uncertainties
+  //    (the calibration of those uncertainties is the next test's job).
   const allan::NoiseTerms& t = rec.terms;
   ASSERT_TRUE(t.n_dpsh.identified) << t.Summary();
   ASSERT_TRUE(t.b_dph.identified) << t.Summary();
@@ -68,13 +67,67 @@ TEST_P(SimulatedNoiseAllan, CurveAndFittedTermsMatchTheGeneratingParameters) {
   EXPECT_NEAR(t.n_dpsh.value / rec.truth.arw_dpsh, 1.0, 0.01) << t.Summary();
   EXPECT_NEAR(t.b_dph.value / rec.truth.bias_instability_dph, 1.0, 0.03) << t.Summary();
   EXPECT_NEAR(t.k_dphpsh.value / rec.truth.rrw_dphpsh, 1.0, 0.35) << t.Summary();
-  EXPECT_LT(std::abs(t.n_dpsh.value - rec.truth.arw_dpsh), 5 * t.n_dpsh.sigma) << t.Summary();
-  EXPECT_LT(std::abs(t.b_dph.value - rec.truth.bias_instability_dph), 5 * t.b_dph.sigma)
+  EXPECT_LT(std::abs(t.n_dpsh.value - rec.truth.arw_dpsh), 3 * t.n_dpsh.sigma) << t.Summary();
+  EXPECT_LT(std::abs(t.b_dph.value - rec.truth.bias_instability_dph), 3 * t.b_dph.sigma)
       << t.Summary();
-  EXPECT_LT(std::abs(t.k_dphpsh.value - rec.truth.rrw_dphpsh), 5 * t.k_dphpsh.sigma) << t.Summary();
+  EXPECT_LT(std::abs(t.k_dphpsh.value - rec.truth.rrw_dphpsh), 3 * t.k_dphpsh.sigma) << t.Summary();
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, SimulatedNoiseAllan, ::testing::Values(1u, 2u, 3u));
+
+// The reported uncertainties are honest: over many independent records, (fit - target) / sigma
+// has a root mean square near 1 and the 95 % intervals cover the target about 95 % of the time.
+// The target is what the fit finds on the exact Allan curve of the generator (its projection on
+// the five-term model): the bias bank's floor ripples by a few per cent, which no five-term model
+// follows, and that model error is not the estimator's. The projection itself stays within a few
+// per cent of the generating parameters. 40 records of 2e5 s at 1 Hz with ARW up to ~30 s, the
+// bias floor to ~3000 s and rate random walk beyond; with calibrated uncertainties the RMS over
+// 40 records is 1 +- 0.11, and the coverage 38 +- 1.4 of 40.
+TEST(SimulatedNoiseAllanCalibration, UncertaintiesCoverTheTruthAtTheirStatedRate) {
+  NoiseParameters p;
+  p.bias_instability_dph = 0.075;
+  p.rrw_dphpsh = 0.1;
+  constexpr Eigen::Index kSamples = 200000;
+  constexpr int kRecords = 40;
+  allan::AllanOptions ao{.grid = allan::TauGrid::kOctave};
+  // Projection of the exact curve (unbounded degrees of freedom: no estimation noise).
+  const allan::AllanResult shape = allan::Compute(GenerateNoise(p, 1.0, kSamples, 0), ao);
+  const auto points = static_cast<Eigen::Index>(shape.points.size());
+  Eigen::VectorXd tau(points), exact(points), edf = Eigen::VectorXd::Constant(points, 1e12);
+  for (Eigen::Index i = 0; i < points; ++i) {
+    const auto& point = shape.points[static_cast<size_t>(i)];
+    tau[i] = point.tau_s;
+    exact[i] = std::sqrt(NoiseAllanVariance(p, 1.0, point.m));
+  }
+  const allan::NoiseTerms target =
+      allan::IdentifyNoise(tau, exact, edf, {.sample_period_s = 1.0});
+  EXPECT_NEAR(target.n_dpsh.value / p.arw_dpsh, 1.0, 0.01) << target.Summary();
+  EXPECT_NEAR(target.b_dph.value / p.bias_instability_dph, 1.0, 0.03) << target.Summary();
+  EXPECT_NEAR(target.k_dphpsh.value / p.rrw_dphpsh, 1.0, 0.05) << target.Summary();
+
+  std::array<double, 3> sum_z2{}, covered{};
+  for (int record = 1; record <= kRecords; ++record) {
+    const allan::NoiseTerms t = allan::IdentifyNoise(
+        allan::Compute(GenerateNoise(p, 1.0, kSamples, static_cast<std::uint64_t>(record)), ao));
+    const std::array<const allan::NoiseTerm*, 3> fitted{&t.n_dpsh, &t.b_dph, &t.k_dphpsh};
+    const std::array<double, 3> truth{target.n_dpsh.value, target.b_dph.value,
+                                      target.k_dphpsh.value};
+    for (size_t j = 0; j < 3; ++j) {
+      ASSERT_TRUE(fitted[j]->identified) << record << ": " << t.Summary();
+      const double z = (fitted[j]->value - truth[j]) / fitted[j]->sigma;
+      sum_z2[j] += z * z;
+      covered[j] += std::abs(z) <= 1.96;
+    }
+  }
+  const char* names[] = {"N", "B", "K"};
+  for (size_t j = 0; j < 3; ++j) {
+    const double rms = std::sqrt(sum_z2[j] / kRecords);
+    std::printf("%s: rms z %.2f, 95 %% coverage %g of %d\n", names[j], rms, covered[j], kRecords);
+    EXPECT_GT(rms, 0.6) << names[j];
+    EXPECT_LT(rms, 1.4) << names[j];
+    EXPECT_GE(covered[j], 34) << names[j];
+  }
+}
 
 }  // namespace
 }  // namespace gyrodrift::simulation
