@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "elm/internal.h"
+#include "elm/kernels.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
@@ -45,6 +46,12 @@ std::string FormatShort(double value) {
   return buffer;
 }
 
+void CheckThreads(int threads) {
+  if (threads < 0 || threads > 1024) {
+    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
+  }
+}
+
 void RequireFiniteMatrix(std::string_view what, const Eigen::Ref<const Eigen::MatrixXd>& m) {
   for (Eigen::Index j = 0; j < m.cols(); ++j) {
     for (Eigen::Index i = 0; i < m.rows(); ++i) {
@@ -73,14 +80,15 @@ void CheckTrainingData(const Eigen::Ref<const Eigen::MatrixXd>& x,
   RequireFiniteMatrix("targets", t);
 }
 
-// Streams the model's hidden layer over fixed row blocks; body(r0, rows, h) runs once per block
-// with h = H[r0 : r0 + rows, :].
+// Streams the model's hidden layer over fixed row blocks on `threads` workers; body(r0, rows, h)
+// runs once per block with h = H[r0 : r0 + rows, :].
 template <class Body>
-void ForEachHiddenBlock(const ElmModel& model, const Eigen::MatrixXd& xs, const Body& body) {
+void ForEachHiddenBlock(const ElmModel& model, const Eigen::MatrixXd& xs, int threads,
+                        const Body& body) {
   const Eigen::Index n = xs.rows();
   const int blocks = internal::NumBlocks(n);
   if (blocks == 0) return;
-  const int workers = std::min(ResolveThreads(model.options.threads), blocks);
+  const int workers = std::min(ResolveThreads(threads), blocks);
   std::vector<Eigen::MatrixXd> buffer(
       static_cast<size_t>(workers),
       Eigen::MatrixXd(std::min(n, internal::kBlockRows), model.num_hidden()));
@@ -96,13 +104,13 @@ void ForEachHiddenBlock(const ElmModel& model, const Eigen::MatrixXd& xs, const 
 
 // Output weights by Householder QR: [H; I/sqrt(C)] beta = [T; 0], or the minimum-norm least
 // squares solution of H beta = T when C is infinite. Stores H (N x L).
-void SolveQr(ElmModel* model, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts,
+void SolveQr(ElmModel* model, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts, int threads,
              ElmReport* report) {
   const Eigen::Index n = xs.rows();
   const Eigen::Index hidden = model->num_hidden();
   const bool ridge = std::isfinite(model->options.ridge_c);
   Eigen::MatrixXd stacked(ridge ? n + hidden : n, hidden);
-  ForEachHiddenBlock(*model, xs, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
+  ForEachHiddenBlock(*model, xs, threads, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
     stacked.middleRows(r0, rows) = h;
   });
   Eigen::MatrixXd h_copy;
@@ -187,9 +195,7 @@ void ElmOptions::Validate() const {
   if (!(max_condition >= 1e3 && max_condition <= 1e15)) {
     ThrowOption("max_condition", FormatValue(max_condition), "in [1e3, 1e15]");
   }
-  if (threads < 0 || threads > 1024) {
-    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
-  }
+  CheckThreads(threads);
 }
 
 std::vector<int> ElmOptions::HiddenUnitGrid() const {
@@ -302,6 +308,8 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   ElmReport& report = fit.report;
   model.activation = options.activation;
   model.options = options;
+  // The thread count is how this run was executed, not part of the model (it changes no bit).
+  model.options.threads = 0;
   model.input_scaler = FitStandardizer(x, options.standardize_inputs);
   model.target_scaler = FitStandardizer(t, options.standardize_targets);
   const Eigen::MatrixXd xs = model.input_scaler.Apply(x);
@@ -359,7 +367,7 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   report.numerical_rank = hidden;
 
   if (options.solver == Solver::kQr) {
-    SolveQr(&model, xs, ts, &report);
+    SolveQr(&model, xs, ts, options.threads, &report);
     return fit;
   }
   if (!have_gram) {
@@ -392,20 +400,29 @@ Eigen::MatrixXd CheckedScaledInputs(const ElmModel& model,
 
 }  // namespace
 
-Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x) {
+Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                            int threads) {
+  CheckThreads(threads);
   const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd h(x.rows(), model.num_hidden());
-  ForEachHiddenBlock(model, xs, [&](Eigen::Index r0, Eigen::Index rows, const auto& block) {
-    h.middleRows(r0, rows) = block;
-  });
+  ForEachHiddenBlock(model, xs, threads,
+                     [&](Eigen::Index r0, Eigen::Index rows, const auto& block) {
+                       h.middleRows(r0, rows) = block;
+                     });
   return h;
 }
 
-Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x) {
+Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                        int threads) {
+  CheckThreads(threads);
   const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd y(x.rows(), model.num_outputs());
-  ForEachHiddenBlock(model, xs, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
-    y.middleRows(r0, rows).noalias() = h * model.output_weights;
+  const internal::Kernels& kernels = internal::ActiveKernels();
+  ForEachHiddenBlock(model, xs, threads, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
+    // The kernel sums each output over the units in one fixed order, so a row predicted alone
+    // gets the same bits as in any batch.
+    kernels.output(h.data(), h.outerStride(), rows, model.num_hidden(),
+                   model.output_weights.data(), model.num_outputs(), y.data() + r0, y.outerStride());
   });
   return model.target_scaler.Invert(y);
 }

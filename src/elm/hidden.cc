@@ -1,10 +1,12 @@
-// Hidden units, the streamed Gram matrix and the Cholesky ridge solver.
+// Hidden units, the streamed Gram matrix and the Cholesky ridge solver. The arithmetic over
+// rows runs in the dispatched kernels (kernels.h).
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "elm/internal.h"
+#include "elm/kernels.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"
 
@@ -21,43 +23,18 @@ void DrawUnits(int inputs, int hidden, std::uint64_t seed, Eigen::MatrixXd* weig
   }
 }
 
+static_assert(static_cast<int>(Activation::kSigmoid) == kKernelSigmoid &&
+              static_cast<int>(Activation::kTanh) == kKernelTanh &&
+              static_cast<int>(Activation::kSine) == kKernelSine &&
+              static_cast<int>(Activation::kRbf) == kKernelRbf &&
+              static_cast<int>(Activation::kLinear) == kKernelLinear);
+
 void ComputeHidden(Activation activation, const Eigen::Ref<const Eigen::MatrixXd>& xs,
-                   const Eigen::Ref<const Eigen::MatrixXd>& weights,
-                   const Eigen::Ref<const Eigen::VectorXd>& biases,
+                   const Eigen::MatrixXd& weights, const Eigen::VectorXd& biases,
                    Eigen::Ref<Eigen::MatrixXd> out) {
-  out.noalias() = xs * weights;
-  auto z = out.array();
-  switch (activation) {
-    case Activation::kSigmoid:
-      z.rowwise() += biases.transpose().array();
-      // exp(-z) overflows to +inf for z < -709, and 1 / (1 + inf) = 0 is the right limit.
-      z = (1.0 + (-z).exp()).inverse();
-      break;
-    case Activation::kTanh:
-      z.rowwise() += biases.transpose().array();
-      z = z.tanh();
-      break;
-    case Activation::kSine:
-      z.rowwise() += biases.transpose().array();
-      z = z.sin();
-      break;
-    case Activation::kLinear:
-      z.rowwise() += biases.transpose().array();
-      break;
-    case Activation::kRbf: {
-      // ||x - a||^2 = ||x||^2 - 2 x.a + ||a||^2; the inputs are standardised, so the
-      // cancellation costs at most a few ulps of the row norm. Clamped at 0.
-      const double inv_d = 1.0 / static_cast<double>(std::max<Eigen::Index>(xs.cols(), 1));
-      const Eigen::ArrayXd row_norm2 = xs.rowwise().squaredNorm().array();
-      for (Eigen::Index j = 0; j < out.cols(); ++j) {
-        const double a_norm2 = weights.col(j).squaredNorm();
-        const double gamma = biases[j] * inv_d;
-        auto col = z.col(j);
-        col = ((row_norm2 - 2.0 * col + a_norm2).max(0.0) * (-gamma)).exp();
-      }
-      break;
-    }
-  }
+  ActiveKernels().hidden(static_cast<int>(activation), xs.data(), xs.outerStride(), xs.rows(),
+                         xs.cols(), weights.data(), biases.data(), weights.cols(), out.data(),
+                         out.outerStride());
 }
 
 Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts,
@@ -67,6 +44,7 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
   const Eigen::Index outputs = ts.cols();
   const int blocks = NumBlocks(n);
   const int workers = std::min(ResolveThreads(threads), blocks);
+  const Kernels& kernels = ActiveKernels();
   std::vector<Eigen::MatrixXd> h_buffer(static_cast<size_t>(workers),
                                         Eigen::MatrixXd(std::min(n, kBlockRows), hidden));
   Gram gram;
@@ -83,10 +61,10 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
         const Eigen::Index rows = std::min(kBlockRows, n - r0);
         auto h = h_buffer[static_cast<size_t>(worker)].topRows(rows);
         ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, h);
-        Partial p;
-        p.hth = Eigen::MatrixXd::Zero(hidden, hidden);
-        p.hth.selfadjointView<Eigen::Lower>().rankUpdate(h.transpose());
-        p.htt.noalias() = h.transpose() * ts.middleRows(r0, rows);
+        // The strict upper triangle of p.hth is never read: left uninitialised.
+        Partial p{Eigen::MatrixXd(hidden, hidden), Eigen::MatrixXd(hidden, outputs)};
+        kernels.gram(h.data(), h.outerStride(), rows, hidden, ts.data() + r0, ts.outerStride(),
+                     outputs, p.hth.data(), p.htt.data());
         return p;
       },
       [&](int block, Partial&& p) {
@@ -98,6 +76,8 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
           gram.htt += p.htt;
         }
       });
+  // Only the lower triangle is summed; a defined upper triangle keeps any later reader honest.
+  gram.hth.triangularView<Eigen::StrictlyUpper>().setZero();
   return gram;
 }
 

@@ -25,16 +25,15 @@ void DrawUnits(int inputs, int hidden, std::uint64_t seed, Eigen::MatrixXd* weig
                Eigen::VectorXd* biases);
 
 // out (rows x L) = g(xs A + b) for standardised inputs xs (rows x d); A is d x L, b has L
-// entries. `out` may be a block of a larger buffer: nothing is allocated except Eigen's GEMM
-// packing buffers and, for RBF, one vector of row norms.
+// entries (RBF: g = exp(-b ||x - a||^2 / d)). `out` may be a block of a larger buffer. Each
+// entry is the same bits whatever the number of rows or the entry's position (kernels.h).
 void ComputeHidden(Activation activation, const Eigen::Ref<const Eigen::MatrixXd>& xs,
-                   const Eigen::Ref<const Eigen::MatrixXd>& weights,
-                   const Eigen::Ref<const Eigen::VectorXd>& biases,
+                   const Eigen::MatrixXd& weights, const Eigen::VectorXd& biases,
                    Eigen::Ref<Eigen::MatrixXd> out);
 
 // H^T H (lower triangle valid) and H^T T of the hidden layer of xs, streamed over row blocks.
 struct Gram {
-  Eigen::MatrixXd hth;  // L x L, lower triangle
+  Eigen::MatrixXd hth;  // L x L, lower triangle (the strict upper triangle is zero)
   Eigen::MatrixXd htt;  // L x m
 };
 Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::MatrixXd& ts,

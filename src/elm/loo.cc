@@ -8,13 +8,13 @@
 // so one eigendecomposition and one N x L x L product per candidate L serve every C.
 // The rows are streamed in fixed blocks; each block returns its sums of e^2 and the sums are
 // added in block order, so the result does not depend on the thread count.
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "elm/internal.h"
+#include "elm/kernels.h"
 #include "gyrodrift/common/parallel.h"
 
 namespace gyrodrift::elm::internal {
@@ -42,6 +42,7 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
   const int num_l = static_cast<int>(hidden_grid.size());
   const int num_c = static_cast<int>(ridge_grid.size());
   const int max_hidden = *std::max_element(hidden_grid.begin(), hidden_grid.end());
+  const Kernels& kernels = ActiveKernels();
 
   // One eigendecomposition per candidate, spread over the workers (each is independent).
   std::vector<CandidatePlan> plans(static_cast<size_t>(num_l));
@@ -49,17 +50,21 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
     CandidatePlan& plan = plans[static_cast<size_t>(q)];
     plan.hidden = hidden_grid[static_cast<size_t>(q)];
     const Eigen::Index l = plan.hidden;
-    // Reads the lower triangle only, which is the part ComputeGram fills.
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gram.hth.topLeftCorner(l, l));
+    Eigen::VectorXd values(l);
+    plan.vectors.resize(l, l);
+    // Reads the lower triangle of the leading block, the part ComputeGram fills.
+    kernels.eigen(gram.hth.data(), gram.hth.outerStride(), l, values.data(), plan.vectors.data());
+    // A failed decomposition (NaN eigenvalues) leaves the candidate with no evaluated C.
+    const bool decomposed = values.allFinite();
     // H^T H is positive semi-definite; rounding can leave tiny negative eigenvalues.
-    const Eigen::ArrayXd lambda = eig.eigenvalues().array().max(0.0);
-    plan.vectors = eig.eigenvectors();
+    const Eigen::ArrayXd lambda = values.array().max(0.0);
     const Eigen::MatrixXd z = plan.vectors.transpose() * gram.htt.topRows(l);
     plan.condition.resize(static_cast<size_t>(num_c));
     for (int c = 0; c < num_c; ++c) {
       const double delta = 1.0 / ridge_grid[static_cast<size_t>(c)];
       plan.condition[static_cast<size_t>(c)] =
-          (lambda.maxCoeff() + delta) / (lambda.minCoeff() + delta);
+          decomposed ? (lambda.maxCoeff() + delta) / (lambda.minCoeff() + delta)
+                     : std::numeric_limits<double>::quiet_NaN();
       if (plan.condition[static_cast<size_t>(c)] <= max_condition) plan.active.push_back(c);
     }
     const Eigen::Index num_active = static_cast<Eigen::Index>(plan.active.size());
@@ -101,6 +106,16 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
       w.fitted.resize(block_rows, max_active * outputs);
       w.hat.resize(block_rows, max_active);
     }
+    std::vector<LooPlanView> views(static_cast<size_t>(num_l));
+    for (int q = 0; q < num_l; ++q) {
+      const CandidatePlan& plan = plans[static_cast<size_t>(q)];
+      views[static_cast<size_t>(q)] = {plan.hidden,
+                                       static_cast<long>(plan.active.size()),
+                                       plan.vectors.data(),
+                                       plan.fit_weights.data(),
+                                       plan.hat_weights.data(),
+                                       offset[static_cast<size_t>(q)]};
+    }
     ParallelOrderedReduce(
         blocks, workers,
         [&](int block, int worker) {
@@ -109,36 +124,10 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
           const Eigen::Index rows = std::min(kBlockRows, n - r0);
           auto h = w.h.topRows(rows);
           ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, h);
-          const auto t = ts.middleRows(r0, rows);
           Eigen::VectorXd sums = Eigen::VectorXd::Zero(total);
-          for (int q = 0; q < num_l; ++q) {
-            const CandidatePlan& plan = plans[static_cast<size_t>(q)];
-            const Eigen::Index num_active = static_cast<Eigen::Index>(plan.active.size());
-            if (num_active == 0) continue;
-            const Eigen::Index l = plan.hidden;
-            auto p = w.p.topLeftCorner(rows, l);
-            auto fitted = w.fitted.topLeftCorner(rows, num_active * outputs);
-            auto hat = w.hat.topLeftCorner(rows, num_active);
-            p.noalias() = h.leftCols(l) * plan.vectors;
-            fitted.noalias() = p * plan.fit_weights;
-            p = p.array().square().matrix();
-            hat.noalias() = p * plan.hat_weights;
-            for (Eigen::Index a = 0; a < num_active; ++a) {
-              for (Eigen::Index k = 0; k < outputs; ++k) {
-                double s = 0.0;
-                for (Eigen::Index i = 0; i < rows; ++i) {
-                  const double leverage_gap = 1.0 - hat(i, a);
-                  // h_ii = 1 means the row is interpolated whatever its target: its
-                  // leave-one-out error is undefined, reported as +inf.
-                  const double e = leverage_gap > 0.0
-                                       ? (t(i, k) - fitted(i, a * outputs + k)) / leverage_gap
-                                       : std::numeric_limits<double>::infinity();
-                  s += e * e;
-                }
-                sums[offset[static_cast<size_t>(q)] + a * outputs + k] = s;
-              }
-            }
-          }
+          kernels.loo(h.data(), h.outerStride(), rows, ts.data() + r0, ts.outerStride(), outputs,
+                      views.data(), num_l, w.p.data(), w.fitted.data(), w.hat.data(),
+                      sums.data());
           return sums;
         },
         [&](int, Eigen::VectorXd&& sums) { sse += sums; });

@@ -105,8 +105,7 @@ json LearnerOptionsJson(const drift::LearnerOptions& l) {
             {"max_condition", Number(e.max_condition)},
             {"standardize_inputs", e.standardize_inputs},
             {"standardize_targets", e.standardize_targets},
-            {"seed", e.seed},
-            {"threads", e.threads}}},
+            {"seed", e.seed}}},  // no "threads": a run-time choice, not part of the model
           {"poly_degree", l.poly_degree},
           {"poly_ridge", Number(l.poly_ridge)},
           {"svr_c", Number(l.svr_c)},
@@ -361,7 +360,9 @@ drift::LearnerOptions ReadLearnerOptions(const Node& n) {
   l.elm.standardize_inputs = e["standardize_inputs"].Bool();
   l.elm.standardize_targets = e["standardize_targets"].Bool();
   l.elm.seed = e["seed"].U64();
-  l.elm.threads = e["threads"].Int();
+  // Files written before the ELM thread count left the model still carry it: read, checked and
+  // dropped, since the count never changes a result.
+  if (e.raw().contains("threads")) e["threads"].Int(0, 1024);
   l.poly_degree = n["poly_degree"].Int();
   l.poly_ridge = n["poly_ridge"].Double();
   l.svr_c = n["svr_c"].Double();

@@ -25,6 +25,11 @@
 // costs 2 N L^2. Leave-one-out selection over candidates L_k <= L_max: O(N L_max^2) for H^T H
 // plus O(N L_k^2 + L_k^3) per candidate. Row blocks run on `threads` workers; results are the same
 // bits for any thread count (blocks are fixed by N alone and sums run in block order).
+// Instruction set: the row kernels are built for baseline x86-64 and for AVX2 + FMA and chosen
+// at run time by the CPU. The FMA kernels round differently, so fitted weights, predictions and
+// leave-one-out errors can differ in the last bits (about 1e-13 relative) between a CPU with
+// AVX2 and one without; on one machine every result is reproducible to the bit, and a model
+// read back from a file predicts exactly what it predicted before it was saved.
 #pragma once
 
 #include <Eigen/Core>
@@ -111,7 +116,10 @@ struct ElmModel {
   Eigen::MatrixXd output_weights;  // L x m: beta, in standardised target units
   Standardizer input_scaler;       // d columns
   Standardizer target_scaler;      // m columns
-  ElmOptions options;              // as fitted: hidden_units = L, ridge_c = C actually used
+  // As fitted: hidden_units = L, ridge_c = C actually used. options.threads is always 0 in a
+  // fitted model and is ignored by Predict: the thread count is a run-time choice (Predict's
+  // argument), not part of the model, so a model does not depend on how many threads fitted it.
+  ElmOptions options;
 
   int num_inputs() const { return static_cast<int>(input_weights.rows()); }
   int num_hidden() const { return static_cast<int>(input_weights.cols()); }
@@ -165,12 +173,16 @@ struct ElmFit {
 ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::MatrixXd>& t,
            const ElmOptions& options);
 
-// Predictions in target units, N x m. Throws DataError if X has the wrong column count or a
-// non-finite value (the model is checked with Validate()).
-Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x);
+// Predictions in target units, N x m, on `threads` workers (0 = every core, in [0, 1024]; the
+// result is the same bits for any count). Each row's prediction is the same bits whether it is
+// predicted alone or within any batch. Throws DataError if X has the wrong column count or a
+// non-finite value (the model is checked with Validate()), UsageError for a bad thread count.
+Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                        int threads = 0);
 
 // Hidden-layer outputs H (N x L) of X in raw input units (the input scaler is applied), the
-// same bits Fit used.
-Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x);
+// same bits Fit used (on this CPU).
+Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                            int threads = 0);
 
 }  // namespace gyrodrift::elm

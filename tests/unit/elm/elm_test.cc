@@ -61,6 +61,16 @@ double Rmse(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return std::sqrt((a - b).squaredNorm() / static_cast<double>(a.size()));
 }
 
+template <class E>
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
 bool SameBits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   if (a.rows() != b.rows() || a.cols() != b.cols()) return false;
   for (Eigen::Index i = 0; i < a.size(); ++i) {
@@ -350,9 +360,56 @@ TEST(Elm, OneAndTwoThreadsGiveTheSameBits) {
         }
       }
       EXPECT_EQ(f1.report.train_rmse, f2.report.train_rmse);
-      ElmModel m2 = f1.model;
-      m2.options.threads = 2;
-      EXPECT_TRUE(SameBits(Predict(f1.model, d.x), Predict(m2, d.x)));
+      EXPECT_TRUE(SameBits(Predict(f1.model, d.x, 1), Predict(f1.model, d.x, 2)));
+      EXPECT_TRUE(SameBits(HiddenLayer(f1.model, d.x, 1), HiddenLayer(f1.model, d.x, 2)));
+    }
+  }
+}
+
+// The thread count is how a run executes, not part of the model: a model fitted on 1 or 3
+// threads is the same struct (so a saved model file is the same text).
+TEST(Elm, ModelDoesNotRecordTheThreadCount) {
+  const Data d = NoisySine(9000, 0.1, 105);
+  for (Selection selection : {Selection::kFixed, Selection::kAuto}) {
+    const ElmFit f1 = Fit(d.x, d.t, {.hidden_units = 20, .selection = selection, .threads = 1});
+    const ElmFit f3 = Fit(d.x, d.t, {.hidden_units = 20, .selection = selection, .threads = 3});
+    EXPECT_EQ(f1.model.options.threads, 0);
+    EXPECT_EQ(f3.model.options.threads, 0);
+    EXPECT_EQ(f3.report.threads, 3);  // the report says how the run executed
+    EXPECT_TRUE(SameBits(f1.model.output_weights, f3.model.output_weights));
+    EXPECT_EQ(f1.model.options.hidden_units, f3.model.options.hidden_units);
+    EXPECT_EQ(f1.model.options.ridge_c, f3.model.options.ridge_c);
+  }
+  const ElmModel model = Fit(d.x, d.t, {.hidden_units = 5}).model;
+  EXPECT_EQ(ErrorOf<UsageError>([&] { Predict(model, d.x, -1); }),
+            "threads = -1: must be an integer in [0, 1024] (0 = all cores)");
+  EXPECT_EQ(ErrorOf<UsageError>([&] { HiddenLayer(model, d.x, 1025); }),
+            "threads = 1025: must be an integer in [0, 1024] (0 = all cores)");
+}
+
+// A row predicted alone, in a short batch or inside a long one (across row blocks and at every
+// position within the kernels' row tiles) is the same bits, for every activation and two outputs.
+TEST(Elm, PredictsEachRowAloneToTheBitOfTheBatch) {
+  const Data train = Smooth(600, 3, 2, 107);
+  const Data test = Smooth(4096 + 45, 3, 2, 108);  // two row blocks, a ragged last tile
+  for (Activation activation : {Activation::kSigmoid, Activation::kTanh, Activation::kSine,
+                                Activation::kRbf, Activation::kLinear}) {
+    // 23 units: not a multiple of the kernels' unit tile either.
+    const ElmModel model = Fit(train.x, train.t, {.hidden_units = 23, .activation = activation}).model;
+    const Eigen::MatrixXd all = Predict(model, test.x);
+    const Eigen::MatrixXd h_all = HiddenLayer(model, test.x);
+    for (Eigen::Index i : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 17, 4095, 4096, 4097, 4140}) {
+      EXPECT_TRUE(SameBits(Predict(model, test.x.row(i)), all.row(i)))
+          << ToString(activation) << " row " << i;
+      EXPECT_TRUE(SameBits(HiddenLayer(model, test.x.row(i)), h_all.row(i)))
+          << ToString(activation) << " row " << i;
+    }
+    for (Eigen::Index first : {0, 3, 4090}) {
+      for (Eigen::Index count : {2, 5, 7, 13}) {
+        EXPECT_TRUE(SameBits(Predict(model, test.x.middleRows(first, count)),
+                             all.middleRows(first, count)))
+            << ToString(activation) << " rows " << first << " + " << count;
+      }
     }
   }
 }
@@ -367,16 +424,6 @@ TEST(Elm, MultiOutputFitsEachColumn) {
   EXPECT_EQ(y.cols(), 2);
   EXPECT_LT(Rmse(y.col(0), t.col(0)), 0.01);
   EXPECT_LT(Rmse(y.col(1), t.col(1)), 1.0);
-}
-
-template <class E>
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  return "(no exception)";
 }
 
 TEST(Elm, BadOptionsAndDataThrowClearErrors) {
