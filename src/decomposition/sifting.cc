@@ -51,69 +51,6 @@ int ZeroRuns(const double* x, Eigen::Index n) {
   return runs;
 }
 
-// Appends base + (index of each set bit of word), in increasing order.
-inline int AppendBits(std::uint64_t word, Eigen::Index base, int* out, int count) {
-  while (word) {
-    out[count++] = static_cast<int>(base + std::countr_zero(word));
-    word &= word - 1;
-  }
-  return count;
-}
-
-// Strict extrema of x into indmin / indmax; returns true when some first difference is exactly
-// zero (plateaus to look at). An interior sample i is a maximum when d[i-1] > 0 > d[i] and a
-// minimum when d[i-1] < 0 < d[i], d[i] = x[i+1] - x[i]: emd.m's test d[i-1] * d[i] < 0 without
-// the product (which could underflow to zero for differences below 1e-154; the sign test is the
-// definition). Signs of 64 differences are packed into bit masks, two per instruction, and the
-// extrema are the bit patterns "+ then -" and "- then +": a few instructions per sample and one
-// bit scan per extremum, so the smooth late modes with few extrema cost little.
-bool FindStrictExtrema(const double* x, Eigen::Index n, int* indmin, int* indmax, int* nmin,
-                       int* nmax) {
-  int count_min = 0, count_max = 0;
-  bool flat = false;
-  const Eigen::Index nd = n - 1;  // differences d[0..nd-1]
-  std::uint64_t carry_pos = 0, carry_neg = 0;  // sign bits of the last difference of the block
-  for (Eigen::Index base = 0; base < nd; base += 64) {
-    const int count = static_cast<int>(std::min<Eigen::Index>(64, nd - base));
-    std::uint64_t pos = 0, neg = 0;
-    int k = 0;
-#if defined(__SSE2__)
-    const __m128d zero = _mm_setzero_pd();
-    int zero_bits = 0;
-    for (; k + 2 <= count; k += 2) {
-      const __m128d d =
-          _mm_sub_pd(_mm_loadu_pd(x + base + k + 1), _mm_loadu_pd(x + base + k));
-      pos |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmpgt_pd(d, zero))) << k;
-      neg |= static_cast<std::uint64_t>(_mm_movemask_pd(_mm_cmplt_pd(d, zero))) << k;
-      zero_bits |= _mm_movemask_pd(_mm_cmpeq_pd(d, zero));
-    }
-    flat |= zero_bits != 0;
-#endif
-    for (; k < count; ++k) {
-      const double d = x[base + k + 1] - x[base + k];
-      pos |= static_cast<std::uint64_t>(d > 0.0) << k;
-      neg |= static_cast<std::uint64_t>(d < 0.0) << k;
-      flat |= d == 0.0;
-    }
-    // Sample base + k is interior with d[base+k-1] before it and d[base+k] after it.
-    const std::uint64_t pos_before = (pos << 1) | carry_pos;
-    const std::uint64_t neg_before = (neg << 1) | carry_neg;
-    std::uint64_t max_bits = pos_before & neg;
-    std::uint64_t min_bits = neg_before & pos;
-    if (base == 0) {  // sample 0 is not interior
-      max_bits &= ~std::uint64_t{1};
-      min_bits &= ~std::uint64_t{1};
-    }
-    count_max = AppendBits(max_bits, base, indmax, count_max);
-    count_min = AppendBits(min_bits, base, indmin, count_min);
-    carry_pos = (pos >> 63) & 1;
-    carry_neg = (neg >> 63) & 1;
-  }
-  *nmin = count_min;
-  *nmax = count_max;
-  return flat;
-}
-
 // emd.m's zero crossings: strict sign changes plus one per run of exact zeros.
 int CountZeroCrossings(const double* x, Eigen::Index n) {
   std::int64_t changes = 0, zeros = 0;
@@ -171,10 +108,11 @@ Sifter::Sifter(Eigen::Index n, const SiftingOptions& options)
   const size_t size = static_cast<size_t>(n);
   indmin_.resize(size + 2);
   indmax_.resize(size + 2);
-  h_.resize(n);
-  next_.resize(n);
-  env_min_.resize(n + EnvelopeSpline::kPadding);
-  env_max_.resize(n + EnvelopeSpline::kPadding);
+  // Padded (zeros) for the fused sift's fixed-width blocks.
+  h_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
+  next_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
+  env_min_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
+  env_max_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
 }
 
 void Sifter::Envelopes() {
@@ -185,8 +123,17 @@ void Sifter::Envelopes() {
 
 ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
   ExtremaCounts c;
-  const bool flat = FindStrictExtrema(h, n_, indmin_.data(), indmax_.data(), &c.minima, &c.maxima);
-  if (count_zero_crossings) c.zero_crossings = CountZeroCrossings(h, n_);
+  ExtremaScan scan;
+  scan.indmin = indmin_.data();
+  scan.indmax = indmax_.data();
+  const bool flat = SimdFindStrictExtrema(h, n_, count_zero_crossings, &scan);
+  c.minima = scan.nmin;
+  c.maxima = scan.nmax;
+  if (count_zero_crossings) {
+    // The zero-crossing count of CountZeroCrossings, from the same pass.
+    c.zero_crossings = static_cast<int>(scan.has_zero ? scan.sign_changes + ZeroRuns(h, n_)
+                                                      : scan.sign_changes);
+  }
   if (flat) {
     // Merge the plateau extrema into the strict ones, from the back, in place.
     int extra_min = 0, extra_max = 0;
@@ -423,7 +370,12 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
     if (rule == StopRule::kFixed && outcome.sifts >= options_.fixed_sifts) break;
 
     if (counts.extrema() < 3 || !BoundaryConditions(h_.data())) break;  // emd.m's catch: stop
-    Envelopes();
+    if (rule == StopRule::kSNumber || rule == StopRule::kFixed) {
+      FitPair(lower_, upper_);
+      lower_.Evaluate(n_, env_min_.data());
+    } else {
+      Envelopes();
+    }
 
     const double* h = h_.data();
     const double* lo = env_min_.data();
@@ -457,7 +409,7 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
       }
       stop = energy == 0.0 || mean_energy / energy < options_.sd_threshold;
     } else {
-      for (Eigen::Index i = 0; i < n_; ++i) next[i] = h[i] - (lo[i] + hi[i]) / 2;
+      upper_.EvaluateSift(n_, lo, h, next);  // the upper envelope is never stored
     }
     if (outcome.sifts >= max_sifts_) {
       outcome.cap_hit = true;

@@ -1,9 +1,6 @@
 #include "decomposition/spline.h"
 
 #include <algorithm>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace gyrodrift::decomposition::internal {
 
@@ -154,77 +151,15 @@ void FitPair(EnvelopeSpline& a, EnvelopeSpline& b) {
   if (mb) b.Coefficients();
 }
 
-void EnvelopeSpline::Evaluate(Eigen::Index n, double* out) const {
-  const size_t m = t_.size();
-  const double* t = t_.data();
-  const double* y = y_.data();
-  if (m == 2) {
-    const double slope = dd_[0];
-    for (Eigen::Index i = 0; i < n; ++i) out[i] = slope * (static_cast<double>(i + 1) - t[0]) + y[0];
-    return;
-  }
-  if (m == 3) {
-    const double c2 = (dd_[1] - dd_[0]) / (t[2] - t[0]);
-    const double c1 = dd_[0] - c2 * (t[1] - t[0]);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double h = static_cast<double>(i + 1) - t[0];
-      out[i] = (c2 * h + c1) * h + y[0];
-    }
-    return;
-  }
-  const double* c1 = c1_.data();
-  const double* c2 = c2_.data();
-  const double* s = slope_.data();
-  Eigen::Index i = 0;
-  for (size_t j = 0; j + 1 < m && i < n; ++j) {
-    // Samples with t in [t_j, t_{j+1}) belong to piece j (the last piece takes the rest).
-    const Eigen::Index end =
-        j + 2 < m ? std::clamp(static_cast<Eigen::Index>(t[j + 1]) - 1, i, n) : n;
-    const double a = c1[j], b = c2[j], c = s[j], d = y[j];
-    const double base = static_cast<double>(i + 1) - t[j];
-    if (end - i <= 4) {
-      // Dense nodes: a fixed-width block (the buffer is padded) avoids a mispredicted loop exit;
-      // values past `end` are overwritten by the next piece.
-#if defined(__SSE2__)
-      const __m128d va = _mm_set1_pd(a), vb = _mm_set1_pd(b), vc = _mm_set1_pd(c), vd = _mm_set1_pd(d);
-      const __m128d h0 = _mm_set_pd(base + 1.0, base);
-      const __m128d h1 = _mm_add_pd(h0, _mm_set1_pd(2.0));
-      __m128d v0 = _mm_add_pd(_mm_mul_pd(h0, va), vb);
-      __m128d v1 = _mm_add_pd(_mm_mul_pd(h1, va), vb);
-      v0 = _mm_add_pd(_mm_mul_pd(v0, h0), vc);
-      v1 = _mm_add_pd(_mm_mul_pd(v1, h1), vc);
-      _mm_storeu_pd(out + i, _mm_add_pd(_mm_mul_pd(v0, h0), vd));
-      _mm_storeu_pd(out + i + 2, _mm_add_pd(_mm_mul_pd(v1, h1), vd));
-#else
-      for (int k = 0; k < 4; ++k) {
-        const double h = base + k;
-        out[i + k] = ((h * a + b) * h + c) * h + d;
-      }
-#endif
-    } else {
-      const Eigen::Index length = end - i;
-      Eigen::Index k = 0;
-#if defined(__SSE2__)
-      // Two samples per step; the same operations in the same order as the scalar Horner form,
-      // so the values are the same bits.
-      const __m128d va = _mm_set1_pd(a), vb = _mm_set1_pd(b), vc = _mm_set1_pd(c), vd = _mm_set1_pd(d);
-      const __m128d two = _mm_set1_pd(2.0);
-      __m128d h = _mm_set_pd(base + 1.0, base);
-      for (; k + 2 <= length; k += 2) {
-        __m128d v = _mm_add_pd(_mm_mul_pd(h, va), vb);
-        v = _mm_add_pd(_mm_mul_pd(v, h), vc);
-        v = _mm_add_pd(_mm_mul_pd(v, h), vd);
-        _mm_storeu_pd(out + i + k, v);
-        h = _mm_add_pd(h, two);
-      }
-#endif
-      for (; k < length; ++k) {
-        const double h = base + static_cast<double>(k);
-        out[i + k] = ((h * a + b) * h + c) * h + d;
-      }
-    }
-    i = end;
-  }
+SplineView EnvelopeSpline::view() const {
+  return {t_.size(), t_.data(), y_.data(), dd_.data(), c1_.data(), c2_.data(), slope_.data()};
+}
+
+void EnvelopeSpline::Evaluate(Eigen::Index n, double* out) const { SimdEvaluate(view(), n, out); }
+
+void EnvelopeSpline::EvaluateSift(Eigen::Index n, const double* lower, const double* h,
+                                  double* next) const {
+  SimdEvaluateSift(view(), n, lower, h, next);
 }
 
 }  // namespace gyrodrift::decomposition::internal

@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "decomposition/simd_kernels.h"
+
 namespace gyrodrift::decomposition::internal {
 
 class EnvelopeSpline {
@@ -20,7 +22,11 @@ class EnvelopeSpline {
   std::vector<double>& y() { return y_; }
   // Evaluates at t = 1..n into out, which must have room for n + kPadding values.
   void Evaluate(Eigen::Index n, double* out) const;
-  static constexpr Eigen::Index kPadding = 8;
+  // One sift's update with this spline as the upper envelope: next[i] = h[i] - (lower[i] + u(i))
+  // / 2 for i < n, the same bits as Evaluate followed by that loop. lower, h and next must have
+  // room for n + kPadding values (values past n are scratch).
+  void EvaluateSift(Eigen::Index n, const double* lower, const double* h, double* next) const;
+  static constexpr Eigen::Index kPadding = kSimdPadding;
 
   // Solves the slopes of both splines.
   friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
@@ -37,6 +43,7 @@ class EnvelopeSpline {
   void Prepare();
   Rows rows();
   void Coefficients();
+  SplineView view() const;
   std::vector<double> t_, y_;
   std::vector<double> inv_dx_, dd_, slope_, diag_, rhs_, sub_, sup_, c1_, c2_;
 };
