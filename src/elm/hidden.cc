@@ -42,42 +42,40 @@ Gram ComputeGram(Activation activation, const Eigen::MatrixXd& xs, const Eigen::
   const Eigen::Index n = xs.rows();
   const Eigen::Index hidden = weights.cols();
   const Eigen::Index outputs = ts.cols();
+  const Eigen::Index cols = hidden + outputs;
   const int blocks = NumBlocks(n);
   const int workers = std::min(ResolveThreads(threads), blocks);
   const Kernels& kernels = ActiveKernels();
-  std::vector<Eigen::MatrixXd> h_buffer(static_cast<size_t>(workers),
-                                        Eigen::MatrixXd(std::min(n, kBlockRows), hidden));
-  Gram gram;
-  gram.hth = Eigen::MatrixXd::Zero(hidden, hidden);
-  gram.htt = Eigen::MatrixXd::Zero(hidden, outputs);
-  struct Partial {
-    Eigen::MatrixXd hth;
-    Eigen::MatrixXd htt;
-  };
+  // Each worker's block is [H T]: one symmetric rank update then gives H^T H and, in its last
+  // rows, T^T H, at matrix-product speed (a separate H^T T would stream H again).
+  std::vector<Eigen::MatrixXd> buffer(static_cast<size_t>(workers),
+                                      Eigen::MatrixXd(std::min(n, kBlockRows), cols));
+  Eigen::MatrixXd sum;  // cols x cols, lower triangle
   ParallelOrderedReduce(
       blocks, workers,
       [&](int block, int worker) {
         const Eigen::Index r0 = block * kBlockRows;
         const Eigen::Index rows = std::min(kBlockRows, n - r0);
-        auto h = h_buffer[static_cast<size_t>(worker)].topRows(rows);
-        ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, h);
-        // The strict upper triangle of p.hth is never read: left uninitialised.
-        Partial p{Eigen::MatrixXd(hidden, hidden), Eigen::MatrixXd(hidden, outputs)};
-        kernels.gram(h.data(), h.outerStride(), rows, hidden, ts.data() + r0, ts.outerStride(),
-                     outputs, p.hth.data(), p.htt.data());
-        return p;
+        auto ht = buffer[static_cast<size_t>(worker)].topRows(rows);
+        ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, ht.leftCols(hidden));
+        ht.rightCols(outputs) = ts.middleRows(r0, rows);
+        // The strict upper triangle is never read: left uninitialised.
+        Eigen::MatrixXd partial(cols, cols);
+        kernels.gram(ht.data(), ht.outerStride(), rows, cols, partial.data());
+        return partial;
       },
-      [&](int block, Partial&& p) {
+      [&](int block, Eigen::MatrixXd&& partial) {
         if (block == 0) {
-          gram.hth = std::move(p.hth);
-          gram.htt = std::move(p.htt);
+          sum = std::move(partial);
         } else {
-          gram.hth.triangularView<Eigen::Lower>() += p.hth;
-          gram.htt += p.htt;
+          sum.triangularView<Eigen::Lower>() += partial;
         }
       });
-  // Only the lower triangle is summed; a defined upper triangle keeps any later reader honest.
+  Gram gram;
+  gram.hth = sum.topLeftCorner(hidden, hidden);
+  // Only the lower triangle was summed; a defined upper triangle keeps any later reader honest.
   gram.hth.triangularView<Eigen::StrictlyUpper>().setZero();
+  gram.htt = sum.bottomLeftCorner(outputs, hidden).transpose();
   return gram;
 }
 

@@ -53,10 +53,9 @@ struct Kernels {
   void (*output)(const double* h, long ld_h, long rows, long hidden, const double* beta,
                  long outputs, double* y, long ld_y);
 
-  // For one row block: hth (L x L, leading dimension L) = lower triangle of h^T h (the strict
-  // upper triangle is left as it was) and htt (L x m) = h^T t.
-  void (*gram)(const double* h, long ld_h, long rows, long hidden, const double* t, long ld_t,
-               long outputs, double* hth, double* htt);
+  // g (c x c, leading dimension c) = lower triangle of a^T a for a (rows x c); the strict upper
+  // triangle of g is left as it was. A symmetric rank-k update: half the flops of a product.
+  void (*gram)(const double* a, long ld_a, long rows, long cols, double* g);
 
   // Symmetric eigendecomposition of the leading n x n block of `a` (leading dimension lda,
   // lower triangle read): ascending eigenvalues and the orthonormal eigenvectors (n x n).

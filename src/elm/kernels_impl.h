@@ -41,7 +41,13 @@ constexpr int kRowVecs = 2;
 constexpr long kTileRows = kLanes * kRowVecs;
 constexpr int kTileUnits = 4;
 
-inline Vec Splat(double x) { return Vec{} + x; }
+inline Vec Splat(double x) {
+#if GYRODRIFT_ELM_KERNEL_FMA
+  return _mm256_set1_pd(x);
+#else
+  return _mm_set1_pd(x);
+#endif
+}
 inline Vec Load(const double* p) {
   Vec v;
   std::memcpy(&v, p, sizeof(v));
@@ -121,65 +127,80 @@ inline Vec Activate(Vec z, double rbf_gamma) {
   }
 }
 
-// Loads rows row[0 .. kLanes-1] of a column; `contiguous` when they are the consecutive rows from row[0] on.
-inline Vec LoadRows(const double* column, const long* row, bool contiguous) {
-  if (contiguous) return Load(column + row[0]);
+// Loads rows row[0 .. kLanes-1] of a column; kContiguous when they are the consecutive rows
+// from row[0] on.
+template <bool kContiguous>
+inline Vec LoadRows(const double* column, const long* row) {
+  if constexpr (kContiguous) return Load(column + row[0]);
   Vec v;
   for (int l = 0; l < kLanes; ++l) v[l] = column[row[l]];
   return v;
 }
 
+template <bool kFull>
 inline void StoreRows(double* column, long first, long valid, Vec v) {
-  if (valid >= kLanes) {
+  if (kFull || valid >= kLanes) {
     Store(column + first, v);
   } else {
     for (long l = 0; l < valid; ++l) column[first + l] = v[l];
   }
 }
 
-template <int kActivation>
-void HiddenImpl(const double* xs, long ld_xs, long rows, long d, const double* w, const double* b,
-                long hidden, double* out, long ld_out) {
+// One tile of kTileRows rows (row[] holds their indices, the last one repeated past the end when
+// not kFull) for every unit, kTileUnits units at a time.
+template <int kActivation, bool kFull>
+inline void HiddenTile(const double* xs, long ld_xs, long rows, long i0, const long* row, long d,
+                       const double* w, const double* b, long hidden, double* out, long ld_out) {
   constexpr bool kDistance = kActivation == gyrodrift::elm::internal::kKernelRbf;
   const double inv_d = 1.0 / static_cast<double>(d > 0 ? d : 1);
-  for (long i0 = 0; i0 < rows; i0 += kTileRows) {
-    const bool full = i0 + kTileRows <= rows;
-    long row[kTileRows];
-    for (long r = 0; r < kTileRows; ++r) row[r] = Min(i0 + r, rows - 1);
-    for (long j0 = 0; j0 < hidden; j0 += kTileUnits) {
-      const double* wu[kTileUnits];
-      Vec acc[kTileUnits][kRowVecs];
+  for (long j0 = 0; j0 < hidden; j0 += kTileUnits) {
+    const double* wu[kTileUnits];
+    Vec acc[kTileUnits][kRowVecs];
+    for (int u = 0; u < kTileUnits; ++u) {
+      const long j = Min(j0 + u, hidden - 1);
+      wu[u] = w + j * d;
+      for (int v = 0; v < kRowVecs; ++v) acc[u][v] = Splat(kDistance ? 0.0 : b[j]);
+    }
+    for (long k = 0; k < d; ++k) {
+      const double* column = xs + k * ld_xs;
+      Vec x[kRowVecs];
+      for (int v = 0; v < kRowVecs; ++v) x[v] = LoadRows<kFull>(column, row + v * kLanes);
       for (int u = 0; u < kTileUnits; ++u) {
-        const long j = Min(j0 + u, hidden - 1);
-        wu[u] = w + j * d;
-        for (int v = 0; v < kRowVecs; ++v) acc[u][v] = Splat(kDistance ? 0.0 : b[j]);
-      }
-      for (long k = 0; k < d; ++k) {
-        const double* column = xs + k * ld_xs;
-        Vec x[kRowVecs];
-        for (int v = 0; v < kRowVecs; ++v) x[v] = LoadRows(column, row + v * kLanes, full);
-        for (int u = 0; u < kTileUnits; ++u) {
-          const Vec wk = Splat(wu[u][k]);
-          for (int v = 0; v < kRowVecs; ++v) {
-            if constexpr (kDistance) {
-              const Vec diff = x[v] - wk;
-              acc[u][v] = MulAdd(diff, diff, acc[u][v]);
-            } else {
-              acc[u][v] = MulAdd(x[v], wk, acc[u][v]);
-            }
+        const Vec wk = Splat(wu[u][k]);
+        for (int v = 0; v < kRowVecs; ++v) {
+          if constexpr (kDistance) {
+            const Vec diff = x[v] - wk;
+            acc[u][v] = MulAdd(diff, diff, acc[u][v]);
+          } else {
+            acc[u][v] = MulAdd(x[v], wk, acc[u][v]);
           }
         }
       }
-      for (int u = 0; u < kTileUnits && j0 + u < hidden; ++u) {
-        const long j = j0 + u;
-        for (int v = 0; v < kRowVecs; ++v) {
-          const long first = i0 + v * kLanes;
-          if (first >= rows) break;
-          StoreRows(out + j * ld_out, first, rows - first,
-                    Activate<kActivation>(acc[u][v], b[j] * inv_d));
-        }
+    }
+    for (int u = 0; u < kTileUnits && j0 + u < hidden; ++u) {
+      const long j = j0 + u;
+      for (int v = 0; v < kRowVecs; ++v) {
+        const long first = i0 + v * kLanes;
+        if (!kFull && first >= rows) break;
+        StoreRows<kFull>(out + j * ld_out, first, rows - first,
+                         Activate<kActivation>(acc[u][v], b[j] * inv_d));
       }
     }
+  }
+}
+
+template <int kActivation>
+void HiddenImpl(const double* xs, long ld_xs, long rows, long d, const double* w, const double* b,
+                long hidden, double* out, long ld_out) {
+  long row[kTileRows];
+  long i0 = 0;
+  for (; i0 + kTileRows <= rows; i0 += kTileRows) {
+    for (long r = 0; r < kTileRows; ++r) row[r] = i0 + r;
+    HiddenTile<kActivation, true>(xs, ld_xs, rows, i0, row, d, w, b, hidden, out, ld_out);
+  }
+  if (i0 < rows) {
+    for (long r = 0; r < kTileRows; ++r) row[r] = Min(i0 + r, rows - 1);
+    HiddenTile<kActivation, false>(xs, ld_xs, rows, i0, row, d, w, b, hidden, out, ld_out);
   }
 }
 
@@ -201,45 +222,51 @@ void Hidden(int activation, const double* xs, long ld_xs, long rows, long d, con
   }
 }
 
+constexpr int kOutputVecs = 4;
+constexpr long kOutputRows = kOutputVecs * kLanes;
+
+template <bool kFull>
+inline void OutputTile(const double* h, long ld_h, long rows, long i0, const long* row,
+                       long hidden, const double* beta_k, double* y_k) {
+  Vec acc[kOutputVecs];
+  for (int v = 0; v < kOutputVecs; ++v) acc[v] = Splat(0.0);
+  for (long j = 0; j < hidden; ++j) {
+    const double* column = h + j * ld_h;
+    const Vec bj = Splat(beta_k[j]);
+    for (int v = 0; v < kOutputVecs; ++v) {
+      acc[v] = MulAdd(LoadRows<kFull>(column, row + v * kLanes), bj, acc[v]);
+    }
+  }
+  for (int v = 0; v < kOutputVecs; ++v) {
+    const long first = i0 + v * kLanes;
+    if (!kFull && first >= rows) break;
+    StoreRows<kFull>(y_k, first, rows - first, acc[v]);
+  }
+}
+
 void Output(const double* h, long ld_h, long rows, long hidden, const double* beta, long outputs,
             double* y, long ld_y) {
-  constexpr int kVecs = 4;
-  constexpr long kRows = kVecs * kLanes;
-  if (rows <= 0) return;
+  long row[kOutputRows];
   for (long k = 0; k < outputs; ++k) {
-    const double* beta_k = beta + k * hidden;
-    for (long i0 = 0; i0 < rows; i0 += kRows) {
-      const bool full = i0 + kRows <= rows;
-      long row[kRows];
-      for (long r = 0; r < kRows; ++r) row[r] = Min(i0 + r, rows - 1);
-      Vec acc[kVecs];
-      for (int v = 0; v < kVecs; ++v) acc[v] = Splat(0.0);
-      for (long j = 0; j < hidden; ++j) {
-        const double* column = h + j * ld_h;
-        const Vec bj = Splat(beta_k[j]);
-        for (int v = 0; v < kVecs; ++v) {
-          acc[v] = MulAdd(LoadRows(column, row + v * kLanes, full), bj, acc[v]);
-        }
-      }
-      for (int v = 0; v < kVecs; ++v) {
-        const long first = i0 + v * kLanes;
-        if (first >= rows) break;
-        StoreRows(y + k * ld_y, first, rows - first, acc[v]);
-      }
+    long i0 = 0;
+    for (; i0 + kOutputRows <= rows; i0 += kOutputRows) {
+      for (long r = 0; r < kOutputRows; ++r) row[r] = i0 + r;
+      OutputTile<true>(h, ld_h, rows, i0, row, hidden, beta + k * hidden, y + k * ld_y);
+    }
+    if (i0 < rows) {
+      for (long r = 0; r < kOutputRows; ++r) row[r] = Min(i0 + r, rows - 1);
+      OutputTile<false>(h, ld_h, rows, i0, row, hidden, beta + k * hidden, y + k * ld_y);
     }
   }
 }
 
 using ConstStrided = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
 
-void Gram(const double* h, long ld_h, long rows, long hidden, const double* t, long ld_t,
-          long outputs, double* hth, double* htt) {
-  const ConstStrided hm(h, rows, hidden, Eigen::OuterStride<>(ld_h));
-  const ConstStrided tm(t, rows, outputs, Eigen::OuterStride<>(ld_t));
-  Eigen::Map<Eigen::MatrixXd> g(hth, hidden, hidden);
-  g.triangularView<Eigen::Lower>().setZero();
-  g.selfadjointView<Eigen::Lower>().rankUpdate(hm.transpose());
-  Eigen::Map<Eigen::MatrixXd>(htt, hidden, outputs).noalias() = hm.transpose() * tm;
+void Gram(const double* h, long ld_h, long rows, long cols, double* g) {
+  const ConstStrided hm(h, rows, cols, Eigen::OuterStride<>(ld_h));
+  Eigen::Map<Eigen::MatrixXd> gm(g, cols, cols);
+  gm.triangularView<Eigen::Lower>().setZero();
+  gm.selfadjointView<Eigen::Lower>().rankUpdate(hm.transpose());
 }
 
 void SymmetricEigen(const double* a, long lda, long n, double* values, double* vectors) {

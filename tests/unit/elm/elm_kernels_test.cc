@@ -176,18 +176,15 @@ TEST(ElmKernels, Avx2AndBaselineAgreeToRounding) {
         << activation;
   }
   const Eigen::MatrixXd h = Hidden(base, kKernelSigmoid, x, w, b);
-  const Eigen::MatrixXd t = RandomMatrix(301, 2, 1.0, 24);
-  Eigen::MatrixXd g1(45, 45), g2(45, 45), ht1(45, 2), ht2(45, 2);
-  base.gram(h.data(), 301, 301, 45, t.data(), 301, 2, g1.data(), ht1.data());
-  avx.gram(h.data(), 301, 301, 45, t.data(), 301, 2, g2.data(), ht2.data());
+  Eigen::MatrixXd g1(45, 45), g2(45, 45);
+  base.gram(h.data(), 301, 301, 45, g1.data());
+  avx.gram(h.data(), 301, 301, 45, g2.data());
   const Eigen::MatrixXd g_ref = h.transpose() * h;
   const Eigen::MatrixXd g1l = g1.triangularView<Eigen::Lower>();
   const Eigen::MatrixXd g2l = g2.triangularView<Eigen::Lower>();
   const Eigen::MatrixXd g_refl = g_ref.triangularView<Eigen::Lower>();
   EXPECT_LT((g1l - g_refl).norm(), 1e-13 * g_ref.norm());
   EXPECT_LT((g2l - g_refl).norm(), 1e-13 * g_ref.norm());
-  EXPECT_LT((ht1 - h.transpose() * t).norm(), 1e-13 * ht1.norm());
-  EXPECT_LT((ht2 - h.transpose() * t).norm(), 1e-13 * ht1.norm());
 
   Eigen::VectorXd v1(45), v2(45);
   Eigen::MatrixXd e1(45, 45), e2(45, 45);
