@@ -103,8 +103,8 @@ Sifter::Sifter(Eigen::Index n, const SiftingOptions& options)
     : n_(n),
       options_(options),
       max_sifts_(options.EffectiveMaxSifts()),
-      lower_(n + 2 * kNbSym + 4),
-      upper_(n + 2 * kNbSym + 4) {
+      lower_(n + 2 * kNbSym + 4, 0),
+      upper_(n + 2 * kNbSym + 4, 1) {
   const size_t size = static_cast<size_t>(n);
   indmin_.resize(size + 2);
   indmax_.resize(size + 2);

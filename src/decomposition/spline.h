@@ -15,7 +15,12 @@ namespace gyrodrift::decomposition::internal {
 
 class EnvelopeSpline {
  public:
-  explicit EnvelopeSpline(Eigen::Index max_nodes);
+    // phase 0 or 1 staggers this spline's arrays against another one's in the cache (see the .cc).
+  explicit EnvelopeSpline(Eigen::Index max_nodes, int phase = 0);
+  EnvelopeSpline(const EnvelopeSpline&) = delete;  // the array pointers point into storage_
+  EnvelopeSpline& operator=(const EnvelopeSpline&) = delete;
+  EnvelopeSpline(EnvelopeSpline&&) = default;  // a moved vector keeps its buffer
+  EnvelopeSpline& operator=(EnvelopeSpline&&) = default;
   // Node times must be integer-valued and strictly increasing, with t[0] <= 1 <= n <= t[m-1]
   // (the sifting's mirrored boundary nodes guarantee it).
   std::vector<double>& t() { return t_; }
@@ -31,21 +36,12 @@ class EnvelopeSpline {
   // Solves the slopes of both splines.
   friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
 
-  // The tridiagonal system's arrays (row j: sub[j] s[j-1] + diag[j] s[j] + sup[j] s[j+1] = rhs[j]).
-  struct Rows {
-    double* diag;
-    double* rhs;
-    const double* sub;
-    const double* sup;
-  };
-
  private:
   void Prepare();
-  Rows rows();
-  void Coefficients();
   SplineView view() const;
   std::vector<double> t_, y_;
-  std::vector<double> inv_dx_, dd_, slope_, diag_, rhs_, sub_, sup_, c1_, c2_;
+  std::vector<double> storage_;  // the per-node arrays below
+  double *inv_dx_, *dd_, *slope_, *diag_, *rhs_, *c1_, *c2_;  // diag_: inverse pivots
 };
 
 void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);

@@ -172,7 +172,9 @@ TEST(SiftingSimd, SiftCountsDoNotDependOnThePath) {
     const SiftOutcome ob = sb.ExtractImf(x.data(), b.data());
     EXPECT_EQ(oa.sifts, ob.sifts);
     EXPECT_EQ(oa.extracted, ob.extracted);
-    if (oa.extracted) EXPECT_TRUE(SameBits(a.data(), b.data(), n)) << n;
+    if (oa.extracted) {
+      EXPECT_TRUE(SameBits(a.data(), b.data(), n)) << n;
+    }
   }
 }
 
