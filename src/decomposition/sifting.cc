@@ -384,18 +384,9 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
     bool stop = false;
     if (rule == StopRule::kRilling) {
       const double t1 = options_.rilling_threshold1, t2 = options_.rilling_threshold2;
-      Eigen::Index above1 = 0;
-      bool above2 = false;
-      for (Eigen::Index i = 0; i < n_; ++i) {
-        const double mean = (lo[i] + hi[i]) / 2;
-        const double amplitude = std::abs(hi[i] - lo[i]) / 2;
-        const double ratio = std::abs(mean) / amplitude;
-        above1 += ratio > t1;
-        above2 |= ratio > t2;
-        next[i] = h[i] - mean;
-      }
-      const bool keep_sifting = static_cast<double>(above1) / n_double > options_.rilling_tolerance ||
-                                above2;
+      const RillingCounts c = SimdRillingSift(lo, hi, h, next, n_, t1, t2);
+      const bool keep_sifting =
+          static_cast<double>(c.above1) / n_double > options_.rilling_tolerance || c.above2;
       stop = !keep_sifting &&
              std::abs(CountZeroCrossings(h, n_) - counts.extrema()) <= 1;
       if (stop) break;

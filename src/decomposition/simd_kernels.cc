@@ -29,6 +29,9 @@ struct V {
   static R Add(R a, R b) { return _mm_add_pd(a, b); }
   static R Sub(R a, R b) { return _mm_sub_pd(a, b); }
   static R Mul(R a, R b) { return _mm_mul_pd(a, b); }
+  static R Div(R a, R b) { return _mm_div_pd(a, b); }
+  static R Abs(R a) { return _mm_andnot_pd(_mm_set1_pd(-0.0), a); }
+  static M Greater(R a, R b) { return _mm_cmpgt_pd(a, b); }
   static unsigned SignBits(R v) { return static_cast<unsigned>(_mm_movemask_pd(v)); }
   static M EqZero(R v) { return _mm_cmpeq_pd(v, _mm_setzero_pd()); }
   static M LtZero(R v) { return _mm_cmplt_pd(v, _mm_setzero_pd()); }
@@ -59,6 +62,9 @@ struct V {  // portable scalar build
   static R Add(R a, R b) { return a + b; }
   static R Sub(R a, R b) { return a - b; }
   static R Mul(R a, R b) { return a * b; }
+  static R Div(R a, R b) { return a / b; }
+  static R Abs(R a) { return std::fabs(a); }
+  static M Greater(R a, R b) { return a > b; }
   static unsigned SignBits(R v) { return std::signbit(v) ? 1u : 0u; }
   static M EqZero(R v) { return v == 0.0; }
   static M LtZero(R v) { return v < 0.0; }
@@ -88,6 +94,9 @@ struct V {
   static R Add(R a, R b) { return _mm256_add_pd(a, b); }
   static R Sub(R a, R b) { return _mm256_sub_pd(a, b); }
   static R Mul(R a, R b) { return _mm256_mul_pd(a, b); }
+  static R Div(R a, R b) { return _mm256_div_pd(a, b); }
+  static R Abs(R a) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), a); }
+  static M Greater(R a, R b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
   static unsigned SignBits(R v) { return static_cast<unsigned>(_mm256_movemask_pd(v)); }
   static M EqZero(R v) { return _mm256_cmp_pd(v, _mm256_setzero_pd(), _CMP_EQ_OQ); }
   static M LtZero(R v) { return _mm256_cmp_pd(v, _mm256_setzero_pd(), _CMP_LT_OQ); }
@@ -149,6 +158,11 @@ void SimdEvaluateSift(const SplineView& s, Eigen::Index n, const double* lower, 
 bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings,
                            ExtremaScan* out) {
   return GYRODRIFT_DISPATCH(FindStrictExtrema(x, n, zero_crossings, out));
+}
+
+RillingCounts SimdRillingSift(const double* lo, const double* hi, const double* h, double* next,
+                              Eigen::Index n, double threshold1, double threshold2) {
+  return GYRODRIFT_DISPATCH(RillingSift(lo, hi, h, next, n, threshold1, threshold2));
 }
 
 #undef GYRODRIFT_DISPATCH

@@ -44,6 +44,16 @@ struct ExtremaScan {
 bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings,
                            ExtremaScan* out);
 
+// One sift under the Rilling-Flandrin rule from the two envelopes: next[i] = h[i] - mean[i] and
+// the counts of the stopping test on ratio = |mean| / amplitude (mean = (lo + hi) / 2,
+// amplitude = |hi - lo| / 2), for i < n.
+struct RillingCounts {
+  std::int64_t above1 = 0;  // samples with ratio > threshold1
+  bool above2 = false;      // some sample has ratio > threshold2
+};
+RillingCounts SimdRillingSift(const double* lo, const double* hi, const double* h, double* next,
+                              Eigen::Index n, double threshold1, double threshold2);
+
 // Which build runs: kAuto picks AVX2 when the processor has it. For tests and benchmarks.
 enum class SimdPath { kAuto, kBaseline, kAvx2 };
 bool SimdAvx2Available();

@@ -1,6 +1,7 @@
 // The vector kernels of one sift: the fused sift update equals the plain evaluation followed by
-// the update, the AVX2 and SSE2 builds give the same bits, and the fused zero-crossing count
-// equals the reference count, including zeros, plateaus and products that underflow.
+// the update, the AVX2 and SSE2 builds give the same bits, the fused zero-crossing count equals
+// the reference count (including zeros, plateaus and products that underflow), and the vector
+// Rilling sift equals its scalar form.
 #include "decomposition/simd_kernels.h"
 
 #include <gtest/gtest.h>
@@ -155,25 +156,61 @@ TEST(SiftingSimd, ScanMatchesTheReferenceCounts) {
   }
 }
 
+TEST(SiftingSimd, RillingSiftMatchesTheScalarForm) {
+  PathGuard guard;
+  Rng rng(14, 0);
+  for (int path = 0; path < 2; ++path) {
+    SetSimdPath(path == 0 ? SimdPath::kBaseline : SimdPath::kAvx2);
+    for (Eigen::Index n : {1, 3, 8, 1001}) {
+      Eigen::VectorXd lo(n), hi(n), h(n), next(n), expected(n);
+      for (Eigen::Index i = 0; i < n; ++i) {
+        lo[i] = rng.Normal();
+        hi[i] = lo[i] + std::fabs(rng.Normal());
+        h[i] = rng.Normal();
+        // Touching envelopes: amplitude 0, ratio 0 / 0 (NaN) or x / 0 (infinite).
+        if (i % 5 == 1) hi[i] = lo[i];
+        if (i % 10 == 1) hi[i] = lo[i] = 0.0;
+      }
+      std::int64_t above1 = 0;
+      bool above2 = false;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double mean = (lo[i] + hi[i]) / 2;
+        const double amplitude = std::abs(hi[i] - lo[i]) / 2;
+        const double ratio = std::abs(mean) / amplitude;
+        above1 += ratio > 0.05;
+        above2 |= ratio > 0.5;
+        expected[i] = h[i] - mean;
+      }
+      const RillingCounts c =
+          SimdRillingSift(lo.data(), hi.data(), h.data(), next.data(), n, 0.05, 0.5);
+      EXPECT_EQ(c.above1, above1) << n;
+      EXPECT_EQ(c.above2, above2) << n;
+      EXPECT_TRUE(SameBits(next.data(), expected.data(), n)) << n;
+    }
+  }
+}
+
 TEST(SiftingSimd, SiftCountsDoNotDependOnThePath) {
   if (!SimdAvx2Available()) GTEST_SKIP() << "no AVX2 on this processor";
   PathGuard guard;
-  SiftingOptions options;
-  options.stop_rule = StopRule::kSNumber;
-  for (const Eigen::VectorXd& x : ScanSignals()) {
-    const Eigen::Index n = x.size();
-    if (n < 60) continue;
-    Eigen::VectorXd a(n), b(n);
-    SetSimdPath(SimdPath::kBaseline);
-    Sifter sa(n, options);
-    const SiftOutcome oa = sa.ExtractImf(x.data(), a.data());
-    SetSimdPath(SimdPath::kAvx2);
-    Sifter sb(n, options);
-    const SiftOutcome ob = sb.ExtractImf(x.data(), b.data());
-    EXPECT_EQ(oa.sifts, ob.sifts);
-    EXPECT_EQ(oa.extracted, ob.extracted);
-    if (oa.extracted) {
-      EXPECT_TRUE(SameBits(a.data(), b.data(), n)) << n;
+  for (StopRule rule : {StopRule::kSNumber, StopRule::kRilling}) {
+    SiftingOptions options;
+    options.stop_rule = rule;
+    for (const Eigen::VectorXd& x : ScanSignals()) {
+      const Eigen::Index n = x.size();
+      if (n < 60) continue;
+      Eigen::VectorXd a(n), b(n);
+      SetSimdPath(SimdPath::kBaseline);
+      Sifter sa(n, options);
+      const SiftOutcome oa = sa.ExtractImf(x.data(), a.data());
+      SetSimdPath(SimdPath::kAvx2);
+      Sifter sb(n, options);
+      const SiftOutcome ob = sb.ExtractImf(x.data(), b.data());
+      EXPECT_EQ(oa.sifts, ob.sifts);
+      EXPECT_EQ(oa.extracted, ob.extracted);
+      if (oa.extracted) {
+        EXPECT_TRUE(SameBits(a.data(), b.data(), n)) << n;
+      }
     }
   }
 }
