@@ -1,4 +1,3 @@
-#include "common/enum_names.h"
 #include "gyrodrift/elm/elm.h"
 
 #include <Eigen/Cholesky>
@@ -10,6 +9,7 @@
 #include <limits>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "elm/internal.h"
 #include "elm/kernels.h"
 #include "gyrodrift/common/check.h"
@@ -400,6 +400,8 @@ Eigen::MatrixXd CheckedScaledInputs(const ElmModel& model,
 
 }  // namespace
 
+std::string_view KernelName() { return internal::ActiveKernels().name; }
+
 Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
                             int threads) {
   CheckThreads(threads);
@@ -421,8 +423,8 @@ Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::Mat
   ForEachHiddenBlock(model, xs, threads, [&](Eigen::Index r0, Eigen::Index rows, const auto& h) {
     // The kernel sums each output over the units in one fixed order, so a row predicted alone
     // gets the same bits as in any batch.
-    kernels.output(h.data(), h.outerStride(), rows, model.num_hidden(),
-                   model.output_weights.data(), model.num_outputs(), y.data() + r0, y.outerStride());
+    kernels.output(h.data(), h.outerStride(), rows, model.num_hidden(), model.output_weights.data(),
+                   model.num_outputs(), y.data() + r0, y.outerStride());
   });
   return model.target_scaler.Invert(y);
 }

@@ -8,7 +8,10 @@ const Kernels* Avx2KernelTableIfBuilt();
 
 const Kernels* Avx2Kernels() {
   static const Kernels* const kernels = []() -> const Kernels* {
-#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#if defined(GYRODRIFT_ELM_FORCE_BASELINE_KERNELS)
+    // A build that tests the baseline path end to end on a CPU with AVX2.
+    return nullptr;
+#elif (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
     __builtin_cpu_init();
     // GCC's and Clang's checks include the operating system's support for the AVX state.
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {

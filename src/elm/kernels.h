@@ -45,8 +45,8 @@ struct Kernels {
   // out (rows x L) = g(z) with z_ij = b_j + sum_k xs_ik w_kj (k ascending) for sigmoid, tanh,
   // sine and linear units, and g = exp(-b_j / d * sum_k (xs_ik - w_kj)^2) for RBF units.
   // xs is rows x d, w is d x L (leading dimension d), b has L entries.
-  void (*hidden)(int activation, const double* xs, long ld_xs, long rows, long d,
-                 const double* w, const double* b, long hidden, double* out, long ld_out);
+  void (*hidden)(int activation, const double* xs, long ld_xs, long rows, long d, const double* w,
+                 const double* b, long hidden, double* out, long ld_out);
 
   // y (rows x m) = h (rows x L) * beta (L x m, leading dimension L), each entry summed over j
   // in ascending order starting from 0.
@@ -72,7 +72,9 @@ struct Kernels {
 
 // The baseline kernels (any x86-64, or any other CPU).
 const Kernels& BaselineKernels();
-// The AVX2 + FMA kernels, or nullptr if they are not built in or the CPU lacks AVX2 or FMA.
+// The AVX2 + FMA kernels, or nullptr if they are not built in, the CPU lacks AVX2 or FMA, or
+// the library was compiled with -DGYRODRIFT_ELM_FORCE_BASELINE_KERNELS (to test the baseline
+// path end to end on an AVX2 machine).
 const Kernels* Avx2Kernels();
 // AVX2 + FMA when available, else baseline; decided once per process.
 const Kernels& ActiveKernels();

@@ -226,8 +226,8 @@ constexpr int kOutputVecs = 4;
 constexpr long kOutputRows = kOutputVecs * kLanes;
 
 template <bool kFull>
-inline void OutputTile(const double* h, long ld_h, long rows, long i0, const long* row,
-                       long hidden, const double* beta_k, double* y_k) {
+inline void OutputTile(const double* h, long ld_h, long rows, long i0, const long* row, long hidden,
+                       const double* beta_k, double* y_k) {
   Vec acc[kOutputVecs];
   for (int v = 0; v < kOutputVecs; ++v) acc[v] = Splat(0.0);
   for (long j = 0; j < hidden; ++j) {

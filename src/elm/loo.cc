@@ -126,8 +126,7 @@ void LooGrid(Activation activation, const Eigen::MatrixXd& xs, const Eigen::Matr
           ComputeHidden(activation, xs.middleRows(r0, rows), weights, biases, h);
           Eigen::VectorXd sums = Eigen::VectorXd::Zero(total);
           kernels.loo(h.data(), h.outerStride(), rows, ts.data() + r0, ts.outerStride(), outputs,
-                      views.data(), num_l, w.p.data(), w.fitted.data(), w.hat.data(),
-                      sums.data());
+                      views.data(), num_l, w.p.data(), w.fitted.data(), w.hat.data(), sums.data());
           return sums;
         },
         [&](int, Eigen::VectorXd&& sums) { sse += sums; });

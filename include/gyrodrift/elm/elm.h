@@ -185,4 +185,9 @@ Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::Mat
 Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
                             int threads = 0);
 
+// The row kernels this process runs: "avx2+fma" or "baseline" (decided once, by the CPU). The
+// last bits of every result depend on it (see the header comment); worth recording next to
+// results that are compared to the bit.
+std::string_view KernelName();
+
 }  // namespace gyrodrift::elm

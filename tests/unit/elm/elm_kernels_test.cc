@@ -1,8 +1,6 @@
 // The ELM's dispatched row kernels (src/elm/kernels.h), each table on its own: the documented
 // order of operations to the bit, the vectorised exp against libm, row-position independence,
 // and agreement of the AVX2 + FMA and baseline builds to rounding.
-#include "elm/kernels.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -12,7 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "elm/kernels.h"
 #include "gyrodrift/common/random.h"
+#include "gyrodrift/elm/elm.h"
 
 namespace gyrodrift::elm::internal {
 namespace {
@@ -42,8 +42,8 @@ Eigen::MatrixXd RandomMatrix(Eigen::Index rows, Eigen::Index cols, double scale,
 Eigen::MatrixXd Hidden(const Kernels& k, int activation, const Eigen::MatrixXd& x,
                        const Eigen::MatrixXd& w, const Eigen::VectorXd& b) {
   Eigen::MatrixXd out(x.rows(), w.cols());
-  k.hidden(activation, x.data(), x.outerStride(), x.rows(), x.cols(), w.data(), b.data(),
-           w.cols(), out.data(), out.outerStride());
+  k.hidden(activation, x.data(), x.outerStride(), x.rows(), x.cols(), w.data(), b.data(), w.cols(),
+           out.data(), out.outerStride());
   return out;
 }
 
@@ -111,15 +111,15 @@ TEST(ElmKernels, SigmoidAndRbfMatchLibmToAFewUlps) {
     }
     // RBF with centre 0 and impact factor 1 on one input: exp(-x^2), for x^2 up to 800.
     const Eigen::MatrixXd xr = x / 27.0;
-    const Eigen::MatrixXd r = Hidden(*k, kKernelRbf, xr, Eigen::MatrixXd::Zero(1, 1),
-                                     Eigen::VectorXd::Ones(1));
+    const Eigen::MatrixXd r =
+        Hidden(*k, kKernelRbf, xr, Eigen::MatrixXd::Zero(1, 1), Eigen::VectorXd::Ones(1));
     for (Eigen::Index i = 0; i < n; ++i) {
       const double d2 = xr(i) * xr(i);
       const double expected = std::exp(-d2);
       if (d2 > 708.0) {
         // Held at e^-708.
-        EXPECT_NEAR(r(i), std::exp(-708.0), 4.0 * std::numeric_limits<double>::epsilon() *
-                                                std::exp(-708.0))
+        EXPECT_NEAR(r(i), std::exp(-708.0),
+                    4.0 * std::numeric_limits<double>::epsilon() * std::exp(-708.0))
             << d2;
       } else {
         EXPECT_NEAR(r(i), expected, 4.0 * std::numeric_limits<double>::epsilon() * expected)
@@ -137,8 +137,7 @@ TEST(ElmKernels, EveryRowIsTheSameBitsAloneAndInABlock) {
   const Eigen::VectorXd b = RandomMatrix(7, 1, 1.0, 13).array().abs();
   const Eigen::MatrixXd beta = RandomMatrix(7, 3, 1.0, 14);
   for (const Kernels* k : Tables()) {
-    for (int activation :
-         {kKernelSigmoid, kKernelTanh, kKernelSine, kKernelRbf, kKernelLinear}) {
+    for (int activation : {kKernelSigmoid, kKernelTanh, kKernelSine, kKernelRbf, kKernelLinear}) {
       const Eigen::MatrixXd h = Hidden(*k, activation, x, w, b);
       Eigen::MatrixXd y(53, 3);
       k->output(h.data(), h.outerStride(), 53, 7, beta.data(), 3, y.data(), y.outerStride());
@@ -198,6 +197,7 @@ TEST(ElmKernels, Avx2AndBaselineAgreeToRounding) {
 TEST(ElmKernels, ActiveTableIsTheBestTheCpuRuns) {
   const Kernels& active = ActiveKernels();
   EXPECT_EQ(&active, Avx2Kernels() != nullptr ? Avx2Kernels() : &BaselineKernels());
+  EXPECT_EQ(KernelName(), active.name);
 }
 
 }  // namespace

@@ -395,7 +395,8 @@ TEST(Elm, PredictsEachRowAloneToTheBitOfTheBatch) {
   for (Activation activation : {Activation::kSigmoid, Activation::kTanh, Activation::kSine,
                                 Activation::kRbf, Activation::kLinear}) {
     // 23 units: not a multiple of the kernels' unit tile either.
-    const ElmModel model = Fit(train.x, train.t, {.hidden_units = 23, .activation = activation}).model;
+    const ElmModel model =
+        Fit(train.x, train.t, {.hidden_units = 23, .activation = activation}).model;
     const Eigen::MatrixXd all = Predict(model, test.x);
     const Eigen::MatrixXd h_all = HiddenLayer(model, test.x);
     for (Eigen::Index i : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 17, 4095, 4096, 4097, 4140}) {
@@ -406,8 +407,8 @@ TEST(Elm, PredictsEachRowAloneToTheBitOfTheBatch) {
     }
     for (Eigen::Index first : {0, 3, 4090}) {
       for (Eigen::Index count : {2, 5, 7, 13}) {
-        EXPECT_TRUE(SameBits(Predict(model, test.x.middleRows(first, count)),
-                             all.middleRows(first, count)))
+        EXPECT_TRUE(
+            SameBits(Predict(model, test.x.middleRows(first, count)), all.middleRows(first, count)))
             << ToString(activation) << " rows " << first << " + " << count;
       }
     }
