@@ -14,7 +14,8 @@
 // same bits whether its row is evaluated alone or in a block. Every element here is computed by
 // the same sequence of vector operations, in whichever lane and tile it falls (rows past the end
 // of a tile repeat the last row and are not stored). The Gram matrix, the leave-one-out products
-// and the eigendecompositions are large and shape-independent in use, so they stay with Eigen.
+// and the eigendecompositions only need the same bits for the same block shapes, which N alone
+// fixes, so they stay with Eigen's tuned products.
 #include <immintrin.h>
 
 #include <Eigen/Core>
