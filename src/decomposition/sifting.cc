@@ -1,8 +1,8 @@
 #include "decomposition/sifting.h"
 
 #include <algorithm>
-#include <cstdint>
 #include <bit>
+#include <cstdint>
 #include <cstring>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -131,8 +131,8 @@ ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
   c.maxima = scan.nmax;
   if (count_zero_crossings) {
     // The zero-crossing count of CountZeroCrossings, from the same pass.
-    c.zero_crossings = static_cast<int>(scan.has_zero ? scan.sign_changes + ZeroRuns(h, n_)
-                                                      : scan.sign_changes);
+    c.zero_crossings =
+        static_cast<int>(scan.has_zero ? scan.sign_changes + ZeroRuns(h, n_) : scan.sign_changes);
   }
   if (flat) {
     // Merge the plateau extrema into the strict ones, from the back, in place.
@@ -145,9 +145,11 @@ ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
       const size_t cap = indmin_.size();
       PlateauExtrema(h, n_, [&](Eigen::Index i, bool is_max) {
         if (is_max) {
-          indmax_[cap - static_cast<size_t>(extra_max) + static_cast<size_t>(px++)] = static_cast<int>(i);
+          indmax_[cap - static_cast<size_t>(extra_max) + static_cast<size_t>(px++)] =
+              static_cast<int>(i);
         } else {
-          indmin_[cap - static_cast<size_t>(extra_min) + static_cast<size_t>(pm++)] = static_cast<int>(i);
+          indmin_[cap - static_cast<size_t>(extra_min) + static_cast<size_t>(pm++)] =
+              static_cast<int>(i);
         }
       });
       auto merge_back = [cap](std::vector<int>& ind, int strict, int extra) {
@@ -362,8 +364,7 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
                          std::abs(counts.zero_crossings - previous.zero_crossings);
       stable = change <= 1 ? stable + 1 : 0;
       previous = counts;
-      if (stable >= options_.s_number &&
-          std::abs(counts.extrema() - counts.zero_crossings) <= 1) {
+      if (stable >= options_.s_number && std::abs(counts.extrema() - counts.zero_crossings) <= 1) {
         break;
       }
     }
@@ -387,8 +388,7 @@ SiftOutcome Sifter::ExtractImf(const double* x, double* imf) {
       const RillingCounts c = SimdRillingSift(lo, hi, h, next, n_, t1, t2);
       const bool keep_sifting =
           static_cast<double>(c.above1) / n_double > options_.rilling_tolerance || c.above2;
-      stop = !keep_sifting &&
-             std::abs(CountZeroCrossings(h, n_) - counts.extrema()) <= 1;
+      stop = !keep_sifting && std::abs(CountZeroCrossings(h, n_) - counts.extrema()) <= 1;
       if (stop) break;
     } else if (rule == StopRule::kCauchySd) {
       double mean_energy = 0.0, energy = 0.0;

@@ -90,7 +90,9 @@ struct V {
   static R Load(const double* p) { return _mm256_loadu_pd(p); }
   static void Store(double* p, R v) { _mm256_storeu_pd(p, v); }
   static R Set1(double v) { return _mm256_set1_pd(v); }
-  static R Iota(double b) { return _mm256_add_pd(_mm256_set1_pd(b), _mm256_set_pd(3.0, 2.0, 1.0, 0.0)); }
+  static R Iota(double b) {
+    return _mm256_add_pd(_mm256_set1_pd(b), _mm256_set_pd(3.0, 2.0, 1.0, 0.0));
+  }
   static R Add(R a, R b) { return _mm256_add_pd(a, b); }
   static R Sub(R a, R b) { return _mm256_sub_pd(a, b); }
   static R Mul(R a, R b) { return _mm256_mul_pd(a, b); }
@@ -155,8 +157,7 @@ void SimdEvaluateSift(const SplineView& s, Eigen::Index n, const double* lower, 
   GYRODRIFT_DISPATCH(EvaluateSift(s, n, lower, h, next));
 }
 
-bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings,
-                           ExtremaScan* out) {
+bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings, ExtremaScan* out) {
   return GYRODRIFT_DISPATCH(FindStrictExtrema(x, n, zero_crossings, out));
 }
 

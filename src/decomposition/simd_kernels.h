@@ -41,8 +41,7 @@ struct ExtremaScan {
 // Strict extrema of x (emd.m's sign test on the first difference); returns true when some first
 // difference is exactly zero (plateaus to look at). With zero_crossings, also fills
 // sign_changes and has_zero.
-bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings,
-                           ExtremaScan* out);
+bool SimdFindStrictExtrema(const double* x, Eigen::Index n, bool zero_crossings, ExtremaScan* out);
 
 // One sift under the Rilling-Flandrin rule from the two envelopes: next[i] = h[i] - mean[i] and
 // the counts of the stopping test on ratio = |mean| / amplitude (mean = (lo + hi) / 2,

@@ -100,7 +100,13 @@ class Backward {
  public:
   Backward(const double* t, const double* inv_dx, const double* dd, const double* inv_diag,
            const double* rhs, double* slope, double* c1, double* c2, size_t m)
-      : t_(t), inv_dx_(inv_dx), dd_(dd), inv_diag_(inv_diag), rhs_(rhs), slope_(slope), c1_(c1),
+      : t_(t),
+        inv_dx_(inv_dx),
+        dd_(dd),
+        inv_diag_(inv_diag),
+        rhs_(rhs),
+        slope_(slope),
+        c1_(c1),
         c2_(c2) {
     next_ = slope_[m - 1] = rhs_[m - 1] * inv_diag_[m - 1];
   }
@@ -139,12 +145,11 @@ void FitPair(EnvelopeSpline& a, EnvelopeSpline& b) {
   if (ma < 4) a.Prepare();
   if (mb < 4) b.Prepare();
   auto forward = [](EnvelopeSpline& s) {
-    return Forward(s.t_.data(), s.y_.data(), s.inv_dx_, s.dd_, s.diag_,
-                   s.rhs_, s.t_.size());
+    return Forward(s.t_.data(), s.y_.data(), s.inv_dx_, s.dd_, s.diag_, s.rhs_, s.t_.size());
   };
   auto backward = [](EnvelopeSpline& s) {
-    return Backward(s.t_.data(), s.inv_dx_, s.dd_, s.diag_, s.rhs_,
-                    s.slope_, s.c1_, s.c2_, s.t_.size());
+    return Backward(s.t_.data(), s.inv_dx_, s.dd_, s.diag_, s.rhs_, s.slope_, s.c1_, s.c2_,
+                    s.t_.size());
   };
   if (ma >= 4 && mb >= 4) {
     // Both systems in one loop: two independent division chains overlap in the processor.

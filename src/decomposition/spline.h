@@ -3,7 +3,8 @@
 // and for 4 or more nodes the C2 piecewise cubic whose first and last two pieces are one cubic
 // (slopes from a tridiagonal system solved in O(nodes)). Buffers are sized once; fitting and
 // evaluating allocate nothing. Two splines (the lower and upper envelope) are fitted together so
-// their sequential eliminations overlap in the processor.
+// their sequential eliminations overlap in the processor; evaluation runs in the vector kernels
+// of simd_kernels.h (SSE2 or AVX2, the same bits).
 #pragma once
 
 #include <Eigen/Core>
@@ -15,7 +16,7 @@ namespace gyrodrift::decomposition::internal {
 
 class EnvelopeSpline {
  public:
-    // phase 0 or 1 staggers this spline's arrays against another one's in the cache (see the .cc).
+  // phase 0 or 1 staggers this spline's arrays against another one's in the cache (see the .cc).
   explicit EnvelopeSpline(Eigen::Index max_nodes, int phase = 0);
   EnvelopeSpline(const EnvelopeSpline&) = delete;  // the array pointers point into storage_
   EnvelopeSpline& operator=(const EnvelopeSpline&) = delete;
@@ -40,7 +41,7 @@ class EnvelopeSpline {
   void Prepare();
   SplineView view() const;
   std::vector<double> t_, y_;
-  std::vector<double> storage_;  // the per-node arrays below
+  std::vector<double> storage_;                               // the per-node arrays below
   double *inv_dx_, *dd_, *slope_, *diag_, *rhs_, *c1_, *c2_;  // diag_: inverse pivots
 };
 
