@@ -6,6 +6,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "drift_cli.h"
+#include "progress.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
@@ -46,7 +47,13 @@ void Run(const FitArgs& a) {
     }
     temperature = table.Column(a.temperature);
   }
+  ProgressBar progress({1.0}, IsTerminal() && !a.quiet);
+  progress.BeginStage(0, a.method);
+  o.progress = [&progress, &a](double fraction, const std::string& step) {
+    progress.Update(fraction, a.method + ": " + step);
+  };
   const drift::DriftModel model = drift::FitDriftModel(y, temperature, o);
+  progress.Finish();
   io::WriteModelFile(a.output, model, info);
   if (a.quiet) return;
   fmt::print("{}\n", model.Summary());

@@ -180,7 +180,9 @@ Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomp
 
 namespace internal {
 
-SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o) {
+SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
+                           bool report) {
+  report = report && static_cast<bool>(o.progress);
   SubSeries out;
   out.model.options = o;
   if (!UsesDecomposition(o.method)) {
@@ -191,6 +193,10 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
   decomposition::DecompositionOptions dopt = o.decomposition;
   dopt.seed = o.seed;
   dopt.threads = o.threads;
+  if (report) {
+    o.progress(0.0, "decompose");
+    dopt.progress = [&o](double fraction) { o.progress(kDecomposeShare * fraction, "decompose"); };
+  }
   const decomposition::Decomposition d = decomposition::Decompose(y, dopt);
   out.model.training_imfs = d.num_imfs();
   out.model.decomposition_summary = d.report.Summary();
@@ -202,6 +208,7 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
     }
     out.model.sub_models.push_back({"residue", {}, true, nullptr});
   } else {
+    if (report) o.progress(kDecomposeShare, "select modes");
     selection::SelectionOptions sopt = o.selection;
     sopt.threads = o.threads;
     const selection::SelectionResult sel = selection::SelectModes(y, d, sopt);
@@ -280,9 +287,13 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const DriftOptions& options) {
   options.Validate();
   RequireFiniteSignal("target", y, 32);
-  internal::SubSeries prepared = internal::PrepareSubSeries(y, options);
+  internal::SubSeries prepared = internal::PrepareSubSeries(y, options, /*report=*/true);
+  prepared.model.options.progress = nullptr;  // a model does not keep the caller's callback
   const Eigen::MatrixXd thermal = ThermalOrEmpty(prepared.model, temperature_c, y.size());
+  const bool decomposed = UsesDecomposition(options.method);
+  if (options.progress) options.progress(decomposed ? 0.85 : 0.0, "fit sub-models");
   internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size());
+  if (options.progress) options.progress(1.0, "fit sub-models");
   return std::move(prepared.model);
 }
 

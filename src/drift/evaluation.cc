@@ -150,6 +150,7 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                                std::to_string(base.seed + static_cast<std::uint64_t>(r)));
         }
         DriftOptions o = base;
+        o.progress = nullptr;  // Evaluate reports through EvaluationOptions::progress
         o.method = method;
         o.seed = base.seed + static_cast<std::uint64_t>(r);
         const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.causal);

@@ -14,7 +14,11 @@ struct SubSeries {
 };
 
 // Decomposes y (if the method needs it), groups the IMFs and defines the sub-models.
-SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o);
+// Reports "decompose" (fractions up to kDecomposeShare) and "select modes" through o.progress
+// when `report` is set.
+constexpr double kDecomposeShare = 0.7;
+SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
+                           bool report = false);
 
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -69,6 +70,10 @@ struct DriftOptions {
   double reference_c = 20.0;
   std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
   int threads = 0;         // 0 = every core
+  // FitDriftModel reports its progress here (fraction of the whole fit in [0, 1], and the step:
+  // "decompose", "select modes", "fit sub-models"), from the calling thread or the thread that
+  // accumulates the ensemble; may be empty. Not part of the model; Evaluate does not call it.
+  std::function<void(double fraction, const std::string& step)> progress;
   DriftOptions();          // sets the learner defaults described above
   void Validate() const;   // throws UsageError naming the field
 };
