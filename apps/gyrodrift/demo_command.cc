@@ -243,9 +243,13 @@ void DecomposeStep(const DemoArgs& a, Study& s) {
   dec::DecompositionOptions dopt = o.decomposition;
   dopt.seed = a.seed;
   dopt.threads = a.threads;
-  s.decomposition = dec::Decompose(s.y, dopt);
   sel::SelectionOptions sopt = o.selection;
   sopt.threads = a.threads;
+  sel::NoiseLevelCollector white_noise(static_cast<int>(s.y.size()), sopt.monte_carlo, sopt.kde,
+                                       sopt.distance);
+  if (sopt.criterion == sel::Criterion::kPdfSimilarity) white_noise.Attach(&dopt);
+  s.decomposition = dec::Decompose(s.y, dopt);
+  sopt.noise_level = white_noise.Level();
   s.selection = sel::SelectModes(s.y, s.decomposition, sopt);
 }
 

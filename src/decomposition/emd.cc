@@ -36,6 +36,7 @@ bool NoiseModes::Next(Sifter& sifter, double* out) {
       const SiftOutcome outcome = sifter.ExtractImf(residue_.data(), out);
       if (outcome.extracted) {
         for (Eigen::Index i = 0; i < n; ++i) residue_[i] = residue_[i] - out[i];
+        ++imfs_;
         return true;
       }
       finished_ = true;

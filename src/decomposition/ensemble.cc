@@ -5,8 +5,8 @@
 // ensemble averages are running sums of term / I accumulated in i order, as the reference
 // ceemdan.m does, so the output is the same bits for any thread count.
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -28,6 +28,15 @@ Eigen::VectorXd DrawNoise(const DecompositionOptions& o, int i, Eigen::Index n) 
   Rng rng(o.seed, static_cast<std::uint64_t>(i));
   rng.FillNormal(w);
   return w;
+}
+
+// The next row of realisation i's noise EMD into out (false: none), shown to the observer when
+// it is an IMF.
+bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseModes& modes, Sifter& sifter,
+                  double* out) {
+  if (!modes.Next(sifter, out)) return false;
+  if (o.noise_imf_observer && modes.last_imf() > 0) o.noise_imf_observer(i, modes.last_imf(), out);
+  return true;
 }
 
 // Per-worker state: a sifter and scratch vectors sized once.
@@ -81,8 +90,10 @@ double Log2Energy(const Eigen::VectorXd& v) { return std::log2(v.squaredNorm());
 void ReportProgress(const DecompositionOptions& o, int stage, int realisation, int ensemble,
                     Eigen::Index n, double& reported) {
   if (!o.progress) return;
-  const double expected = std::max<double>(stage + 2, std::floor(std::log2(static_cast<double>(n))) - 1);
-  const double estimate = std::min(0.99, (stage + static_cast<double>(realisation + 1) / ensemble) / expected);
+  const double expected =
+      std::max<double>(stage + 2, std::floor(std::log2(static_cast<double>(n))) - 1);
+  const double estimate =
+      std::min(0.99, (stage + static_cast<double>(realisation + 1) / ensemble) / expected);
   reported = std::max(reported, estimate);
   o.progress(reported);
 }
@@ -93,8 +104,9 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
   const Eigen::Index n = x.size();
   const int ensemble = EnsembleSize(o);
   const int max_imfs =
-      o.max_imfs > 0 ? o.max_imfs
-                     : std::max(1, static_cast<int>(std::floor(std::log2(static_cast<double>(n)))) - 1);
+      o.max_imfs > 0
+          ? o.max_imfs
+          : std::max(1, static_cast<int>(std::floor(std::log2(static_cast<double>(n)))) - 1);
   const double amplitude = o.noise_strength * SampleStd(x.data(), n);
   auto workers = MakeWorkers(ensemble, o, n);
 
@@ -133,8 +145,8 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
   report.seed = o.seed;
   report.supplied_noise = static_cast<bool>(o.supplied_noise);
   for (const auto& s : stats) s.Report(report, ensemble);
-  report.stop_reason = "fixed IMF count " + std::to_string(max_imfs) +
-                       " (EEMD aligns every member's modes)";
+  report.stop_reason =
+      "fixed IMF count " + std::to_string(max_imfs) + " (EEMD aligns every member's modes)";
   Decomposition result;
   result.imfs = std::move(mean_imfs);
   result.residue = std::move(mean_residue);
@@ -183,11 +195,12 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
             Eigen::VectorXd white = DrawNoise(o, i, n);
             wk.input = xn + eps * white;
             modes_i.emplace(std::move(white));
-          } else if (modes_i->Next(wk.sifter, wk.noise.data())) {
+          } else if (NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data())) {
             // Torres et al. 2011, stage k: r_k + eps_k E_k(w); here eps_k keeps the added noise
             // at eps * std(r_k), a constant SNR per stage.
             const double sn = SampleStd(wk.noise.data(), n);
-            for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = r[j] + sr * (eps * (wk.noise[j] / sn));
+            for (Eigen::Index j = 0; j < n; ++j)
+              wk.input[j] = r[j] + sr * (eps * (wk.noise[j] / sn));
           } else {
             wk.input = r;
           }
@@ -301,14 +314,15 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
           auto& modes_i = noise[static_cast<size_t>(i)];
           if (stage == 0) modes_i.emplace(DrawNoise(o, i, n));
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
-          const bool has_noise = modes_i->Next(wk.sifter, wk.noise.data());
+          const bool has_noise = NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data());
           if (stage == 0) {
             const double se = SampleStd(wk.noise.data(), n);
             for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = xn[j] + (eps * wk.noise[j]) / se;
           } else if (has_noise) {
             if (constant_snr) {
               const double se = SampleStd(wk.noise.data(), n);
-              for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = r[j] + sr * (eps * (wk.noise[j] / se));
+              for (Eigen::Index j = 0; j < n; ++j)
+                wk.input[j] = r[j] + sr * (eps * (wk.noise[j] / se));
             } else {
               for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = r[j] + sr * (eps * wk.noise[j]);
             }

@@ -18,10 +18,13 @@ class NoiseModes {
   explicit NoiseModes(Eigen::VectorXd noise);
   // Writes row `next` of the noise EMD into out and advances; false when there is no such row.
   bool Next(Sifter& sifter, double* out);
+  // The IMF number of the row the last successful Next wrote, 0 if it was the residue.
+  int last_imf() const { return residue_given_ ? 0 : imfs_; }
 
  private:
   Eigen::VectorXd residue_;
   double input_max_abs_;
+  int imfs_ = 0;  // IMF rows written so far
   bool finished_ = false;
   bool residue_given_ = false;
 };

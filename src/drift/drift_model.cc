@@ -1,4 +1,3 @@
-#include "common/enum_names.h"
 #include "gyrodrift/drift/drift_model.h"
 
 #include <algorithm>
@@ -7,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "drift/internal.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -91,7 +91,9 @@ Mode ModeFromString(std::string_view name) { return EnumFromName(name, "mode", k
 std::string_view ToString(Method method) { return EnumName(method, kMethods); }
 Method MethodFromString(std::string_view name) { return EnumFromName(name, "method", kMethods); }
 std::string_view ToString(Protocol protocol) { return EnumName(protocol, kProtocols); }
-Protocol ProtocolFromString(std::string_view name) { return EnumFromName(name, "protocol", kProtocols); }
+Protocol ProtocolFromString(std::string_view name) {
+  return EnumFromName(name, "protocol", kProtocols);
+}
 
 std::vector<Method> AllMethods() {
   std::vector<Method> all;
@@ -197,6 +199,15 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
     o.progress(0.0, "decompose");
     dopt.progress = [&o](double fraction) { o.progress(kDecomposeShare * fraction, "decompose"); };
   }
+  selection::SelectionOptions sopt = o.selection;
+  sopt.threads = o.threads;
+  // The selection's white-noise level from the decomposition's own noise EMDs (the same IMFs the
+  // Monte-Carlo would compute: half the cost of a fit on a long record).
+  selection::NoiseLevelCollector white_noise(static_cast<int>(y.size()), sopt.monte_carlo, sopt.kde,
+                                             sopt.distance);
+  if (o.method != Method::kEmdElm && sopt.criterion == selection::Criterion::kPdfSimilarity) {
+    white_noise.Attach(&dopt);
+  }
   const decomposition::Decomposition d = decomposition::Decompose(y, dopt);
   out.model.training_imfs = d.num_imfs();
   out.model.decomposition_summary = d.report.Summary();
@@ -209,8 +220,7 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
     out.model.sub_models.push_back({"residue", {}, true, nullptr});
   } else {
     if (report) o.progress(kDecomposeShare, "select modes");
-    selection::SelectionOptions sopt = o.selection;
-    sopt.threads = o.threads;
+    sopt.noise_level = white_noise.Level();
     const selection::SelectionResult sel = selection::SelectModes(y, d, sopt);
     out.model.selection_summary = sel.Summary();
     for (const auto& group : sel.groups) {

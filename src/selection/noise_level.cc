@@ -1,6 +1,7 @@
 #include "gyrodrift/selection/noise_level.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <future>
@@ -35,6 +36,34 @@ std::string Fmt(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
+}
+
+// The level from G_k of R realisations (g[i][k - 1]; realisations may have different mode counts).
+NoiseLevel LevelFromSamples(int length, double confidence, std::uint64_t seed,
+                            const std::vector<std::vector<double>>& g) {
+  size_t modes = 0;
+  for (const auto& gi : g) modes = std::max(modes, gi.size());
+  NoiseLevel out;
+  out.length = length;
+  out.realisations = static_cast<int>(g.size());
+  out.confidence = confidence;
+  out.seed = seed;
+  out.level.assign(modes, std::numeric_limits<double>::quiet_NaN());
+  out.median.assign(modes, std::numeric_limits<double>::quiet_NaN());
+  out.realisations_with_mode.assign(modes, 0);
+  std::vector<double> values;
+  for (size_t k = 0; k < modes; ++k) {
+    values.clear();
+    for (const auto& gi : g) {
+      if (k < gi.size()) values.push_back(gi[k]);
+    }
+    out.realisations_with_mode[k] = static_cast<int>(values.size());
+    if (values.size() < static_cast<size_t>(kMinRealisationsPerMode)) continue;
+    std::sort(values.begin(), values.end());
+    out.level[k] = SortedQuantile(values, confidence);
+    out.median[k] = SortedQuantile(values, 0.5);
+  }
+  return out;
 }
 
 std::string CacheKey(int length, const MonteCarloOptions& mc, const KdeOptions& kde,
@@ -112,7 +141,7 @@ double NoiseLevel::LevelFor(int k) const {
 std::string NoiseLevel::Summary() const {
   std::string s = "white-noise level N=" + std::to_string(length) +
                   " R=" + std::to_string(realisations) + " q=" + FormatValue(confidence) +
-                  " seed=" + std::to_string(seed) + ":";
+                  " seed=" + std::to_string(seed) + (partial ? " (reused noise EMDs)" : "") + ":";
   char buf[32];
   for (double v : level) {
     std::snprintf(buf, sizeof buf, " %.4g", v);
@@ -145,29 +174,55 @@ NoiseLevel ComputeNoiseLevel(int length, const MonteCarloOptions& monte_carlo,
     }
   });
 
-  size_t modes = 0;
-  for (const auto& gi : g) modes = std::max(modes, gi.size());
-  NoiseLevel out;
-  out.length = length;
-  out.realisations = r;
-  out.confidence = monte_carlo.confidence;
-  out.seed = monte_carlo.seed;
-  out.level.assign(modes, std::numeric_limits<double>::quiet_NaN());
-  out.median.assign(modes, std::numeric_limits<double>::quiet_NaN());
-  out.realisations_with_mode.assign(modes, 0);
-  std::vector<double> values;
-  for (size_t k = 0; k < modes; ++k) {
-    values.clear();
-    for (const auto& gi : g) {
-      if (k < gi.size()) values.push_back(gi[k]);
-    }
-    out.realisations_with_mode[k] = static_cast<int>(values.size());
-    if (values.size() < static_cast<size_t>(kMinRealisationsPerMode)) continue;
-    std::sort(values.begin(), values.end());
-    out.level[k] = SortedQuantile(values, monte_carlo.confidence);
-    out.median[k] = SortedQuantile(values, 0.5);
+  return LevelFromSamples(length, monte_carlo.confidence, monte_carlo.seed, g);
+}
+
+NoiseLevelCollector::NoiseLevelCollector(int length, const MonteCarloOptions& monte_carlo,
+                                         const KdeOptions& kde, PdfDistance distance)
+    : length_(length), monte_carlo_(monte_carlo), kde_(kde), distance_(distance) {
+  monte_carlo_.Validate();
+  kde_.Validate();
+}
+
+bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposition) {
+  using decomposition::Method;
+  const auto& d = *decomposition;
+  const auto& a = d.sifting;
+  const auto& b = monte_carlo_.sifting;
+  const bool same_sifting =
+      a.stop_rule == b.stop_rule && a.rilling_threshold1 == b.rilling_threshold1 &&
+      a.rilling_threshold2 == b.rilling_threshold2 && a.rilling_tolerance == b.rilling_tolerance &&
+      a.s_number == b.s_number && a.fixed_sifts == b.fixed_sifts &&
+      a.sd_threshold == b.sd_threshold && a.EffectiveMaxSifts() == b.EffectiveMaxSifts();
+  const bool family =
+      d.method == Method::kCeemdan || d.method == Method::kIceemdan || d.method == Method::kBeemdan;
+  if (!family || d.supplied_noise || d.ensemble_size < monte_carlo_.realisations || !same_sifting ||
+      monte_carlo_.max_imfs != 0 || length_ < 16) {
+    return false;
   }
-  return out;
+  attached_ = true;
+  seed_ = d.seed;
+  g_.assign(static_cast<size_t>(monte_carlo_.realisations), {});
+  decomposition->noise_imf_observer = [this](int realisation, [[maybe_unused]] int mode,
+                                             const double* imf) {
+    if (realisation >= monte_carlo_.realisations) return;
+    // One realisation's modes arrive in order and never concurrently (the decomposition's
+    // contract), so its slot needs no lock; the scratch is per thread.
+    thread_local internal::Scratch scratch;
+    auto& gi = g_[static_cast<size_t>(realisation)];
+    assert(static_cast<int>(gi.size()) == mode - 1);
+    gi.push_back(internal::SelfSimilarity(Eigen::Map<const Eigen::VectorXd>(imf, length_), kde_,
+                                          distance_, &scratch));
+  };
+  return true;
+}
+
+std::shared_ptr<const NoiseLevel> NoiseLevelCollector::Level() const {
+  if (!attached_) return nullptr;
+  NoiseLevel level = LevelFromSamples(length_, monte_carlo_.confidence, seed_, g_);
+  if (level.level.empty()) return nullptr;
+  level.partial = true;
+  return std::make_shared<const NoiseLevel>(std::move(level));
 }
 
 struct NoiseLevelCache::Impl {

@@ -1,4 +1,3 @@
-#include "common/enum_names.h"
 #include "gyrodrift/selection/selection.h"
 
 #include <algorithm>
@@ -9,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
@@ -246,6 +246,12 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
       }
       int k_noise = 0;
       for (int k = 1; k <= k_count; ++k) {
+        if (level->partial && k > static_cast<int>(level->level.size()) && k_noise == k - 1) {
+          // The noise run outlasted a level collected from the decomposition: the rest needs
+          // the Monte-Carlo (modes 1..k-1 agree with it when the seeds do).
+          level = NoiseLevelCache::Global().Get(static_cast<int>(n), options.monte_carlo, kde,
+                                                options.distance, &result.noise_level_computed);
+        }
         const double lk = level->LevelFor(k);
         result.noise_level.push_back(lk);
         // A NaN level (the noise rarely had a mode k) or G_k above it ends the run.
@@ -254,6 +260,12 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
         }
       }
       result.k_noise = k_noise;
+      if (level->partial && static_cast<int>(level->level.size()) < k_count) {
+        AppendNote(&result.note,
+                   "white-noise level reused from the decomposition's noise EMDs, "
+                   "known for modes 1.." +
+                       std::to_string(level->level.size()));
+      }
       result.mixed_end = std::max(k_noise, k_star);
       if (k_noise == 0)
         AppendNote(&result.note, "no IMF passes the white-noise test: no noise group");

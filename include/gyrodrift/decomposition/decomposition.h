@@ -8,7 +8,8 @@
 //   CEEMDAN  Torres, Colominas, Schlotthauer & Flandrin, ICASSP 2011.
 //   ICEEMDAN Colominas, Schlotthauer & Torres, Biomed. Signal Process. Control 14 (2014).
 //   BEEMDAN  ICEEMDAN stages bounded to the noise-dominated early modes (Chen & Cui, Signal
-//            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11 (2004).
+//            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11
+//            (2004).
 // Cost: one sift is O(N); EMD is O(N * total sifts); the ensemble methods multiply the per-mode
 // cost by the ensemble size I and spread realisations over `threads` workers. Results are the
 // same bits for any thread count (realisation i draws from stream (seed, i), sums run in i order).
@@ -31,12 +32,12 @@ Method MethodFromString(std::string_view name);  // "emd", "eemd", ...; throws U
 
 // When to stop sifting one IMF.
 enum class StopRule {
-  kRilling,  // Rilling-Flandrin: share of |mean|/amplitude > threshold1 under tolerance, none >
-             // threshold2, and |#zero crossings - #extrema| <= 1
-  kSNumber,  // Huang 2003 (libeemd's reading): extrema and zero-crossing counts change by at
-             // most one for S consecutive sifts, and then differ from each other by at most one
-  kFixed,    // exactly fixed_sifts sifts
-  kCauchySd, // Huang 1998: sum (h_prev - h)^2 / sum h_prev^2 < sd_threshold
+  kRilling,   // Rilling-Flandrin: share of |mean|/amplitude > threshold1 under tolerance, none >
+              // threshold2, and |#zero crossings - #extrema| <= 1
+  kSNumber,   // Huang 2003 (libeemd's reading): extrema and zero-crossing counts change by at
+              // most one for S consecutive sifts, and then differ from each other by at most one
+  kFixed,     // exactly fixed_sifts sifts
+  kCauchySd,  // Huang 1998: sum (h_prev - h)^2 / sum h_prev^2 < sd_threshold
 };
 std::string_view ToString(StopRule rule);
 StopRule StopRuleFromString(std::string_view name);  // "rilling", "snumber", "fixed", "sd"
@@ -79,10 +80,10 @@ struct DecompositionOptions {
   int max_imfs = 0;  // cap on the IMF count (residue not counted), 0 = until the residue is
                      // monotone; EEMD with 0 uses floor(log2 N) - 1 so all members align
   // Noise-assisted methods.
-  int ensemble_size = 100;     // I, >= 1
-  double noise_strength = 0.2; // eps (EEMD: noise std / signal std; CEEMDAN family: eps_0)
-  std::uint64_t seed = 1;      // realisation i draws from stream (seed, i)
-  int threads = 0;             // workers, 0 = every core
+  int ensemble_size = 100;      // I, >= 1
+  double noise_strength = 0.2;  // eps (EEMD: noise std / signal std; CEEMDAN family: eps_0)
+  std::uint64_t seed = 1;       // realisation i draws from stream (seed, i)
+  int threads = 0;              // workers, 0 = every core
   NoiseScaling noise_scaling = NoiseScaling::kColominas2014;
   // Supplied white noise (N x I, one realisation per column) used instead of drawing; for the
   // CEEMDAN family in the normalised domain x / std(x), for EEMD scaled by eps * std(x).
@@ -96,28 +97,35 @@ struct DecompositionOptions {
   // concurrently (from the thread that accumulates the ensemble); may be empty. For progress
   // displays only: it does not change the result.
   std::function<void(double fraction)> progress;
+  // CEEMDAN, ICEEMDAN, BEEMDAN: called with IMF `mode` (1-based) of white-noise realisation
+  // `realisation`'s own EMD (unit variance, before any scaling; N samples) each time the method
+  // extracts one, in increasing mode order per realisation, from the worker threads (calls for
+  // different realisations may run concurrently; those for one realisation never do). Lets a
+  // caller reuse these EMDs instead of computing its own (selection's white-noise level, see
+  // selection::NoiseLevelCollector). May be empty; it does not change the result.
+  std::function<void(int realisation, int mode, const double* imf)> noise_imf_observer;
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range
 };
 
 struct DecompositionReport {
   Method method = Method::kEmd;
-  std::vector<int> sifts_per_imf;   // EMD: sifts of IMF k; ensembles: mean over realisations
-  std::vector<bool> sift_cap_hit;   // IMF k hit the sift cap (any realisation)
-  int sift_cap_hits = 0;            // total number of one-mode extractions that hit the cap
-  int ensemble_size = 0;            // 0 for plain EMD
+  std::vector<int> sifts_per_imf;  // EMD: sifts of IMF k; ensembles: mean over realisations
+  std::vector<bool> sift_cap_hit;  // IMF k hit the sift cap (any realisation)
+  int sift_cap_hits = 0;           // total number of one-mode extractions that hit the cap
+  int ensemble_size = 0;           // 0 for plain EMD
   std::uint64_t seed = 0;
   bool supplied_noise = false;
-  int noise_assisted_stages = 0;    // CEEMDAN family: stages run with noise
-  std::string stop_reason;          // why the decomposition (or BEEMDAN's noise assistance) ended
+  int noise_assisted_stages = 0;  // CEEMDAN family: stages run with noise
+  std::string stop_reason;        // why the decomposition (or BEEMDAN's noise assistance) ended
   std::vector<double> mode_log2_energy;       // BEEMDAN: log2 energy of each tested mode
   std::vector<double> noise_band_log2_upper;  // BEEMDAN: the band's upper limit for that mode
-  std::string Summary() const;      // one line
+  std::string Summary() const;                // one line
 };
 
 struct Decomposition {
-  Eigen::MatrixXd imfs;      // N x K, one IMF per column
-  Eigen::VectorXd residue;   // N
+  Eigen::MatrixXd imfs;     // N x K, one IMF per column
+  Eigen::VectorXd residue;  // N
   DecompositionReport report;
   int num_imfs() const { return static_cast<int>(imfs.cols()); }
 };

@@ -15,6 +15,10 @@
 // Cost: R plain EMDs of length N plus R * K KDEs, dominated by the EMDs: for N = 28,800 about
 // 0.1 s of CPU per realisation, so R = 100 costs about 10 s of CPU (bench_selection).
 // NoiseLevelCache keeps one level per (N, options) so a process pays this once.
+// NoiseLevelCollector avoids the cost altogether after a CEEMDAN-family decomposition with at least
+// R realisations: those already decompose R white-noise realisations of length N by plain EMD,
+// so their IMFs are the Monte-Carlo's IMFs (the same bits when the seeds agree) and only the
+// KDEs remain to be done.
 #pragma once
 
 #include <Eigen/Core>
@@ -55,6 +59,10 @@ struct NoiseLevel {
   std::vector<double> level;                // level of mode k at index k - 1 (NaN: no level)
   std::vector<double> median;               // median G_k of the white-noise mode k (diagnostic)
   std::vector<int> realisations_with_mode;  // how many realisations had a mode k
+  // The level covers modes 1..level.size() only: it was collected from a decomposition whose
+  // white-noise EMDs stopped there (NoiseLevelCollector). Past them the level is unknown, not
+  // absent; SelectModes then falls back to the Monte-Carlo.
+  bool partial = false;
   // Level of mode k (1-based); NaN beyond the modes the noise produced.
   double LevelFor(int k) const;
   std::string Summary() const;  // one line
@@ -63,6 +71,36 @@ struct NoiseLevel {
 // Runs the Monte-Carlo (no cache). length >= 16. Throws UsageError for bad options.
 NoiseLevel ComputeNoiseLevel(int length, const MonteCarloOptions& monte_carlo,
                              const KdeOptions& kde, PdfDistance distance);
+
+// The level of the white-noise IMFs a CEEMDAN-family decomposition computes anyway:
+//   NoiseLevelCollector collector(n, selection.monte_carlo, selection.kde, selection.distance);
+//   collector.Attach(&decomposition_options);   // before Decompose
+//   selection.noise_level = collector.Level();  // after it (nullptr if not attached)
+// Realisations 0..R-1 of the decomposition play the Monte-Carlo's; their G_k are computed in the
+// decomposition's worker threads as each noise IMF appears. The result equals ComputeNoiseLevel
+// with the decomposition's seed (bit for bit) for the modes the decomposition reached, and is
+// marked partial. The collector must outlive the Decompose call.
+class NoiseLevelCollector {
+ public:
+  NoiseLevelCollector(int length, const MonteCarloOptions& monte_carlo, const KdeOptions& kde,
+                      PdfDistance distance);
+  // Installs the observer when the decomposition's noise is what the Monte-Carlo would use: a
+  // CEEMDAN-family method with drawn (not supplied) noise, at least R realisations, the
+  // Monte-Carlo's sifting options and no IMF cap on its side. Returns whether it did.
+  bool Attach(decomposition::DecompositionOptions* decomposition);
+  // After the decomposition: the level of the modes it reached, or nullptr when not attached or
+  // when no noise IMF was seen.
+  std::shared_ptr<const NoiseLevel> Level() const;
+
+ private:
+  int length_;
+  MonteCarloOptions monte_carlo_;
+  KdeOptions kde_;
+  PdfDistance distance_;
+  bool attached_ = false;
+  std::uint64_t seed_ = 0;
+  std::vector<std::vector<double>> g_;  // G_k of realisation i's noise IMFs, in mode order
+};
 
 // Thread-safe cache of levels keyed by (length, every option except threads). Concurrent callers
 // asking for the same key wait for one computation. A failed computation is not cached.

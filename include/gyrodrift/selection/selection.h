@@ -54,7 +54,8 @@ struct SelectionOptions {
   // shapes and not the offset the residue carries [choice].
   bool center_signal = true;
   MonteCarloOptions monte_carlo;  // the white-noise level (kPdfSimilarity only)
-  // A precomputed level (length must equal N); skips NoiseLevelCache::Global().
+  // A precomputed level (length must equal N), e.g. NoiseLevelCollector's; skips
+  // NoiseLevelCache::Global() unless it is partial and the noise run outlasts it.
   std::shared_ptr<const NoiseLevel> noise_level;
   // kEnergyModel band: 0.99 (a = 0.46, b = -1.919) or 0.95 (a = 0.474, b = -2.449), the two
   // bands Flandrin et al. fitted; other values are rejected.

@@ -77,7 +77,8 @@ TEST_P(Decomposer, ImfCapIsRespected) {
   EXPECT_EQ(d.num_imfs(), 2);
   if (GetParam() != Method::kEemd) {
     const Eigen::VectorXd x = Noisy(512, 3);
-    EXPECT_LE((d.imfs.rowwise().sum() + d.residue - x).cwiseAbs().maxCoeff(), 1e-12 * x.cwiseAbs().maxCoeff());
+    EXPECT_LE((d.imfs.rowwise().sum() + d.residue - x).cwiseAbs().maxCoeff(),
+              1e-12 * x.cwiseAbs().maxCoeff());
   }
 }
 
@@ -193,8 +194,46 @@ TEST_P(Decomposer, ProgressIsMonotoneAndDoesNotChangeTheResult) {
   EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
 }
 
+// The observer sees exactly the plain-EMD IMFs of each realisation's white noise (CEEMDAN family),
+// in mode order, and watching does not change the result.
+TEST_P(Decomposer, NoiseImfObserverSeesTheNoiseEmdAndDoesNotChangeTheResult) {
+  const Eigen::VectorXd x = Noisy(512, 8);
+  DecompositionOptions o = Options(GetParam());
+  o.threads = 2;
+  const Decomposition plain = Decompose(x, o);
+  std::vector<std::vector<Eigen::VectorXd>> seen(static_cast<size_t>(o.ensemble_size));
+  std::vector<int> out_of_order(static_cast<size_t>(o.ensemble_size), 0);
+  o.noise_imf_observer = [&](int i, int mode, const double* imf) {
+    auto& modes = seen[static_cast<size_t>(i)];
+    out_of_order[static_cast<size_t>(i)] += static_cast<int>(modes.size()) != mode - 1;
+    modes.push_back(Eigen::Map<const Eigen::VectorXd>(imf, x.size()));
+  };
+  const Decomposition watched = Decompose(x, o);
+  EXPECT_EQ(plain.imfs, watched.imfs);
+  EXPECT_EQ(plain.residue, watched.residue);
+  const bool family = GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
+                      GetParam() == Method::kBeemdan;
+  for (int i = 0; i < o.ensemble_size; ++i) {
+    const auto& modes = seen[static_cast<size_t>(i)];
+    if (!family) {
+      EXPECT_TRUE(modes.empty()) << i;
+      continue;
+    }
+    EXPECT_EQ(out_of_order[static_cast<size_t>(i)], 0) << i;
+    ASSERT_GE(modes.size(), 3u) << i;
+    Eigen::VectorXd w(x.size());
+    Rng(o.seed, static_cast<std::uint64_t>(i)).FillNormal(w);
+    const Decomposition noise = Emd(w, o.sifting);
+    ASSERT_LE(static_cast<int>(modes.size()), noise.num_imfs()) << i;
+    for (size_t k = 0; k < modes.size(); ++k) {
+      EXPECT_EQ(modes[k], noise.imfs.col(static_cast<Eigen::Index>(k))) << i << " mode " << k + 1;
+    }
+  }
+}
+
 TEST_P(Decomposer, EveryStopRuleTerminatesWithinItsCap) {
-  for (StopRule rule : {StopRule::kRilling, StopRule::kSNumber, StopRule::kFixed, StopRule::kCauchySd}) {
+  for (StopRule rule :
+       {StopRule::kRilling, StopRule::kSNumber, StopRule::kFixed, StopRule::kCauchySd}) {
     DecompositionOptions o = Options(GetParam());
     o.sifting.stop_rule = rule;
     const Decomposition d = Decompose(Noisy(600, 6), o);

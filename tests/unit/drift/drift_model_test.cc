@@ -121,6 +121,34 @@ TEST(DriftModel, MsElmPredictModeBuildsGroupsThatSumToTheSignal) {
   EXPECT_LE((series.rowwise().sum() - log.rate).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// The white-noise level comes from the decomposition's own noise EMDs: the fit runs no
+// Monte-Carlo and equals, bit for bit, a fit given the Monte-Carlo level of the same seed.
+TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
+  const Log log = MakeLog(1500, 3);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  o.decomposition.ensemble_size = 20;
+  // ICEEMDAN decomposes the noise to full depth; BEEMDAN's bound may stop before the noise run
+  // does, and then SelectModes completes the level by the Monte-Carlo (selection_test).
+  o.decomposition.method = decomposition::Method::kIceemdan;
+  o.seed = 4;
+  ASSERT_EQ(selection::NoiseLevelCache::Global().Size(), 0u);
+  const DriftModel reused = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  EXPECT_EQ(selection::NoiseLevelCache::Global().Size(), 0u) << reused.selection_summary;
+  DriftOptions given = o;
+  selection::MonteCarloOptions mc = o.selection.monte_carlo;
+  mc.seed = o.seed;
+  given.selection.noise_level = std::make_shared<const selection::NoiseLevel>(
+      selection::ComputeNoiseLevel(1500, mc, o.selection.kde, o.selection.distance));
+  const DriftModel reference = FitDriftModel(log.rate, Eigen::VectorXd(), given);
+  EXPECT_EQ(reused.selection_summary, reference.selection_summary);
+  ASSERT_EQ(reused.sub_models.size(), reference.sub_models.size());
+  for (size_t g = 0; g < reused.sub_models.size(); ++g) {
+    EXPECT_EQ(reused.sub_models[g].imfs, reference.sub_models[g].imfs) << g;
+  }
+  EXPECT_EQ(PredictOneStep(reused, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
+            PredictOneStep(reference, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
+}
+
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   const Log log = MakeLog(900, 2);
   for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {

@@ -12,6 +12,7 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
+#include "gyrodrift/decomposition/decomposition.h"
 
 namespace gyrodrift::selection {
 namespace {
@@ -125,6 +126,97 @@ TEST(NoiseLevelCache, ConcurrentCallersShareOneComputation) {
   EXPECT_EQ(a.get(), b.get());
   EXPECT_EQ(a.get(), c.get());
   EXPECT_EQ(ca + cb + cc, 1);
+}
+
+// A slow sinusoid in white noise, decomposed by a CEEMDAN-family method with the Monte-Carlo's
+// realisation count.
+struct Decomposed {
+  Eigen::VectorXd x;
+  decomposition::Decomposition d;
+  std::shared_ptr<const NoiseLevel> level;
+  bool attached = false;
+};
+Decomposed DecomposeWithCollector(decomposition::DecompositionOptions o,
+                                  const MonteCarloOptions& mc) {
+  Decomposed out;
+  out.x.resize(kLength);
+  Rng(11, 0).FillNormal(out.x);
+  for (int t = 0; t < kLength; ++t) out.x[t] += 3.0 * std::sin(2 * kPi * t / 700.0);
+  NoiseLevelCollector collector(kLength, mc, {}, PdfDistance::kL2);
+  out.attached = collector.Attach(&o);
+  out.d = decomposition::Decompose(out.x, o);
+  out.level = collector.Level();
+  return out;
+}
+
+decomposition::DecompositionOptions FamilyRun(decomposition::Method method, int threads) {
+  decomposition::DecompositionOptions o;
+  o.method = method;
+  o.ensemble_size = 40;
+  o.seed = 5;
+  o.threads = threads;
+  return o;
+}
+
+TEST(NoiseLevelCollector, EqualsTheMonteCarloForTheModesTheDecompositionReached) {
+  const NoiseLevel mc = ComputeNoiseLevel(kLength, SmallRun(0, 5), {}, PdfDistance::kL2);
+  for (auto method : {decomposition::Method::kCeemdan, decomposition::Method::kIceemdan,
+                      decomposition::Method::kBeemdan}) {
+    const std::string name(decomposition::ToString(method));
+    for (int threads : {1, 2}) {
+      const Decomposed run = DecomposeWithCollector(FamilyRun(method, threads), SmallRun(0, 1));
+      ASSERT_TRUE(run.attached) << name;
+      ASSERT_TRUE(run.level) << name;
+      const NoiseLevel& level = *run.level;
+      EXPECT_TRUE(level.partial);
+      EXPECT_EQ(level.seed, 5u);  // the decomposition's seed, not the Monte-Carlo's
+      EXPECT_EQ(level.realisations, 40);
+      ASSERT_GE(level.level.size(), 3u) << name;
+      ASSERT_LE(level.level.size(), mc.level.size()) << name;
+      const size_t d = level.level.size();
+      EXPECT_TRUE(SameBits(level.level, {mc.level.begin(), mc.level.begin() + d})) << name;
+      EXPECT_TRUE(SameBits(level.median, {mc.median.begin(), mc.median.begin() + d})) << name;
+      EXPECT_EQ(level.realisations_with_mode,
+                std::vector<int>(mc.realisations_with_mode.begin(),
+                                 mc.realisations_with_mode.begin() + d))
+          << name;
+    }
+  }
+  // BEEMDAN with 2 noise-assisted stages reaches noise mode 2 only.
+  decomposition::DecompositionOptions bounded = FamilyRun(decomposition::Method::kBeemdan, 2);
+  bounded.beemdan_bound = decomposition::BeemdanBound::kFixedStages;
+  bounded.noise_stages = 2;
+  const Decomposed run = DecomposeWithCollector(bounded, SmallRun());
+  ASSERT_TRUE(run.level);
+  EXPECT_EQ(run.level->level.size(), 2u);
+}
+
+TEST(NoiseLevelCollector, StaysOutWhenTheNoiseIsNotTheMonteCarlos) {
+  using decomposition::Method;
+  auto refused = [](decomposition::DecompositionOptions o, const MonteCarloOptions& mc) {
+    const Decomposed run = DecomposeWithCollector(o, mc);
+    return !run.attached && !run.level;
+  };
+  EXPECT_TRUE(refused(FamilyRun(Method::kEemd, 2), SmallRun()));
+  EXPECT_TRUE(refused(FamilyRun(Method::kEmd, 2), SmallRun()));
+  decomposition::DecompositionOptions few = FamilyRun(Method::kIceemdan, 2);
+  few.ensemble_size = 39;
+  EXPECT_TRUE(refused(few, SmallRun()));
+  decomposition::DecompositionOptions snumber = FamilyRun(Method::kIceemdan, 2);
+  snumber.sifting.stop_rule = decomposition::StopRule::kSNumber;
+  EXPECT_TRUE(refused(snumber, SmallRun()));
+  MonteCarloOptions capped = SmallRun();
+  capped.max_imfs = 3;
+  EXPECT_TRUE(refused(FamilyRun(Method::kIceemdan, 2), capped));
+  decomposition::DecompositionOptions supplied = FamilyRun(Method::kIceemdan, 2);
+  Eigen::MatrixXd noise(kLength, 40);
+  for (int i = 0; i < 40; ++i) {
+    Eigen::VectorXd w(kLength);
+    Rng(5, static_cast<std::uint64_t>(i)).FillNormal(w);
+    noise.col(i) = w;
+  }
+  supplied.supplied_noise = std::make_shared<const Eigen::MatrixXd>(noise);
+  EXPECT_TRUE(refused(supplied, SmallRun()));
 }
 
 TEST(NoiseLevel, RejectsBadOptions) {

@@ -230,6 +230,38 @@ TEST(SelectModes, EdgeCaseNoiseFreeSignalAndNanLevel) {
   EXPECT_EQ(Members(r, GroupKind::kMixed), (std::vector<int>{3, 4, 5}));
 }
 
+TEST(SelectModes, PartialLevelFallsBackToTheMonteCarloOnlyWhenTheNoiseRunOutlastsIt) {
+  const Synthetic s = ThreeGroupCase();
+  auto partial = std::make_shared<NoiseLevel>(*FlatLevel(2));
+  partial->partial = true;
+  SelectionOptions options;
+  options.noise_level = partial;
+  const SelectionResult r = SelectModes(s.x, s.imfs, s.residue, options);
+  // Modes 1-2 pass the partial level, so mode 3 needs the Monte-Carlo's.
+  const auto full =
+      NoiseLevelCache::Global().Get(kN, options.monte_carlo, options.kde, options.distance);
+  ASSERT_EQ(r.noise_level.size(), 7u);
+  EXPECT_EQ(r.noise_level[0], 0.15);
+  EXPECT_EQ(r.noise_level[1], 0.15);
+  for (int k = 3; k <= 7; ++k) {
+    const double expected = full->LevelFor(k);
+    const double got = r.noise_level[static_cast<size_t>(k - 1)];
+    EXPECT_TRUE(got == expected || (std::isnan(got) && std::isnan(expected))) << k;
+  }
+  EXPECT_GE(r.k_noise, 2);
+  EXPECT_EQ(r.note.find("known for modes"), std::string::npos) << r.note;
+  ExpectValidPartition(r, s.imfs, s.residue);
+
+  // A level under which mode 2 fails ends the run inside the partial level: no Monte-Carlo,
+  // and the curve says where the level stops.
+  partial->level = {0.15, 1e-9};
+  const SelectionResult inside = SelectModes(s.x, s.imfs, s.residue, options);
+  EXPECT_EQ(inside.k_noise, 1);
+  EXPECT_FALSE(inside.noise_level_computed);
+  EXPECT_TRUE(std::isnan(inside.noise_level[2]));
+  EXPECT_NE(inside.note.find("known for modes 1..2"), std::string::npos) << inside.note;
+}
+
 TEST(SelectModes, PartitionForEveryCriterionDistanceAndShape) {
   for (int trial = 0; trial < 24; ++trial) {
     Rng rng(77, static_cast<std::uint64_t>(trial));
