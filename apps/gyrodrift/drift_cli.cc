@@ -36,7 +36,6 @@ std::string Columns(const io::CsvTable& table) {
 
 }  // namespace
 
-
 void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
   cmd->add_option("input", a->input, "CSV file with a header row")->required()->check(kInputFile);
   cmd->add_option("--target,-t", a->target, "column of the gyro output (name or 1-based index)")
@@ -60,6 +59,15 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
   a->rate_option = cmd->add_option("--rate-hz", a->rate_hz,
                                    "sample rate, Hz (default: from the median step of a time_s "
                                    "column, else 1)");
+  cmd->add_option("--thermal-features", a->thermal_features,
+                  "temperature inputs: auto (classic for poly, ladder otherwise) | ladder (rungs "
+                  "between first-order lags of T, the slowest lag, (T - 20)^2) | classic (T and "
+                  "its smoothed rate) | lag-bank (T, each lag and its rate); docs/drift.md 1.1")
+      ->capture_default_str();
+  cmd->add_option("--time-constants", a->time_constants_s,
+                  "time constants of the thermal lags, seconds, comma-separated (default "
+                  "60,300,900,1800,3600)")
+      ->delimiter(',');
   cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
       ->capture_default_str();
   cmd->add_option("--realisations", a->realisations,
@@ -99,6 +107,8 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
   }
   o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
   if (a.rate_option != nullptr && a.rate_option->count() > 0) o.features.rate_hz = a.rate_hz;
+  o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
+  if (!a.time_constants_s.empty()) o.features.time_constants_s = a.time_constants_s;
   o.Validate();
   return o;
 }

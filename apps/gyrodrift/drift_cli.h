@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
@@ -28,14 +29,16 @@ struct DriftArgs {
   CLI::Option* rate_option = nullptr;  // to tell "--rate-hz given" from the default
   int ensemble = 100;
   int realisations = 100;  // white-noise realisations of the selection's Monte-Carlo level
+  std::string thermal_features = "auto";  // drift::ThermalSet name
+  std::vector<double> time_constants_s;   // empty = the library default
   std::uint64_t seed = 1;
   int threads = 0;
   bool quiet = false;
 };
 
-
 // Adds input, --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
-// --ensemble, --realisations, --seed, --threads and --quiet to cmd.
+// --thermal-features, --time-constants, --ensemble, --realisations, --seed, --threads and
+// --quiet to cmd.
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args);
 
 // DriftOptions from the arguments (method = `method`), before any file is read; the sample rate

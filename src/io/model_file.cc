@@ -388,6 +388,11 @@ drift::DriftOptions ReadOptions(const Node& n) {
   o.features.use_temperature = f["use_temperature"].Bool();
   o.features.time_constants_s = f["time_constants_s"].Doubles();
   o.features.rate_hz = f["rate_hz"].Double();
+  // Files written before the feature set was stored were all fitted with "auto" (the CLI could
+  // not choose another), which is what a missing field means.
+  if (f.raw().contains("thermal_set")) {
+    o.features.thermal_set = f["thermal_set"].Enum(drift::ThermalSetFromString);
+  }
   o.learner = ReadLearnerOptions(n["learner"]);
   o.auto_lags = n["auto_lags"].Bool();
   o.lag_candidates = n["lag_candidates"].Ints();
@@ -487,7 +492,8 @@ nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
            {{"lags", f.lags},
             {"use_temperature", f.use_temperature},
             {"time_constants_s", Numbers(f.time_constants_s)},
-            {"rate_hz", Number(f.rate_hz)}}},
+            {"rate_hz", Number(f.rate_hz)},
+            {"thermal_set", drift::ToString(f.thermal_set)}}},
           {"learner", LearnerOptionsJson(o.learner)},
           {"auto_lags", o.auto_lags},
           {"lag_candidates", o.lag_candidates},

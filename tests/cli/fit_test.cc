@@ -129,6 +129,24 @@ TEST_F(FitCli, LagsHiddenAndRateOptions) {
   EXPECT_EQ(json["model"]["sub_models"][0]["learner"]["kind"], "poly");
 }
 
+TEST_F(FitCli, ThermalFeatureSetAndTimeConstantsAreStoredAndUsed) {
+  const std::string model = dir_ + "/m.json";
+  auto r =
+      Fit("-t rate_dph -T temperature_c --mode compensate -m poly --thermal-features "
+          "lag-bank --time-constants 120,600",
+          model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("5 inputs"), std::string::npos) << r.out;  // T, 2 lags, 2 rates
+  const auto json = nlohmann::json::parse(io::ReadTextFile(model));
+  EXPECT_EQ(json["options"]["features"]["thermal_set"], "lag-bank");
+  EXPECT_EQ(json["options"]["features"]["time_constants_s"], nlohmann::json({120.0, 600.0}));
+  const io::LoadedModel loaded = io::ReadModelFile(model);
+  EXPECT_EQ(loaded.model.options.features.thermal_set, drift::ThermalSet::kLagBank);
+  EXPECT_EQ(loaded.model.num_inputs(), 5);
+  r = test::RunCli("compensate '" + model + "' '" + input_ + "' -o '" + dir_ + "/c.csv'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST_F(FitCli, EveryBaselineFits) {
   for (const char* method : {"elm", "poly", "svr", "bp"}) {
     const std::string model = dir_ + "/" + method + ".json";
@@ -176,6 +194,18 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
        "realisations = 5"},
       {"negative rate", "fit %IN% -t rate_dph --mode predict --rate-hz -1", 2, "rate_hz"},
       {"negative seed", "fit %IN% -t rate_dph --mode predict --seed -1", 2, "seed"},
+      {"unknown feature set",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--thermal-features spline",
+       2, "thermal_set = 'spline'"},
+      {"zero time constant",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--time-constants 60,0",
+       2, "time constant (s) = 0"},
+      {"text time constant",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--time-constants 60,slow",
+       2, "--time-constants"},
       {"negative threads", "fit %IN% -t rate_dph --mode predict -j -2", 2, "threads"},
       {"nan target", "fit %DIR%/nan.csv -t rate_dph --mode predict", 3, "data row 3"},
       {"too short", "fit %DIR%/short.csv -t rate_dph --mode predict -m elm", 3, "at least 32"},
@@ -183,7 +213,8 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
   };
   const std::string out = dir_ + "/bad.json";
   for (const auto& c : cases) {
-    const auto r = test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
+    const auto r =
+        test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
   const auto r = Fit(ok, dir_ + "/no/such/dir/m.json");

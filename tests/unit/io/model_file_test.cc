@@ -179,6 +179,7 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.features.lags = 7;
   o.features.time_constants_s = {std::nextafter(60.0, 0.0), 1e6, 1.0};
   o.features.rate_hz = 1.0 / 7.0;
+  o.features.thermal_set = drift::ThermalSet::kLagBank;
   o.learner.elm.hidden_units = 12;
   o.learner.elm.activation = elm::Activation::kTanh;
   o.learner.elm.solver = elm::Solver::kQr;
@@ -208,6 +209,11 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   EXPECT_EQ(r.selection.monte_carlo.seed, 1ULL << 63);
   EXPECT_EQ(r.features.time_constants_s, o.features.time_constants_s);
   EXPECT_EQ(r.features.rate_hz, 1.0 / 7.0);
+  EXPECT_EQ(r.features.thermal_set, drift::ThermalSet::kLagBank);
+  // A file written before the feature set was stored means "auto".
+  json old_file = reparsed;
+  old_file["features"].erase("thermal_set");
+  EXPECT_EQ(DriftOptionsFromJson(old_file, "x").features.thermal_set, drift::ThermalSet::kAuto);
   EXPECT_TRUE(std::isinf(r.learner.elm.ridge_c));
   EXPECT_EQ(r.learner.elm.ridge_c_candidates, o.learner.elm.ridge_c_candidates);
   EXPECT_EQ(r.learner.bp_hidden, o.learner.bp_hidden);
