@@ -21,6 +21,7 @@ struct CompensateArgs {
   std::string model;
   std::string input;
   std::string output;
+  std::string truth;  // "" = none
   bool quiet = false;
 };
 
@@ -43,6 +44,8 @@ void Run(const CompensateArgs& a) {
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   const Eigen::VectorXd temperature = table.Column(loaded.info.temperature_column);
   const Eigen::VectorXd estimate = drift::EstimateDrift(model, temperature);
+  Eigen::VectorXd truth;
+  if (!a.truth.empty()) truth = table.Column(a.truth);
 
   std::vector<io::CsvColumn> columns;
   for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
@@ -67,13 +70,29 @@ void Run(const CompensateArgs& a) {
   sidecar["samples"] = y.size();
   sidecar["std_before"] = rms(y);
   sidecar["std_after"] = rms(compensated);
+  // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
+  // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
+  std::string truth_line;
+  if (truth.size() > 0) {
+    const double truth_rms = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
+    const double residual_rms =
+        std::sqrt((truth - estimate).squaredNorm() / static_cast<double>(truth.size()));
+    const double removed = truth_rms > 0.0 ? 100.0 * (1.0 - residual_rms / truth_rms) : NAN;
+    sidecar["truth"] = {{"column", ColumnName(table, a.truth)},
+                        {"rms", truth_rms},
+                        {"residual_rms", residual_rms},
+                        {"removed_percent", removed}};
+    truth_line =
+        fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({:.1f} % removed)\n",
+                    ColumnName(table, a.truth), truth_rms, residual_rms, removed);
+  }
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
     fmt::print(
-        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\nwrote {} and {}\n",
-        model.Summary(), loaded.info.target_column, rms(y), rms(compensated), y.size(), a.output,
-        SidecarPath(a.output));
+        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n{}wrote {} and {}\n",
+        model.Summary(), loaded.info.target_column, rms(y), rms(compensated), y.size(), truth_line,
+        a.output, SidecarPath(a.output));
   }
 }
 
@@ -90,6 +109,8 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       "writes out.csv: every column of test.csv, then drift_est (the model's drift estimate,\n"
       "from the temperature history only) and compensated (= target column - drift_est), one\n"
       "row per input row; out.csv.json records the model and the std before and after.\n"
+      "With --truth drift_dph (a simulated log) it also reports how much of the true drift's\n"
+      "RMS the estimate removes: 1 - RMS(truth - drift_est) / RMS(truth).\n"
       "test.csv needs the columns the model was trained with (here rate_dph and temperature_c).");
   cmd->add_option("model", args->model, "model file written by 'gyrodrift fit --mode compensate'")
       ->required()
@@ -99,6 +120,9 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       ->check(kInputFile);
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
+  cmd->add_option("--truth", args->truth,
+                  "column of the true drift (e.g. the simulator's drift_dph): also report the "
+                  "share of its RMS the estimate removes");
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

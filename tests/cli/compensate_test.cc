@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -82,6 +83,24 @@ TEST_F(CompensateCli, AddsTheEstimateAndTheCompensatedOutput) {
   EXPECT_EQ(json["command"], "compensate");
   EXPECT_EQ(json["model"]["temperature_column"], "temperature_c");
   EXPECT_LT(json["std_after"].get<double>(), json["std_before"].get<double>());
+  EXPECT_FALSE(json.contains("truth"));
+}
+
+TEST_F(CompensateCli, TruthColumnGivesTheShareOfTheDriftRemoved) {
+  const std::string out = Dir() + "/truth.csv";
+  const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                              "/test.csv' --truth drift_dph -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto table = io::CsvTable::Read(out);
+  const Eigen::VectorXd truth = table.Column("drift_dph");
+  const double removed = 100.0 * (1.0 - Rms(truth - table.Column("drift_est")) / Rms(truth));
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["truth"]["column"], "drift_dph");
+  EXPECT_NEAR(json["truth"]["removed_percent"].get<double>(), removed, 1e-9);
+  EXPECT_EQ(json["truth"]["rms"].get<double>(), Rms(truth));
+  char line[64];
+  std::snprintf(line, sizeof line, "(%.1f %% removed)", removed);
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out;
 }
 
 TEST_F(CompensateCli, RunsOnALogWithOnlyTheModelsColumns) {
@@ -128,6 +147,8 @@ TEST_F(CompensateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"target missing", "compensate %DIR%/ms.json %DIR%/no_rate.csv", 3,
        "model needs column 'rate_dph' (trained with --target rate_dph); "},
       {"nan temperature", "compensate %DIR%/ms.json %DIR%/nan.csv", 3, "data row 2"},
+      {"unknown truth column", "compensate %DIR%/ms.json %DIR%/test.csv --truth truth", 2,
+       "column 'truth' not found"},
       {"already compensated", "compensate %DIR%/ms.json %DIR%/twice.csv", 3,
        "already has a column 'drift_est'"},
   };
