@@ -5,17 +5,20 @@
 // models, tables and one self-contained HTML report to a folder. With --input: the same study on
 // a user's log (scored against the measured output; compensate mode by chronological split).
 #include <fmt/core.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <limits>
 #include <map>
-#include <optional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 #include <string>
 #include <vector>
@@ -79,22 +82,58 @@ double ParseDuration(const std::string& text) {
   ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
 }
 
+// "all" or a comma-separated list. A repeated method would give two model files of one name, and
+// the atomic writer would fail after renaming some of the set: refuse it before any work.
 std::vector<drift::Method> ParseMethods(const std::string& text) {
   if (text == "all") return drift::AllMethods();
   std::vector<drift::Method> methods;
   size_t start = 0;
   while (start <= text.size()) {
     const size_t comma = text.find(',', start);
-    const std::string name = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    methods.push_back(drift::MethodFromString(name));
+    std::string name =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    name.erase(0, name.find_first_not_of(' '));
+    name.erase(name.find_last_not_of(' ') + 1);
+    drift::Method m;
+    try {
+      m = drift::MethodFromString(name);
+    } catch (const UsageError& e) {
+      throw UsageError("--methods = '" + text + "': " + e.what());
+    }
+    if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
+      ThrowOption("--methods", "'" + text + "'", "a list without repeats");
+    }
+    methods.push_back(m);
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
   return methods;
 }
 
+// -o must name a folder that exists or can be created. Found out before the study, which takes
+// half a minute or more, rather than when the files are written.
+void CheckOutputFolder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path existing = fs::absolute(fs::path(dir), ec);
+  if (ec) throw IoError(dir + ": not a usable output folder (" + ec.message() + ")");
+  while (existing.has_relative_path() && !fs::exists(existing, ec)) {
+    existing = existing.parent_path();
+  }
+  if (!fs::is_directory(existing, ec)) {
+    throw IoError(dir + ": cannot create the output folder (" + existing.string() +
+                  " is not a folder)");
+  }
+  if (::access(existing.c_str(), W_OK) != 0) {
+    throw IoError(dir + ": cannot create the output folder (" + existing.string() + ": " +
+                  std::strerror(errno) + ")");
+  }
+}
+
+// NaN marks a cell with no value (no simulator setting for the minimum ADEV, a noise fit that
+// failed): a dash reads as "not applicable" where "nan" reads as a computation gone wrong.
 std::string Fmt(double v, int digits = 4) {
-  if (std::isnan(v)) return "nan";
+  if (std::isnan(v)) return "-";
   return fmt::format("{:.{}g}", v, digits);
 }
 
@@ -161,7 +200,7 @@ struct Study {
   std::string source;       // "simulation" or the input file
   std::string target_name;  // the analysed column
   std::string unit;         // of the target
-  std::string temperature_unit;
+  std::string temperature_name;  // the temperature column (what a saved model reads)
   double rate_hz = 1.0;
   std::string rate_how;
   // Run A (or the user's log) and, for a simulation, run B.
@@ -348,7 +387,8 @@ void CompensateSplit(const DemoArgs& a, const std::vector<drift::Method>& method
     drift::DriftOptions o = base;
     o.method = m;
     const drift::DriftModel model = drift::FitDriftModel(s.y, s.temperature, o);
-    io::ModelFileInfo info{s.target_name, "temperature", s.source, ""};
+    // gyrodrift compensate reads the temperature from the column named here.
+    io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, ""};
     s.model_files.push_back(
         {"models/" + std::string(drift::ToString(m)) + "_compensate.json", io::RenderModelFile(model, info)});
   }
@@ -627,7 +667,8 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     io::ReportFigure f;
     f.title = s.simulated ? "Run A: temperatures" : "Temperature channel";
     f.x_label = "time (h)";
-    f.y_label = "temperature (" + s.temperature_unit + ")";
+    // A user's temperature column may be in any unit (raw counts, for one): its name, not a unit.
+    f.y_label = s.simulated ? "temperature (degC)" : s.temperature_name;
     f.x = s.time_h;
     if (s.simulated) {
       f.series.push_back(Series("chamber", s.a.chamber_c));
@@ -841,8 +882,11 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
   report.AddHeading("6. Settings and timing");
   report.AddTable(s.settings_table.Report());
   report.AddTable(s.timing_table.Report());
-  report.AddParagraph("Everything plotted here is in the CSV files beside this report at full precision; the "
-                      "fitted compensation models are in models/*.json (gyrodrift compensate --model ...).");
+  report.AddParagraph(
+      "Everything plotted here is in the CSV files beside this report at full precision; the "
+      "fitted compensation models are in models/*.json (gyrodrift compensate "
+      "models/ms-elm_compensate.json LOG.csv -o OUT.csv; LOG.csv needs the columns " +
+      s.target_name + " and " + s.temperature_name + ").");
   return report.Render(assets);
 }
 
@@ -862,16 +906,25 @@ void Run(const DemoArgs& a) {
   if (a.ensemble < 1 || a.ensemble > 10000) ThrowOption("--ensemble", std::to_string(a.ensemble), "an integer in [1, 10000]");
   if (a.window < 16 || a.window > 1000000) ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
   if (a.threads < 0) ThrowOption("--threads", std::to_string(a.threads), "an integer >= 0");
+  // The library would name these "realisations" and "units"; the user typed the options.
+  if (a.realisations < 20 || a.realisations > 100000) {
+    ThrowOption("--realisations", std::to_string(a.realisations), "an integer in [20, 100000]");
+  }
+  try {
+    (void)allan::RateUnitFromString(a.units);
+  } catch (const UsageError&) {
+    ThrowOption("--units", a.units, "one of dph, dps, rads");
+  }
   const std::vector<drift::Method> methods = ParseMethods(a.methods);
-  (void)allan::RateUnitFromString(a.units);
   const double duration_s = ParseDuration(a.duration);
   if (user && a.rate_option->count() > 0) RequireInRange("--rate-hz", a.rate_hz, 1e-6, 1e6);
   {
     drift::DriftOptions probe = BaseOptions(a, 1.0);
     probe.Validate();
   }
-  // The report needs dygraphs; find out now, not after the work.
+  // The report needs dygraphs and the files need their folder; find out now, not after the work.
   const io::DygraphsAssets assets = io::LoadDygraphs();
+  CheckOutputFolder(a.output);
 
   Study s;
   s.simulated = !user;
@@ -900,7 +953,7 @@ void Run(const DemoArgs& a) {
     s.source = "simulation";
     s.target_name = "rate_dph";
     s.unit = "deg/h";
-    s.temperature_unit = "degC";
+    s.temperature_name = "temperature_c";
     s.rate_hz = so.rate_hz;
     s.rate_how = "simulated";
     s.y = s.a.rate_dph;
@@ -915,7 +968,7 @@ void Run(const DemoArgs& a) {
     s.source = a.input;
     s.target_name = table.header()[static_cast<size_t>(table.ResolveColumn(a.target))];
     s.unit = a.units == "dph" ? "deg/h" : a.units == "dps" ? "deg/s" : "rad/s";
-    s.temperature_unit = table.header()[static_cast<size_t>(table.ResolveColumn(a.temperature))];
+    s.temperature_name = table.header()[static_cast<size_t>(table.ResolveColumn(a.temperature))];
     if (a.rate_option->count() > 0) {
       s.rate_hz = a.rate_hz;
       s.rate_how = "given by --rate-hz";
@@ -1106,7 +1159,8 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "demo", "The whole study in one command: simulate, decompose, model, compensate, report.");
   cmd->footer(
       "Example:\n"
-      "  gyrodrift demo                       # simulated FOG, ~2-3 min on 2 cores -> ./gyrodrift-demo/\n"
+      "  gyrodrift demo                       # simulated FOG, about 30 s on 2 cores -> "
+      "./gyrodrift-demo/\n"
       "  gyrodrift demo -o /tmp/study\n"
       "  gyrodrift demo --input log.csv --target gyro_x --temperature temp --rate-hz 1\n"
       "Writes run_a.csv, run_b.csv (simulation), imfs.csv, selection.csv, predict_table.csv,\n"

@@ -115,14 +115,23 @@ TEST(DemoCli, UserLogStudy) {
   EXPECT_EQ(compensate, (std::set<std::string>{"ms-elm/paper", "ms-elm/causal", "elm/paper", "elm/causal",
                                                "poly/paper", "poly/causal"}));
   EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 6u);
-  const io::ReportCheck check = io::CheckReportHtml(io::ReadTextFile(work + "/out/report.html"));
+  const std::string html = io::ReadTextFile(work + "/out/report.html");
+  const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
+  // The saved models name the log's own columns, so `gyrodrift compensate` applies them to it.
+  const auto c = RunCli("compensate " + work + "/out/models/ms-elm_compensate.json " + work +
+                        "/log.csv -o " + work + "/compensated.csv --quiet");
+  EXPECT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_TRUE(io::CsvTable::Read(work + "/compensated.csv").HasColumn("compensated"));
+  EXPECT_EQ(html.find("compensate --model"), std::string::npos);  // no such option
 }
 
 TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
   const std::string dir = test::TempDir("demo_bad");
   const std::string csv = dir + "/tiny.csv";
   io::WriteFileAtomically(csv, "time_s,rate,temp\n1,0.1,20\n2,0.2,20\n3,0.1,21\n");
+  const std::string not_a_folder = dir + "/a_file";
+  io::WriteFileAtomically(not_a_folder, "x\n");
   struct Case {
     std::string args;
     int code;
@@ -138,8 +147,16 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo --ensemble 0", 2, "--ensemble"},
       {"demo --window 4", 2, "--window"},
       {"demo --methods ms-elm,nope", 2, "nope"},
+      // Two model files of one name: refused before the work, not half-written after it.
+      {"demo --methods elm,poly,elm -o " + dir + "/o", 2, "--methods"},
+      {"demo --units furlongs", 2, "--units"},
+      {"demo --realisations 3", 2, "--realisations"},
+      // Found out before the study (a full one takes half a minute), not when writing.
+      {"demo -o " + not_a_folder, 4, "not a folder"},
+      {"demo -o " + not_a_folder + "/sub", 4, "not a folder"},
       {"demo --input " + csv + " --target nope --temperature temp -o " + dir + "/o", 2, "nope"},
-      {"demo --input " + csv + " --target rate --temperature temp -o " + dir + "/o", 3, "at least 64"},
+      {"demo --input " + csv + " --target rate --temperature temp -o " + dir + "/o", 3,
+       "at least 64"},
   };
   for (const auto& c : cases) {
     const auto r = RunCli(c.args);
