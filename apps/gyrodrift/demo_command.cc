@@ -550,6 +550,20 @@ io::ReportSeries Reference(std::string name, Eigen::VectorXd v) {
   return s;
 }
 
+// A user's measured output is as noisy as the predictions: drawn thick and black on top it hides
+// them, so it goes first (underneath) in light grey.
+io::ReportSeries Measured(std::string name, Eigen::VectorXd v) {
+  io::ReportSeries s = Series(std::move(name), std::move(v));
+  s.color = "#aaaaaa";
+  return s;
+}
+
+// The paper and causal rows of a single model are one computation (it never decomposes): a figure
+// draws one of them.
+bool DuplicateRow(drift::Method method, const std::string& protocol) {
+  return !drift::UsesDecomposition(method) && protocol == drift::ToString(drift::Protocol::kCausal);
+}
+
 // Trailing mean over w samples (the first w - 1 use what exists): shows the slow structure of a
 // residual that sample-to-sample noise hides.
 Eigen::VectorXd TrailingMean(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Index w) {
@@ -614,12 +628,19 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
     f.series.push_back(Series("simulator noise model (exact)", v, true));
     f.series.back().color = "#000000";
   }
-  f.caption = std::string("Log-log; shaded: 68.3 % chi-square confidence bands; dashed: the fitted IEEE 952 "
-              "models (table below)") +
-              (s.simulated ? " and the exact Allan deviation of the simulated noise" : "") +
-              ". The raw curve rises at long tau because the thermal drift dominates there; after "
-              "compensation it should come down towards the noise-only curve. Where the compensated "
-              "curve stays above it, the residual drift is what remains.";
+  f.caption =
+      std::string(
+          "Log-log; shaded: 68.3 % chi-square confidence bands; dashed: the fitted IEEE 952 "
+          "models (table below)") +
+      (s.simulated ? " and the exact Allan deviation of the simulated noise" : "") +
+      ". The raw curve rises at long tau because the thermal drift dominates there; after "
+      "compensation it should come down" +
+      (s.simulated
+           ? std::string(" towards the noise-only curve. Where the compensated curve stays above "
+                         "it, the residual drift is what remains.")
+           : std::string(". There is no noise-only curve for a measured log: a compensated curve "
+                         "at or above the raw one at long tau means the model removed nothing "
+                         "there, or added error."));
   report.AddFigure(f);
 }
 
@@ -708,6 +729,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "IMF index k";
     f.y_label = "L2 distance between densities";
     f.draw_points = true;
+    f.integer_x = true;
     f.x.resize(k_count);
     for (int k = 0; k < k_count; ++k) f.x[k] = k + 1;
     auto vec = [&](const std::vector<double>& v) {
@@ -731,6 +753,8 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
                 std::to_string(s.selection.k_star) +
                 " ends the mixed group; the rest plus the residue is the drift group. Look for the peak of "
                 "D_k: below it the IMFs look like noise, above it like the signal.";
+    // The rule above in general; the edge case this record met (no mixed group, say) in particular.
+    if (!s.selection.note.empty()) f.caption += " Here: " + s.selection.note + ".";
     report.AddFigure(f);
   }
   {
@@ -739,6 +763,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "IMF index k";
     f.y_label = "log2 energy";
     f.draw_points = true;
+    f.integer_x = true;
     f.x.resize(k_count);
     Eigen::VectorXd e(k_count), band(k_count);
     for (int k = 0; k < k_count; ++k) {
@@ -750,8 +775,15 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     }
     f.series.push_back(Series("log2 energy of IMF k", e));
     f.series.push_back(Series("99 % white-noise band, upper", band, true));
-    f.caption = "White noise gives IMF energies that halve with each k (Flandrin et al. 2004). IMFs above the "
-                "dashed band carry more than noise: that is where the thermal drift lives.";
+    int above = 0;
+    for (int k = 0; k < k_count; ++k) above += e[k] > band[k];  // NaN compares false
+    f.caption =
+        "White noise gives IMF energies that halve with each k (Flandrin et al. 2004). IMFs above "
+        "the dashed band carry more than noise: that is where the thermal drift lives." +
+        std::string(above == 0
+                        ? " Here no IMF rises above the band: by energy alone, every IMF could be "
+                          "noise, and the drift hides in the slowest ones and the residue."
+                        : "");
     report.AddFigure(f);
   }
   {
@@ -760,11 +792,32 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = s.time_h;
-    for (const auto& g : s.selection.groups) f.series.push_back(Series(std::string(sel::ToString(g.kind)), g.series));
-    if (s.simulated) f.series.push_back(Series("true drift", s.truth, true));
-    f.caption = s.simulated ? "The drift group should follow the true drift (dashed); the noise group should "
-                              "look like the white noise. MS-ELM fits one ELM to each."
-                            : "MS-ELM fits one ELM to each of these series and sums the outputs.";
+    for (const auto& g : s.selection.groups) {
+      f.series.push_back(Series(std::string(sel::ToString(g.kind)), g.series));
+      // A user's log carries its sensor bias in the drift group, which would flatten the other
+      // groups to a line on a shared axis.
+      if (!s.simulated && g.kind == sel::GroupKind::kDrift) f.series.back().right_axis = true;
+    }
+    if (!s.simulated) f.y2_label = "drift group (" + s.unit + ", right axis)";
+    if (s.simulated) {
+      // Thick and dashed: a thin line of its own would vanish in the noise group's band.
+      f.series.push_back(Reference("true drift", s.truth));
+      f.series.back().dashed = true;
+    }
+    const sel::ModeGroup* drift_group = s.selection.Group(sel::GroupKind::kDrift);
+    const bool residue_only = drift_group && drift_group->imfs.empty();
+    f.caption =
+        s.simulated
+            ? "The drift group should follow the true drift (thick dashed); the noise group "
+              "should look like the white noise. MS-ELM fits one ELM to each."
+            : "MS-ELM fits one ELM to each of these series and sums the outputs. The drift "
+              "group is on the right axis (it carries the sensor's bias).";
+    if (residue_only) {
+      f.caption +=
+          " Here the drift group is the residue alone: whatever slow structure the residue misses "
+          "(compare the last IMFs below with the temperature) is in the " +
+          std::string(s.selection.Group(sel::GroupKind::kMixed) ? "mixed" : "noise") + " group.";
+    }
     report.AddFigure(f);
   }
   for (int k = 0; k < k_count; ++k) {
@@ -775,8 +828,21 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x = s.time_h;
     f.height_px = 150;
     f.series.push_back(Series("imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)));
-    f.caption = "Plotted as min/max per bucket of " +
-                std::to_string(std::max<Eigen::Index>(1, s.time_h.size() / 2000)) + " samples.";
+    const std::string group = GroupOf(s.selection, k + 1);
+    f.caption =
+        group == "noise"
+            ? "Noise group: should look like noise of steady amplitude, with no trace of the "
+              "temperature programme."
+        : group == "mixed"
+            ? "Mixed group: noise with slower structure in it; look for swings that line "
+              "up with the temperature changes."
+            : "Drift group: slow structure that should follow the temperature history.";
+    // Only a series longer than the plotted rows is decimated (io::DecimateMinMax).
+    const Eigen::Index n = s.time_h.size();
+    if (n > f.max_points) {
+      f.caption += " Plotted as the min and max of each run of " +
+                   Fmt(static_cast<double>(n) / (f.max_points / 2), 3) + " samples.";
+    }
     report.AddFigure(f);
   }
   {
@@ -787,7 +853,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x = s.time_h;
     f.height_px = 150;
     f.series.push_back(Series("residue", s.decomposition.residue));
-    f.caption = "The monotone trend left after the last IMF (part of the drift group).";
+    f.caption = "The slow trend left after the last IMF (part of the drift group).";
     report.AddFigure(f);
   }
 
@@ -802,6 +868,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.y_label = s.unit;
     f.x = test_h;
     // MS-ELM under both protocols and the best single model; every row is in predict_estimates.csv.
+    if (!s.simulated) f.series.push_back(Measured("measured output", s.predict.reference));
     const drift::EvaluationRow* best = nullptr;
     for (const auto& r : s.predict.rows) {
       if (r.method == drift::Method::kMsElm) {
@@ -811,12 +878,13 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
       }
     }
     if (best) f.series.push_back(Series(std::string(drift::ToString(best->method)) + " (best single model)", best->estimate));
-    f.series.push_back(Reference(s.simulated ? "true drift" : "measured output", s.predict.reference));
-    f.caption = "Each model predicts the next output sample from the previous ones (MS-ELM under both "
-                "protocols and the best single model; every method is in predict_estimates.csv). Under the "
-                "paper protocol the sub-series were decomposed with the future in view. Predictions of a "
-                "noisy output are noisy: zoom into a few minutes to compare them with the thick black "
-                "reference.";
+    if (s.simulated) f.series.push_back(Reference("true drift", s.predict.reference));
+    f.caption =
+        "Each model predicts the next output sample from the previous ones (MS-ELM under both "
+        "protocols and the best single model; every method is in predict_estimates.csv). Under the "
+        "paper protocol the sub-series were decomposed with the future in view. Predictions of a "
+        "noisy output are noisy: zoom into a few minutes to compare them with the " +
+        std::string(s.simulated ? "thick black true drift." : "grey measured output they predict.");
     report.AddFigure(f);
   }
   {
@@ -850,13 +918,22 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = s.comp_time_h;
+    if (!s.simulated) f.series.push_back(Measured("measured output", s.comp_reference));
     for (const auto& r : s.compensate) {
-      f.series.push_back(Series(std::string(drift::ToString(r.method)) +
-                                    (s.simulated ? "" : " " + r.protocol), r.estimate));
+      if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
+      const bool both = !s.simulated && drift::UsesDecomposition(r.method);
+      f.series.push_back(Series(
+          std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""), r.estimate));
     }
-    f.series.push_back(Reference(s.simulated ? "true drift (run B)" : "measured output", s.comp_reference));
-    f.caption = "Only the temperature channel reaches these models, as on a navigation computer. A good "
-                "model tracks the drift through ramps it was not trained on.";
+    if (s.simulated) f.series.push_back(Reference("true drift (run B)", s.comp_reference));
+    f.caption =
+        s.simulated
+            ? "Only the temperature channel reaches these models, as on a navigation computer. A "
+              "good model tracks the thick black true drift through ramps it was not trained on."
+            : "Only the temperature channel reaches these models, as on a navigation computer. A "
+              "good model runs through the middle of the grey measured output over the test "
+              "block, which it never saw. Single models are drawn once (the same under both "
+              "protocols).";
     report.AddFigure(f);
   }
   {
@@ -866,11 +943,19 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.y_label = s.unit;
     f.x = s.comp_time_h;
     for (const auto& r : s.compensate) {
-      f.series.push_back(Series(std::string(drift::ToString(r.method)) +
-                                    (s.simulated ? "" : " " + r.protocol), s.comp_reference - r.estimate));
+      if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
+      const bool both = !s.simulated && drift::UsesDecomposition(r.method);
+      f.series.push_back(
+          Series(std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""),
+                 s.comp_reference - r.estimate));
     }
-    f.caption = "What is left after compensation. Flat near zero is good; spikes at the ramps are the "
-                "Shupe part the temperature history did not explain.";
+    f.caption =
+        s.simulated
+            ? "What is left after compensation. Flat near zero is good; spikes at the ramps are "
+              "the Shupe part the temperature history did not explain."
+            : "The measured output minus the estimate, noise included. A band centred on zero "
+              "is good; a trend or a step is drift the temperature history did not explain, or "
+              "a bias the model added.";
     report.AddFigure(f);
   }
 
@@ -1052,8 +1137,17 @@ void Run(const DemoArgs& a) {
   if (s.simulated) {
     settings.Add({"duration, rate", Fmt(duration_s / 3600.0) + " h per run at 1 Hz (" +
                                         std::to_string(s.a.samples) + " samples)"});
+  } else {
+    // The rate sets every time axis and the thermal time constants: say where it came from.
+    settings.Add({"columns", "output " + s.target_name + " (" + s.unit + "), temperature " +
+                                 s.temperature_name});
+    settings.Add({"samples, rate", std::to_string(s.y.size()) + " samples at " + Fmt(s.rate_hz) +
+                                       " Hz (" + s.rate_how + "), " +
+                                       Fmt(s.time_h[s.time_h.size() - 1]) + " h"});
   }
-  settings.Add({"seed", std::to_string(a.seed) + (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)" : "")});
+  settings.Add({"seed", std::to_string(a.seed) +
+                            (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)"
+                                         : " (decomposition and learners)")});
   settings.Add({"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) +
                                      " (also in each causal window), noise 0.2, energy-band bound"});
   settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " + std::to_string(a.realisations) +

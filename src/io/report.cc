@@ -69,7 +69,8 @@ void AppendArray(std::string& out, const Eigen::Ref<const Eigen::VectorXd>& v) {
 
 bool LooksNumeric(const std::string& cell) {
   if (cell.empty()) return false;
-  if (cell == "nan" || cell == "inf" || cell == "-inf") return true;
+  // "-" is an empty numeric cell (no value): aligned with the numbers of its column.
+  if (cell == "-" || cell == "nan" || cell == "inf" || cell == "-inf") return true;
   char* end = nullptr;
   std::strtod(cell.c_str(), &end);
   return end == cell.c_str() + cell.size();
@@ -124,14 +125,30 @@ constexpr std::string_view kPlotScript = R"JS(
     });
     var right = f.series.some(function (s) { return s.right; });
     var shades = f.shades;
+    var target = document.getElementById(blocks[b].dataset.target);
+    // At dygraphs' 30 px per label a short panel (the IMFs) gets one y tick and no scale; labels
+    // such as -0.0725 or 0.00007 need more than its 50 px, else they run into the axis title.
+    var yAxis = { axisLabelWidth: 64, pixelsPerLabel: target.clientHeight < 200 ? 16 : 30 };
+    var xAxis = { logscale: f.logx };
+    if (f.intx) {
+      xAxis.ticker = function (min, max) {
+        var ticks = [];
+        for (var v = Math.ceil(min); v <= max; ++v) ticks.push({ v: v, label: String(v) });
+        return ticks;
+      };
+    }
+    var axes = { x: xAxis, y: yAxis };
+    if (right) {
+      axes.y2 = { independentTicks: true, axisLabelWidth: yAxis.axisLabelWidth,
+                  pixelsPerLabel: yAxis.pixelsPerLabel };
+    }
     var colours = ['rgba(255,200,0,0.15)', 'rgba(0,150,255,0.12)', 'rgba(0,200,100,0.12)',
                    'rgba(200,0,200,0.10)'];
-    new Dygraph(document.getElementById(blocks[b].dataset.target), rows, {
+    new Dygraph(target, rows, {
       labels: [f.xlabel].concat(f.series.map(function (s) { return s.name; })),
       xlabel: f.xlabel, ylabel: f.ylabel,
       customBars: bars, logscale: f.logy,
-      axes: right ? { x: { logscale: f.logx }, y2: { independentTicks: true } }
-                  : { x: { logscale: f.logx } },
+      axes: axes, xRangePad: f.intx ? 12 : 0,
       y2label: right ? f.y2label : undefined,
       drawPoints: f.points, pointSize: 2.5,
       series: seriesOptions,
@@ -292,10 +309,12 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
   const Decimated d = DecimateMinMax(f.x, values, lower, upper, f.max_points);
 
   const std::string id = "fig" + std::to_string(++figures_);
-  std::string json = "{\"title\":" + JsonString(f.title) + ",\"xlabel\":" + JsonString(f.x_label) +
-                     ",\"ylabel\":" + JsonString(f.y_label) + ",\"y2label\":" + JsonString(f.y2_label) + ",\"logx\":" +
-                     (f.log_x ? "true" : "false") + ",\"logy\":" + (f.log_y ? "true" : "false") +
-                     ",\"points\":" + (f.draw_points ? "true" : "false") + ",\"x\":";
+  std::string json =
+      "{\"title\":" + JsonString(f.title) + ",\"xlabel\":" + JsonString(f.x_label) +
+      ",\"ylabel\":" + JsonString(f.y_label) + ",\"y2label\":" + JsonString(f.y2_label) +
+      ",\"logx\":" + (f.log_x ? "true" : "false") + ",\"logy\":" + (f.log_y ? "true" : "false") +
+      ",\"points\":" + (f.draw_points ? "true" : "false") +
+      ",\"intx\":" + (f.integer_x ? "true" : "false") + ",\"x\":";
   AppendArray(json, d.x);
   json += ",\"series\":[";
   for (Eigen::Index c = 0; c < cols; ++c) {

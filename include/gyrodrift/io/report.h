@@ -63,6 +63,8 @@ struct ReportFigure {
   std::vector<ReportSeries> series;
   bool log_x = false, log_y = false;
   bool draw_points = false;  // mark every point (short curves such as per-IMF statistics)
+  // x holds indices (IMF k): ticks at the integers only, and a margin so the end points show.
+  bool integer_x = false;
   std::vector<ReportShade> shades;
   // Plotted rows after decimation, in [16, 1e6]. Default 4000.
   int max_points = 4000;
