@@ -1,10 +1,12 @@
 #include "progress.h"
 
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numeric>
 
 namespace gyrodrift::cli {
@@ -76,7 +78,11 @@ void ProgressBar::DrawLocked() {
     remaining = std::max(
         0.0, remaining_at_report_ - std::chrono::duration<double>(now - last_report_).count());
   }
-  std::string line = Format(fraction_, label_, elapsed, remaining, 24);
+  winsize size{};
+  const int columns =
+      ::ioctl(STDERR_FILENO, TIOCGWINSZ, &size) == 0 && size.ws_col > 0 ? size.ws_col : 80;
+  // One column short of the width: a line that fills the last column wraps on some terminals.
+  std::string line = Format(fraction_, label_, elapsed, remaining, 24, columns - 1);
   const size_t width = line.size();
   if (width < drawn_width_) line.append(drawn_width_ - width, ' ');
   drawn_width_ = width;
@@ -125,15 +131,27 @@ std::string ProgressBar::FormatSeconds(double seconds) {
 }
 
 std::string ProgressBar::Format(double fraction, const std::string& label, double elapsed_s,
-                                double remaining_s, int width) {
+                                double remaining_s, int width, int max_columns) {
   fraction = std::clamp(fraction, 0.0, 1.0);
   const int filled = static_cast<int>(std::floor(fraction * width));
   std::string bar = "[" + std::string(static_cast<size_t>(filled), '#') +
                     std::string(static_cast<size_t>(width - filled), '-') + "]";
   char percent[16];
   std::snprintf(percent, sizeof(percent), "%4d%%", static_cast<int>(std::floor(fraction * 100.0)));
-  std::string text = bar + percent + "  " + label + "  elapsed " + FormatSeconds(elapsed_s) +
-                     "  left " + (remaining_s < 0.0 ? std::string("?") : FormatSeconds(remaining_s));
+  const std::string times = "  elapsed " + FormatSeconds(elapsed_s) + "  left " +
+                            (remaining_s < 0.0 ? std::string("?") : FormatSeconds(remaining_s));
+  std::string shown = label;
+  if (max_columns > 0) {
+    const long room = static_cast<long>(max_columns) -
+                      static_cast<long>(bar.size() + std::strlen(percent) + 2 + times.size());
+    if (static_cast<long>(shown.size()) > room) {
+      shown = room >= 4 ? shown.substr(0, static_cast<size_t>(room - 3)) + "..." : "";
+    }
+  }
+  std::string text = bar + percent + "  " + shown + times;
+  if (max_columns > 0 && static_cast<long>(text.size()) > max_columns) {
+    text.resize(static_cast<size_t>(std::max(max_columns, 1)));
+  }
   return text;
 }
 

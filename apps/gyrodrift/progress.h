@@ -38,10 +38,11 @@ class ProgressBar {
   bool shown() const { return enabled_; }
   double elapsed_s() const;
 
-  // Text of the bar for a fraction, elapsed and remaining time (remaining < 0: unknown).
-  // Exposed for tests; no terminal needed.
+  // Text of the bar for a fraction, elapsed and remaining time (remaining < 0: unknown), at
+  // most max_columns characters (0 = no limit): a long label is shortened with "..." so the
+  // line never wraps, which would leave a trail of half-erased lines.
   static std::string Format(double fraction, const std::string& label, double elapsed_s,
-                            double remaining_s, int width);
+                            double remaining_s, int width, int max_columns = 0);
   // "45s", "3m05s", "1h02m".
   static std::string FormatSeconds(double seconds);
 

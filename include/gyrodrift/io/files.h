@@ -14,8 +14,10 @@ namespace gyrodrift::io {
 // Throws IoError naming the path when the file cannot be read.
 std::string ReadTextFile(const std::string& path);
 
-// Writes each (path, contents) atomically as a set. Throws IoError naming the path that failed;
-// then no target is created or changed.
+// Writes each (path, contents) atomically as a set: every file is written to a temporary beside
+// its target, then renamed into place; existing targets are moved aside first and put back if a
+// later rename fails. Throws IoError naming the path that failed (also for a path named twice or
+// a directory target); then no target is created or changed.
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
@@ -72,6 +73,20 @@ TEST(Files, FailedSetLeavesNothingBehind) {
   EXPECT_THROW(WriteFilesAtomically({{dir + "/ok.txt", "x"}, {dir + "/missing/dir/f.txt", "y"}}),
                IoError);
   EXPECT_FALSE(test::FileExists(dir + "/ok.txt"));
+  // A directory among the targets or a target named twice: refused before anything is written,
+  // and existing files keep their contents.
+  WriteFileAtomically(dir + "/old.txt", "old");
+  std::filesystem::create_directory(dir + "/sub");
+  EXPECT_THROW(WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/sub", "z"}}), IoError);
+  EXPECT_THROW(WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/./old.txt", "z"}}),
+               IoError);
+  EXPECT_EQ(ReadTextFile(dir + "/old.txt"), "old");
+  // A set that succeeds replaces existing files and leaves no temporary or backup behind.
+  WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/other.txt", "o"}});
+  EXPECT_EQ(ReadTextFile(dir + "/old.txt"), "new");
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 3);  // old.txt, other.txt, sub
 }
 
 }  // namespace
