@@ -119,6 +119,8 @@ void Run(const AllanArgs& a) {
 
   const io::CsvTable table = io::CsvTable::Read(a.input);
   const Eigen::VectorXd data = table.Column(a.column);
+  RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
+                       "its Allan deviation is zero at every tau (a logging fault?)");
   const al::AllanResult r = al::Compute(data, o);
 
   // Noise terms need an Allan-variance curve; for the other estimators fit an OADEV on the same

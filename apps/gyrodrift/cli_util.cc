@@ -1,10 +1,14 @@
 #include "cli_util.h"
 
 #include <sys/stat.h>
-#include <charconv>
-#include <cstdint>
 #include <unistd.h>
 
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <regex>
+
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/version.h"
 
 namespace gyrodrift::cli {
@@ -35,5 +39,24 @@ nlohmann::json SidecarHeader(const std::string& command) {
 }
 
 bool IsTerminal() { return ::isatty(STDERR_FILENO) != 0; }
+
+std::string ColumnName(const io::CsvTable& table, const std::string& spec) {
+  return table.header()[static_cast<size_t>(table.ResolveColumn(spec))];
+}
+
+double ParseDuration(const std::string& text) {
+  static const std::regex kPattern(
+      R"(^\s*([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\s*(s|min|h)?\s*$)");
+  std::smatch m;
+  if (std::regex_match(text, m, kPattern)) {
+    const std::string number = m[1].str() + m[3].str();
+    double value = 0.0;
+    const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
+    const std::string unit = m[4].str();
+    const double seconds = unit == "h" ? value * 3600.0 : unit == "min" ? value * 60.0 : value;
+    if (ec == std::errc() && seconds > 0.0 && std::isfinite(seconds)) return seconds;
+  }
+  ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
+}
 
 }  // namespace gyrodrift::cli

@@ -27,4 +27,11 @@ nlohmann::json SidecarHeader(const std::string& command);
 // True when stdout or stderr is a terminal and progress may be shown.
 bool IsTerminal();
 
+// --duration text: "30s", "10min", "8h", "1.5h", "3600" (seconds), "1e4s". Anything else, or a
+// value that is not positive and finite, is a UsageError naming --duration.
+double ParseDuration(const std::string& text);
+
+// Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
+std::string ColumnName(const io::CsvTable& table, const std::string& spec);
+
 }  // namespace gyrodrift::cli

@@ -7,11 +7,12 @@
 
 #include "cli_util.h"
 #include "command.h"
-#include "progress.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
+#include "progress.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -87,6 +88,8 @@ void Run(const DecomposeArgs& a) {
 
   const io::CsvTable table = io::CsvTable::Read(a.input);
   const Eigen::VectorXd x = table.Column(a.column);
+  RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", x,
+                       "it has no oscillation to decompose");
   if (!a.noise_file.empty()) {
     if (o.method == dec::Method::kEmd) {
       throw UsageError("--noise-file = " + a.noise_file + ": must not be given with --method emd");
@@ -130,7 +133,8 @@ void Run(const DecomposeArgs& a) {
   };
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
-  if (!a.quiet) fmt::print("{}\nwrote {} and {}\n", d.report.Summary(), a.output, SidecarPath(a.output));
+  if (!a.quiet)
+    fmt::print("{}\nwrote {} and {}\n", d.report.Summary(), a.output, SidecarPath(a.output));
 }
 
 const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
@@ -145,7 +149,9 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
       "option, the seed and the report: sifts per IMF, noise-assisted stages and why they ended).\n"
       "Defaults follow Rilling & Flandrin's emd.m (stop 0.05/0.5/0.05, 2000 sifts) and\n"
       "Colominas et al. 2014 (eps 0.2); libeemd's rule is --stop snumber (S = 4, 50 sifts).");
-  cmd->add_option("input", args->input, "CSV file with a header row")->required()->check(kInputFile);
+  cmd->add_option("input", args->input, "CSV file with a header row")
+      ->required()
+      ->check(kInputFile);
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();

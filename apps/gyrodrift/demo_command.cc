@@ -65,21 +65,10 @@ struct DemoArgs {
   bool quiet = false;
 };
 
+constexpr double kMinDurationS = 2 * 3600.0;
+
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-// "30s", "10min", "8h", "1.5h", "3600": seconds.
-double ParseDuration(const std::string& text) {
-  static const std::regex kPattern(R"(^\s*([0-9]+(\.[0-9]*)?|\.[0-9]+)\s*(s|min|h)?\s*$)");
-  std::smatch m;
-  if (std::regex_match(text, m, kPattern)) {
-    const double value = std::stod(m[1].str());
-    const std::string unit = m[3].str();
-    const double seconds = unit == "h" ? value * 3600.0 : unit == "min" ? value * 60.0 : value;
-    if (seconds > 0.0 && std::isfinite(seconds)) return seconds;
-  }
-  ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
 }
 
 // "all" or a comma-separated list. A repeated method would give two model files of one name, and
@@ -151,8 +140,8 @@ struct Table {
     double value = std::numeric_limits<double>::quiet_NaN();
     bool numeric = false;
     int digits = 4;
-    Cell(std::string t) : text(std::move(t)) {}              // NOLINT: cells read naturally
-    Cell(const char* t) : text(t) {}                         // NOLINT
+    Cell(std::string t) : text(std::move(t)) {}  // NOLINT: cells read naturally
+    Cell(const char* t) : text(t) {}             // NOLINT
     Cell(double v, int d = 4) : value(v), numeric(true), digits(d) {}  // NOLINT
   };
   void Add(const std::vector<Cell>& cells) {
@@ -183,7 +172,8 @@ struct Table {
     auto line = [&](const std::vector<std::string>& cells) {
       std::string out = " ";
       for (size_t i = 0; i < cells.size(); ++i) {
-        out += i < 2 ? fmt::format(" {:<{}}", cells[i], width[i]) : fmt::format(" {:>{}}", cells[i], width[i]);
+        out += i < 2 ? fmt::format(" {:<{}}", cells[i], width[i])
+                     : fmt::format(" {:>{}}", cells[i], width[i]);
       }
       return out + "\n";
     };
@@ -197,9 +187,9 @@ struct Table {
 // Everything the study produced, for the files and the report.
 struct Study {
   bool simulated = false;
-  std::string source;       // "simulation" or the input file
-  std::string target_name;  // the analysed column
-  std::string unit;         // of the target
+  std::string source;            // "simulation" or the input file
+  std::string target_name;       // the analysed column
+  std::string unit;              // of the target
   std::string temperature_name;  // the temperature column (what a saved model reads)
   double rate_hz = 1.0;
   std::string rate_how;
@@ -238,9 +228,9 @@ struct Study {
 // Evaluate reports the share of its trials done; the trials differ in cost by orders of magnitude
 // (a causal MS-ELM trial decomposes one window per test sample), so the bar maps the trial index
 // to a share of the expected cost instead. Weights: measured shares of the default demo.
-std::function<void(double, const std::string&)> TrialProgress(ProgressBar& bar,
-                                                              const std::vector<drift::Method>& methods,
-                                                              drift::Mode mode, const std::string& prefix) {
+std::function<void(double, const std::string&)> TrialProgress(
+    ProgressBar& bar, const std::vector<drift::Method>& methods, drift::Mode mode,
+    const std::string& prefix) {
   const std::vector<drift::Protocol> protocols{drift::Protocol::kPaper, drift::Protocol::kCausal};
   std::vector<double> cumulative{0.0};
   for (drift::Method m : methods) {
@@ -256,7 +246,8 @@ std::function<void(double, const std::string&)> TrialProgress(ProgressBar& bar,
   }
   return [&bar, cumulative, prefix](double fraction, const std::string& label) {
     const double trials = static_cast<double>(cumulative.size() - 1);
-    const size_t i = std::min(cumulative.size() - 1, static_cast<size_t>(std::lround(fraction * trials)));
+    const size_t i =
+        std::min(cumulative.size() - 1, static_cast<size_t>(std::lround(fraction * trials)));
     bar.Update(cumulative[i] / cumulative.back(), prefix + label);
   };
 }
@@ -303,8 +294,13 @@ void FillPredictTable(Study& s) {
               "the same computation under both.";
   t.header = {"method", "protocol", "rmse", "mae", "max_abs", "train_s", "predict_s"};
   for (const auto& r : s.predict.rows) {
-    t.Add({std::string(drift::ToString(r.method)), std::string(drift::ToString(r.protocol)), r.rmse,
-           r.mae, r.max_abs, {r.train_s, 3}, {r.predict_s, 3}});
+    t.Add({std::string(drift::ToString(r.method)),
+           std::string(drift::ToString(r.protocol)),
+           r.rmse,
+           r.mae,
+           r.max_abs,
+           {r.train_s, 3},
+           {r.predict_s, 3}});
   }
 }
 
@@ -312,18 +308,26 @@ void FillCompensateTable(Study& s) {
   Table& t = s.compensate_table;
   t.title = s.simulated ? "Compensate mode: trained on run A (chamber), tested on run B (chamber-b)"
                         : "Compensate mode: chronological split (train first 70 %, test last 30 %)";
-  t.caption = std::string("Drift estimated from temperature only; error = ") +
-              (s.simulated ? "true drift of run B - estimate; removed = 1 - RMS(error) / RMS(true drift)"
-                           : "measured output - estimate on the test block; removed = 1 - RMS(error) / "
-                             "RMS(output - its mean), the share of the output's variation explained") +
-              " (negative: the estimate adds more error than it removes). " +
-              (s.simulated ? "The model is fitted on run A alone and sees only run B's temperature: causal by construction."
-                           : "paper = the whole record decomposed before the split; causal = the "
-                             "training block alone.");
+  t.caption =
+      std::string("Drift estimated from temperature only; error = ") +
+      (s.simulated ? "true drift of run B - estimate; removed = 1 - RMS(error) / RMS(true drift)"
+                   : "measured output - estimate on the test block; removed = 1 - RMS(error) / "
+                     "RMS(output - its mean), the share of the output's variation explained") +
+      " (negative: the estimate adds more error than it removes). " +
+      (s.simulated ? "The model is fitted on run A alone and sees only run B's temperature: causal "
+                     "by construction."
+                   : "paper = the whole record decomposed before the split; causal = the "
+                     "training block alone.");
   t.header = {"method", "protocol", "rmse", "mae", "max_abs", "removed_%", "train_s", "estimate_s"};
   for (const auto& r : s.compensate) {
-    t.Add({std::string(drift::ToString(r.method)), r.protocol, r.metrics.rmse, r.metrics.mae,
-           r.metrics.max_abs, {100.0 * r.share_removed, 4}, {r.train_s, 3}, {r.estimate_s, 3}});
+    t.Add({std::string(drift::ToString(r.method)),
+           r.protocol,
+           r.metrics.rmse,
+           r.metrics.mae,
+           r.metrics.max_abs,
+           {100.0 * r.share_removed, 4},
+           {r.train_s, 3},
+           {r.estimate_s, 3}});
   }
 }
 
@@ -351,8 +355,9 @@ void CompensateSimulated(const DemoArgs& a, const std::vector<drift::Method>& me
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
     row.summary = model.Summary();
     io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", ""};
-    s.model_files.push_back({"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
-                             io::RenderModelFile(model, info)});
+    s.model_files.push_back(
+        {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
+         io::RenderModelFile(model, info)});
     s.compensate.push_back(std::move(row));
   }
 }
@@ -376,8 +381,10 @@ void CompensateSplit(const DemoArgs& a, const std::vector<drift::Method>& method
   // taken of the output's variation about its mean instead.
   const double reference_rms = Rms(s.comp_reference.array() - s.comp_reference.mean());
   for (const auto& r : s.compensate_split.rows) {
-    Study::CompensateRow row{r.method, std::string(drift::ToString(r.protocol)), {}, 0.0,
-                             r.train_s, r.predict_s, r.estimate, r.model_summary};
+    Study::CompensateRow row{r.method,   std::string(drift::ToString(r.protocol)),
+                             {},         0.0,
+                             r.train_s,  r.predict_s,
+                             r.estimate, r.model_summary};
     row.metrics = drift::ComputeMetrics(s.comp_reference - r.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
     s.compensate.push_back(std::move(row));
@@ -389,8 +396,8 @@ void CompensateSplit(const DemoArgs& a, const std::vector<drift::Method>& method
     const drift::DriftModel model = drift::FitDriftModel(s.y, s.temperature, o);
     // gyrodrift compensate reads the temperature from the column named here.
     io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, ""};
-    s.model_files.push_back(
-        {"models/" + std::string(drift::ToString(m)) + "_compensate.json", io::RenderModelFile(model, info)});
+    s.model_files.push_back({"models/" + std::string(drift::ToString(m)) + "_compensate.json",
+                             io::RenderModelFile(model, info)});
   }
 }
 
@@ -401,15 +408,18 @@ void AllanStep(const DemoArgs& a, Study& s) {
     if (r.method == drift::Method::kMsElm && (r.protocol != "paper")) best = &r;
   }
   if (!best && !s.compensate.empty()) best = &s.compensate.front();
-  s.compensated_by = best ? std::string(drift::ToString(best->method)) + " (" + best->protocol + ")" : "";
+  s.compensated_by =
+      best ? std::string(drift::ToString(best->method)) + " (" + best->protocol + ")" : "";
   const Study::CompensateRow* lowest = nullptr;
   for (const auto& r : s.compensate) {
     if (r.protocol != "paper" && (!lowest || r.metrics.rmse < lowest->metrics.rmse)) lowest = &r;
   }
   // Another method only when it is clearly better (linear sub-models of MS-ELM and EMD-ELM can sum
   // to the same estimate).
-  if (lowest == best || (best && lowest && lowest->metrics.rmse > 0.99 * best->metrics.rmse)) lowest = nullptr;
-  if (lowest) s.best_by = std::string(drift::ToString(lowest->method)) + " (" + lowest->protocol + ")";
+  if (lowest == best || (best && lowest && lowest->metrics.rmse > 0.99 * best->metrics.rmse))
+    lowest = nullptr;
+  if (lowest)
+    s.best_by = std::string(drift::ToString(lowest->method)) + " (" + lowest->protocol + ")";
   allan::AllanOptions o;
   o.rate_hz = s.rate_hz;
   o.units = allan::RateUnitFromString(a.units);
@@ -443,9 +453,10 @@ void AllanStep(const DemoArgs& a, Study& s) {
   Table& t = s.terms_table;
   t.title = "IEEE 952 noise terms of " + std::string(s.simulated ? "run B" : "the test block") +
             ": raw vs compensated";
-  t.caption = "Fitted to the overlapping Allan deviation (octave grid, 68.3 % bands); 0 = the term "
-              "carries < 10 % of the model variance at every tau. Units: Q urad, N deg/sqrt(h), "
-              "B deg/h, K deg/h/sqrt(h), R deg/h/h.";
+  t.caption =
+      "Fitted to the overlapping Allan deviation (octave grid, 68.3 % bands); - = not identified: "
+      "the term carries < 10 % of the model variance at every tau. Units: Q urad, N deg/sqrt(h), "
+      "B deg/h, K deg/h/sqrt(h), R deg/h/h.";
   t.header = {"term", "unit", "raw", "compensated: " + s.compensated_by};
   if (!s.best_by.empty()) t.header.push_back("compensated: " + s.best_by);
   if (s.simulated) {
@@ -465,11 +476,15 @@ void AllanStep(const DemoArgs& a, Study& s) {
       {"K rate random walk", "deg/h/sqrt(h)", &allan::NoiseTerms::k_dphpsh, np.rrw_dphpsh},
       {"R rate ramp", "deg/h/h", &allan::NoiseTerms::r_dphph, np.rate_ramp_dphph},
   };
-  auto value = [](const std::optional<allan::NoiseTerms>& n, const allan::NoiseTerm allan::NoiseTerms::*m) {
-    return n ? ((*n).*m).value : std::numeric_limits<double>::quiet_NaN();
+  auto value = [](const std::optional<allan::NoiseTerms>& n,
+                  const allan::NoiseTerm allan::NoiseTerms::*m) {
+    // A term the fit could not identify (it matters nowhere in the fitted range) is a dash, as
+    // `gyrodrift allan` prints "not identified": its 0 is not a measurement.
+    return n && ((*n).*m).identified ? ((*n).*m).value : std::numeric_limits<double>::quiet_NaN();
   };
   for (const Row& r : rows) {
-    std::vector<Table::Cell> cells{r.name, r.unit, value(s.terms_raw, r.term), value(s.terms_comp, r.term)};
+    std::vector<Table::Cell> cells{r.name, r.unit, value(s.terms_raw, r.term),
+                                   value(s.terms_comp, r.term)};
     if (!s.best_by.empty()) cells.emplace_back(value(s.terms_best, r.term));
     if (s.simulated) {
       cells.emplace_back(value(s.terms_noise, r.term));
@@ -480,7 +495,8 @@ void AllanStep(const DemoArgs& a, Study& s) {
   auto min_dev = [](const std::optional<allan::NoiseTerms>& n) {
     return n ? n->min_dev_dph : std::numeric_limits<double>::quiet_NaN();
   };
-  std::vector<Table::Cell> cells{"minimum ADEV", "deg/h", min_dev(s.terms_raw), min_dev(s.terms_comp)};
+  std::vector<Table::Cell> cells{"minimum ADEV", "deg/h", min_dev(s.terms_raw),
+                                 min_dev(s.terms_comp)};
   if (!s.best_by.empty()) cells.emplace_back(min_dev(s.terms_best));
   if (s.simulated) {
     cells.emplace_back(min_dev(s.terms_noise));
@@ -507,7 +523,8 @@ std::string SimCsv(const sim::SimulationResult& r) {
 
 std::string GroupOf(const sel::SelectionResult& s, int k) {
   for (const auto& g : s.groups) {
-    if (std::find(g.imfs.begin(), g.imfs.end(), k) != g.imfs.end()) return std::string(sel::ToString(g.kind));
+    if (std::find(g.imfs.begin(), g.imfs.end(), k) != g.imfs.end())
+      return std::string(sel::ToString(g.kind));
   }
   return "drift";  // beyond the listed IMFs: with the residue
 }
@@ -608,8 +625,12 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
   add("compensated: " + s.compensated_by, s.allan_comp, kMsElm);
   if (!s.best_by.empty()) add("compensated: " + s.best_by, s.allan_best, kBest);
   if (s.simulated) add("noise only (truth)", s.allan_noise, "#7f7f7f");
-  const double from_dph = 1.0 / allan::ToDegPerHour(allan::RateUnitFromString(s.unit == "rad/s" ? "rads" : s.unit == "deg/s" ? "dps" : "dph"));
-  auto model = [&](const std::string& name, const std::optional<allan::NoiseTerms>& t, const char* colour) {
+  const double from_dph =
+      1.0 / allan::ToDegPerHour(allan::RateUnitFromString(s.unit == "rad/s"   ? "rads"
+                                                          : s.unit == "deg/s" ? "dps"
+                                                                              : "dph"));
+  auto model = [&](const std::string& name, const std::optional<allan::NoiseTerms>& t,
+                   const char* colour) {
     if (!t) return;
     Eigen::VectorXd v(f.x.size());
     for (Eigen::Index i = 0; i < f.x.size(); ++i) v[i] = t->ModelDevDph(f.x[i]) * from_dph;
@@ -623,7 +644,8 @@ void AllanFigure(io::HtmlReport& report, const Study& s) {
     const sim::NoiseParameters np = sim::PresetParameters(sim::Preset::kNavigation).noise;
     Eigen::VectorXd v(f.x.size());
     for (Eigen::Index i = 0; i < f.x.size(); ++i) {
-      v[i] = std::sqrt(sim::NoiseAllanVariance(np, 1.0 / s.rate_hz, s.allan_raw.points[static_cast<size_t>(i)].m));
+      v[i] = std::sqrt(sim::NoiseAllanVariance(np, 1.0 / s.rate_hz,
+                                               s.allan_raw.points[static_cast<size_t>(i)].m));
     }
     f.series.push_back(Series("simulator noise model (exact)", v, true));
     f.series.back().color = "#000000";
@@ -653,17 +675,24 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
   report.AddParagraph(
       s.simulated
           ? "A navigation-grade fibre optic gyro (1 km coil, quadrupole winding) is simulated at " +
-                Fmt(s.rate_hz) + " Hz through two thermal-chamber programmes: run A ('chamber') to train and "
-                "evaluate, run B ('chamber-b', another thermal history) to test compensation. The simulator "
-                "keeps the true drift apart from the noise, so every model is scored against the truth."
+                Fmt(s.rate_hz) +
+                " Hz through two thermal-chamber programmes: run A ('chamber') to train and "
+                "evaluate, run B ('chamber-b', another thermal history) to test compensation. The "
+                "simulator "
+                "keeps the true drift apart from the noise, so every model is scored against the "
+                "truth."
           : "The log " + s.source + " (column " + s.target_name + ", " + Fmt(s.rate_hz) +
-                " Hz, rate " + s.rate_how + ") analysed like the simulated demo. There is no truth column: "
+                " Hz, rate " + s.rate_how +
+                ") analysed like the simulated demo. There is no truth column: "
                 "models are scored against the measured output, and compensation is tested by a "
                 "chronological split.");
   report.AddParagraph(
-      "Method: BEEMDAN decomposes the output into intrinsic mode functions (IMFs); the PDF-similarity "
-      "criterion groups them into noise, mixed and drift sub-series; MS-ELM fits one extreme learning "
-      "machine per sub-series and sums them (Chen & Cui, Signal Processing 128, 2016). Baselines: a "
+      "Method: BEEMDAN decomposes the output into intrinsic mode functions (IMFs); the "
+      "PDF-similarity "
+      "criterion groups them into noise, mixed and drift sub-series; MS-ELM fits one extreme "
+      "learning "
+      "machine per sub-series and sums them (Chen & Cui, Signal Processing 128, 2016). Baselines: "
+      "a "
       "single ELM, EMD-ELM (one ELM per IMF), polynomial regression, SVR and a BP network.");
 
   report.AddHeading(s.simulated ? "1. The simulated runs" : "1. The record");
@@ -676,12 +705,15 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     f.series.push_back(Series("output", s.y));
     if (s.simulated) f.series.push_back(Reference("true drift", s.truth));
     f.shades.push_back({split_h, end_h, "predict-mode test block (last 30 %)"});
-    f.caption = s.simulated
-                    ? "The output is the drift plus white and bias-instability noise. The drift follows "
-                      "the temperature ramps (Shupe effect: the rate of temperature change inside the coil) "
-                      "and the temperature level (stress and electronics bias). Zoom into a ramp to see the "
-                      "noise riding on it."
-                    : "The analysed column. Shaded: the last 30 %, where every model is tested.";
+    f.caption =
+        s.simulated
+            ? "The output is the drift plus white and bias-instability noise. The drift follows "
+              "the temperature ramps (Shupe effect: the rate of temperature change inside the "
+              "coil) "
+              "and the temperature level (stress and electronics bias). Zoom into a ramp to see "
+              "the "
+              "noise riding on it."
+            : "The analysed column. Shaded: the last 30 %, where every model is tested.";
     report.AddFigure(f);
   }
   {
@@ -698,9 +730,11 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     } else {
       f.series.push_back(Series("temperature", s.temperature));
     }
-    f.caption = s.simulated ? "The chamber programme, the case sensor a user logs (the only temperature the "
-                              "models see) and the true mean coil temperature, which lags the case by minutes."
-                            : "The temperature column the compensate-mode models use.";
+    f.caption =
+        s.simulated
+            ? "The chamber programme, the case sensor a user logs (the only temperature the "
+              "models see) and the true mean coil temperature, which lags the case by minutes."
+            : "The temperature column the compensate-mode models use.";
     report.AddFigure(f);
   }
   if (s.simulated) {
@@ -715,8 +749,9 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     io::ReportSeries t = Series("case sensor (right axis)", s.b.temperature_c);
     t.right_axis = true;
     f.series.push_back(t);
-    f.caption = "Run B uses a different programme (slower ramps, other levels), so a compensation "
-                "model trained on run A meets a thermal history it has not seen.";
+    f.caption =
+        "Run B uses a different programme (slower ramps, other levels), so a compensation "
+        "model trained on run A meets a thermal history it has not seen.";
     report.AddFigure(f);
   }
 
@@ -725,7 +760,9 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
   const int k_count = s.decomposition.num_imfs();
   {
     io::ReportFigure f;
-    f.title = "Selection curves: distance of each IMF's PDF to the signal's (D_k) and to a Gaussian (G_k)";
+    f.title =
+        "Selection curves: distance of each IMF's PDF to the signal's (D_k) and to a Gaussian "
+        "(G_k)";
     f.x_label = "IMF index k";
     f.y_label = "L2 distance between densities";
     f.draw_points = true;
@@ -735,24 +772,30 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     auto vec = [&](const std::vector<double>& v) {
       Eigen::VectorXd out(k_count);
       for (int k = 0; k < k_count; ++k) {
-        out[k] = k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)] : std::numeric_limits<double>::quiet_NaN();
+        out[k] = k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)]
+                                                : std::numeric_limits<double>::quiet_NaN();
       }
       return out;
     };
     f.series.push_back(Series("D_k: PDF(IMF k) vs PDF(signal)", vec(s.selection.pdf_distance)));
     f.y2_label = "G_k (right axis)";
-    f.series.push_back(Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
-    f.series.push_back(Series("white-noise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
+    f.series.push_back(
+        Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
+    f.series.push_back(
+        Series("white-noise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
     f.series[1].right_axis = f.series[2].right_axis = true;
     for (const auto& g : s.selection.groups) {
       if (g.imfs.empty()) continue;
-      f.shades.push_back({g.imfs.front() - 0.45, g.imfs.back() + 0.45, std::string(sel::ToString(g.kind))});
+      f.shades.push_back(
+          {g.imfs.front() - 0.45, g.imfs.back() + 0.45, std::string(sel::ToString(g.kind))});
     }
-    f.caption = "Shaded: the chosen groups. Noise = the leading IMFs whose G_k stays under the white-noise "
-                "level (k_N = " + std::to_string(s.selection.k_noise) + "); k* = argmax D_k = " +
-                std::to_string(s.selection.k_star) +
-                " ends the mixed group; the rest plus the residue is the drift group. Look for the peak of "
-                "D_k: below it the IMFs look like noise, above it like the signal.";
+    f.caption =
+        "Shaded: the chosen groups. Noise = the leading IMFs whose G_k stays under the white-noise "
+        "level (k_N = " +
+        std::to_string(s.selection.k_noise) +
+        "); k* = argmax D_k = " + std::to_string(s.selection.k_star) +
+        " ends the mixed group; the rest plus the residue is the drift group. Look for the peak of "
+        "D_k: below it the IMFs look like noise, above it like the signal.";
     // The rule above in general; the edge case this record met (no mixed group, say) in particular.
     if (!s.selection.note.empty()) f.caption += " Here: " + s.selection.note + ".";
     report.AddFigure(f);
@@ -768,7 +811,9 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     Eigen::VectorXd e(k_count), band(k_count);
     for (int k = 0; k < k_count; ++k) {
       f.x[k] = k + 1;
-      e[k] = k < static_cast<int>(s.selection.log2_energy.size()) ? s.selection.log2_energy[static_cast<size_t>(k)] : NAN;
+      e[k] = k < static_cast<int>(s.selection.log2_energy.size())
+                 ? s.selection.log2_energy[static_cast<size_t>(k)]
+                 : NAN;
       band[k] = k < static_cast<int>(s.selection.energy_band_log2_upper.size())
                     ? s.selection.energy_band_log2_upper[static_cast<size_t>(k)]
                     : NAN;
@@ -872,12 +917,15 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
     const drift::EvaluationRow* best = nullptr;
     for (const auto& r : s.predict.rows) {
       if (r.method == drift::Method::kMsElm) {
-        f.series.push_back(Series("ms-elm " + std::string(drift::ToString(r.protocol)), r.estimate));
+        f.series.push_back(
+            Series("ms-elm " + std::string(drift::ToString(r.protocol)), r.estimate));
       } else if (!drift::UsesDecomposition(r.method) && (!best || r.rmse < best->rmse)) {
         best = &r;
       }
     }
-    if (best) f.series.push_back(Series(std::string(drift::ToString(best->method)) + " (best single model)", best->estimate));
+    if (best)
+      f.series.push_back(Series(std::string(drift::ToString(best->method)) + " (best single model)",
+                                best->estimate));
     if (s.simulated) f.series.push_back(Reference("true drift", s.predict.reference));
     f.caption =
         "Each model predicts the next output sample from the previous ones (MS-ELM under both "
@@ -889,22 +937,26 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
   }
   {
     io::ReportFigure f;
-    const Eigen::Index w = std::clamp<Eigen::Index>(
-        static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1, std::max<Eigen::Index>(1, test_h.size() / 20));
-    f.title = "Predict mode: residuals (reference - prediction), trailing mean over " + std::to_string(w) + " samples";
+    const Eigen::Index w =
+        std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1,
+                                 std::max<Eigen::Index>(1, test_h.size() / 20));
+    f.title = "Predict mode: residuals (reference - prediction), trailing mean over " +
+              std::to_string(w) + " samples";
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = test_h;
     for (const auto& r : s.predict.rows) {
       if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
       std::string name = std::string(drift::ToString(r.method));
-      if (drift::UsesDecomposition(r.method)) name += " " + std::string(drift::ToString(r.protocol));
+      if (drift::UsesDecomposition(r.method))
+        name += " " + std::string(drift::ToString(r.protocol));
       f.series.push_back(Series(name, TrailingMean(s.predict.reference - r.estimate, w)));
     }
-    f.caption = "Averaged over " + Fmt(static_cast<double>(w) / s.rate_hz) +
-                " s so that the sample-to-sample noise drops out: what remains is drift the model "
-                "missed or a bias it added. Near zero is good; single models are one curve (the same "
-                "under both protocols).";
+    f.caption =
+        "Averaged over " + Fmt(static_cast<double>(w) / s.rate_hz) +
+        " s so that the sample-to-sample noise drops out: what remains is drift the model "
+        "missed or a bias it added. Near zero is good; single models are one curve (the same "
+        "under both protocols).";
     report.AddFigure(f);
   }
 
@@ -913,8 +965,9 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
   report.AddTable(s.compensate_table.Report());
   {
     io::ReportFigure f;
-    f.title = s.simulated ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
-                          : "Compensate mode: drift estimated from temperature vs the measured output";
+    f.title = s.simulated
+                  ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
+                  : "Compensate mode: drift estimated from temperature vs the measured output";
     f.x_label = "time (h)";
     f.y_label = s.unit;
     f.x = s.comp_time_h;
@@ -984,12 +1037,16 @@ void Run(const DemoArgs& a) {
   if (!user && (!a.target.empty() || !a.temperature.empty() || a.rate_option->count() > 0)) {
     throw UsageError("--target, --temperature and --rate-hz need --input FILE.csv");
   }
-  if (user && a.target.empty()) throw UsageError("--input needs --target COL (the gyro output column)");
+  if (user && a.target.empty())
+    throw UsageError("--input needs --target COL (the gyro output column)");
   if (user && a.temperature.empty()) {
-    throw UsageError("--input needs --temperature COL (compensate mode models drift from temperature)");
+    throw UsageError(
+        "--input needs --temperature COL (compensate mode models drift from temperature)");
   }
-  if (a.ensemble < 1 || a.ensemble > 10000) ThrowOption("--ensemble", std::to_string(a.ensemble), "an integer in [1, 10000]");
-  if (a.window < 16 || a.window > 1000000) ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
+  if (a.ensemble < 1 || a.ensemble > 10000)
+    ThrowOption("--ensemble", std::to_string(a.ensemble), "an integer in [1, 10000]");
+  if (a.window < 16 || a.window > 1000000)
+    ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
   if (a.threads < 0) ThrowOption("--threads", std::to_string(a.threads), "an integer >= 0");
   // The library would name these "realisations" and "units"; the user typed the options.
   if (a.realisations < 20 || a.realisations > 100000) {
@@ -1002,6 +1059,12 @@ void Run(const DemoArgs& a) {
   }
   const std::vector<drift::Method> methods = ParseMethods(a.methods);
   const double duration_s = ParseDuration(a.duration);
+  // Run A must show the model a ramp and a dwell at a new level: the chamber programme ramps from
+  // 30 to 70 min. On shorter runs the level and rate responses cannot be told apart, and every
+  // compensation model extrapolates wildly on run B (docs/demo.md).
+  if (duration_s < kMinDurationS) {
+    ThrowOption("--duration", a.duration, "at least 2h (run A needs a ramp and a dwell)");
+  }
   if (user && a.rate_option->count() > 0) RequireInRange("--rate-hz", a.rate_hz, 1e-6, 1e6);
   {
     drift::DriftOptions probe = BaseOptions(a, 1.0);
@@ -1014,7 +1077,8 @@ void Run(const DemoArgs& a) {
   Study s;
   s.simulated = !user;
   // Stage weights: seconds the stages took in the measured runs (docs/demo.md).
-  ProgressBar bar(user ? std::vector<double>{0.1, 0.5, 12, 5, 0.1, 1} : std::vector<double>{0.2, 5, 68, 22, 0.1, 3},
+  ProgressBar bar(user ? std::vector<double>{0.1, 0.5, 12, 5, 0.1, 1}
+                       : std::vector<double>{0.2, 5, 68, 22, 0.1, 3},
                   !a.quiet);
   auto say = [&](const std::string& text) {
     if (!a.quiet) bar.Print(text);
@@ -1045,7 +1109,8 @@ void Run(const DemoArgs& a) {
     s.temperature = s.a.temperature_c;
     s.truth = s.a.drift_dph;
     s.time_h = s.a.time_s / 3600.0;
-    say(fmt::format("1. simulated run A: {}\n   simulated run B: {}\n", s.a.Summary(), s.b.Summary()));
+    say(fmt::format("1. simulated run A: {}\n   simulated run B: {}\n", s.a.Summary(),
+                    s.b.Summary()));
   } else {
     const io::CsvTable table = io::CsvTable::Read(a.input);
     s.y = table.Column(a.target);
@@ -1061,10 +1126,13 @@ void Run(const DemoArgs& a) {
       const Eigen::VectorXd t = table.Column("time_s");
       std::vector<double> steps;
       for (Eigen::Index i = 1; i < t.size(); ++i) steps.push_back(t[i] - t[i - 1]);
-      if (steps.empty()) throw DataError(a.input + ": too few rows to read a sample rate from time_s");
-      std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2), steps.end());
+      if (steps.empty())
+        throw DataError(a.input + ": too few rows to read a sample rate from time_s");
+      std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2),
+                       steps.end());
       const double step = steps[steps.size() / 2];
-      if (!(step > 0.0)) throw DataError(a.input + ": time_s does not increase (median step " + Fmt(step) + " s)");
+      if (!(step > 0.0))
+        throw DataError(a.input + ": time_s does not increase (median step " + Fmt(step) + " s)");
       s.rate_hz = 1.0 / step;
       s.rate_how = "from the median step of time_s";
     } else {
@@ -1073,12 +1141,14 @@ void Run(const DemoArgs& a) {
     }
     if (s.y.size() < 64) {
       throw DataError(a.input + ": " + std::to_string(s.y.size()) +
-                      " samples; the study needs at least 64 (a 70/30 split with 32 training and 16 test samples, "
+                      " samples; the study needs at least 64 (a 70/30 split with 32 training and "
+                      "16 test samples, "
                       "and room for the decomposition)");
     }
-    s.time_h = Eigen::VectorXd::LinSpaced(s.y.size(), 0.0, static_cast<double>(s.y.size() - 1)) / (3600.0 * s.rate_hz);
-    say(fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", a.input, s.y.size(), s.target_name,
-                    Fmt(s.rate_hz), s.rate_how));
+    s.time_h = Eigen::VectorXd::LinSpaced(s.y.size(), 0.0, static_cast<double>(s.y.size() - 1)) /
+               (3600.0 * s.rate_hz);
+    say(fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", a.input, s.y.size(),
+                    s.target_name, Fmt(s.rate_hz), s.rate_how));
   }
   stage_done(user ? "read" : "simulate A and B", t0);
 
@@ -1133,7 +1203,10 @@ void Run(const DemoArgs& a) {
   settings.title = "Settings of this run";
   settings.header = {"setting", "value"};
   const drift::DriftOptions base = BaseOptions(a, s.rate_hz);
-  settings.Add({"source", s.simulated ? "simulation: navigation preset, programmes chamber (A) and chamber-b (B)" : s.source});
+  settings.Add(
+      {"source", s.simulated
+                     ? "simulation: navigation preset, programmes chamber (A) and chamber-b (B)"
+                     : s.source});
   if (s.simulated) {
     settings.Add({"duration, rate", Fmt(duration_s / 3600.0) + " h per run at 1 Hz (" +
                                         std::to_string(s.a.samples) + " samples)"});
@@ -1148,18 +1221,23 @@ void Run(const DemoArgs& a) {
   settings.Add({"seed", std::to_string(a.seed) +
                             (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)"
                                          : " (decomposition and learners)")});
-  settings.Add({"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) +
-                                     " (also in each causal window), noise 0.2, energy-band bound"});
-  settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " + std::to_string(a.realisations) +
-                                 " white-noise realisations"});
-  settings.Add({"learner", "ELM sigmoid, hidden units <= " + std::to_string(base.learner.elm.hidden_units) +
-                               " and ridge by leave-one-out; SVR/BP/poly library defaults"});
-  settings.Add({"predict mode", std::to_string(base.features.lags) + " lags, split 70/30, causal window " +
+  settings.Add(
+      {"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble) +
+                            " (also in each causal window), noise 0.2, energy-band bound"});
+  settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " +
+                                 std::to_string(a.realisations) + " white-noise realisations"});
+  settings.Add(
+      {"learner", "ELM sigmoid, hidden units <= " + std::to_string(base.learner.elm.hidden_units) +
+                      " and ridge by leave-one-out; SVR/BP/poly library defaults"});
+  settings.Add({"predict mode", std::to_string(base.features.lags) +
+                                    " lags, split 70/30, causal window " +
                                     std::to_string(a.window) + " samples"});
-  settings.Add({"compensate mode", std::string(base.linear_compensation ? "linear ELM sub-models" : "learner as given") +
-                                       ", estimate referenced to " +
-                                       (std::isnan(base.reference_c) ? std::string("the fitted intercept (user log)")
-                                                                     : "equilibrium at " + Fmt(base.reference_c) + " degC")});
+  settings.Add(
+      {"compensate mode",
+       std::string(base.linear_compensation ? "linear ELM sub-models" : "learner as given") +
+           ", estimate referenced to " +
+           (std::isnan(base.reference_c) ? std::string("the fitted intercept (user log)")
+                                         : "equilibrium at " + Fmt(base.reference_c) + " degC")});
   settings.Add({"threads", a.threads == 0 ? "all cores" : std::to_string(a.threads)});
   Table& timing = s.timing_table;
   timing.title = "Wall time of each stage";
@@ -1176,19 +1254,23 @@ void Run(const DemoArgs& a) {
   }
   {
     std::vector<io::CsvColumn> c{{"time_s", s.time_h * 3600.0}};
-    for (int k = 0; k < s.decomposition.num_imfs(); ++k) c.push_back({"imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)});
+    for (int k = 0; k < s.decomposition.num_imfs(); ++k)
+      c.push_back({"imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)});
     c.push_back({"residue", s.decomposition.residue});
-    for (const auto& g : s.selection.groups) c.push_back({"group_" + std::string(sel::ToString(g.kind)), g.series});
+    for (const auto& g : s.selection.groups)
+      c.push_back({"group_" + std::string(sel::ToString(g.kind)), g.series});
     files.push_back({path("imfs.csv"), io::RenderCsv(c)});
     Table sc;
-    sc.header = {"k", "group", "pdf_distance", "self_distance", "noise_level", "log2_energy", "band_log2_upper"};
+    sc.header = {"k",           "group",       "pdf_distance",   "self_distance",
+                 "noise_level", "log2_energy", "band_log2_upper"};
     auto at = [](const std::vector<double>& v, int k) {
-      return k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)] : std::numeric_limits<double>::quiet_NaN();
+      return k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)]
+                                            : std::numeric_limits<double>::quiet_NaN();
     };
     for (int k = 0; k < s.decomposition.num_imfs(); ++k) {
       sc.Add({std::to_string(k + 1), GroupOf(s.selection, k + 1), at(s.selection.pdf_distance, k),
-              at(s.selection.self_distance, k), at(s.selection.noise_level, k), at(s.selection.log2_energy, k),
-              at(s.selection.energy_band_log2_upper, k)});
+              at(s.selection.self_distance, k), at(s.selection.noise_level, k),
+              at(s.selection.log2_energy, k), at(s.selection.energy_band_log2_upper, k)});
     }
     files.push_back({path("selection.csv"), sc.Csv()});
   }
@@ -1200,7 +1282,9 @@ void Run(const DemoArgs& a) {
     std::vector<io::CsvColumn> c{{"time_s", s.time_h.tail(s.y.size() - split) * 3600.0},
                                  {s.simulated ? "drift_dph" : "reference", s.predict.reference}};
     for (const auto& r : s.predict.rows) {
-      c.push_back({std::string(drift::ToString(r.method)) + "_" + std::string(drift::ToString(r.protocol)), r.estimate});
+      c.push_back(
+          {std::string(drift::ToString(r.method)) + "_" + std::string(drift::ToString(r.protocol)),
+           r.estimate});
     }
     files.push_back({path("predict_estimates.csv"), io::RenderCsv(c)});
   }
@@ -1209,7 +1293,8 @@ void Run(const DemoArgs& a) {
                                  {"output", s.comp_raw},
                                  {s.simulated ? "drift_dph" : "reference", s.comp_reference}};
     for (const auto& r : s.compensate) {
-      c.push_back({std::string(drift::ToString(r.method)) + (s.simulated ? "" : "_" + r.protocol) + "_estimate",
+      c.push_back({std::string(drift::ToString(r.method)) + (s.simulated ? "" : "_" + r.protocol) +
+                       "_estimate",
                    r.estimate});
     }
     files.push_back({path("compensate_estimates.csv"), io::RenderCsv(c)});
@@ -1220,13 +1305,13 @@ void Run(const DemoArgs& a) {
   const std::string html = RenderReport(s, assets);
   files.push_back({path("report.html"), html});
   nlohmann::json sidecar = SidecarHeader("demo");
-  sidecar["options"] = {{"output", a.output},   {"input", a.input},
-                        {"target", a.target},   {"temperature", a.temperature},
-                        {"rate_hz", s.rate_hz}, {"rate_source", s.rate_how},
-                        {"units", a.units},     {"duration_s", s.simulated ? duration_s : 0.0},
+  sidecar["options"] = {{"output", a.output},     {"input", a.input},
+                        {"target", a.target},     {"temperature", a.temperature},
+                        {"rate_hz", s.rate_hz},   {"rate_source", s.rate_how},
+                        {"units", a.units},       {"duration_s", s.simulated ? duration_s : 0.0},
                         {"ensemble", a.ensemble}, {"realisations", a.realisations},
-                        {"window", a.window},   {"methods", a.methods},
-                        {"seed", a.seed},       {"threads", a.threads}};
+                        {"window", a.window},     {"methods", a.methods},
+                        {"seed", a.seed},         {"threads", a.threads}};
   sidecar["drift_options"] = io::DriftOptionsToJson(base);
   sidecar["decomposition"] = s.decomposition.report.Summary();
   sidecar["selection"] = s.selection.Summary();
@@ -1242,8 +1327,9 @@ void Run(const DemoArgs& a) {
   io::WriteFilesAtomically(files);
   bar.Finish();
   if (!a.quiet) {
-    fmt::print("6. wrote {} files to {} (report: {}, {:.1f} MB) in {:.1f} s of wall time\n", files.size(), dir,
-               path("report.html"), static_cast<double>(html.size()) / 1e6, Seconds(wall_start));
+    fmt::print("6. wrote {} files to {} (report: {}, {:.1f} MB) in {:.1f} s of wall time\n",
+               files.size(), dir, path("report.html"), static_cast<double>(html.size()) / 1e6,
+               Seconds(wall_start));
   }
 }
 
@@ -1262,21 +1348,29 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "noise_terms.csv, models/<method>_compensate.json, demo.json and report.html (open it in a\n"
       "browser; it works offline). The study's size options (--duration, --ensemble, --window,\n"
       "--realisations, --methods) trade fidelity for time; docs/demo.md lists the defaults' cost.");
-  cmd->add_option("-o,--output", args->output, "output folder (created if needed)")->capture_default_str();
-  cmd->add_option("--input", args->input, "a uniformly sampled CSV log of your own instead of the simulation")
-      ->check(kInputFile);
-  cmd->add_option("--target", args->target, "with --input: the gyro output column (name or 1-based index)");
-  cmd->add_option("--temperature", args->temperature, "with --input: the temperature column");
-  args->rate_option = cmd->add_option("--rate-hz", args->rate_hz,
-                                      "with --input: sample rate, Hz (default: from a time_s column, else 1)");
-  cmd->add_option("--units", args->units, "unit of the --input target for the Allan noise terms: dph|dps|rads")
+  cmd->add_option("-o,--output", args->output, "output folder (created if needed)")
       ->capture_default_str();
-  cmd->add_option("--seed", args->seed, "seed of the simulation (run B uses seed + 1), decomposition and learners")
+  cmd->add_option("--input", args->input,
+                  "a uniformly sampled CSV log of your own instead of the simulation")
+      ->check(kInputFile);
+  cmd->add_option("--target", args->target,
+                  "with --input: the gyro output column (name or 1-based index)");
+  cmd->add_option("--temperature", args->temperature, "with --input: the temperature column");
+  args->rate_option =
+      cmd->add_option("--rate-hz", args->rate_hz,
+                      "with --input: sample rate, Hz (default: from a time_s column, else 1)");
+  cmd->add_option("--units", args->units,
+                  "unit of the --input target for the Allan noise terms: dph|dps|rads")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed,
+                  "seed of the simulation (run B uses seed + 1), decomposition and learners")
       ->capture_default_str()
       ->check(kSeed);
-  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+      ->capture_default_str();
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
-  cmd->add_option("--duration", args->duration, "advanced: length of each simulated run (30s, 10min, 8h)")
+  cmd->add_option("--duration", args->duration,
+                  "advanced: length of each simulated run (30s, 10min, 8h)")
       ->capture_default_str()
       ->group("Advanced");
   cmd->add_option("--ensemble", args->ensemble, "advanced: BEEMDAN ensemble size")
@@ -1286,7 +1380,8 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
                   "advanced: white-noise realisations of the selection's Monte-Carlo level (>= 20)")
       ->capture_default_str()
       ->group("Advanced");
-  cmd->add_option("--window", args->window, "advanced: trailing window of the causal protocol, samples")
+  cmd->add_option("--window", args->window,
+                  "advanced: trailing window of the causal protocol, samples")
       ->capture_default_str()
       ->group("Advanced");
   cmd->add_option("--methods", args->methods, "advanced: all, or a list such as ms-elm,elm,poly")

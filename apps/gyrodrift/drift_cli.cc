@@ -108,7 +108,10 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
   o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
   if (a.rate_option != nullptr && a.rate_option->count() > 0) o.features.rate_hz = a.rate_hz;
   o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
-  if (!a.time_constants_s.empty()) o.features.time_constants_s = a.time_constants_s;
+  if (!a.time_constants_s.empty()) {
+    o.features.time_constants_s = a.time_constants_s;
+    o.features.limit_time_constants = false;  // the user's constants, all of them
+  }
   o.Validate();
   return o;
 }
@@ -140,10 +143,6 @@ double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string*
   }
   *how = "time_s";
   return 1.0 / median;
-}
-
-std::string ColumnName(const io::CsvTable& table, const std::string& spec) {
-  return table.header()[static_cast<size_t>(table.ResolveColumn(spec))];
 }
 
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table) {

@@ -50,9 +50,6 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& args, drift::Method method
 // median step is not positive.
 double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::string* how);
 
-// Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
-std::string ColumnName(const io::CsvTable& table, const std::string& spec);
-
 // Throws DataError "model needs column 'X' (trained with --target X); IN.csv has: a, b" unless
 // the table has the model's target column and, when the model uses it, its temperature column.
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);

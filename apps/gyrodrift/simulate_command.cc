@@ -34,22 +34,6 @@ struct SimulateArgs {
   bool quiet = false;
 };
 
-// "30s", "10min", "8h", "1.5h", "3600": seconds. Anything else is a usage error.
-double ParseDuration(const std::string& text) {
-  static const std::regex kPattern(
-      R"(^\s*([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\s*(s|min|h)?\s*$)");
-  std::smatch m;
-  if (std::regex_match(text, m, kPattern)) {
-    const std::string number = m[1].str() + m[3].str();
-    double value = 0.0;
-    const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
-    const std::string unit = m[4].str();
-    const double seconds = unit == "h" ? value * 3600.0 : unit == "min" ? value * 60.0 : value;
-    if (ec == std::errc() && seconds > 0.0 && std::isfinite(seconds)) return seconds;
-  }
-  ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
-}
-
 // A built-in name, or a CSV file with columns time_s and temperature_c.
 sim::TemperatureProgramme LoadProgramme(const std::string& profile) {
   for (const auto& name : sim::BuiltinProgrammeNames()) {

@@ -32,8 +32,7 @@ void ThrowOption(std::string_view name, std::string_view value, std::string_view
 
 void RequireInRange(std::string_view name, double value, double lo, double hi) {
   if (!(value >= lo && value <= hi)) {
-    ThrowOption(name, FormatValue(value),
-                "in [" + FormatValue(lo) + ", " + FormatValue(hi) + "]");
+    ThrowOption(name, FormatValue(value), "in [" + FormatValue(lo) + ", " + FormatValue(hi) + "]");
   }
 }
 
@@ -52,8 +51,8 @@ void RequireNonNegative(std::string_view name, double value) {
 void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
                          Eigen::Index min_samples) {
   if (x.size() < min_samples) {
-    throw DataError(std::string(what) + " has " + std::to_string(x.size()) +
-                    " samples: at least " + std::to_string(min_samples) + " are needed");
+    throw DataError(std::string(what) + " has " + std::to_string(x.size()) + " samples: at least " +
+                    std::to_string(min_samples) + " are needed");
   }
   for (Eigen::Index i = 0; i < x.size(); ++i) {
     if (!std::isfinite(x[i])) {
@@ -61,6 +60,13 @@ void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::Ve
                       FormatValue(x[i]) + ": every sample must be finite");
     }
   }
+}
+
+void RequireVaryingSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
+                          std::string_view consequence) {
+  if (x.size() == 0 || (x.array() != x[0]).any()) return;
+  throw DataError(std::string(what) + " is constant (every sample is " + FormatValue(x[0]) +
+                  "): " + std::string(consequence));
 }
 
 }  // namespace gyrodrift

@@ -297,7 +297,20 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const DriftOptions& options) {
   options.Validate();
   RequireFiniteSignal("target", y, 32);
-  internal::SubSeries prepared = internal::PrepareSubSeries(y, options, /*report=*/true);
+  RequireVaryingSignal("target", y, "there is nothing to model");
+  if (options.mode == Mode::kCompensate || options.features.use_temperature) {
+    // Checked before the decomposition, which is the slow part.
+    if (temperature_c.size() != y.size()) {
+      throw DataError("temperature has " + std::to_string(temperature_c.size()) +
+                      " samples, the target " + std::to_string(y.size()) + ": they must match");
+    }
+    RequireFiniteSignal("temperature", temperature_c, y.size());
+    RequireVaryingSignal("temperature", temperature_c,
+                         "a drift model on temperature needs a record whose temperature changes");
+  }
+  DriftOptions o = options;
+  o.features = ForTrainingRecord(o.features, y.size());
+  internal::SubSeries prepared = internal::PrepareSubSeries(y, o, /*report=*/true);
   prepared.model.options.progress = nullptr;  // a model does not keep the caller's callback
   const Eigen::MatrixXd thermal = ThermalOrEmpty(prepared.model, temperature_c, y.size());
   const bool decomposed = UsesDecomposition(options.method);

@@ -23,8 +23,10 @@ struct Trial {
 
 // Fits and scores one (method, protocol, seed) on the split record.
 Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
-               const Eigen::Ref<const Eigen::VectorXd>& temperature_c, const DriftOptions& o,
+               const Eigen::Ref<const Eigen::VectorXd>& temperature_c, const DriftOptions& given,
                Protocol protocol, Eigen::Index split, const CausalOptions& causal) {
+  DriftOptions o = given;
+  o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
   const Eigen::Index n = y.size();
   const Eigen::Index test = n - split;
   const bool thermal_needed = o.mode == Mode::kCompensate || o.features.use_temperature;

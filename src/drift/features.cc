@@ -1,5 +1,6 @@
 #include "gyrodrift/drift/features.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -76,6 +77,21 @@ void FeatureOptions::Validate() const {
     ThrowOption("time constants", "(empty)",
                 "at least one value with thermal_set = classic (the first smooths the rate)");
   }
+}
+
+FeatureOptions ForTrainingRecord(FeatureOptions options, Eigen::Index samples) {
+  if (options.limit_time_constants && !options.time_constants_s.empty()) {
+    const double limit_s = 0.25 * static_cast<double>(samples) / options.rate_hz;
+    const double shortest =
+        *std::min_element(options.time_constants_s.begin(), options.time_constants_s.end());
+    std::vector<double> kept;
+    for (double tau : options.time_constants_s) {
+      if (tau <= limit_s || tau == shortest) kept.push_back(tau);
+    }
+    options.time_constants_s = std::move(kept);
+  }
+  options.limit_time_constants = false;
+  return options;
 }
 
 Eigen::MatrixXd ThermalFeatures(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,

@@ -393,6 +393,9 @@ drift::DriftOptions ReadOptions(const Node& n) {
   if (f.raw().contains("thermal_set")) {
     o.features.thermal_set = f["thermal_set"].Enum(drift::ThermalSetFromString);
   }
+  // Older files stored the constants they were fitted with, all of them.
+  o.features.limit_time_constants =
+      f.raw().contains("limit_time_constants") && f["limit_time_constants"].Bool();
   o.learner = ReadLearnerOptions(n["learner"]);
   o.auto_lags = n["auto_lags"].Bool();
   o.lag_candidates = n["lag_candidates"].Ints();
@@ -493,7 +496,8 @@ nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
             {"use_temperature", f.use_temperature},
             {"time_constants_s", Numbers(f.time_constants_s)},
             {"rate_hz", Number(f.rate_hz)},
-            {"thermal_set", drift::ToString(f.thermal_set)}}},
+            {"thermal_set", drift::ToString(f.thermal_set)},
+            {"limit_time_constants", f.limit_time_constants}}},
           {"learner", LearnerOptionsJson(o.learner)},
           {"auto_lags", o.auto_lags},
           {"lag_candidates", o.lag_candidates},

@@ -53,7 +53,8 @@ std::set<std::string> Pairs(const std::string& path) {
     start = end + 1;
   }
   const Eigen::VectorXd rmse = t.Column("rmse");
-  for (Eigen::Index i = 0; i < rmse.size(); ++i) EXPECT_TRUE(std::isfinite(rmse[i]) && rmse[i] >= 0.0) << path;
+  for (Eigen::Index i = 0; i < rmse.size(); ++i)
+    EXPECT_TRUE(std::isfinite(rmse[i]) && rmse[i] >= 0.0) << path;
   return pairs;
 }
 
@@ -62,7 +63,8 @@ const char* kMethods[] = {"ms-elm", "elm", "emd-elm", "poly", "svr", "bp"};
 TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   if (!HaveDygraphs()) GTEST_SKIP() << "libjs-dygraphs not installed";
   const std::string dir = test::TempDir("demo_sim") + "/out";
-  const auto r = RunCli("demo -o " + dir + " --duration 1h --ensemble 10 --realisations 20 --window 64 --quiet");
+  const auto r = RunCli("demo -o " + dir +
+                        " --duration 2h --ensemble 10 --realisations 20 --window 64 --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
   EXPECT_TRUE(r.err.empty()) << r.err;  // no progress bar off a terminal
@@ -83,11 +85,12 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   }
   const std::set<std::string> compensate = Pairs(dir + "/compensate_table.csv");
   EXPECT_EQ(compensate.size(), 6u);
-  for (const char* m : kMethods) EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
+  for (const char* m : kMethods)
+    EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
   // Data: one row per simulated second.
-  EXPECT_EQ(io::CsvTable::Read(dir + "/run_a.csv").rows(), 3600);
-  EXPECT_EQ(io::CsvTable::Read(dir + "/imfs.csv").rows(), 3600);
-  EXPECT_EQ(io::CsvTable::Read(dir + "/predict_estimates.csv").rows(), 3600 - 2520);
+  EXPECT_EQ(io::CsvTable::Read(dir + "/run_a.csv").rows(), 7200);
+  EXPECT_EQ(io::CsvTable::Read(dir + "/imfs.csv").rows(), 7200);
+  EXPECT_EQ(io::CsvTable::Read(dir + "/predict_estimates.csv").rows(), 7200 - 5040);
   // The report: well formed, every figure has data, dygraphs inlined, nothing external.
   const std::string html = io::ReadTextFile(dir + "/report.html");
   const io::ReportCheck check = io::CheckReportHtml(html);
@@ -95,7 +98,8 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   EXPECT_GE(check.figures, 12);
   EXPECT_GE(check.tables, 4);
   EXPECT_LT(html.size(), 10u * 1000u * 1000u);
-  for (const char* needle : {"Selection curves", "Allan deviation", "residual", "IMF 1 ", "compensate"}) {
+  for (const char* needle :
+       {"Selection curves", "Allan deviation", "residual", "IMF 1 ", "compensate"}) {
     EXPECT_NE(html.find(needle), std::string::npos) << needle;
   }
 }
@@ -105,15 +109,17 @@ TEST(DemoCli, UserLogStudy) {
   // A log of our own: simulate one (the demo reads any uniformly sampled CSV).
   const std::string work = test::TempDir("demo_user");
   ASSERT_EQ(RunCli("simulate --duration 30min -o " + work + "/log.csv").exit_code, 0);
-  const auto r = RunCli("demo --input " + work + "/log.csv --target rate_dph --temperature temperature_c "
-                        "--ensemble 10 --realisations 20 --window 64 --methods ms-elm,elm,poly -o " +
-                        work + "/out");
+  const auto r =
+      RunCli("demo --input " + work +
+             "/log.csv --target rate_dph --temperature temperature_c "
+             "--ensemble 10 --realisations 20 --window 64 --methods ms-elm,elm,poly -o " +
+             work + "/out");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("from the median step of time_s"), std::string::npos) << r.out;
   EXPECT_FALSE(test::FileExists(work + "/out/run_a.csv"));  // no simulation
   const std::set<std::string> compensate = Pairs(work + "/out/compensate_table.csv");
-  EXPECT_EQ(compensate, (std::set<std::string>{"ms-elm/paper", "ms-elm/causal", "elm/paper", "elm/causal",
-                                               "poly/paper", "poly/causal"}));
+  EXPECT_EQ(compensate, (std::set<std::string>{"ms-elm/paper", "ms-elm/causal", "elm/paper",
+                                               "elm/causal", "poly/paper", "poly/causal"}));
   EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 6u);
   const std::string html = io::ReadTextFile(work + "/out/report.html");
   const io::ReportCheck check = io::CheckReportHtml(html);
@@ -144,6 +150,7 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo --input " + dir + "/missing.csv --target a --temperature b", 2, "no such file"},
       {"demo --duration 0s", 2, "--duration"},
       {"demo --duration '8 hours'", 2, "--duration"},
+      {"demo --duration 90min", 2, "at least 2h"},
       {"demo --ensemble 0", 2, "--ensemble"},
       {"demo --window 4", 2, "--window"},
       {"demo --methods ms-elm,nope", 2, "nope"},

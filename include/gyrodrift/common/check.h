@@ -27,4 +27,9 @@ void RequireNonNegative(std::string_view name, double value);
 void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
                          Eigen::Index min_samples);
 
+// Throws DataError "<what> is constant (every sample is <v>): <consequence>" when every sample of
+// x (non-empty) is equal.
+void RequireVaryingSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
+                          std::string_view consequence);
+
 }  // namespace gyrodrift

@@ -40,6 +40,11 @@ struct FeatureOptions {
   // Time constants of the thermal-history bank, seconds, each in [1, 1e6]; may be empty (then
   // only T itself is a feature).
   std::vector<double> time_constants_s{60.0, 300.0, 900.0, 1800.0, 3600.0};
+  // At fit time, drop the time constants longer than a quarter of the training record (the
+  // shortest is always kept): a lag as slow as the record is indistinguishable from a trend and
+  // makes the thermal fit extrapolate wildly (docs/drift.md section 1.1). The fitted model stores
+  // the constants it kept, with this off. `fit --time-constants` turns it off.
+  bool limit_time_constants = true;
   double rate_hz = 1.0;  // sample rate of the log, Hz, in (0, 1e6]
   // Which thermal features; kAuto = kClassic for the poly method, kLadder otherwise (the drift
   // model resolves it; ThermalFeatures itself treats kAuto as kLadder). kClassic needs at least
@@ -54,6 +59,10 @@ struct FeatureOptions {
 // DataError on a non-finite sample or an empty record.
 Eigen::MatrixXd ThermalFeatures(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                 const FeatureOptions& options);
+
+// The options with limit_time_constants applied for a training record of `samples` samples at
+// options.rate_hz (and the flag cleared).
+FeatureOptions ForTrainingRecord(FeatureOptions options, Eigen::Index samples);
 
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,

@@ -108,6 +108,26 @@ DriftOptions Fast(Mode mode, Method method) {
   return o;
 }
 
+TEST(ThermalFeatures, TimeConstantsLongerThanAQuarterOfTheTrainingRecordAreDropped) {
+  FeatureOptions o;  // 60, 300, 900, 1800, 3600 s at 1 Hz
+  EXPECT_EQ(ForTrainingRecord(o, 28800).time_constants_s, o.time_constants_s);  // 8 h: all
+  EXPECT_EQ(ForTrainingRecord(o, 7200).time_constants_s, (std::vector<double>{60, 300, 900, 1800}));
+  EXPECT_EQ(ForTrainingRecord(o, 3000).time_constants_s, (std::vector<double>{60, 300}));
+  EXPECT_EQ(ForTrainingRecord(o, 100).time_constants_s, (std::vector<double>{60}));  // shortest
+  EXPECT_FALSE(ForTrainingRecord(o, 100).limit_time_constants);
+  o.rate_hz = 0.1;  // 3000 samples are 30000 s
+  EXPECT_EQ(ForTrainingRecord(o, 3000).time_constants_s, o.time_constants_s);
+  o.rate_hz = 1.0;
+  o.limit_time_constants = false;
+  EXPECT_EQ(ForTrainingRecord(o, 100).time_constants_s, o.time_constants_s);
+  // A fitted model keeps what it used, with the limit off, so a saved model estimates the same.
+  const Log log = MakeLog(3000, 12);
+  const DriftModel model =
+      FitDriftModel(log.rate, log.temperature, Fast(Mode::kCompensate, Method::kPoly));
+  EXPECT_EQ(model.options.features.time_constants_s, (std::vector<double>{60, 300}));
+  EXPECT_FALSE(model.options.features.limit_time_constants);
+}
+
 TEST(DriftModel, MsElmPredictModeBuildsGroupsThatSumToTheSignal) {
   const Log log = MakeLog(1500, 1);
   const DriftModel model =
@@ -193,6 +213,7 @@ TEST(DriftModel, CompensateModeNeedsOnlyTemperatureAtRunTime) {
 TEST(DriftModel, CompensateModeIsLinearPerGroupReferencedAndThreadCountFree) {
   const Log train = MakeLog(3000, 8);
   DriftOptions o = Fast(Mode::kCompensate, Method::kMsElm);
+  o.features.limit_time_constants = false;  // all five lags on this 50-minute log
   const DriftModel model = FitDriftModel(train.rate, train.temperature, o);
   ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
   EXPECT_EQ(model.num_inputs(), 7);  // the ladder: 5 rungs, the slowest lag, (T - 20)^2
