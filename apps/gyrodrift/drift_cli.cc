@@ -49,11 +49,11 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
       ->required();
   cmd->add_option("--decomposition", a->decomposition, "beemdan|iceemdan|ceemdan|eemd|emd")
       ->capture_default_str();
-  cmd->add_option("--lags,-p", a->lags,
+  a->lags_option = cmd->add_option("--lags,-p", a->lags,
                   "own lags per sub-model: auto (chosen on the last 20% of the training record "
                   "among 1,2,4,8,16) or p in [1,256] (predict mode)")
       ->capture_default_str();
-  cmd->add_option("--hidden", a->hidden,
+  a->hidden_option = cmd->add_option("--hidden", a->hidden,
                   "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed L")
       ->capture_default_str();
   a->rate_option = cmd->add_option("--rate-hz", a->rate_hz,
@@ -99,6 +99,11 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
   if (hidden > 0) {
     o.learner.elm.selection = elm::Selection::kFixed;
     o.learner.elm.hidden_units = hidden;
+  }
+  if (o.mode == drift::Mode::kCompensate && a.lags_option != nullptr &&
+      a.lags_option->count() > 0) {
+    throw UsageError("--lags = " + a.lags +
+                     ": applies to --mode predict (a compensate-mode model sees temperature only)");
   }
   if (o.mode == drift::Mode::kCompensate && a.temperature.empty()) {
     throw UsageError(

@@ -27,6 +27,8 @@ struct DriftArgs {
   std::string hidden = "auto";  // "auto" or L
   double rate_hz = 1.0;
   CLI::Option* rate_option = nullptr;  // to tell "--rate-hz given" from the default
+  CLI::Option* lags_option = nullptr;    // ... "--lags given"
+  CLI::Option* hidden_option = nullptr;  // ... "--hidden given"
   int ensemble = 100;
   int realisations = 100;  // white-noise realisations of the selection's Monte-Carlo level
   std::string thermal_features = "auto";  // drift::ThermalSet name

@@ -18,7 +18,6 @@ namespace {
 struct FitArgs : DriftArgs {
   std::string method = "ms-elm";
   std::string output;
-  CLI::Option* hidden_option = nullptr;
 };
 
 void Run(const FitArgs& a) {
@@ -30,6 +29,12 @@ void Run(const FitArgs& a) {
     throw UsageError("--hidden = " + a.hidden +
                      ": applies to the ELM methods (ms-elm, emd-elm, elm), not --method " +
                      a.method);
+  }
+  if (o.mode == drift::Mode::kCompensate && o.linear_compensation && method != drift::Method::kElm &&
+      elm_based && a.hidden_option->count() > 0 && a.hidden != "auto") {
+    throw UsageError("--hidden = " + a.hidden + ": compensate-mode " + a.method +
+                     " fits linear sub-models (docs/drift.md 1.2); --hidden applies to predict "
+                     "mode and to --method elm");
   }
 
   const io::CsvTable table = io::CsvTable::Read(a.input);
@@ -97,7 +102,6 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
   AddDriftOptions(cmd, args.get());
   cmd->add_option("--method,-m", args->method, "ms-elm|elm|emd-elm|poly|svr|bp")
       ->capture_default_str();
-  args->hidden_option = cmd->get_option("--hidden");
   cmd->add_option("-o,--output", args->output, "model file to write (JSON)")->required();
   cmd->callback([args] { Run(*args); });
 });

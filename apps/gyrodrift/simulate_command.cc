@@ -27,7 +27,8 @@ struct SimulateArgs {
   double rate_hz = 1.0;
   std::uint64_t seed = 1;
   std::string winding;              // empty: the preset's
-  double asymmetry = std::nan("");  // NaN: the preset's
+  double asymmetry = 0.0;
+  CLI::Option* asymmetry_option = nullptr;  // not given: the preset's
   double input_rate_dph = 0.0;
   bool no_noise = false;
   std::string output;
@@ -132,7 +133,7 @@ nlohmann::json ParametersJson(const sim::FogParameters& p) {
 void Run(const SimulateArgs& a) {
   sim::FogParameters params = sim::PresetParameters(sim::PresetFromString(a.preset));
   if (!a.winding.empty()) params.coil.winding = sim::WindingPatternFromString(a.winding);
-  if (!std::isnan(a.asymmetry)) params.coil.winding_asymmetry = a.asymmetry;
+  if (a.asymmetry_option->count() > 0) params.coil.winding_asymmetry = a.asymmetry;
   params.Validate();
   sim::SimulationOptions o;
   o.rate_hz = a.rate_hz;
@@ -217,7 +218,7 @@ const RegisterCommand kRegister("simulate", 10, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--winding", args->winding,
                   "override the preset: quadrupole|dipole|octupole|conventional|symmetric");
-  cmd->add_option("--asymmetry", args->asymmetry,
+  args->asymmetry_option = cmd->add_option("--asymmetry", args->asymmetry,
                   "override the preset's winding asymmetry (fraction, |a| < 0.5)");
   cmd->add_option("--input-rate-dph", args->input_rate_dph,
                   "true rate on the sensitive axis, e.g. an Earth-rate component, deg/h")

@@ -1,6 +1,8 @@
 #include "common/enum_names.h"
 #include "gyrodrift/decomposition/decomposition.h"
 
+#include <unistd.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -99,25 +101,22 @@ void DecompositionOptions::Validate() const {
   if (max_imfs < 0 || max_imfs > 1000) {
     ThrowOption("max_imfs", std::to_string(max_imfs), "an integer in [0, 1000] (0 = no cap)");
   }
-  if (method != Method::kEmd) {
-    if (!supplied_noise && (ensemble_size < 1 || ensemble_size > 1000000)) {
-      ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 1000000]");
-    }
-    if (!(noise_strength > 0 && noise_strength <= 10)) {
-      ThrowOption("noise_strength", FormatValue(noise_strength), "in (0, 10]");
-    }
-    if (threads < 0 || threads > 1024) {
-      ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
-    }
+  // Every field is checked whatever the method, so a mistyped option is never silently ignored.
+  if (!supplied_noise && (ensemble_size < 1 || ensemble_size > 100000)) {
+    ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 100000]");
   }
-  if (method == Method::kBeemdan) {
-    if (band_confidence != 0.95 && band_confidence != 0.99) {
-      ThrowOption("band_confidence", FormatValue(band_confidence),
-                  "0.95 or 0.99 (the bands fitted by Flandrin et al. 2004)");
-    }
-    if (noise_stages < 1 || noise_stages > 1000) {
-      ThrowOption("noise_stages", std::to_string(noise_stages), "an integer in [1, 1000]");
-    }
+  if (!(noise_strength > 0 && noise_strength <= 10)) {
+    ThrowOption("noise_strength", FormatValue(noise_strength), "in (0, 10]");
+  }
+  if (threads < 0 || threads > 1024) {
+    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
+  }
+  if (band_confidence != 0.95 && band_confidence != 0.99) {
+    ThrowOption("band_confidence", FormatValue(band_confidence),
+                "0.95 or 0.99 (the bands fitted by Flandrin et al. 2004)");
+  }
+  if (noise_stages < 1 || noise_stages > 1000) {
+    ThrowOption("noise_stages", std::to_string(noise_stages), "an integer in [1, 1000]");
   }
 }
 
@@ -153,6 +152,25 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
                       std::to_string(n) + ") and at least one realisation column");
     }
     if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
+  }
+  if (options.method == Method::kCeemdan || options.method == Method::kIceemdan ||
+      options.method == Method::kBeemdan) {
+    // Each realisation keeps the running residue of its noise EMD (N doubles): refuse an
+    // ensemble whose state alone would not fit in the machine, instead of dying of it.
+    const double ensemble =
+        options.supplied_noise ? static_cast<double>(options.supplied_noise->cols())
+                               : static_cast<double>(options.ensemble_size);
+    const double state_bytes = ensemble * static_cast<double>(n) * sizeof(double);
+    const double memory_bytes =
+        static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+    if (memory_bytes > 0 && state_bytes > 0.5 * memory_bytes) {
+      char rule[160];
+      std::snprintf(rule, sizeof rule,
+                    "small enough that its noise state (%.3g GB for %lld samples) fits in half "
+                    "the memory (%.3g GB)",
+                    state_bytes / 1e9, static_cast<long long>(n), memory_bytes / 1e9);
+      ThrowOption("ensemble_size", std::to_string(static_cast<long long>(ensemble)), rule);
+    }
   }
   // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.
   if (internal::CountExtrema(x.data(), n).extrema() < 3) {

@@ -78,6 +78,8 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
   io::WriteFileAtomically(dir_ + "/empty.csv", "");
   io::WriteFileAtomically(dir_ + "/ragged.csv", "a,b\n1,2\n3\n");
   io::WriteFileAtomically(dir_ + "/w_short.csv", "w0\n1\n2\n");
+  io::WriteFileAtomically(dir_ + "/inf.csv", "x\n1\ninf\n3\n4\n5\n");
+  io::WriteFileAtomically(dir_ + "/constant.csv", "x\n2\n2\n2\n2\n2\n");
   const std::vector<BadCase> cases = {
       {"missing file", "decompose %DIR%/nope.csv -c x", 2, "no such file"},
       {"missing column", "decompose %IN% -c gyro", 2, "column 'gyro' not found"},
@@ -97,6 +99,10 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"negative seed", "decompose %IN% -c 2 --seed -1", 2, "[0, 2^64)"},
       {"noise rows", "decompose %IN% -c 2 --noise-file %DIR%/w_short.csv", 3, "supplied noise"},
       {"noise with emd", "decompose %IN% -c 2 -m emd --noise-file %DIR%/w_short.csv", 2, "--noise-file"},
+      {"unused option still checked", "decompose %IN% -c 2 -m emd -I 0", 2, "ensemble_size = 0"},
+      {"inf cell", "decompose %DIR%/inf.csv -c x", 3, "data row 2"},
+      {"negative threads", "decompose %IN% -c 2 -j -3", 2, "threads"},
+      {"constant column", "decompose %DIR%/constant.csv -c x", 3, "column 'x' is constant"},
   };
   const std::string out = dir_ + "/bad.csv";
   for (const auto& c : cases) {

@@ -189,6 +189,10 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"zero hidden", "fit %IN% -t rate_dph --mode predict --hidden 0", 2, "--hidden = '0'"},
       {"hidden for poly", "fit %IN% -t rate_dph --mode predict -m poly --hidden 5", 2,
        "applies to the ELM methods"},
+      {"hidden for linear compensation", "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--hidden 20", 2, "fits linear sub-models"},
+      {"lags in compensate mode", "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--lags 8", 2, "--lags = 8: applies to --mode predict"},
       {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "ensemble_size = 0"},
       {"few realisations", "fit %IN% -t rate_dph --mode predict --realisations 5", 2,
        "realisations = 5"},

@@ -151,6 +151,7 @@ TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--rate-hz abc", 2, "rate-hz");
   ExpectFailure("--winding sextupole", 2, "winding = sextupole");
   ExpectFailure("--asymmetry 0.7", 2, "winding_asymmetry = 0.7");
+  ExpectFailure("--asymmetry nan", 2, "winding_asymmetry = nan");
   ExpectFailure("--seed -1", 2, "--seed: -1: must be an integer");
   ExpectFailure("--seed 18446744073709551616", 2, "must be an integer in [0, 2^64)");
   ExpectFailure("--bogus", 2, "bogus");

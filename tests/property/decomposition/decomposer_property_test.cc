@@ -165,13 +165,31 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
   bad = o;
   bad.max_imfs = -1;
   EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
+  // Every option is checked, also those the method does not use.
+  bad = o;
+  bad.ensemble_size = 0;
+  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
+  bad = o;
+  bad.noise_strength = -0.1;
+  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
+  bad = o;
+  bad.band_confidence = 0.5;
+  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
+  if (GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
+      GetParam() == Method::kBeemdan) {
+    // 1e5 realisations of 1e7 samples would hold 8 TB of noise state: refused before any work.
+    bad = o;
+    bad.ensemble_size = 100000;
+    const Eigen::VectorXd long_signal = Eigen::VectorXd::LinSpaced(10000000, 0.0, 1.0);
+    try {
+      Decompose(long_signal, bad);
+      FAIL();
+    } catch (const UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("fits in half the memory"), std::string::npos)
+          << e.what();
+    }
+  }
   if (GetParam() != Method::kEmd) {
-    bad = o;
-    bad.ensemble_size = 0;
-    EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
-    bad = o;
-    bad.noise_strength = -0.1;
-    EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
     bad = o;
     bad.supplied_noise = std::make_shared<Eigen::MatrixXd>(Eigen::MatrixXd::Zero(63, 4));
     EXPECT_THROW(Decompose(Noisy(64, 5), bad), DataError);
