@@ -104,7 +104,8 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
 }
 
 void Run(const AllanArgs& a) {
-  RequirePositive("--rate-hz", a.rate_hz);
+  // Beyond this range the averages under- or overflow (1e308 Hz gave all-zero deviations).
+  RequireInRange("--rate-hz", a.rate_hz, 1e-9, 1e9);
   al::AllanOptions o;
   o.rate_hz = a.rate_hz;
   o.data_type = al::DataTypeFromString(a.type);
@@ -113,6 +114,15 @@ void Run(const AllanArgs& a) {
   o.confidence = a.confidence;
   o.threads = a.threads;
   ParseTaus(a.taus, &o);
+  for (double tau : o.tau_list_s) {
+    // Averages span whole samples: a tau between two is not silently moved to the nearer one.
+    const double m = tau * a.rate_hz;
+    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 * m) {
+      ThrowOption("--taus", fmt::format("{:g}", tau),
+                  fmt::format("a whole number of sample periods at {:g} Hz (nearest: {:g} s)",
+                              a.rate_hz, std::max(1.0, std::round(m)) / a.rate_hz));
+    }
+  }
   o.Validate();
   const al::NoiseFitOptions fit_options{.tau_min_s = a.fit_tau_min_s, .tau_max_s = a.fit_tau_max_s};
   fit_options.Validate();  // every option error before any file is read

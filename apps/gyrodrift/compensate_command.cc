@@ -86,13 +86,23 @@ void Run(const CompensateArgs& a) {
         fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({:.1f} % removed)\n",
                     ColumnName(table, a.truth), truth_rms, residual_rms, removed);
   }
+  // A thermal model beyond the temperatures it was fitted on extrapolates: say where.
+  const double outside = drift::ShareOutsideTrainingRange(model, temperature);
+  sidecar["outside_training_temperature_share"] = outside;
+  std::string outside_line;
+  if (outside > 0.0) {
+    outside_line = fmt::format(
+        "note: {:.1f} % of the samples lie outside the training temperature range [{:.4g}, {:.4g}] "
+        "degC: the estimate extrapolates there\n",
+        100.0 * outside, model.temperature_min_c, model.temperature_max_c);
+  }
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
     fmt::print(
-        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n{}wrote {} and {}\n",
+        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n{}{}wrote {} and {}\n",
         model.Summary(), loaded.info.target_column, rms(y), rms(compensated), y.size(), truth_line,
-        a.output, SidecarPath(a.output));
+        outside_line, a.output, SidecarPath(a.output));
   }
 }
 

@@ -25,6 +25,7 @@
 
 #include "cli_util.h"
 #include "command.h"
+#include "drift_cli.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -71,33 +72,6 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-// "all" or a comma-separated list. A repeated method would give two model files of one name, and
-// the atomic writer would fail after renaming some of the set: refuse it before any work.
-std::vector<drift::Method> ParseMethods(const std::string& text) {
-  if (text == "all") return drift::AllMethods();
-  std::vector<drift::Method> methods;
-  size_t start = 0;
-  while (start <= text.size()) {
-    const size_t comma = text.find(',', start);
-    std::string name =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    name.erase(0, name.find_first_not_of(' '));
-    name.erase(name.find_last_not_of(' ') + 1);
-    drift::Method m;
-    try {
-      m = drift::MethodFromString(name);
-    } catch (const UsageError& e) {
-      throw UsageError("--methods = '" + text + "': " + e.what());
-    }
-    if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
-      ThrowOption("--methods", "'" + text + "'", "a list without repeats");
-    }
-    methods.push_back(m);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return methods;
-}
 
 // -o must name a folder that exists or can be created. Found out before the study, which takes
 // half a minute or more, rather than when the files are written.

@@ -56,4 +56,8 @@ double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::stri
 // the table has the model's target column and, when the model uses it, its temperature column.
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);
 
+// --methods: "all" (every drift::Method) or a comma-separated list without repeats or empty
+// items. Throws UsageError naming --methods.
+std::vector<drift::Method> ParseMethods(const std::string& text);
+
 }  // namespace gyrodrift::cli

@@ -30,29 +30,6 @@ struct EvaluateArgs : DriftArgs {
   std::string output;
 };
 
-std::vector<drift::Method> ParseMethods(const std::string& list) {
-  if (list == "all") return drift::AllMethods();
-  std::vector<drift::Method> methods;
-  std::stringstream stream(list);
-  for (std::string item; std::getline(stream, item, ',');) {
-    item.erase(0, item.find_first_not_of(' '));
-    item.erase(item.find_last_not_of(' ') + 1);
-    drift::Method m;
-    try {
-      m = drift::MethodFromString(item);
-    } catch (const UsageError& e) {
-      throw UsageError("--methods = '" + list + "': " + e.what());
-    }
-    if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
-      ThrowOption("--methods", "'" + list + "'", "a list without repeats");
-    }
-    methods.push_back(m);
-  }
-  if (methods.empty())
-    ThrowOption("--methods", "'" + list + "'", "'all' or a comma-separated list");
-  return methods;
-}
-
 std::vector<drift::Protocol> ParseProtocols(const std::string& text) {
   if (text == "both") return {drift::Protocol::kPaper, drift::Protocol::kCausal};
   if (text != "paper" && text != "causal")
@@ -138,7 +115,24 @@ void Run(const EvaluateArgs& a) {
                     {"predict_s", r.predict_s},
                     {"model_summary", r.model_summary}});
   }
+  // Test temperatures beyond the training block's make every thermal model extrapolate.
+  std::string outside_line;
+  double outside = 0.0;
+  if (temperature.size() > 0 && result.split_index > 0) {
+    const auto train = temperature.head(result.split_index);
+    const double lo = train.minCoeff(), hi = train.maxCoeff();
+    const auto test = temperature.tail(temperature.size() - result.split_index).array();
+    outside = static_cast<double>(((test < lo) || (test > hi)).count()) /
+              static_cast<double>(test.size());
+    if (outside > 0.0) {
+      outside_line = fmt::format(
+          "note: {:.1f} % of the test samples lie outside the training temperature range "
+          "[{:.4g}, {:.4g}] degC: thermal models extrapolate there\n",
+          100.0 * outside, lo, hi);
+    }
+  }
   sidecar["result"] = {{"mode", drift::ToString(result.mode)},
+                       {"test_outside_training_temperature_share", outside},
                        {"samples", y.size()},
                        {"first_test_sample", result.split_index + 1},
                        {"test_samples", y.size() - result.split_index},
@@ -148,9 +142,9 @@ void Run(const EvaluateArgs& a) {
       {{a.output, TableCsv(result)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
     fmt::print(
-        "{} mode, trained on samples 1..{}, scored on {}..{} against {}\n{}wrote {} and {}\n",
+        "{} mode, trained on samples 1..{}, scored on {}..{} against {}\n{}{}wrote {} and {}\n",
         drift::ToString(result.mode), result.split_index, result.split_index + 1, y.size(),
-        result.against_truth ? truth_column : target, result.Table(), a.output,
+        result.against_truth ? truth_column : target, result.Table(), outside_line, a.output,
         SidecarPath(a.output));
   }
 }

@@ -316,8 +316,22 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decomposed = UsesDecomposition(options.method);
   if (options.progress) options.progress(decomposed ? 0.85 : 0.0, "fit sub-models");
   internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size());
+  if (prepared.model.uses_temperature()) {
+    prepared.model.temperature_min_c = temperature_c.minCoeff();
+    prepared.model.temperature_max_c = temperature_c.maxCoeff();
+  }
   if (options.progress) options.progress(1.0, "fit sub-models");
   return std::move(prepared.model);
+}
+
+double ShareOutsideTrainingRange(const DriftModel& model,
+                                 const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
+  if (!(model.temperature_min_c <= model.temperature_max_c) || temperature_c.size() == 0) {
+    return 0.0;
+  }
+  const auto outside = (temperature_c.array() < model.temperature_min_c) ||
+                       (temperature_c.array() > model.temperature_max_c);
+  return static_cast<double>(outside.count()) / static_cast<double>(temperature_c.size());
 }
 
 Eigen::VectorXd EstimateDrift(const DriftModel& model,

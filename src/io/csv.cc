@@ -75,6 +75,13 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
         if (table.header_[i].empty()) {
           throw DataError(source + ": header column " + std::to_string(i + 1) + " has no name");
         }
+        for (size_t j = 0; j < i; ++j) {
+          // A column is chosen by name: two of one name would make the choice silent guesswork.
+          if (table.header_[j] == table.header_[i]) {
+            throw DataError(source + ": header names column '" + table.header_[i] + "' twice (" +
+                            std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
+          }
+        }
       }
       table.columns_.resize(table.header_.size());
       table.first_bad_.resize(table.header_.size());

@@ -149,6 +149,8 @@ json ModelJson(const drift::DriftModel& model) {
           {"decomposition_summary", model.decomposition_summary},
           {"selection_summary", model.selection_summary},
           {"lag_validation_rmse", Numbers(model.lag_validation_rmse)},
+          {"temperature_range_c",
+           Numbers({model.temperature_min_c, model.temperature_max_c})},
           {"sub_models", std::move(subs)}};
 }
 
@@ -444,6 +446,13 @@ drift::DriftModel ReadModel(const Node& root) {
   model.decomposition_summary = m["decomposition_summary"].String();
   model.selection_summary = m["selection_summary"].String();
   model.lag_validation_rmse = m["lag_validation_rmse"].Doubles();
+  // Files written before the range was stored have none (NaN: no extrapolation check).
+  if (m.raw().contains("temperature_range_c")) {
+    const std::vector<double> range = m["temperature_range_c"].Doubles();
+    if (range.size() != 2) m["temperature_range_c"].Fail("must hold 2 values (min, max)");
+    model.temperature_min_c = range[0];
+    model.temperature_max_c = range[1];
+  }
   const bool predict = model.options.mode == drift::Mode::kPredict;
   if (predict && (model.lags < 1 || model.lags > 256)) {
     m["lags"].Fail("= " + std::to_string(model.lags) +

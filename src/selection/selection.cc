@@ -80,7 +80,11 @@ const ModeGroup* SelectionResult::Group(GroupKind kind) const {
 std::string SelectionResult::Summary() const {
   std::string s = std::string(ToString(criterion)) + "/" + std::string(ToString(distance)) +
                   ": K=" + std::to_string(num_imfs) + " k*=" + std::to_string(k_star);
-  if (criterion == Criterion::kPdfSimilarity) s += " k_N=" + std::to_string(k_noise);
+  if (criterion == Criterion::kPdfSimilarity) {
+    s += " k_N=" + std::to_string(k_noise) + " (level R=" +
+         std::to_string(noise_level_realisations) + " seed=" + std::to_string(noise_level_seed) +
+         ")";
+  }
   if (criterion == Criterion::kEnergyModel) {
     s += " band exit=" + std::to_string(energy_signal_start);
   }
@@ -260,6 +264,8 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
         }
       }
       result.k_noise = k_noise;
+      result.noise_level_realisations = level->realisations;
+      result.noise_level_seed = level->seed;
       if (level->partial && static_cast<int>(level->level.size()) < k_count) {
         AppendNote(&result.note,
                    "white-noise level reused from the decomposition's noise EMDs, "

@@ -108,6 +108,7 @@ TEST(CliAllan, BadInputGivesOneLineErrorAndNoOutput) {
     std::ofstream(dir + "/nan.csv") << "rate_dph\n1.0\nnan\n2.0\n";
     std::ofstream(dir + "/inf.csv") << "rate_dph\n1.0\ninf\n2.0\n";
     std::ofstream(dir + "/short.csv") << "rate_dph\n1.0\n";
+    std::ofstream(dir + "/constant.csv") << "rate_dph\n3\n3\n3\n3\n";
   }
   const BadCase cases[] = {
       {"no file", "$DIR/missing.csv -c rate_dph --rate-hz 1 -o $OUT", 2, "no such file"},
@@ -124,6 +125,13 @@ TEST(CliAllan, BadInputGivesOneLineErrorAndNoOutput) {
       {"non-positive tau", "$LOG -c rate_dph --rate-hz 1 --taus 1,0,10 -o $OUT", 2, "--taus"},
       {"negative tau", "$LOG -c rate_dph --rate-hz 1 --taus -3 -o $OUT", 2, "--taus"},
       {"junk tau", "$LOG -c rate_dph --rate-hz 1 --taus 1,x -o $OUT", 2, "--taus"},
+      {"tau between samples", "$LOG -c rate_dph --rate-hz 1 --taus 1,1.5 -o $OUT", 2,
+       "--taus = 1.5: must be a whole number of sample periods at 1 Hz (nearest: 2 s)"},
+      {"tau below one sample", "$LOG -c rate_dph --rate-hz 2 --taus 0.2 -o $OUT", 2,
+       "nearest: 0.5 s"},
+      {"absurd rate", "$LOG -c rate_dph --rate-hz 1e308 -o $OUT", 2, "--rate-hz = 1e+308"},
+      {"constant column", "$DIR/constant.csv -c rate_dph --rate-hz 1 -o $OUT", 3,
+       "column 'rate_dph' is constant"},
       {"bad dev", "$LOG -c rate_dph --rate-hz 1 --dev allan -o $OUT", 2, "dev = allan"},
       {"bad type", "$LOG -c rate_dph --rate-hz 1 --type phase -o $OUT", 2, "type = phase"},
       {"bad units", "$LOG -c rate_dph --rate-hz 1 --units rpm -o $OUT", 2, "units = rpm"},

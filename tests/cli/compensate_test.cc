@@ -86,6 +86,35 @@ TEST_F(CompensateCli, AddsTheEstimateAndTheCompensatedOutput) {
   EXPECT_FALSE(json.contains("truth"));
 }
 
+TEST_F(CompensateCli, SaysWhereTheTemperatureLeavesTheTrainingRange) {
+  const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
+  const auto train = io::CsvTable::Read(Dir() + "/train.csv");
+  EXPECT_EQ(loaded.model.temperature_min_c, train.Column("temperature_c").minCoeff());
+  EXPECT_EQ(loaded.model.temperature_max_c, train.Column("temperature_c").maxCoeff());
+  auto run = [&](const std::string& csv) {
+    const std::string out = Dir() + "/range_out.csv";
+    const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + csv + "' -o '" + out + "'");
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+    return std::make_pair(r.out, json["outside_training_temperature_share"].get<double>());
+  };
+  const auto [inside_out, inside] = run(Dir() + "/test.csv");
+  EXPECT_EQ(inside, 0.0);
+  EXPECT_EQ(inside_out.find("note:"), std::string::npos) << inside_out;
+  // The same log 10 degC warmer: the upper part of the cycle is beyond anything seen in training.
+  const auto input = io::CsvTable::Read(Dir() + "/test.csv");
+  const Eigen::VectorXd warmer = (input.Column("temperature_c").array() + 10.0).matrix();
+  io::WriteCsv(Dir() + "/warmer.csv",
+               {{"rate_dph", input.Column("rate_dph")}, {"temperature_c", warmer}});
+  const auto [outside_out, outside] = run(Dir() + "/warmer.csv");
+  const double expected = static_cast<double>((warmer.array() > loaded.model.temperature_max_c).count()) /
+                          static_cast<double>(warmer.size());
+  EXPECT_GT(expected, 0.1);
+  EXPECT_EQ(outside, expected);
+  EXPECT_NE(outside_out.find("outside the training temperature range"), std::string::npos)
+      << outside_out;
+}
+
 TEST_F(CompensateCli, TruthColumnGivesTheShareOfTheDriftRemoved) {
   const std::string out = Dir() + "/truth.csv";
   const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +

@@ -116,6 +116,7 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"unknown method", p + "--methods elm,lstm", 2, "method = 'lstm'"},
       {"repeated method", p + "--methods elm,elm", 2, "without repeats"},
       {"empty methods", p + "--methods ,", 2, "--methods"},
+      {"trailing comma", p + "--methods elm,", 2, "--methods = 'elm,'"},
       {"bad protocol", p + "--protocol future", 2, "--protocol = 'future'"},
       {"bad split", p + "--split 0.99", 2, "split = 0.99"},
       {"zero repeats", p + "--repeats 0", 2, "repeats = 0"},

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -97,6 +98,10 @@ struct DriftModel {
   std::string decomposition_summary;        // report of the training decomposition
   std::string selection_summary;            // report of the grouping (kMsElm)
   std::vector<double> lag_validation_rmse;  // auto_lags: per candidate
+  // Range of the training temperature, degC (NaN when the model does not use temperature): a
+  // thermal model outside it extrapolates (ShareOutsideTrainingRange).
+  double temperature_min_c = std::numeric_limits<double>::quiet_NaN();
+  double temperature_max_c = std::numeric_limits<double>::quiet_NaN();
   bool uses_temperature() const;
   int num_inputs() const;       // inputs of each sub-model
   std::string Summary() const;  // one line
@@ -116,6 +121,11 @@ Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomp
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                          const DriftOptions& options);
+
+// Share of temperature samples outside [temperature_min_c, temperature_max_c] of the model (0 for
+// a model without temperature): where the estimate extrapolates.
+double ShareOutsideTrainingRange(const DriftModel& model,
+                                 const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
 
 // Compensate mode: the drift estimate at every sample of a temperature record (relative to
 // equilibrium at options.reference_c unless that is NaN).

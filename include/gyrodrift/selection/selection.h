@@ -22,6 +22,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -94,6 +95,10 @@ struct SelectionResult {
   bool grid_under_resolved = false;   // the grid cap left a density below points_per_bandwidth
   double signal_bandwidth = 0.0;      // Silverman bandwidth of x (units of x)
   bool noise_level_computed = false;  // this call ran the Monte-Carlo (false: cache or supplied)
+  // The white-noise level's realisations and seed (kPdfSimilarity; 0 otherwise): with the level
+  // reused from a decomposition the seed is the decomposition's, not monte_carlo.seed.
+  int noise_level_realisations = 0;
+  std::uint64_t noise_level_seed = 0;
   // max_t |x - (sum_k imf_k + residue)| / max_t |x|: the groups add up to the decomposition's
   // reconstruction; for a non-complete decomposition (EEMD) that differs from x by this much.
   double reconstruction_error = 0.0;

@@ -50,6 +50,16 @@ TEST(CsvTable, NonNumericAndNonFiniteCellsNameTheRow) {
   }
 }
 
+TEST(CsvTable, DuplicateHeaderNamesAreErrors) {
+  try {
+    CsvTable::Parse("a,b,a\n1,2,3\n", "dup.csv");
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("names column 'a' twice (1 and 3)"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(CsvTable, RaggedRowsAndEmptyFilesAreErrors) {
   EXPECT_THROW(CsvTable::Parse("a,b\n1\n", "f"), DataError);
   EXPECT_THROW(CsvTable::Parse("", "f"), DataError);

@@ -118,8 +118,9 @@ TEST(SelectModes, ThreeGroupsOnSyntheticModes) {
   EXPECT_LE(r.reconstruction_error, 1e-15);
   EXPECT_FALSE(r.noise_level_computed);
   EXPECT_TRUE(r.note.empty()) << r.note;
-  EXPECT_EQ(r.Summary(), "pdf/l2: K=7 k*=5 k_N=4 noise{1-4} mixed{5} drift{6-7+r} grid=" +
-                             std::to_string(r.grid_points));
+  EXPECT_EQ(r.Summary(),
+            "pdf/l2: K=7 k*=5 k_N=4 (level R=0 seed=0) noise{1-4} mixed{5} drift{6-7+r} grid=" +
+                std::to_string(r.grid_points));
   // The common grid resolves the narrowest density.
   EXPECT_FALSE(r.grid_under_resolved);
   EXPECT_GT(r.grid_points, 512);
