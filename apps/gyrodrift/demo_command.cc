@@ -1344,7 +1344,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
   cmd->add_option("--duration", args->duration,
-                  "advanced: length of each simulated run (30s, 10min, 8h)")
+                  "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
       ->capture_default_str()
       ->group("Advanced");
   cmd->add_option("--ensemble", args->ensemble, "advanced: BEEMDAN ensemble size")
