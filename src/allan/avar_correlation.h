@@ -1,7 +1,8 @@
 // Correlation between overlapping Allan-variance estimates at different averaging times, for a
 // Gaussian noise process with the IEEE 952 power-law spectrum. The noise fit (noise_fit.cc) uses
-// it for generalised least squares: neighbouring points of a curve share most of their data, so
-// treating them as independent makes the fitted terms' uncertainties several times too small.
+// it for the sandwich covariance of its terms and the design effect of its term tests: neighbouring
+// points of a curve share most of their data, so treating them as independent makes the fitted
+// terms' uncertainties several times too small and their significance too large.
 //
 // Theory. The overlapping estimator at factor m is the mean of D_k^2 / 2 over its n terms, where
 // D is y filtered by the second difference of m-sample means, |H_m(f)|^2 =
@@ -14,8 +15,8 @@
 //   Q (white angle): 8 c sin^2(pi f) / tau0^2     N (white rate): 2 c / tau0
 //   B (flicker rate): c / (pi f)                  K (random-walk rate): c tau0 / (2 sin^2(pi f))
 // each of which integrates to its term of the IEEE 952 model (K: the discrete random walk, whose
-// spectrum is c tau0 / (2 pi^2 f^2) at low f; the difference matters at the smallest factors). The rate ramp R is a trend, not a
-// stationary noise, and contributes nothing here.
+// spectrum is c tau0 / (2 pi^2 f^2) at low f; the difference matters at the smallest factors). The
+// rate ramp R is a trend, not a stationary noise, and contributes nothing here.
 //
 // Quadrature. Octave panels [f, 2f) from f = 1 / (1024 m_max) to 1/2, 1024 midpoints each, so the
 // cost does not depend on the record length (about 4e4 points x T^2 / 2 for T averaging times).

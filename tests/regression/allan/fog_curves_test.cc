@@ -47,10 +47,16 @@ Curve LoadChannel(const std::string& file, const std::string& channel) {
     c.adev_dph[k] = adev[i] * to_dph;
     c.lo_dph[k] = lci[i] * to_dph;
     c.hi_dph[k] = uci[i] * to_dph;
-    // Degrees of freedom implied by the band width: relative sd of a deviation ~ 1/sqrt(2 edf).
-    // Only the relative weights matter to the fit, so the band's confidence level does not.
-    const double rel = (uci[i] - lci[i]) / (2.0 * adev[i]);
-    c.edf[k] = 1.0 / (2.0 * rel * rel);
+    // Degrees of freedom implied by the band. avar's band is adev (1 +- 2 e) with
+    // e = 1 / sqrt(2 (T / tau - 1)) (avar's R/avar.r and src/allan_variance.cpp; the KVH 1750
+    // band at tau = 1.024 s, T / tau = 976.6, is 1 +- 0.0453 as that predicts), the relative
+    // standard deviation of a non-overlapping deviation with T / tau - 1 degrees of freedom: so
+    // edf = 1 / (2 e^2), e = half-width / (2 adev). (The maximal-overlap estimator has more; this
+    // is the conservative reading.) The level matters: the fit keeps a term only if it is
+    // significant, so a band read as 1 sigma (4 times fewer degrees of freedom, as this test did
+    // before the fit selected terms by a chi-square test) hides a floor the band shows.
+    const double e = (uci[i] - lci[i]) / (4.0 * adev[i]);
+    c.edf[k] = 1.0 / (2.0 * e * e);
   }
   return c;
 }
