@@ -69,7 +69,8 @@ nlohmann::json TermJson(const al::NoiseTerm& t, const char* unit) {
           {"tau_lo_s", t.tau_lo_s},
           {"tau_hi_s", t.tau_hi_s},
           {"slope_reading", t.slope_reading},
-          {"slope_tau_s", t.slope_tau_s}};
+          {"slope_tau_s", t.slope_tau_s},
+          {"evidence_chi2", t.evidence_chi2}};
 }
 
 std::string Num(double v) { return std::isfinite(v) ? fmt::format("{:.4g}", v) : "-"; }
@@ -80,8 +81,8 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
       "IEEE 952 noise terms ({} curve, fit in log variance, {} points {}..{} s, "
       "chi2/dof {}):\n",
       source, t.points_used, Num(t.tau_min_s), Num(t.tau_max_s), Num(t.chi2_per_dof));
-  s += fmt::format("  {:<34} {:>24}   {:>12} {:>12}\n", "term", "fitted", "slope method",
-                   "at tau [s]");
+  s += fmt::format("  {:<34} {:>24} {:>9}   {:>12} {:>12}\n", "term", "fitted", "evidence",
+                   "slope method", "at tau [s]");
   struct Row {
     const char* name;
     const al::NoiseTerm* term;
@@ -95,9 +96,13 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
     const std::string fitted = r.term->identified
                                    ? fmt::format("{:.4g} +- {:.2g}", r.term->value, r.term->sigma)
                                    : std::string("not identified");
-    s += fmt::format("  {:<34} {:>24}   {:>12} {:>12}\n", r.name, fitted,
-                     Num(r.term->slope_reading), Num(r.term->slope_tau_s));
+    s += fmt::format("  {:<34} {:>24} {:>9}   {:>12} {:>12}\n", r.name, fitted,
+                     Num(r.term->evidence_chi2), Num(r.term->slope_reading),
+                     Num(r.term->slope_tau_s));
   }
+  s += fmt::format(
+      "  evidence: chi-square rise of the misfit without the term (the term is kept above {})\n",
+      Num(t.critical_chi2));
   s += fmt::format("  curve minimum {} deg/h at tau {} s (B slope reading = minimum / 0.664)\n",
                    Num(t.min_dev_dph), Num(t.min_dev_tau_s));
   return s;
@@ -209,8 +214,12 @@ void Run(const AllanArgs& a) {
     sidecar["noise_terms"] = {
         {"source_dev", fit_source},
         {"method",
-         "IEEE 952 model, weighted non-negative least squares on AVAR (weights EDF / "
-         "(2 AVAR^2)); terms below 10 % of the model at every tau dropped"},
+         "IEEE 952 model fitted in log variance (weights from the EDF); terms removed steepest "
+         "first (R, Q, K, N, B) while a nested chi-square test at the significance level, "
+         "corrected for the correlated overlapping points, finds them unnecessary, or while they "
+         "stay below 10 % of the model at every tau; uncertainties from the correlated points "
+         "(docs/allan.md)"},
+        {"critical_chi2", terms->critical_chi2},
         {"points_used", terms->points_used},
         {"tau_min_s", terms->tau_min_s},
         {"tau_max_s", terms->tau_max_s},
