@@ -245,6 +245,8 @@ void Run(const AllanArgs& a) {
   } else {
     fmt::print("noise terms not fitted: {}\n", fit_error);
   }
+  const std::string time_note = NonUniformTimeNote(table);
+  if (!time_note.empty()) fmt::print("{}\n", time_note);
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));
 }
 

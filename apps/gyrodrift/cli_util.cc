@@ -1,8 +1,10 @@
 #include "cli_util.h"
 
+#include <fmt/core.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -57,6 +59,67 @@ double ParseDuration(const std::string& text) {
     if (ec == std::errc() && seconds > 0.0 && std::isfinite(seconds)) return seconds;
   }
   ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
+}
+
+namespace {
+
+double MedianStep(const Eigen::VectorXd& t) {
+  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
+  const size_t mid = steps.size() / 2;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
+  double median = steps[mid];
+  if (steps.size() % 2 == 0) {
+    const double below =
+        *std::max_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid));
+    median = 0.5 * (median + below);
+  }
+  return median;
+}
+
+}  // namespace
+
+double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how) {
+  if (given > 0.0) {
+    *how = "given";
+    return given;
+  }
+  if (!table.HasColumn("time_s") || table.rows() < 2) {
+    *how = "default";
+    return 1.0;
+  }
+  const double median = MedianStep(table.Column("time_s"));
+  if (!(median > 0.0)) {
+    throw DataError(table.source() + ": column 'time_s' has a median step of " +
+                    FormatValue(median) +
+                    " s: it must increase to give the sample rate (or pass --rate-hz)");
+  }
+  *how = "time_s";
+  return 1.0 / median;
+}
+
+std::string NonUniformTimeNote(const io::CsvTable& table) {
+  if (!table.HasColumn("time_s") || table.rows() < 3) return "";
+  const Eigen::VectorXd t = table.Column("time_s");
+  const double median = MedianStep(t);
+  if (!(median > 0.0)) return "";
+  long off = 0;
+  double largest = 0.0;
+  Eigen::Index largest_row = 0;
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
+    const double step = t[i + 1] - t[i];
+    if (std::abs(step - median) > 0.5 * median) ++off;
+    if (std::abs(step - median) > std::abs(largest - median)) {
+      largest = step;
+      largest_row = i + 2;  // 1-based data row of the sample after the step
+    }
+  }
+  if (off == 0) return "";
+  return fmt::format(
+      "note: time_s is not uniform: {} of {} steps differ from the median step {:g} s by more than "
+      "half (largest {:g} s, before data row {}); the models and the Allan analysis treat the "
+      "samples as equally spaced",
+      off, t.size() - 1, median, largest, largest_row);
 }
 
 }  // namespace gyrodrift::cli

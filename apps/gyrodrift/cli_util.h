@@ -31,6 +31,16 @@ bool IsTerminal();
 // value that is not positive and finite, is a UsageError naming --duration.
 double ParseDuration(const std::string& text);
 
+// The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
+// column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
+// its median step is not positive.
+double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how);
+
+// "" for a log without time_s or with a uniform one; otherwise a one-line note that the time axis
+// has gaps or jitter (steps more than half the median step away from it: how many, the largest
+// and its row), since every model and the Allan analysis assume uniform sampling.
+std::string NonUniformTimeNote(const io::CsvTable& table);
+
 // Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
 std::string ColumnName(const io::CsvTable& table, const std::string& spec);
 

@@ -72,7 +72,6 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-
 // -o must name a folder that exists or can be created. Found out before the study, which takes
 // half a minute or more, rather than when the files are written.
 void CheckOutputFolder(const std::string& dir) {
@@ -167,6 +166,7 @@ struct Study {
   std::string temperature_name;  // the temperature column (what a saved model reads)
   double rate_hz = 1.0;
   std::string rate_how;
+  std::string time_note;  // a non-uniform time_s column (user logs), empty otherwise
   // Run A (or the user's log) and, for a simulation, run B.
   sim::SimulationResult a, b;
   Eigen::VectorXd y, temperature, truth;  // analysed record (truth empty for a user's log)
@@ -1093,26 +1093,12 @@ void Run(const DemoArgs& a) {
     s.target_name = table.header()[static_cast<size_t>(table.ResolveColumn(a.target))];
     s.unit = a.units == "dph" ? "deg/h" : a.units == "dps" ? "deg/s" : "rad/s";
     s.temperature_name = table.header()[static_cast<size_t>(table.ResolveColumn(a.temperature))];
-    if (a.rate_option->count() > 0) {
-      s.rate_hz = a.rate_hz;
-      s.rate_how = "given by --rate-hz";
-    } else if (table.HasColumn("time_s")) {
-      const Eigen::VectorXd t = table.Column("time_s");
-      std::vector<double> steps;
-      for (Eigen::Index i = 1; i < t.size(); ++i) steps.push_back(t[i] - t[i - 1]);
-      if (steps.empty())
-        throw DataError(a.input + ": too few rows to read a sample rate from time_s");
-      std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2),
-                       steps.end());
-      const double step = steps[steps.size() / 2];
-      if (!(step > 0.0))
-        throw DataError(a.input + ": time_s does not increase (median step " + Fmt(step) + " s)");
-      s.rate_hz = 1.0 / step;
-      s.rate_how = "from the median step of time_s";
-    } else {
-      s.rate_hz = 1.0;
-      s.rate_how = "assumed 1 Hz (no --rate-hz, no time_s column)";
-    }
+    std::string how;
+    s.rate_hz = ResolveSampleRate(table, a.rate_option->count() > 0 ? a.rate_hz : 0.0, &how);
+    s.rate_how = how == "given"    ? "given by --rate-hz"
+                 : how == "time_s" ? "from the median step of time_s"
+                                   : "assumed 1 Hz (no --rate-hz, no time_s column)";
+    s.time_note = NonUniformTimeNote(table);
     if (s.y.size() < 64) {
       throw DataError(a.input + ": " + std::to_string(s.y.size()) +
                       " samples; the study needs at least 64 (a 70/30 split with 32 training and "
@@ -1123,6 +1109,7 @@ void Run(const DemoArgs& a) {
                (3600.0 * s.rate_hz);
     say(fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", a.input, s.y.size(),
                     s.target_name, Fmt(s.rate_hz), s.rate_how));
+    if (!s.time_note.empty()) say("   " + s.time_note + "\n");
   }
   stage_done(user ? "read" : "simulate A and B", t0);
 

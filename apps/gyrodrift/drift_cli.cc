@@ -49,13 +49,15 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
       ->required();
   cmd->add_option("--decomposition", a->decomposition, "beemdan|iceemdan|ceemdan|eemd|emd")
       ->capture_default_str();
-  a->lags_option = cmd->add_option("--lags,-p", a->lags,
-                  "own lags per sub-model: auto (chosen on the last 20% of the training record "
-                  "among 1,2,4,8,16) or p in [1,256] (predict mode)")
-      ->capture_default_str();
-  a->hidden_option = cmd->add_option("--hidden", a->hidden,
-                  "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed L")
-      ->capture_default_str();
+  a->lags_option =
+      cmd->add_option("--lags,-p", a->lags,
+                      "own lags per sub-model: auto (chosen on the last 20% of the training record "
+                      "among 1,2,4,8,16) or p in [1,256] (predict mode)")
+          ->capture_default_str();
+  a->hidden_option =
+      cmd->add_option("--hidden", a->hidden,
+                      "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed L")
+          ->capture_default_str();
   a->rate_option = cmd->add_option("--rate-hz", a->rate_hz,
                                    "sample rate, Hz (default: from the median step of a time_s "
                                    "column, else 1)");
@@ -122,32 +124,8 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
 }
 
 double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string* how) {
-  if (a.rate_option != nullptr && a.rate_option->count() > 0) {
-    *how = "given";
-    return a.rate_hz;
-  }
-  if (!table.HasColumn("time_s") || table.rows() < 2) {
-    *how = "default";
-    return 1.0;
-  }
-  const Eigen::VectorXd t = table.Column("time_s");
-  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
-  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
-  const size_t mid = steps.size() / 2;
-  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
-  double median = steps[mid];
-  if (steps.size() % 2 == 0) {
-    const double below =
-        *std::max_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid));
-    median = 0.5 * (median + below);
-  }
-  if (!(median > 0.0)) {
-    throw DataError(table.source() + ": column 'time_s' has a median step of " +
-                    FormatValue(median) +
-                    " s: it must increase to give the sample rate (or pass --rate-hz)");
-  }
-  *how = "time_s";
-  return 1.0 / median;
+  const bool given = a.rate_option != nullptr && a.rate_option->count() > 0;
+  return ResolveSampleRate(table, given ? a.rate_hz : 0.0, how);
 }
 
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table) {

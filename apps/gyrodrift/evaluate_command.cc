@@ -9,13 +9,13 @@
 #include "cli_util.h"
 #include "command.h"
 #include "drift_cli.h"
-#include "progress.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/evaluation.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
+#include "progress.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -116,7 +116,8 @@ void Run(const EvaluateArgs& a) {
                     {"model_summary", r.model_summary}});
   }
   // Test temperatures beyond the training block's make every thermal model extrapolate.
-  std::string outside_line;
+  std::string notes = NonUniformTimeNote(table);
+  if (!notes.empty()) notes += "\n";
   double outside = 0.0;
   if (temperature.size() > 0 && result.split_index > 0) {
     const auto train = temperature.head(result.split_index);
@@ -125,7 +126,7 @@ void Run(const EvaluateArgs& a) {
     outside = static_cast<double>(((test < lo) || (test > hi)).count()) /
               static_cast<double>(test.size());
     if (outside > 0.0) {
-      outside_line = fmt::format(
+      notes += fmt::format(
           "note: {:.1f} % of the test samples lie outside the training temperature range "
           "[{:.4g}, {:.4g}] degC: thermal models extrapolate there\n",
           100.0 * outside, lo, hi);
@@ -144,7 +145,7 @@ void Run(const EvaluateArgs& a) {
     fmt::print(
         "{} mode, trained on samples 1..{}, scored on {}..{} against {}\n{}{}wrote {} and {}\n",
         drift::ToString(result.mode), result.split_index, result.split_index + 1, y.size(),
-        result.against_truth ? truth_column : target, result.Table(), outside_line, a.output,
+        result.against_truth ? truth_column : target, result.Table(), notes, a.output,
         SidecarPath(a.output));
   }
 }

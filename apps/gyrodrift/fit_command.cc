@@ -6,11 +6,11 @@
 #include "cli_util.h"
 #include "command.h"
 #include "drift_cli.h"
-#include "progress.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
+#include "progress.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -30,8 +30,9 @@ void Run(const FitArgs& a) {
                      ": applies to the ELM methods (ms-elm, emd-elm, elm), not --method " +
                      a.method);
   }
-  if (o.mode == drift::Mode::kCompensate && o.linear_compensation && method != drift::Method::kElm &&
-      elm_based && a.hidden_option->count() > 0 && a.hidden != "auto") {
+  if (o.mode == drift::Mode::kCompensate && o.linear_compensation &&
+      method != drift::Method::kElm && elm_based && a.hidden_option->count() > 0 &&
+      a.hidden != "auto") {
     throw UsageError("--hidden = " + a.hidden + ": compensate-mode " + a.method +
                      " fits linear sub-models (docs/drift.md 1.2); --hidden applies to predict "
                      "mode and to --method elm");
@@ -78,8 +79,10 @@ void Run(const FitArgs& a) {
         "  {:<8} {}\n", sub.name,
         sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");
   }
-  fmt::print("sample rate: {} Hz ({})\nwrote {}\n", o.features.rate_hz,
-             rate_how == "time_s" ? "from the median step of time_s" : rate_how, a.output);
+  const std::string time_note = NonUniformTimeNote(table);
+  fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", o.features.rate_hz,
+             rate_how == "time_s" ? "from the median step of time_s" : rate_how,
+             time_note.empty() ? "" : time_note + "\n", a.output);
 }
 
 const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {

@@ -147,6 +147,25 @@ TEST_F(FitCli, ThermalFeatureSetAndTimeConstantsAreStoredAndUsed) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
+  // Rows 101.. shifted by 300 s: a logging gap the models cannot see.
+  std::string csv = LogCsv(300, 4);
+  const auto table = io::CsvTable::Parse(csv, "log");
+  Eigen::VectorXd t = table.Column("time_s");
+  t.tail(200).array() += 300.0;
+  io::WriteCsv(dir_ + "/gap.csv", {{"time_s", t}, {"rate_dph", table.Column("rate_dph")}});
+  auto r = test::RunCli("fit '" + dir_ + "/gap.csv' -t rate_dph --mode predict -m poly -o '" +
+                        dir_ + "/g.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: time_s is not uniform: 1 of 299 steps differ from the median step "
+                       "1 s by more than half (largest 301 s, before data row 101)"),
+            std::string::npos)
+      << r.out;
+  r = Fit("-t rate_dph --mode predict -m poly", dir_ + "/u.json");  // the uniform log
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("not uniform"), std::string::npos) << r.out;
+}
+
 TEST_F(FitCli, EveryBaselineFits) {
   for (const char* method : {"elm", "poly", "svr", "bp"}) {
     const std::string model = dir_ + "/" + method + ".json";
@@ -189,10 +208,14 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"zero hidden", "fit %IN% -t rate_dph --mode predict --hidden 0", 2, "--hidden = '0'"},
       {"hidden for poly", "fit %IN% -t rate_dph --mode predict -m poly --hidden 5", 2,
        "applies to the ELM methods"},
-      {"hidden for linear compensation", "fit %IN% -t rate_dph -T temperature_c --mode compensate "
-       "--hidden 20", 2, "fits linear sub-models"},
-      {"lags in compensate mode", "fit %IN% -t rate_dph -T temperature_c --mode compensate "
-       "--lags 8", 2, "--lags = 8: applies to --mode predict"},
+      {"hidden for linear compensation",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--hidden 20",
+       2, "fits linear sub-models"},
+      {"lags in compensate mode",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--lags 8",
+       2, "--lags = 8: applies to --mode predict"},
       {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "ensemble_size = 0"},
       {"few realisations", "fit %IN% -t rate_dph --mode predict --realisations 5", 2,
        "realisations = 5"},
