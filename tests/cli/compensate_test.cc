@@ -6,9 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
-#include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -18,22 +16,6 @@
 namespace gyrodrift {
 namespace {
 
-// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
-std::string LogCsv(int n, std::uint64_t seed) {
-  Rng rng(seed, 0);
-  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
-  double lagged = 20.0;
-  for (int t = 0; t < n; ++t) {
-    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
-    const double previous = lagged;
-    lagged += (temperature - lagged) / 40.0;
-    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
-    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
-           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
-  }
-  return csv;
-}
-
 double Rms(const Eigen::VectorXd& v) {
   return std::sqrt(v.squaredNorm() / static_cast<double>(v.size()));
 }
@@ -42,8 +24,8 @@ class CompensateCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new std::string(test::TempDir("cli_compensate"));
-    io::WriteFileAtomically(Dir() + "/train.csv", LogCsv(600, 1));
-    io::WriteFileAtomically(Dir() + "/test.csv", LogCsv(600, 2));  // same programme, new noise
+    io::WriteFileAtomically(Dir() + "/train.csv", test::ThermalLogCsv(600, 1));
+    io::WriteFileAtomically(Dir() + "/test.csv", test::ThermalLogCsv(600, 2));  // same programme, new noise
     const std::string fit = "fit '" + Dir() + "/train.csv' -t rate_dph -T temperature_c -I 10 -q ";
     ASSERT_EQ(test::RunCli(fit + "--mode compensate -o '" + Dir() + "/ms.json'").exit_code, 0);
     ASSERT_EQ(test::RunCli(fit + "--mode predict -m elm -o '" + Dir() + "/pred.json'").exit_code,

@@ -4,9 +4,7 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
-#include "gyrodrift/common/random.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "support/test_support.h"
@@ -14,28 +12,12 @@
 namespace gyrodrift {
 namespace {
 
-// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
-std::string LogCsv(int n, std::uint64_t seed) {
-  Rng rng(seed, 0);
-  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
-  double lagged = 20.0;
-  for (int t = 0; t < n; ++t) {
-    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
-    const double previous = lagged;
-    lagged += (temperature - lagged) / 40.0;
-    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
-    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
-           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
-  }
-  return csv;
-}
-
 class EvaluateCli : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = test::TempDir("cli_evaluate");
     input_ = dir_ + "/log.csv";
-    io::WriteFileAtomically(input_, LogCsv(400, 1));
+    io::WriteFileAtomically(input_, test::ThermalLogCsv(400, 1));
   }
   std::string dir_, input_;
 };
@@ -105,9 +87,9 @@ struct BadCase {
 };
 
 TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
-  io::WriteFileAtomically(dir_ + "/short.csv", LogCsv(50, 2));
-  io::WriteFileAtomically(dir_ + "/seventy.csv", LogCsv(70, 2));
-  std::string nan_truth = LogCsv(200, 3);
+  io::WriteFileAtomically(dir_ + "/short.csv", test::ThermalLogCsv(50, 2));
+  io::WriteFileAtomically(dir_ + "/seventy.csv", test::ThermalLogCsv(70, 2));
+  std::string nan_truth = test::ThermalLogCsv(200, 3);
   nan_truth.replace(nan_truth.rfind(',') + 1, std::string::npos, "nan\n");
   io::WriteFileAtomically(dir_ + "/nan_truth.csv", nan_truth);
   const std::string p = "evaluate %IN% -t rate_dph --mode predict -I 10 ";

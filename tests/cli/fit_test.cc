@@ -3,9 +3,7 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
-#include "gyrodrift/common/random.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
@@ -13,22 +11,6 @@
 
 namespace gyrodrift {
 namespace {
-
-// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
-std::string LogCsv(int n, std::uint64_t seed, double step_s = 1.0) {
-  Rng rng(seed, 0);
-  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
-  double lagged = 20.0;
-  for (int t = 0; t < n; ++t) {
-    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
-    const double previous = lagged;
-    lagged += (temperature - lagged) / 40.0;
-    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
-    csv += io::FormatDouble(t * step_s) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) +
-           "," + io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
-  }
-  return csv;
-}
 
 // Removes every "threads" entry (options and learner scalars), which records but never changes
 // the result.
@@ -46,7 +28,7 @@ class FitCli : public ::testing::Test {
   void SetUp() override {
     dir_ = test::TempDir("cli_fit");
     input_ = dir_ + "/train.csv";
-    io::WriteFileAtomically(input_, LogCsv(400, 1));
+    io::WriteFileAtomically(input_, test::ThermalLogCsv(400, 1));
   }
   test::CommandResult Fit(const std::string& args, const std::string& model) {
     return test::RunCli("fit '" + input_ + "' " + args + " -o '" + model + "'");
@@ -119,7 +101,7 @@ TEST_F(FitCli, LagsHiddenAndRateOptions) {
   EXPECT_EQ(json["model"]["lag_validation_rmse"].size(), 5u);
 
   // A time_s column sampled at 0.5 s gives 2 Hz.
-  io::WriteFileAtomically(dir_ + "/fast.csv", LogCsv(300, 2, 0.5));
+  io::WriteFileAtomically(dir_ + "/fast.csv", test::ThermalLogCsv(300, 2, 0.5));
   r = test::RunCli("fit '" + dir_ + "/fast.csv' -t rate_dph --mode predict -m poly --lags 3 -o '" +
                    model + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -149,7 +131,7 @@ TEST_F(FitCli, ThermalFeatureSetAndTimeConstantsAreStoredAndUsed) {
 
 TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   // Rows 101.. shifted by 300 s: a logging gap the models cannot see.
-  std::string csv = LogCsv(300, 4);
+  std::string csv = test::ThermalLogCsv(300, 4);
   const auto table = io::CsvTable::Parse(csv, "log");
   Eigen::VectorXd t = table.Column("time_s");
   t.tail(200).array() += 300.0;
@@ -185,7 +167,7 @@ struct BadCase {
 
 TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
   io::WriteFileAtomically(dir_ + "/nan.csv", "rate_dph,temperature_c\n1,2\n2,3\nnan,4\n");
-  io::WriteFileAtomically(dir_ + "/short.csv", LogCsv(20, 3));
+  io::WriteFileAtomically(dir_ + "/short.csv", test::ThermalLogCsv(20, 3));
   io::WriteFileAtomically(dir_ + "/backwards.csv", "time_s,rate_dph\n5,1\n4,2\n3,3\n2,4\n");
   const std::string ok = "-t rate_dph -T temperature_c --mode compensate -I 10";
   const std::vector<BadCase> cases = {

@@ -5,9 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <numbers>
 
-#include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -17,29 +15,13 @@
 namespace gyrodrift {
 namespace {
 
-// A thermal log: time_s, rate_dph = drift + noise, temperature_c, drift_dph (the truth).
-std::string LogCsv(int n, std::uint64_t seed) {
-  Rng rng(seed, 0);
-  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
-  double lagged = 20.0;
-  for (int t = 0; t < n; ++t) {
-    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
-    const double previous = lagged;
-    lagged += (temperature - lagged) / 40.0;
-    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
-    csv += io::FormatDouble(t) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) + "," +
-           io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
-  }
-  return csv;
-}
-
 // Models are fitted once for the suite (through the CLI, as a user would).
 class PredictCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new std::string(test::TempDir("cli_predict"));
-    io::WriteFileAtomically(Dir() + "/train.csv", LogCsv(300, 1));
-    io::WriteFileAtomically(Dir() + "/test.csv", LogCsv(120, 2));
+    io::WriteFileAtomically(Dir() + "/train.csv", test::ThermalLogCsv(300, 1));
+    io::WriteFileAtomically(Dir() + "/test.csv", test::ThermalLogCsv(120, 2));
     const std::string fit = "fit '" + Dir() + "/train.csv' -t rate_dph -I 10 -q ";
     ASSERT_EQ(test::RunCli(fit + "--mode predict -m ms-elm --lags 3 -o '" + Dir() + "/ms.json'")
                   .exit_code,
@@ -126,10 +108,10 @@ struct BadCase {
 TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
   io::WriteFileAtomically(Dir() + "/no_rate.csv",
                           "time_s,gyro,temperature_c\n0,1,20\n1,2,21\n2,3,22\n");
-  std::string no_temp = LogCsv(60, 3);
+  std::string no_temp = test::ThermalLogCsv(60, 3);
   no_temp.replace(0, no_temp.find('\n') + 1, "time_s,rate_dph,temp_c,drift_dph\n");
   io::WriteFileAtomically(Dir() + "/no_temp.csv", no_temp);
-  io::WriteFileAtomically(Dir() + "/short.csv", LogCsv(12, 4));
+  io::WriteFileAtomically(Dir() + "/short.csv", test::ThermalLogCsv(12, 4));
   io::WriteFileAtomically(Dir() + "/nan.csv", "rate_dph\n1\n2\n3\n4\n5\nnan\n7\n8\n");
   std::string damaged = io::ReadTextFile(Dir() + "/ms.json");
   const size_t digit = damaged.find_first_of("123456789", damaged.find("\"output_weights\""));

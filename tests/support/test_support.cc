@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gyrodrift/common/random.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 
@@ -113,6 +114,21 @@ void ExpectCleanFailure(const CommandResult& result, int exit_code, const std::s
   EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << label << ": " << result.err;
   EXPECT_FALSE(FileExists(output)) << label;
   EXPECT_FALSE(FileExists(output + ".json")) << label;
+}
+
+std::string ThermalLogCsv(int n, std::uint64_t seed, double step_s) {
+  Rng rng(seed, 0);
+  std::string csv = "time_s,rate_dph,temperature_c,drift_dph\n";
+  double lagged = 20.0;
+  for (int t = 0; t < n; ++t) {
+    const double temperature = 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * t / n);
+    const double previous = lagged;
+    lagged += (temperature - lagged) / 40.0;
+    const double drift = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous);
+    csv += io::FormatDouble(t * step_s) + "," + io::FormatDouble(drift + 0.02 * rng.Normal()) +
+           "," + io::FormatDouble(temperature) + "," + io::FormatDouble(drift) + "\n";
+  }
+  return csv;
 }
 
 }  // namespace gyrodrift::test

@@ -39,6 +39,11 @@ struct CommandResult {
 };
 // Runs the built gyrodrift binary with the given argument string (shell-quoted by the caller).
 CommandResult RunCli(const std::string& args);
+
+// A small thermal log for the CLI tests, one row per `step_s` seconds: time_s, rate_dph = drift +
+// white noise (0.02), temperature_c (1.5 cycles of 20 +- 15 degC), drift_dph (the truth: a
+// first-order lag of the temperature, tau 40 samples, and its rate).
+std::string ThermalLogCsv(int n, std::uint64_t seed, double step_s = 1.0);
 bool FileExists(const std::string& path);
 
 // `text` with every occurrence of each placeholder key replaced by its value.
