@@ -14,6 +14,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
+#include "progress.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -61,8 +62,16 @@ void Run(const PredictArgs& a) {
                     " samples: the model needs more than " + std::to_string(first) +
                     " (its history) to predict any");
   }
-  const Eigen::VectorXd prediction = drift::PredictOneStep(
-      model, y, temperature, first, protocol, drift::CausalOptions{a.window, a.threads});
+  drift::CausalOptions causal{.window = a.window, .threads = a.threads};
+  Eigen::VectorXd prediction;
+  {
+    // Causal prediction decomposes one trailing window per sample: minutes on a long log.
+    const bool windows = protocol == drift::Protocol::kCausal && decomposes;
+    ProgressBar progress({1.0}, windows && IsTerminal() && !a.quiet);  // Finish() on every path
+    progress.BeginStage(0, "causal windows");
+    causal.progress = [&progress](double fraction) { progress.Update(fraction, ""); };
+    prediction = drift::PredictOneStep(model, y, temperature, first, protocol, causal);
+  }
 
   const Eigen::Index count = y.size() - first;
   std::vector<io::CsvColumn> columns;

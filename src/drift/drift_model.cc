@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <utility>
 
 #include "common/enum_names.h"
@@ -412,6 +414,10 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
   std::vector<Eigen::MatrixXd> rows(groups, Eigen::MatrixXd(count, p + thermal.cols()));
+  std::atomic<Eigen::Index> windows_done{0};
+  std::mutex progress_mutex;
+  double reported = 0.0;
+  const Eigen::Index report_every = std::max<Eigen::Index>(1, count / 200);
   ParallelFor(static_cast<int>(count), causal.threads, [&](int r, int) {
     const Eigen::Index t = first + r;
     const Eigen::Index start = std::max<Eigen::Index>(0, t - causal.window);
@@ -422,6 +428,15 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
       for (int k = 0; k < p; ++k)
         rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
       if (thermal.cols() > 0) rows[g].row(r).tail(thermal.cols()) = thermal.row(t - 1);
+    }
+    const Eigen::Index done = ++windows_done;
+    if (causal.progress && (done % report_every == 0 || done == count)) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      const double fraction = static_cast<double>(done) / static_cast<double>(count);
+      if (fraction > reported) {
+        reported = fraction;
+        causal.progress(fraction);
+      }
     }
   });
   Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);

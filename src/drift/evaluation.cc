@@ -155,7 +155,17 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
         o.progress = nullptr;  // Evaluate reports through EvaluationOptions::progress
         o.method = method;
         o.seed = base.seed + static_cast<std::uint64_t>(r);
-        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.causal);
+        CausalOptions causal = options.causal;
+        if (options.progress) {
+          // The causal trial's windows are most of an evaluation's time: report within it too.
+          const std::string label = std::string(ToString(method)) + " / " +
+                                    std::string(ToString(protocol)) + " / seed " +
+                                    std::to_string(o.seed) + " / windows";
+          causal.progress = [&options, done, total, label](double fraction) {
+            options.progress((done + fraction) / total, label);
+          };
+        }
+        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, causal);
         const Metrics m = ComputeMetrics(trial.estimate - result.reference);
         rmse.push_back(m.rmse);
         row.mae += m.mae / options.repeats;

@@ -18,9 +18,9 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <memory>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -75,8 +75,8 @@ struct DriftOptions {
   // "decompose", "select modes", "fit sub-models"), from the calling thread or the thread that
   // accumulates the ensemble; may be empty. Not part of the model; Evaluate does not call it.
   std::function<void(double fraction, const std::string& step)> progress;
-  DriftOptions();          // sets the learner defaults described above
-  void Validate() const;   // throws UsageError naming the field
+  DriftOptions();         // sets the learner defaults described above
+  void Validate() const;  // throws UsageError naming the field
 };
 
 // One sub-series and its learner.
@@ -156,6 +156,9 @@ struct CausalOptions {
   // 46 ms with 100; 8,640 test samples of an 8-h record), and docs/drift.md shows what 20
   // instead of 100 costs in accuracy.
   int ensemble_size = 20;
+  // Called with the fraction of windows decomposed, increasing, never concurrently (from whichever
+  // worker finished one); may be empty. For progress displays: it does not change the result.
+  std::function<void(double fraction)> progress;
 };
 
 // One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -167,6 +168,26 @@ TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
   }
   EXPECT_EQ(PredictOneStep(reused, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
             PredictOneStep(reference, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
+}
+
+TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
+  const Log log = MakeLog(700, 5);
+  const DriftModel model =
+      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  CausalOptions causal;
+  causal.window = 64;
+  causal.threads = 2;
+  const Eigen::VectorXd quiet =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  std::vector<double> seen;
+  causal.progress = [&seen](double f) { seen.push_back(f); };
+  const Eigen::VectorXd reported =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  EXPECT_EQ(quiet, reported);
+  ASSERT_GE(seen.size(), 10u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
 }
 
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
