@@ -122,7 +122,9 @@ void Run(const AllanArgs& a) {
   for (double tau : o.tau_list_s) {
     // Averages span whole samples: a tau between two is not silently moved to the nearer one.
     const double m = tau * a.rate_hz;
-    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 * m) {
+    // Absolute in samples (a relative test would let half a sample through at large factors),
+    // loose enough for decimal taus such as 0.1 s at 10 Hz.
+    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 + 1e-12 * m) {
       ThrowOption("--taus", fmt::format("{:g}", tau),
                   fmt::format("a whole number of sample periods at {:g} Hz (nearest: {:g} s)",
                               a.rate_hz, std::max(1.0, std::round(m)) / a.rate_hz));

@@ -100,18 +100,28 @@ double ResolveSampleRate(const io::CsvTable& table, double given, std::string* h
 
 std::string NonUniformTimeNote(const io::CsvTable& table) {
   if (!table.HasColumn("time_s") || table.rows() < 3) return "";
-  const Eigen::VectorXd t = table.Column("time_s");
+  Eigen::VectorXd t;
+  try {
+    t = table.Column("time_s");
+  } catch (const Error&) {
+    return "";  // a note never fails a command; where time_s is needed it is read and refused
+  }
   const double median = MedianStep(t);
-  if (!(median > 0.0)) return "";
+  if (!(median > 0.0)) {
+    return fmt::format(
+        "note: time_s does not increase (median step {:g} s); the samples are taken as equally "
+        "spaced",
+        median);
+  }
   long off = 0;
-  double largest = 0.0;
-  Eigen::Index largest_row = 0;
+  double largest = t[1] - t[0];
+  Eigen::Index largest_row = 2;  // 1-based data row of the sample after the step
   for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
     const double step = t[i + 1] - t[i];
-    if (std::abs(step - median) > 0.5 * median) ++off;
+    if (!(std::abs(step - median) <= 0.5 * median)) ++off;
     if (std::abs(step - median) > std::abs(largest - median)) {
       largest = step;
-      largest_row = i + 2;  // 1-based data row of the sample after the step
+      largest_row = i + 2;
     }
   }
   if (off == 0) return "";

@@ -43,9 +43,9 @@ void Run(const CompensateArgs& a) {
   }
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   const Eigen::VectorXd temperature = table.Column(loaded.info.temperature_column);
-  const Eigen::VectorXd estimate = drift::EstimateDrift(model, temperature);
-  Eigen::VectorXd truth;
+  Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
   if (!a.truth.empty()) truth = table.Column(a.truth);
+  const Eigen::VectorXd estimate = drift::EstimateDrift(model, temperature);
 
   std::vector<io::CsvColumn> columns;
   for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
@@ -82,9 +82,11 @@ void Run(const CompensateArgs& a) {
                         {"rms", truth_rms},
                         {"residual_rms", residual_rms},
                         {"removed_percent", removed}};
-    truth_line =
-        fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({:.1f} % removed)\n",
-                    ColumnName(table, a.truth), truth_rms, residual_rms, removed);
+    // A zero truth has no share to remove: say so instead of printing "nan %".
+    const std::string share =
+        truth_rms > 0.0 ? fmt::format("{:.1f} % removed", removed) : "no drift to remove";
+    truth_line = fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({})\n",
+                             ColumnName(table, a.truth), truth_rms, residual_rms, share);
   }
   // A thermal model beyond the temperatures it was fitted on extrapolates: say where.
   const double outside = drift::ShareOutsideTrainingRange(model, temperature);

@@ -189,6 +189,10 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
   report = report && static_cast<bool>(o.progress);
   SubSeries out;
   out.model.options = o;
+  // A model keeps no caller callbacks: it may run later, from other threads, after they are gone.
+  out.model.options.progress = nullptr;
+  out.model.options.decomposition.progress = nullptr;
+  out.model.options.decomposition.noise_imf_observer = nullptr;
   if (!UsesDecomposition(o.method)) {
     out.model.sub_models.push_back({"signal", {}, true, nullptr});
     out.series = y;
@@ -313,7 +317,6 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   DriftOptions o = options;
   o.features = ForTrainingRecord(o.features, y.size());
   internal::SubSeries prepared = internal::PrepareSubSeries(y, o, /*report=*/true);
-  prepared.model.options.progress = nullptr;  // a model does not keep the caller's callback
   const Eigen::MatrixXd thermal = ThermalOrEmpty(prepared.model, temperature_c, y.size());
   const bool decomposed = UsesDecomposition(options.method);
   if (options.progress) options.progress(decomposed ? 0.85 : 0.0, "fit sub-models");

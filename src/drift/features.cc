@@ -81,7 +81,9 @@ void FeatureOptions::Validate() const {
 
 FeatureOptions ForTrainingRecord(FeatureOptions options, Eigen::Index samples) {
   if (options.limit_time_constants && !options.time_constants_s.empty()) {
-    const double limit_s = 0.25 * static_cast<double>(samples) / options.rate_hz;
+    // A rate read from time_s carries rounding (10 Hz can be 10.000000000003 Hz): a constant
+    // exactly at the limit must not depend on it.
+    const double limit_s = 0.25 * static_cast<double>(samples) / options.rate_hz * (1.0 + 1e-9);
     const double shortest =
         *std::min_element(options.time_constants_s.begin(), options.time_constants_s.end());
     std::vector<double> kept;

@@ -59,40 +59,53 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
       throw IoError(path + ": write failed (disk full?)");
     }
   }
-  // Existing targets are moved aside first, so a failed rename can put every earlier one back:
-  // the set appears complete or the targets are as they were.
+  // Each target is replaced by one atomic rename, so a reader sees the old file or the new one,
+  // never none. For a set, existing targets are first hard-linked (or copied) to backups, so that
+  // a failed later rename can rename every earlier backup back over its new file.
+  const bool set = files.size() > 1;
   std::vector<std::string> backups(files.size());
-  size_t placed = 0;
-  auto roll_back = [&] {
-    for (size_t j = 0; j < files.size(); ++j) {
-      const std::string& target = files[j].first;
-      if (j < placed) std::remove(target.c_str());
-      if (!backups[j].empty()) std::rename(backups[j].c_str(), target.c_str());
+  auto remove_backups = [&] {
+    for (const auto& b : backups) {
+      if (!b.empty()) std::remove(b.c_str());
     }
-    remove_temps();
   };
-  for (size_t i = 0; i < files.size(); ++i) {
-    const std::string& target = files[i].first;
-    std::error_code ec;
-    if (fs::exists(fs::symlink_status(target, ec))) {
+  if (set) {
+    for (size_t i = 0; i < files.size(); ++i) {
+      const std::string& target = files[i].first;
+      std::error_code ec;
+      if (!fs::exists(fs::symlink_status(target, ec))) continue;
       const std::string backup = target + ".bak" + suffix;
-      if (std::rename(target.c_str(), backup.c_str()) != 0) {
-        const std::string reason = std::strerror(errno);
-        roll_back();
-        throw IoError(target + ": cannot replace the existing file (" + reason + ")");
+      if (::link(target.c_str(), backup.c_str()) != 0) {
+        fs::copy_file(target, backup, fs::copy_options::overwrite_existing, ec);
+        if (ec) {
+          remove_backups();
+          remove_temps();
+          throw IoError(target + ": cannot keep a copy of the existing file (" + ec.message() +
+                        ")");
+        }
       }
       backups[i] = backup;
     }
-    if (std::rename(temps[i].c_str(), target.c_str()) != 0) {
-      const std::string reason = std::strerror(errno);
-      roll_back();
-      throw IoError(target + ": cannot rename the temporary file into place (" + reason + ")");
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string& target = files[i].first;
+    if (std::rename(temps[i].c_str(), target.c_str()) == 0) continue;
+    const std::string reason = std::strerror(errno);
+    std::string restore_failed;
+    for (size_t j = 0; j < i; ++j) {
+      const std::string& placed = files[j].first;
+      const bool ok = backups[j].empty() ? std::remove(placed.c_str()) == 0
+                                         : std::rename(backups[j].c_str(), placed.c_str()) == 0;
+      if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + placed;
     }
-    ++placed;
+    remove_backups();
+    remove_temps();
+    throw IoError(target + ": cannot rename the temporary file into place (" + reason + ")" +
+                  (restore_failed.empty()
+                       ? ""
+                       : "; could not restore the earlier state of " + restore_failed));
   }
-  for (const auto& b : backups) {
-    if (!b.empty()) std::remove(b.c_str());
-  }
+  remove_backups();
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {

@@ -149,8 +149,7 @@ json ModelJson(const drift::DriftModel& model) {
           {"decomposition_summary", model.decomposition_summary},
           {"selection_summary", model.selection_summary},
           {"lag_validation_rmse", Numbers(model.lag_validation_rmse)},
-          {"temperature_range_c",
-           Numbers({model.temperature_min_c, model.temperature_max_c})},
+          {"temperature_range_c", Numbers({model.temperature_min_c, model.temperature_max_c})},
           {"sub_models", std::move(subs)}};
 }
 
@@ -449,7 +448,11 @@ drift::DriftModel ReadModel(const Node& root) {
   // Files written before the range was stored have none (NaN: no extrapolation check).
   if (m.raw().contains("temperature_range_c")) {
     const std::vector<double> range = m["temperature_range_c"].Doubles();
-    if (range.size() != 2) m["temperature_range_c"].Fail("must hold 2 values (min, max)");
+    const bool none = range.size() == 2 && std::isnan(range[0]) && std::isnan(range[1]);
+    if (range.size() != 2 ||
+        !(none || (std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] <= range[1]))) {
+      m["temperature_range_c"].Fail("must hold min <= max, finite (or both nan: no temperature)");
+    }
     model.temperature_min_c = range[0];
     model.temperature_max_c = range[1];
   }
@@ -561,9 +564,10 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
   }
   const Node root(j, "", source);
   const long long version = root["format_version"].Int(0, std::numeric_limits<int>::max());
-  if (version != kModelFormatVersion) {
+  if (version < kOldestReadableModelFormatVersion || version > kModelFormatVersion) {
     throw DataError(source + ": model format_version " + std::to_string(version) +
-                    " is not supported (this gyrodrift reads version " +
+                    " is not supported (this gyrodrift reads versions " +
+                    std::to_string(kOldestReadableModelFormatVersion) + " to " +
                     std::to_string(kModelFormatVersion) + ")");
   }
   const std::string stored = root["checksum"].String();

@@ -196,8 +196,9 @@ bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposit
       a.sd_threshold == b.sd_threshold && a.EffectiveMaxSifts() == b.EffectiveMaxSifts();
   const bool family =
       d.method == Method::kCeemdan || d.method == Method::kIceemdan || d.method == Method::kBeemdan;
-  if (!family || d.supplied_noise || d.ensemble_size < monte_carlo_.realisations || !same_sifting ||
-      monte_carlo_.max_imfs != 0 || length_ < 16) {
+  if (!family || d.supplied_noise || d.noise_imf_observer ||
+      d.ensemble_size < monte_carlo_.realisations || !same_sifting || monte_carlo_.max_imfs != 0 ||
+      length_ < 16) {
     return false;
   }
   attached_ = true;

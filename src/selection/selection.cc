@@ -81,9 +81,9 @@ std::string SelectionResult::Summary() const {
   std::string s = std::string(ToString(criterion)) + "/" + std::string(ToString(distance)) +
                   ": K=" + std::to_string(num_imfs) + " k*=" + std::to_string(k_star);
   if (criterion == Criterion::kPdfSimilarity) {
-    s += " k_N=" + std::to_string(k_noise) + " (level R=" +
-         std::to_string(noise_level_realisations) + " seed=" + std::to_string(noise_level_seed) +
-         ")";
+    s += " k_N=" + std::to_string(k_noise) +
+         " (level R=" + std::to_string(noise_level_realisations) +
+         " seed=" + std::to_string(noise_level_seed) + ")";
   }
   if (criterion == Criterion::kEnergyModel) {
     s += " band exit=" + std::to_string(energy_signal_start);
@@ -253,6 +253,10 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
         if (level->partial && k > static_cast<int>(level->level.size()) && k_noise == k - 1) {
           // The noise run outlasted a level collected from the decomposition: the rest needs
           // the Monte-Carlo (modes 1..k-1 agree with it when the seeds do).
+          AppendNote(&result.note, "white-noise level of modes 1.." + std::to_string(k - 1) +
+                                       " from the decomposition's noise (seed " +
+                                       std::to_string(level->seed) +
+                                       "), later modes from the Monte-Carlo");
           level = NoiseLevelCache::Global().Get(static_cast<int>(n), options.monte_carlo, kde,
                                                 options.distance, &result.noise_level_computed);
         }

@@ -15,9 +15,11 @@ namespace gyrodrift::io {
 std::string ReadTextFile(const std::string& path);
 
 // Writes each (path, contents) atomically as a set: every file is written to a temporary beside
-// its target, then renamed into place; existing targets are moved aside first and put back if a
-// later rename fails. Throws IoError naming the path that failed (also for a path named twice or
-// a directory target); then no target is created or changed.
+// its target, then renamed into place (one atomic replace per file: readers never find it
+// missing); for a set, existing targets are first hard-linked (or copied) to backups that are
+// renamed back if a later rename fails. Throws IoError naming the path that failed (also for a
+// path named twice or a directory target); then no target is created or changed (the message
+// says so if a restore itself failed).
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 

@@ -35,7 +35,11 @@
 namespace gyrodrift::io {
 
 inline constexpr std::string_view kModelFormat = "gyrodrift-model";
-inline constexpr int kModelFormatVersion = 1;
+// Version 2 stores the thermal feature set, whether the time constants were limited, and the
+// training temperature range; version-1 files (all fitted with the "auto" set) still load. A
+// version-1 reader refuses version 2, which it would otherwise misread.
+inline constexpr int kModelFormatVersion = 2;
+inline constexpr int kOldestReadableModelFormatVersion = 1;
 
 // What the model was trained on, beside the model itself.
 struct ModelFileInfo {

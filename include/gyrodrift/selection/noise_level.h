@@ -86,7 +86,8 @@ class NoiseLevelCollector {
                       PdfDistance distance);
   // Installs the observer when the decomposition's noise is what the Monte-Carlo would use: a
   // CEEMDAN-family method with drawn (not supplied) noise, at least R realisations, the
-  // Monte-Carlo's sifting options and no IMF cap on its side. Returns whether it did.
+  // Monte-Carlo's sifting options and no IMF cap on its side, and no observer is installed yet.
+  // Returns whether it did.
   bool Attach(decomposition::DecompositionOptions* decomposition);
   // After the decomposition: the level of the modes it reached, or nullptr when not attached or
   // when no noise IMF was seen.

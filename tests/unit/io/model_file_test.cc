@@ -280,8 +280,26 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 2;
-  ExpectRefused(Reseal(j), "format_version 2 is not supported");
+  j["format_version"] = 3;
+  ExpectRefused(Reseal(j),
+                "format_version 3 is not supported (this gyrodrift reads versions 1 to 2)");
+  j["format_version"] = 0;
+  ExpectRefused(Reseal(j), "format_version 0 is not supported");
+  // A version-1 file (before the feature set, the limit flag and the range were stored) loads,
+  // with what those files meant: the "auto" set, every stored constant, no range.
+  j = Json();
+  j["format_version"] = 1;
+  j["options"]["features"].erase("thermal_set");
+  j["options"]["features"].erase("limit_time_constants");
+  j["model"].erase("temperature_range_c");
+  const LoadedModel old = ParseModelFile(Reseal(j), "v1.json");
+  EXPECT_EQ(old.model.options.features.thermal_set, drift::ThermalSet::kAuto);
+  EXPECT_FALSE(old.model.options.features.limit_time_constants);
+  EXPECT_TRUE(std::isnan(old.model.temperature_min_c));
+  // A range must be ordered and finite.
+  j = Json();
+  j["model"]["temperature_range_c"] = json::array({30.0, 20.0});
+  ExpectRefused(Reseal(j), "temperature_range_c");
 }
 
 TEST_F(Refusal, MissingFieldsAreNamed) {
