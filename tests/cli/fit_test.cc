@@ -143,6 +143,24 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
                        "1 s by more than half (largest 301 s, before data row 101)"),
             std::string::npos)
       << r.out;
+  // A step only 0.8 s too long is still the largest; an unreadable time_s is no reason to fail
+  // a fit that was given --rate-hz.
+  t = table.Column("time_s");
+  t.tail(150).array() += 0.8;
+  io::WriteCsv(dir_ + "/jitter.csv", {{"time_s", t}, {"rate_dph", table.Column("rate_dph")}});
+  r = test::RunCli("fit '" + dir_ + "/jitter.csv' -t rate_dph --mode predict -m poly -o '" + dir_ +
+                   "/j.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(largest 1.8 s, before data row 151)"), std::string::npos) << r.out;
+  std::string broken = "time_s,rate_dph\n";
+  for (int i = 0; i < 100; ++i) {
+    broken += (i == 50 ? std::string("x") : std::to_string(i)) + "," + std::to_string(i % 7) + "\n";
+  }
+  io::WriteFileAtomically(dir_ + "/broken_time.csv", broken);
+  r = test::RunCli("fit '" + dir_ + "/broken_time.csv' -t rate_dph --mode predict -m poly " +
+                   "--rate-hz 1 -o '" + dir_ + "/b.json'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
   r = Fit("-t rate_dph --mode predict -m poly", dir_ + "/u.json");  // the uniform log
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.find("not uniform"), std::string::npos) << r.out;
