@@ -89,7 +89,8 @@ void Run(const CompensateArgs& a) {
                              ColumnName(table, a.truth), truth_rms, residual_rms, share);
   }
   // A thermal model beyond the temperatures it was fitted on extrapolates: say where.
-  const double outside = drift::ShareOutsideTrainingRange(model, temperature);
+  const double outside =
+      drift::ShareOutsideRange(temperature, model.temperature_min_c, model.temperature_max_c);
   sidecar["outside_training_temperature_share"] = outside;
   std::string outside_line;
   if (outside > 0.0) {

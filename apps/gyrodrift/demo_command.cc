@@ -249,12 +249,13 @@ void DecomposeStep(const DemoArgs& a, Study& s) {
   dopt.threads = a.threads;
   sel::SelectionOptions sopt = o.selection;
   sopt.threads = a.threads;
-  sel::NoiseLevelCollector white_noise(static_cast<int>(s.y.size()), sopt.monte_carlo, sopt.kde,
-                                       sopt.distance);
-  if (sopt.criterion == sel::Criterion::kPdfSimilarity) white_noise.Attach(&dopt);
-  s.decomposition = dec::Decompose(s.y, dopt);
-  sopt.noise_level = white_noise.Level();
-  s.selection = sel::SelectModes(s.y, s.decomposition, sopt);
+  sel::GroupedDecomposition grouped = sel::DecomposeAndSelect(s.y, dopt, sopt);
+  if (!grouped.selection) {
+    throw DataError(s.target_name +
+                    " has fewer than 3 extrema: there is nothing to decompose or to model");
+  }
+  s.decomposition = std::move(grouped.decomposition);
+  s.selection = std::move(*grouped.selection);
 }
 
 void FillPredictTable(Study& s) {

@@ -118,19 +118,12 @@ void Run(const EvaluateArgs& a) {
   // Test temperatures beyond the training block's make every thermal model extrapolate.
   std::string notes = NonUniformTimeNote(table);
   if (!notes.empty()) notes += "\n";
-  double outside = 0.0;
-  if (temperature.size() > 0 && result.split_index > 0) {
-    const auto train = temperature.head(result.split_index);
-    const double lo = train.minCoeff(), hi = train.maxCoeff();
-    const auto test = temperature.tail(temperature.size() - result.split_index).array();
-    outside = static_cast<double>(((test < lo) || (test > hi)).count()) /
-              static_cast<double>(test.size());
-    if (outside > 0.0) {
-      notes += fmt::format(
-          "note: {:.1f} % of the test samples lie outside the training temperature range "
-          "[{:.4g}, {:.4g}] degC: thermal models extrapolate there\n",
-          100.0 * outside, lo, hi);
-    }
+  const double outside = result.test_outside_training_temperature_share;
+  if (outside > 0.0) {
+    notes += fmt::format(
+        "note: {:.1f} % of the test samples lie outside the training temperature range "
+        "[{:.4g}, {:.4g}] degC: thermal models extrapolate there\n",
+        100.0 * outside, result.training_temperature_min_c, result.training_temperature_max_c);
   }
   sidecar["result"] = {{"mode", drift::ToString(result.mode)},
                        {"test_outside_training_temperature_share", outside},

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <utility>
 
 #include "common/enum_names.h"
@@ -50,14 +51,19 @@ LearnerKind KindOf(Method method) {
   }
 }
 
-Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
-                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
-                               Eigen::Index n) {
-  if (!model.uses_temperature()) return Eigen::MatrixXd(n, 0);
+void RequireTemperatureFor(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, Eigen::Index n) {
   if (temperature_c.size() != n) {
     throw DataError("temperature has " + std::to_string(temperature_c.size()) +
                     " samples, the target " + std::to_string(n) + ": they must match");
   }
+  RequireFiniteSignal("temperature", temperature_c, n);
+}
+
+Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
+                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               Eigen::Index n) {
+  if (!model.uses_temperature()) return Eigen::MatrixXd(n, 0);
+  RequireTemperatureFor(temperature_c, n);
   return ThermalFeatures(temperature_c, EffectiveFeatures(model.options));
 }
 
@@ -140,8 +146,8 @@ void DriftOptions::Validate() const {
   }
 }
 
-bool DriftModel::uses_temperature() const {
-  return options.mode == Mode::kCompensate || options.features.use_temperature;
+bool DriftOptions::uses_temperature() const {
+  return mode == Mode::kCompensate || features.use_temperature;
 }
 
 int DriftModel::num_inputs() const {
@@ -205,16 +211,17 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
     o.progress(0.0, "decompose");
     dopt.progress = [&o](double fraction) { o.progress(kDecomposeShare * fraction, "decompose"); };
   }
-  selection::SelectionOptions sopt = o.selection;
-  sopt.threads = o.threads;
-  // The selection's white-noise level from the decomposition's own noise EMDs (the same IMFs the
-  // Monte-Carlo would compute: half the cost of a fit on a long record).
-  selection::NoiseLevelCollector white_noise(static_cast<int>(y.size()), sopt.monte_carlo, sopt.kde,
-                                             sopt.distance);
-  if (o.method != Method::kEmdElm && sopt.criterion == selection::Criterion::kPdfSimilarity) {
-    white_noise.Attach(&dopt);
+  decomposition::Decomposition d;
+  std::optional<selection::SelectionResult> sel;
+  if (o.method == Method::kEmdElm) {
+    d = decomposition::Decompose(y, dopt);
+  } else {
+    selection::SelectionOptions sopt = o.selection;
+    sopt.threads = o.threads;
+    selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt);
+    d = std::move(grouped.decomposition);
+    sel = std::move(grouped.selection);
   }
-  const decomposition::Decomposition d = decomposition::Decompose(y, dopt);
   out.model.training_imfs = d.num_imfs();
   out.model.decomposition_summary = d.report.Summary();
   if (d.num_imfs() == 0) {
@@ -225,11 +232,8 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
     }
     out.model.sub_models.push_back({"residue", {}, true, nullptr});
   } else {
-    if (report) o.progress(kDecomposeShare, "select modes");
-    sopt.noise_level = white_noise.Level();
-    const selection::SelectionResult sel = selection::SelectModes(y, d, sopt);
-    out.model.selection_summary = sel.Summary();
-    for (const auto& group : sel.groups) {
+    out.model.selection_summary = sel->Summary();
+    for (const auto& group : sel->groups) {
       out.model.sub_models.push_back(
           {std::string(selection::ToString(group.kind)), group.imfs, group.has_residue, nullptr});
     }
@@ -304,13 +308,9 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   options.Validate();
   RequireFiniteSignal("target", y, 32);
   RequireVaryingSignal("target", y, "there is nothing to model");
-  if (options.mode == Mode::kCompensate || options.features.use_temperature) {
+  if (options.uses_temperature()) {
     // Checked before the decomposition, which is the slow part.
-    if (temperature_c.size() != y.size()) {
-      throw DataError("temperature has " + std::to_string(temperature_c.size()) +
-                      " samples, the target " + std::to_string(y.size()) + ": they must match");
-    }
-    RequireFiniteSignal("temperature", temperature_c, y.size());
+    RequireTemperatureFor(temperature_c, y.size());
     RequireVaryingSignal("temperature", temperature_c,
                          "a drift model on temperature needs a record whose temperature changes");
   }
@@ -319,7 +319,8 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   internal::SubSeries prepared = internal::PrepareSubSeries(y, o, /*report=*/true);
   const Eigen::MatrixXd thermal = ThermalOrEmpty(prepared.model, temperature_c, y.size());
   const bool decomposed = UsesDecomposition(options.method);
-  if (options.progress) options.progress(decomposed ? 0.85 : 0.0, "fit sub-models");
+  if (options.progress)
+    options.progress(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
   internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size());
   if (prepared.model.uses_temperature()) {
     prepared.model.temperature_min_c = temperature_c.minCoeff();
@@ -329,13 +330,10 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   return std::move(prepared.model);
 }
 
-double ShareOutsideTrainingRange(const DriftModel& model,
-                                 const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
-  if (!(model.temperature_min_c <= model.temperature_max_c) || temperature_c.size() == 0) {
-    return 0.0;
-  }
-  const auto outside = (temperature_c.array() < model.temperature_min_c) ||
-                       (temperature_c.array() > model.temperature_max_c);
+double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double min_c,
+                         double max_c) {
+  if (!(min_c <= max_c) || temperature_c.size() == 0) return 0.0;
+  const auto outside = (temperature_c.array() < min_c) || (temperature_c.array() > max_c);
   return static_cast<double>(outside.count()) / static_cast<double>(temperature_c.size());
 }
 

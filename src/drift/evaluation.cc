@@ -29,7 +29,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
   const Eigen::Index n = y.size();
   const Eigen::Index test = n - split;
-  const bool thermal_needed = o.mode == Mode::kCompensate || o.features.use_temperature;
+  const bool thermal_needed = o.uses_temperature();
   Trial trial;
   auto start = std::chrono::steady_clock::now();
   DriftModel model;
@@ -101,7 +101,7 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   options.Validate();
   RequireFiniteSignal("target", y, 64);
   const Eigen::Index n = y.size();
-  const bool thermal_needed = base.mode == Mode::kCompensate || base.features.use_temperature;
+  const bool thermal_needed = base.uses_temperature();
   if (thermal_needed) {
     if (temperature_c.size() != n) {
       throw DataError(std::string(ToString(base.mode)) + " mode" +
@@ -122,6 +122,13 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   if (split < 32 || n - split < 16) {
     throw DataError("split at sample " + std::to_string(split) + " of " + std::to_string(n) +
                     " leaves too little data (at least 32 training and 16 test samples)");
+  }
+  if (temperature_c.size() == n) {
+    result.training_temperature_min_c = temperature_c.head(split).minCoeff();
+    result.training_temperature_max_c = temperature_c.head(split).maxCoeff();
+    result.test_outside_training_temperature_share =
+        ShareOutsideRange(temperature_c.tail(n - split), result.training_temperature_min_c,
+                          result.training_temperature_max_c);
   }
   result.against_truth = truth.size() != 0;
   result.reference = result.against_truth ? Eigen::VectorXd(truth.tail(n - split))

@@ -14,9 +14,9 @@ struct SubSeries {
 };
 
 // Decomposes y (if the method needs it), groups the IMFs and defines the sub-models.
-// Reports "decompose" (fractions up to kDecomposeShare) and "select modes" through o.progress
-// when `report` is set.
+// Reports "decompose" (fractions up to kDecomposeShare) through o.progress when `report` is set.
 constexpr double kDecomposeShare = 0.7;
+constexpr double kGroupsDoneShare = 0.85;  // the decomposition and the grouping done
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
                            bool report = false);
 

@@ -187,18 +187,11 @@ NoiseLevelCollector::NoiseLevelCollector(int length, const MonteCarloOptions& mo
 bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposition) {
   using decomposition::Method;
   const auto& d = *decomposition;
-  const auto& a = d.sifting;
-  const auto& b = monte_carlo_.sifting;
-  const bool same_sifting =
-      a.stop_rule == b.stop_rule && a.rilling_threshold1 == b.rilling_threshold1 &&
-      a.rilling_threshold2 == b.rilling_threshold2 && a.rilling_tolerance == b.rilling_tolerance &&
-      a.s_number == b.s_number && a.fixed_sifts == b.fixed_sifts &&
-      a.sd_threshold == b.sd_threshold && a.EffectiveMaxSifts() == b.EffectiveMaxSifts();
   const bool family =
       d.method == Method::kCeemdan || d.method == Method::kIceemdan || d.method == Method::kBeemdan;
   if (!family || d.supplied_noise || d.noise_imf_observer ||
-      d.ensemble_size < monte_carlo_.realisations || !same_sifting || monte_carlo_.max_imfs != 0 ||
-      length_ < 16) {
+      d.ensemble_size < monte_carlo_.realisations || !(d.sifting == monte_carlo_.sifting) ||
+      monte_carlo_.max_imfs != 0 || length_ < 16) {
     return false;
   }
   attached_ = true;

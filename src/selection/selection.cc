@@ -105,6 +105,22 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
   return SelectModes(x, decomposition.imfs, decomposition.residue, options);
 }
 
+GroupedDecomposition DecomposeAndSelect(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        decomposition::DecompositionOptions decomposition_options,
+                                        SelectionOptions options) {
+  NoiseLevelCollector white_noise(static_cast<int>(x.size()), options.monte_carlo, options.kde,
+                                  options.distance);
+  if (options.criterion == Criterion::kPdfSimilarity && !options.noise_level) {
+    white_noise.Attach(&decomposition_options);
+  }
+  GroupedDecomposition out;
+  out.decomposition = decomposition::Decompose(x, decomposition_options);
+  if (out.decomposition.num_imfs() == 0) return out;
+  if (!options.noise_level) options.noise_level = white_noise.Level();
+  out.selection = SelectModes(x, out.decomposition, options);
+  return out;
+}
+
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const Eigen::Ref<const Eigen::MatrixXd>& imfs,
                             const Eigen::Ref<const Eigen::VectorXd>& residue,

@@ -211,7 +211,8 @@ struct NoiseTerm {
   // selected model; not identified, how much it falls when the term is added (0: the term would
   // fit at zero). In chi-square units: divided by the design effect of the correlated points and by
   // the larger model's reduced chi-square when that exceeds 1; compare with
-  // NoiseTerms::critical_chi2. NaN if that model has more terms than points.
+  // NoiseTerms::critical_chi2. NaN if that model has more terms than points, or when the term is
+  // the selected model's only one (the empty model is not fitted).
   double evidence_chi2 = std::numeric_limits<double>::quiet_NaN();
 };
 

@@ -55,6 +55,7 @@ struct SiftingOptions {
   int max_sifts = 0;
   int EffectiveMaxSifts() const;
   void Validate() const;  // throws UsageError naming the field
+  friend bool operator==(const SiftingOptions&, const SiftingOptions&) = default;
 };
 
 // How BEEMDAN decides how many stages get noise assistance.

@@ -72,11 +72,13 @@ struct DriftOptions {
   std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
   int threads = 0;         // 0 = every core
   // FitDriftModel reports its progress here (fraction of the whole fit in [0, 1], and the step:
-  // "decompose", "select modes", "fit sub-models"), from the calling thread or the thread that
-  // accumulates the ensemble; may be empty. Not part of the model; Evaluate does not call it.
+  // "decompose" (the grouping included), "fit sub-models"), from the calling thread or the thread
+  // that accumulates the ensemble; may be empty. Not part of the model; Evaluate does not call it.
   std::function<void(double fraction, const std::string& step)> progress;
   DriftOptions();         // sets the learner defaults described above
   void Validate() const;  // throws UsageError naming the field
+  // Compensate mode, or predict mode with features.use_temperature: needs the temperature channel.
+  bool uses_temperature() const;
 };
 
 // One sub-series and its learner.
@@ -99,10 +101,10 @@ struct DriftModel {
   std::string selection_summary;            // report of the grouping (kMsElm)
   std::vector<double> lag_validation_rmse;  // auto_lags: per candidate
   // Range of the training temperature, degC (NaN when the model does not use temperature): a
-  // thermal model outside it extrapolates (ShareOutsideTrainingRange).
+  // thermal model outside it extrapolates (ShareOutsideRange).
   double temperature_min_c = std::numeric_limits<double>::quiet_NaN();
   double temperature_max_c = std::numeric_limits<double>::quiet_NaN();
-  bool uses_temperature() const;
+  bool uses_temperature() const { return options.uses_temperature(); }
   int num_inputs() const;       // inputs of each sub-model
   std::string Summary() const;  // one line
 };
@@ -122,10 +124,10 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                          const DriftOptions& options);
 
-// Share of temperature samples outside [temperature_min_c, temperature_max_c] of the model (0 for
-// a model without temperature): where the estimate extrapolates.
-double ShareOutsideTrainingRange(const DriftModel& model,
-                                 const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
+// Share of temperature samples outside [min_c, max_c] (0 when the range is NaN: no temperature),
+// e.g. a model's training range: where a thermal model extrapolates.
+double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double min_c,
+                         double max_c);
 
 // Compensate mode: the drift estimate at every sample of a temperature record (relative to
 // equilibrium at options.reference_c unless that is NaN).

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -41,7 +42,7 @@ struct EvaluationRow {
   Method method = Method::kMsElm;
   Protocol protocol = Protocol::kPaper;
   double rmse = 0.0, rmse_std = 0.0, mae = 0.0, max_abs = 0.0;  // means over repeats
-  double train_s = 0.0, predict_s = 0.0;                         // wall-clock means
+  double train_s = 0.0, predict_s = 0.0;                        // wall-clock means
   Eigen::VectorXd estimate;  // of the last repeat, on the test block
   std::string model_summary;
 };
@@ -50,8 +51,13 @@ struct EvaluationResult {
   Mode mode = Mode::kPredict;
   Eigen::Index split_index = 0;  // first test sample
   bool against_truth = false;
-  Eigen::VectorXd reference;  // what the rows were scored against, on the test block
+  Eigen::VectorXd reference;        // what the rows were scored against, on the test block
   std::vector<EvaluationRow> rows;  // method-major, protocols in the order asked
+  // With a temperature channel: its range on the training block and the share of test samples
+  // outside it, where every thermal model extrapolates (NaN, NaN, 0 without temperature).
+  double training_temperature_min_c = std::numeric_limits<double>::quiet_NaN();
+  double training_temperature_max_c = std::numeric_limits<double>::quiet_NaN();
+  double test_outside_training_temperature_share = 0.0;
   std::string Table() const;  // aligned text table
 };
 

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -118,5 +119,17 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const decomposition::Decomposition& decomposition,
                             const SelectionOptions& options = {});
+
+// Decompose then SelectModes, with the pdf criterion's white-noise level taken from the
+// decomposition's own noise EMDs where they are the Monte-Carlo's (NoiseLevelCollector): the way
+// to group a signal's IMFs without paying for the Monte-Carlo a second time. A decomposition
+// without IMF has no selection. Throws as Decompose and SelectModes do.
+struct GroupedDecomposition {
+  decomposition::Decomposition decomposition;
+  std::optional<SelectionResult> selection;  // nullopt when the decomposition has no IMF
+};
+GroupedDecomposition DecomposeAndSelect(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        decomposition::DecompositionOptions decomposition_options,
+                                        SelectionOptions options);
 
 }  // namespace gyrodrift::selection

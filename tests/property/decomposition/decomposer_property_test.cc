@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
@@ -159,22 +161,20 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("sample 11"), std::string::npos) << e.what();
   }
-  DecompositionOptions bad = o;
-  bad.sifting.rilling_threshold1 = 2.0;
-  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
-  bad = o;
-  bad.max_imfs = -1;
-  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
   // Every option is checked, also those the method does not use.
-  bad = o;
-  bad.ensemble_size = 0;
-  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
-  bad = o;
-  bad.noise_strength = -0.1;
-  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
-  bad = o;
-  bad.band_confidence = 0.5;
-  EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError);
+  const std::vector<std::pair<const char*, void (*)(DecompositionOptions&)>> bad_options = {
+      {"rilling_threshold1", [](DecompositionOptions& b) { b.sifting.rilling_threshold1 = 2.0; }},
+      {"max_imfs", [](DecompositionOptions& b) { b.max_imfs = -1; }},
+      {"ensemble_size", [](DecompositionOptions& b) { b.ensemble_size = 0; }},
+      {"noise_strength", [](DecompositionOptions& b) { b.noise_strength = -0.1; }},
+      {"band_confidence", [](DecompositionOptions& b) { b.band_confidence = 0.5; }},
+  };
+  DecompositionOptions bad;
+  for (const auto& [field, spoil] : bad_options) {
+    bad = o;
+    spoil(bad);
+    EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError) << field;
+  }
   if (GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
       GetParam() == Method::kBeemdan) {
     // 1e5 realisations of 1e7 samples would hold 8 TB of noise state: refused before any work.

@@ -311,6 +311,26 @@ TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
   // Single models do not decompose: both protocols are the same computation.
   EXPECT_EQ(r.rows[2].rmse, r.rows[3].rmse);
   EXPECT_NE(r.Table().find("ms-elm"), std::string::npos);
+  EXPECT_TRUE(std::isnan(r.training_temperature_min_c));  // no temperature given
+  EXPECT_EQ(r.test_outside_training_temperature_share, 0.0);
+}
+
+TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
+  Log log = MakeLog(1000, 9);
+  // A slow warming on top of the cycle: the last 300 samples reach above anything before them.
+  for (Eigen::Index t = 0; t < 1000; ++t) log.temperature[t] += 0.02 * static_cast<double>(t);
+  EvaluationOptions eo;
+  eo.methods = {Method::kPoly};
+  const EvaluationResult r =
+      Evaluate(log.rate, log.temperature, log.drift, Fast(Mode::kCompensate, Method::kPoly), eo);
+  EXPECT_EQ(r.training_temperature_max_c, log.temperature.head(700).maxCoeff());
+  const double expected =
+      static_cast<double>(
+          (log.temperature.tail(300).array() > r.training_temperature_max_c).count()) /
+      300.0;
+  EXPECT_GT(expected, 0.2);
+  EXPECT_EQ(r.test_outside_training_temperature_share, expected);
+  EXPECT_EQ(ShareOutsideRange(log.temperature, std::nan(""), std::nan("")), 0.0);
 }
 
 }  // namespace
