@@ -8,7 +8,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <regex>
+#include <vector>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/version.h"
@@ -41,6 +43,69 @@ nlohmann::json SidecarHeader(const std::string& command) {
 }
 
 bool IsTerminal() { return ::isatty(STDERR_FILENO) != 0; }
+
+std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
+  // Library field -> the flags that may set it, the first one the subcommand has wins.
+  static const std::map<std::string, std::vector<std::string>, std::less<>> kFlags = {
+      {"band_confidence", {"--band"}},
+      {"BEEMDAN bound", {"--bound"}},
+      {"causal ensemble_size", {"--ensemble"}},
+      {"causal window", {"--window"}},
+      {"coil.winding_asymmetry", {"--asymmetry"}},
+      {"confidence", {"--confidence"}},
+      {"decomposition method", {"--decomposition", "--method"}},
+      {"dev", {"--dev"}},
+      {"deviation", {"--dev"}},
+      {"duration_s", {"--duration"}},
+      {"ensemble_size", {"--ensemble"}},
+      {"fixed_sifts", {"--fixed-sifts"}},
+      {"hidden_units", {"--hidden"}},
+      {"input_rate_dph", {"--input-rate-dph"}},
+      {"lags", {"--lags"}},
+      {"learner", {"--method"}},
+      {"max_imfs", {"--max-imfs"}},
+      {"max_sifts", {"--max-sifts"}},
+      {"method", {"--method"}},
+      {"methods", {"--methods"}},
+      {"mode", {"--mode"}},
+      {"noise scaling", {"--noise-scaling"}},
+      {"noise_stages", {"--noise-stages"}},
+      {"noise_strength", {"--noise"}},
+      {"preset", {"--preset"}},
+      {"profile", {"--profile"}},
+      {"protocol", {"--protocol"}},
+      {"protocols", {"--protocol"}},
+      {"rate_hz", {"--rate-hz"}},
+      {"realisations", {"--realisations"}},
+      {"repeats", {"--repeats"}},
+      {"s_number", {"--s-number"}},
+      {"sd_threshold", {"--sd"}},
+      {"split", {"--split"}},
+      {"stop rule", {"--stop"}},
+      {"tau_list_s", {"--taus"}},
+      {"tau_max_s", {"--fit-tau-max"}},
+      {"tau_min_s", {"--fit-tau-min"}},
+      {"taus", {"--taus"}},
+      {"thermal_set", {"--thermal-features"}},
+      {"threads", {"--threads"}},
+      {"time constant (s)", {"--time-constants"}},
+      {"time constants", {"--time-constants"}},
+      {"type", {"--type"}},
+      {"units", {"--units"}},
+      {"winding", {"--winding"}},
+  };
+  const auto flags = kFlags.find(error.option());
+  if (flags != kFlags.end()) {
+    for (const CLI::App* command : app.get_subcommands()) {
+      for (const std::string& flag : flags->second) {
+        if (command->get_option_no_throw(flag) != nullptr) {
+          return flag + " = " + error.value() + ": must be " + error.rule();
+        }
+      }
+    }
+  }
+  return error.what();
+}
 
 std::string ColumnName(const io::CsvTable& table, const std::string& spec) {
   return table.header()[static_cast<size_t>(table.ResolveColumn(spec))];

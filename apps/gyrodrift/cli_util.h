@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
 
 namespace gyrodrift::cli {
@@ -40,6 +41,11 @@ double ResolveSampleRate(const io::CsvTable& table, double given, std::string* h
 // has gaps or jitter (steps more than half the median step away from it: how many, the largest
 // and its row), since every model and the Allan analysis assume uniform sampling.
 std::string NonUniformTimeNote(const io::CsvTable& table);
+
+// The one-line message for an option error: the library names its field (`ensemble_size = 0:
+// must be ...`); when the subcommand that ran has the flag that sets that field, the message
+// names the flag instead (`--ensemble = 0: must be ...`).
+std::string OptionErrorMessage(const CLI::App& app, const OptionError& error);
 
 // Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
 std::string ColumnName(const io::CsvTable& table, const std::string& spec);

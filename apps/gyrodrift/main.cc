@@ -1,9 +1,11 @@
 // gyrodrift: the command line tool. Subcommands live in *_command.cc and register themselves.
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <exception>
-#include <fmt/core.h>
 
+#include "cli_util.h"
 #include "command.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
@@ -46,6 +48,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
     return gyrodrift::ExitCode(gyrodrift::ErrorKind::kUsage);
+  } catch (const gyrodrift::OptionError& e) {
+    fmt::print(stderr, "gyrodrift: error: {}\n", gyrodrift::cli::OptionErrorMessage(app, e));
+    return gyrodrift::ExitCode(e.kind());
   } catch (const gyrodrift::Error& e) {
     fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
     return gyrodrift::ExitCode(e.kind());

@@ -62,7 +62,9 @@ void Run(const PredictArgs& a) {
                     " samples: the model needs more than " + std::to_string(first) +
                     " (its history) to predict any");
   }
-  drift::CausalOptions causal{.window = a.window, .threads = a.threads};
+  drift::CausalOptions causal;
+  causal.window = a.window;
+  causal.threads = a.threads;
   Eigen::VectorXd prediction;
   {
     // Causal prediction decomposes one trailing window per sample: minutes on a long log.

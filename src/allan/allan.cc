@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "allan/kernels.h"
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
@@ -14,49 +15,34 @@
 namespace gyrodrift::allan {
 namespace {
 
-template <class E, size_t K>
-E FromName(std::string_view field, std::string_view s,
-           const std::array<std::pair<const char*, E>, K>& names) {
-  std::string allowed;
-  for (const auto& [name, value] : names) {
-    if (s == name) return value;
-    if (!allowed.empty()) allowed += "|";
-    allowed += name;
-  }
-  ThrowOption(field, s, "one of " + allowed);
-}
+using gyrodrift::internal::EnumFromName;
+using gyrodrift::internal::EnumName;
+using gyrodrift::internal::EnumNames;
 
-constexpr std::array<std::pair<const char*, Deviation>, 7> kDeviationNames{{
-    {"adev", Deviation::kAdev},
-    {"oadev", Deviation::kOadev},
-    {"mdev", Deviation::kMdev},
-    {"hdev", Deviation::kHdev},
-    {"ohdev", Deviation::kOhdev},
-    {"tdev", Deviation::kTdev},
-    {"totdev", Deviation::kTotdev},
+constexpr EnumNames<Deviation, 7> kDeviationNames{{
+    {Deviation::kAdev, "adev"},
+    {Deviation::kOadev, "oadev"},
+    {Deviation::kMdev, "mdev"},
+    {Deviation::kHdev, "hdev"},
+    {Deviation::kOhdev, "ohdev"},
+    {Deviation::kTdev, "tdev"},
+    {Deviation::kTotdev, "totdev"},
 }};
-constexpr std::array<std::pair<const char*, DataType>, 2> kDataTypeNames{{
-    {"rate", DataType::kRate},
-    {"angle", DataType::kAngle},
+constexpr EnumNames<DataType, 2> kDataTypeNames{{
+    {DataType::kRate, "rate"},
+    {DataType::kAngle, "angle"},
 }};
-constexpr std::array<std::pair<const char*, RateUnit>, 3> kUnitNames{{
-    {"dph", RateUnit::kDegPerHour},
-    {"dps", RateUnit::kDegPerSecond},
-    {"rads", RateUnit::kRadPerSecond},
+constexpr EnumNames<RateUnit, 3> kUnitNames{{
+    {RateUnit::kDegPerHour, "dph"},
+    {RateUnit::kDegPerSecond, "dps"},
+    {RateUnit::kRadPerSecond, "rads"},
 }};
-constexpr std::array<std::pair<const char*, TauGrid>, 4> kGridNames{{
-    {"all", TauGrid::kAll},
-    {"octave", TauGrid::kOctave},
-    {"decade", TauGrid::kDecade},
-    {"list", TauGrid::kList},
+constexpr EnumNames<TauGrid, 4> kGridNames{{
+    {TauGrid::kAll, "all"},
+    {TauGrid::kOctave, "octave"},
+    {TauGrid::kDecade, "decade"},
+    {TauGrid::kList, "list"},
 }};
-
-template <class E, size_t K>
-std::string NameOf(E value, const std::array<std::pair<const char*, E>, K>& names) {
-  for (const auto& [name, v] : names)
-    if (v == value) return name;
-  return "?";
-}
 
 // Angle (phase) samples the estimators work on, in rate unit x seconds. The mean rate (or the
 // straight line through the end angles) is removed first: every estimator here is blind to a
@@ -95,14 +81,16 @@ int DifferenceOrder(Deviation d) {
 
 }  // namespace
 
-std::string ToString(Deviation d) { return NameOf(d, kDeviationNames); }
-Deviation DeviationFromString(std::string_view s) { return FromName("dev", s, kDeviationNames); }
-std::string ToString(DataType t) { return NameOf(t, kDataTypeNames); }
-DataType DataTypeFromString(std::string_view s) { return FromName("type", s, kDataTypeNames); }
-std::string ToString(RateUnit u) { return NameOf(u, kUnitNames); }
-RateUnit RateUnitFromString(std::string_view s) { return FromName("units", s, kUnitNames); }
-std::string ToString(TauGrid g) { return NameOf(g, kGridNames); }
-TauGrid TauGridFromString(std::string_view s) { return FromName("taus", s, kGridNames); }
+std::string ToString(Deviation d) { return std::string(EnumName(d, kDeviationNames)); }
+Deviation DeviationFromString(std::string_view s) {
+  return EnumFromName(s, "dev", kDeviationNames);
+}
+std::string ToString(DataType t) { return std::string(EnumName(t, kDataTypeNames)); }
+DataType DataTypeFromString(std::string_view s) { return EnumFromName(s, "type", kDataTypeNames); }
+std::string ToString(RateUnit u) { return std::string(EnumName(u, kUnitNames)); }
+RateUnit RateUnitFromString(std::string_view s) { return EnumFromName(s, "units", kUnitNames); }
+std::string ToString(TauGrid g) { return std::string(EnumName(g, kGridNames)); }
+TauGrid TauGridFromString(std::string_view s) { return EnumFromName(s, "taus", kGridNames); }
 
 double ToDegPerHour(RateUnit u) {
   switch (u) {

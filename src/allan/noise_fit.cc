@@ -172,7 +172,8 @@ void SlopeReadings(const Eigen::VectorXd& tau, const Eigen::VectorXd& adev,
 void NoiseFitOptions::Validate() const {
   RequireNonNegative("tau_min_s", tau_min_s);
   if (!(tau_max_s > tau_min_s))
-    ThrowOption("tau_max_s", FormatValue(tau_max_s), "> tau_min_s = " + FormatValue(tau_min_s));
+    ThrowOption("tau_max_s", FormatValue(tau_max_s),
+                "> the smallest fitted tau (" + FormatValue(tau_min_s) + ")");
   if (!(min_share >= 0.0 && min_share < 1.0))
     ThrowOption("min_share", FormatValue(min_share), "in [0, 1)");
   if (!(significance > 0.0 && significance <= 0.5))

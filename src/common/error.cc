@@ -26,8 +26,7 @@ std::string FormatValue(double value) {
 }
 
 void ThrowOption(std::string_view name, std::string_view value, std::string_view rule) {
-  throw UsageError(std::string(name) + " = " + std::string(value) + ": must be " +
-                   std::string(rule));
+  throw OptionError(std::string(name), std::string(value), std::string(rule));
 }
 
 void RequireInRange(std::string_view name, double value, double lo, double hi) {

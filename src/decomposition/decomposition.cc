@@ -1,4 +1,3 @@
-#include "common/enum_names.h"
 #include "gyrodrift/decomposition/decomposition.h"
 
 #include <unistd.h>
@@ -8,6 +7,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "decomposition/internal.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -44,7 +44,9 @@ constexpr std::array<std::pair<NoiseScaling, std::string_view>, 2> kScalings{{
 }  // namespace
 
 std::string_view ToString(Method method) { return EnumName(method, kMethods); }
-Method MethodFromString(std::string_view name) { return EnumFromName(name, "method", kMethods); }
+Method MethodFromString(std::string_view name) {
+  return EnumFromName(name, "decomposition method", kMethods);
+}
 std::string_view ToString(StopRule rule) { return EnumName(rule, kStopRules); }
 StopRule StopRuleFromString(std::string_view name) {
   return EnumFromName(name, "stop rule", kStopRules);
@@ -157,12 +159,12 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
       options.method == Method::kBeemdan) {
     // Each realisation keeps the running residue of its noise EMD (N doubles): refuse an
     // ensemble whose state alone would not fit in the machine, instead of dying of it.
-    const double ensemble =
-        options.supplied_noise ? static_cast<double>(options.supplied_noise->cols())
-                               : static_cast<double>(options.ensemble_size);
+    const double ensemble = options.supplied_noise
+                                ? static_cast<double>(options.supplied_noise->cols())
+                                : static_cast<double>(options.ensemble_size);
     const double state_bytes = ensemble * static_cast<double>(n) * sizeof(double);
-    const double memory_bytes =
-        static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+    const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
+                                static_cast<double>(::sysconf(_SC_PAGESIZE));
     if (memory_bytes > 0 && state_bytes > 0.5 * memory_bytes) {
       char rule[160];
       std::snprintf(rule, sizeof rule,

@@ -25,7 +25,8 @@ class CompensateCli : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new std::string(test::TempDir("cli_compensate"));
     io::WriteFileAtomically(Dir() + "/train.csv", test::ThermalLogCsv(600, 1));
-    io::WriteFileAtomically(Dir() + "/test.csv", test::ThermalLogCsv(600, 2));  // same programme, new noise
+    // The same programme with new noise.
+    io::WriteFileAtomically(Dir() + "/test.csv", test::ThermalLogCsv(600, 2));
     const std::string fit = "fit '" + Dir() + "/train.csv' -t rate_dph -T temperature_c -I 10 -q ";
     ASSERT_EQ(test::RunCli(fit + "--mode compensate -o '" + Dir() + "/ms.json'").exit_code, 0);
     ASSERT_EQ(test::RunCli(fit + "--mode predict -m elm -o '" + Dir() + "/pred.json'").exit_code,
@@ -75,7 +76,8 @@ TEST_F(CompensateCli, SaysWhereTheTemperatureLeavesTheTrainingRange) {
   EXPECT_EQ(loaded.model.temperature_max_c, train.Column("temperature_c").maxCoeff());
   auto run = [&](const std::string& csv) {
     const std::string out = Dir() + "/range_out.csv";
-    const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + csv + "' -o '" + out + "'");
+    const auto r =
+        test::RunCli("compensate '" + Dir() + "/ms.json' '" + csv + "' -o '" + out + "'");
     EXPECT_EQ(r.exit_code, 0) << r.err;
     const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
     return std::make_pair(r.out, json["outside_training_temperature_share"].get<double>());
@@ -89,8 +91,9 @@ TEST_F(CompensateCli, SaysWhereTheTemperatureLeavesTheTrainingRange) {
   io::WriteCsv(Dir() + "/warmer.csv",
                {{"rate_dph", input.Column("rate_dph")}, {"temperature_c", warmer}});
   const auto [outside_out, outside] = run(Dir() + "/warmer.csv");
-  const double expected = static_cast<double>((warmer.array() > loaded.model.temperature_max_c).count()) /
-                          static_cast<double>(warmer.size());
+  const double expected =
+      static_cast<double>((warmer.array() > loaded.model.temperature_max_c).count()) /
+      static_cast<double>(warmer.size());
   EXPECT_GT(expected, 0.1);
   EXPECT_EQ(outside, expected);
   EXPECT_NE(outside_out.find("outside the training temperature range"), std::string::npos)

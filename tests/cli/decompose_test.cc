@@ -19,7 +19,9 @@ class DecomposeCli : public ::testing::Test {
     for (int i = 0; i < 600; ++i) {
       const double t = i;
       csv += std::to_string(t) + "," +
-             std::to_string(std::sin(t / 5.0) + 0.3 * std::sin(t / 37.0) + 1e-3 * t + 0.05 * std::cos(1.7 * t * t)) + "\n";
+             std::to_string(std::sin(t / 5.0) + 0.3 * std::sin(t / 37.0) + 1e-3 * t +
+                            0.05 * std::cos(1.7 * t * t)) +
+             "\n";
     }
     io::WriteFileAtomically(input_, csv);
   }
@@ -28,7 +30,9 @@ class DecomposeCli : public ::testing::Test {
 
 TEST_F(DecomposeCli, WritesImfsAndSidecar) {
   const std::string out = dir_ + "/imfs.csv";
-  const auto r = test::RunCli("decompose '" + input_ + "' --column rate_dph --method iceemdan -I 10 --seed 3 -o '" + out + "'");
+  const auto r =
+      test::RunCli("decompose '" + input_ +
+                   "' --column rate_dph --method iceemdan -I 10 --seed 3 -o '" + out + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto table = io::CsvTable::Read(out);
   EXPECT_EQ(table.rows(), 600);
@@ -48,16 +52,25 @@ TEST_F(DecomposeCli, WritesImfsAndSidecar) {
 
 TEST_F(DecomposeCli, ColumnByIndexAndSameSeedSameBytes) {
   const std::string a = dir_ + "/a.csv", b = dir_ + "/b.csv";
-  ASSERT_EQ(test::RunCli("decompose '" + input_ + "' -c 2 -m beemdan -I 8 --seed 5 -q -o '" + a + "'").exit_code, 0);
-  ASSERT_EQ(test::RunCli("decompose '" + input_ + "' -c rate_dph -m beemdan -I 8 --seed 5 -j 1 -q -o '" + b + "'").exit_code, 0);
+  ASSERT_EQ(
+      test::RunCli("decompose '" + input_ + "' -c 2 -m beemdan -I 8 --seed 5 -q -o '" + a + "'")
+          .exit_code,
+      0);
+  ASSERT_EQ(test::RunCli("decompose '" + input_ +
+                         "' -c rate_dph -m beemdan -I 8 --seed 5 -j 1 -q -o '" + b + "'")
+                .exit_code,
+            0);
   EXPECT_EQ(io::ReadTextFile(a), io::ReadTextFile(b));
 }
 
 TEST_F(DecomposeCli, SuppliedNoiseFile) {
   std::string noise = "w0,w1\n";
-  for (int i = 0; i < 600; ++i) noise += std::to_string(std::sin(i * 12.9898) * 1.7) + "," + std::to_string(std::cos(i * 78.233) * 1.7) + "\n";
+  for (int i = 0; i < 600; ++i)
+    noise += std::to_string(std::sin(i * 12.9898) * 1.7) + "," +
+             std::to_string(std::cos(i * 78.233) * 1.7) + "\n";
   io::WriteFileAtomically(dir_ + "/w.csv", noise);
-  const auto r = test::RunCli("decompose '" + input_ + "' -c rate_dph -m iceemdan --noise-file '" + dir_ + "/w.csv' -o '" + dir_ + "/o.csv'");
+  const auto r = test::RunCli("decompose '" + input_ + "' -c rate_dph -m iceemdan --noise-file '" +
+                              dir_ + "/w.csv' -o '" + dir_ + "/o.csv'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto json = nlohmann::json::parse(io::ReadTextFile(dir_ + "/o.csv.json"));
   EXPECT_EQ(json["report"]["ensemble_size"], 2);
@@ -89,24 +102,26 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"too short", "decompose %DIR%/short.csv -c x", 3, "at least 4"},
       {"empty file", "decompose %DIR%/empty.csv -c x", 3, "empty file"},
       {"ragged", "decompose %DIR%/ragged.csv -c a", 3, "line 3"},
-      {"unknown method", "decompose %IN% -c 2 -m wavelet", 2, "method = 'wavelet'"},
-      {"unknown stop", "decompose %IN% -c 2 --stop never", 2, "stop rule"},
-      {"zero ensemble", "decompose %IN% -c 2 -I 0", 2, "ensemble_size = 0"},
-      {"negative noise", "decompose %IN% -c 2 --noise -1", 2, "noise_strength"},
-      {"bad band", "decompose %IN% -c 2 --band 0.5", 2, "band_confidence"},
-      {"negative imfs", "decompose %IN% -c 2 --max-imfs -2", 2, "max_imfs"},
+      {"unknown method", "decompose %IN% -c 2 -m wavelet", 2, "--method = 'wavelet'"},
+      {"unknown stop", "decompose %IN% -c 2 --stop never", 2, "--stop = 'never'"},
+      {"zero ensemble", "decompose %IN% -c 2 -I 0", 2, "--ensemble = 0"},
+      {"negative noise", "decompose %IN% -c 2 --noise -1", 2, "--noise = -1"},
+      {"bad band", "decompose %IN% -c 2 --band 0.5", 2, "--band = 0.5"},
+      {"negative imfs", "decompose %IN% -c 2 --max-imfs -2", 2, "--max-imfs = -2"},
       {"not a number", "decompose %IN% -c 2 --seed many", 2, "seed"},
       {"negative seed", "decompose %IN% -c 2 --seed -1", 2, "[0, 2^64)"},
       {"noise rows", "decompose %IN% -c 2 --noise-file %DIR%/w_short.csv", 3, "supplied noise"},
-      {"noise with emd", "decompose %IN% -c 2 -m emd --noise-file %DIR%/w_short.csv", 2, "--noise-file"},
-      {"unused option still checked", "decompose %IN% -c 2 -m emd -I 0", 2, "ensemble_size = 0"},
+      {"noise with emd", "decompose %IN% -c 2 -m emd --noise-file %DIR%/w_short.csv", 2,
+       "--noise-file"},
+      {"unused option still checked", "decompose %IN% -c 2 -m emd -I 0", 2, "--ensemble = 0"},
       {"inf cell", "decompose %DIR%/inf.csv -c x", 3, "data row 2"},
       {"negative threads", "decompose %IN% -c 2 -j -3", 2, "threads"},
       {"constant column", "decompose %DIR%/constant.csv -c x", 3, "column 'x' is constant"},
   };
   const std::string out = dir_ + "/bad.csv";
   for (const auto& c : cases) {
-    const auto r = test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
+    const auto r =
+        test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
 }

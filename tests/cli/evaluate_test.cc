@@ -100,9 +100,9 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"empty methods", p + "--methods ,", 2, "--methods"},
       {"trailing comma", p + "--methods elm,", 2, "--methods = 'elm,'"},
       {"bad protocol", p + "--protocol future", 2, "--protocol = 'future'"},
-      {"bad split", p + "--split 0.99", 2, "split = 0.99"},
-      {"zero repeats", p + "--repeats 0", 2, "repeats = 0"},
-      {"small window", p + "--window 4", 2, "window = 4"},
+      {"bad split", p + "--split 0.99", 2, "--split = 0.99"},
+      {"zero repeats", p + "--repeats 0", 2, "--repeats = 0"},
+      {"small window", p + "--window 4", 2, "--window = 4"},
       {"compensate without temperature", "evaluate %IN% -t rate_dph --mode compensate", 2,
        "needs --temperature"},
       {"missing truth", p + "--truth drift", 2, "column 'drift' not found"},
@@ -118,7 +118,8 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
   };
   const std::string out = dir_ + "/bad.csv";
   for (const auto& c : cases) {
-    const auto r = test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
+    const auto r =
+        test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
   const auto r =

@@ -143,15 +143,15 @@ TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--duration 8x", 2, "--duration = 8x");
   ExpectFailure("--duration -5s", 2, "--duration");
   ExpectFailure("--duration 0", 2, "--duration = 0");
-  ExpectFailure("--duration 1s", 2, "duration_s");  // a single sample
+  ExpectFailure("--duration 1s", 2, "--duration = 1");  // a single sample
   ExpectFailure("--duration 1e400", 2, "--duration = 1e400");
   ExpectFailure("--duration 200d", 2, "--duration = 200d");
   ExpectFailure("--duration 3000h", 2, "1e7 samples");
   ExpectFailure("--rate-hz 0", 2, "--rate-hz = 0");
   ExpectFailure("--rate-hz abc", 2, "rate-hz");
   ExpectFailure("--winding sextupole", 2, "winding = sextupole");
-  ExpectFailure("--asymmetry 0.7", 2, "winding_asymmetry = 0.7");
-  ExpectFailure("--asymmetry nan", 2, "winding_asymmetry = nan");
+  ExpectFailure("--asymmetry 0.7", 2, "--asymmetry = 0.7");
+  ExpectFailure("--asymmetry nan", 2, "--asymmetry = nan");
   ExpectFailure("--seed -1", 2, "--seed: -1: must be an integer");
   ExpectFailure("--seed 18446744073709551616", 2, "must be an integer in [0, 2^64)");
   ExpectFailure("--bogus", 2, "bogus");

@@ -9,6 +9,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace gyrodrift {
 
@@ -30,6 +31,24 @@ class Error : public std::runtime_error {
 class UsageError : public Error {
  public:
   explicit UsageError(const std::string& message) : Error(ErrorKind::kUsage, message) {}
+};
+
+// An option outside what it allows, named as the library calls it (`ensemble_size`,
+// `coil.winding_asymmetry`): "option = value: must be rule". The parts stay separate so the CLI
+// can name the flag the user typed instead.
+class OptionError : public UsageError {
+ public:
+  OptionError(std::string option, std::string value, std::string rule)
+      : UsageError(option + " = " + value + ": must be " + rule),
+        option_(std::move(option)),
+        value_(std::move(value)),
+        rule_(std::move(rule)) {}
+  const std::string& option() const { return option_; }
+  const std::string& value() const { return value_; }
+  const std::string& rule() const { return rule_; }
+
+ private:
+  std::string option_, value_, rule_;
 };
 
 class DataError : public Error {
