@@ -155,8 +155,18 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
     }
     if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
   }
-  if (options.method == Method::kCeemdan || options.method == Method::kIceemdan ||
-      options.method == Method::kBeemdan) {
+  const bool ceemdan_family = options.method == Method::kCeemdan ||
+                              options.method == Method::kIceemdan ||
+                              options.method == Method::kBeemdan;
+  if (options.noise_emds && !(ceemdan_family && options.noise_emds->Matches(n, options))) {
+    throw UsageError("noise_emds (" + std::to_string(options.noise_emds->length()) +
+                     " samples, ensemble " + std::to_string(options.noise_emds->ensemble_size()) +
+                     ") do not match this decomposition (" + std::string(ToString(options.method)) +
+                     ", " + std::to_string(n) +
+                     " samples): they serve the CEEMDAN family with the same length, seed, "
+                     "ensemble size and sifting, without supplied noise");
+  }
+  if (ceemdan_family) {
     // Each realisation keeps the running residue of its noise EMD (N doubles): refuse an
     // ensemble whose state alone would not fit in the machine, instead of dying of it.
     const double ensemble = options.supplied_noise

@@ -9,8 +9,11 @@
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "decomposition/internal.h"
+#include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"
 
@@ -30,9 +33,39 @@ Eigen::VectorXd DrawNoise(const DecompositionOptions& o, int i, Eigen::Index n) 
   return w;
 }
 
+// Realisation i's noise EMD, row by row: read from the shared NoiseEmds when the options carry
+// one, else computed on demand.
+class NoiseRows {
+ public:
+  explicit NoiseRows(Eigen::VectorXd white) : modes_(std::in_place, std::move(white)) {}
+  explicit NoiseRows(const NoiseEmds::Realisation& cached) : cached_(&cached) {}
+  // Writes the next row into out; false when there is none.
+  bool Next(Sifter& sifter, double* out) {
+    if (modes_) {
+      if (!modes_->Next(sifter, out)) return false;
+      last_imf_ = modes_->last_imf();
+      return true;
+    }
+    if (next_ >= cached_->rows.size()) return false;
+    const Eigen::VectorXd& row = cached_->rows[next_];
+    std::copy(row.data(), row.data() + row.size(), out);
+    ++next_;
+    last_imf_ = static_cast<int>(next_) <= cached_->imfs ? static_cast<int>(next_) : 0;
+    return true;
+  }
+  // The IMF number of the row the last successful Next wrote, 0 if it was the residue.
+  int last_imf() const { return last_imf_; }
+
+ private:
+  std::optional<NoiseModes> modes_;
+  const NoiseEmds::Realisation* cached_ = nullptr;
+  size_t next_ = 0;
+  int last_imf_ = 0;
+};
+
 // The next row of realisation i's noise EMD into out (false: none), shown to the observer when
 // it is an IMF.
-bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseModes& modes, Sifter& sifter,
+bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseRows& modes, Sifter& sifter,
                   double* out) {
   if (!modes.Next(sifter, out)) return false;
   if (o.noise_imf_observer && modes.last_imf() > 0) o.noise_imf_observer(i, modes.last_imf(), out);
@@ -162,7 +195,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
   const double sx = SampleStd(x.data(), n);
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
-  std::vector<std::optional<NoiseModes>> noise(static_cast<size_t>(ensemble));
+  std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
   DecompositionReport report;
   report.method = Method::kCeemdan;
   report.ensemble_size = ensemble;
@@ -190,7 +223,11 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
-          if (stage == 0) {
+          if (stage == 0 && o.noise_emds) {
+            const NoiseEmds::Realisation& cached = o.noise_emds->realisation(i);
+            wk.input = xn + eps * cached.white;
+            modes_i.emplace(cached);
+          } else if (stage == 0) {
             // Stage 1 adds the realisation itself; its EMD then feeds the later stages.
             Eigen::VectorXd white = DrawNoise(o, i, n);
             wk.input = xn + eps * white;
@@ -220,7 +257,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
     ++report.noise_assisted_stages;
   }
   // The realisations' noise state (one N-vector each) is the bulk of the memory: free it first.
-  std::vector<std::optional<NoiseModes>>().swap(noise);
+  std::vector<std::optional<NoiseRows>>().swap(noise);
   Scale(modes, r, sx);
   return AssembleResult(std::move(modes), std::move(r), std::move(report));
 }
@@ -235,7 +272,7 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
   const double sx = SampleStd(x.data(), n);
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
-  std::vector<std::optional<NoiseModes>> noise(static_cast<size_t>(ensemble));
+  std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
   DecompositionReport report;
   report.method = o.method;
   report.ensemble_size = ensemble;
@@ -312,7 +349,11 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
-          if (stage == 0) modes_i.emplace(DrawNoise(o, i, n));
+          if (stage == 0 && o.noise_emds) {
+            modes_i.emplace(o.noise_emds->realisation(i));
+          } else if (stage == 0) {
+            modes_i.emplace(DrawNoise(o, i, n));
+          }
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
           const bool has_noise = NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data());
           if (stage == 0) {
@@ -363,9 +404,46 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
     ++report.noise_assisted_stages;
   }
   // The realisations' noise state (one N-vector each) is the bulk of the memory: free it first.
-  std::vector<std::optional<NoiseModes>>().swap(noise);
+  std::vector<std::optional<NoiseRows>>().swap(noise);
   Scale(modes, r, sx);
   return AssembleResult(std::move(modes), std::move(r), std::move(report));
 }
 
 }  // namespace gyrodrift::decomposition::internal
+
+namespace gyrodrift::decomposition {
+
+NoiseEmds::NoiseEmds(Eigen::Index length, const DecompositionOptions& options)
+    : length_(length), seed_(options.seed), sifting_(options.sifting) {
+  options.Validate();
+  if (options.supplied_noise) {
+    throw UsageError(
+        "NoiseEmds draws its own white noise: compute the EMDs of supplied noise "
+        "by decomposing with it");
+  }
+  if (length < 4) {
+    throw DataError("NoiseEmds length " + std::to_string(length) + ": must be >= 4 samples");
+  }
+  realisations_.resize(static_cast<size_t>(options.ensemble_size));
+  std::vector<std::optional<internal::Sifter>> sifters(
+      static_cast<size_t>(ResolveThreads(options.threads)));
+  ParallelFor(options.ensemble_size, options.threads, [&](int i, int w) {
+    auto& sifter = sifters[static_cast<size_t>(w)];
+    if (!sifter) sifter.emplace(length, options.sifting);
+    Realisation& r = realisations_[static_cast<size_t>(i)];
+    r.white = internal::DrawNoise(options, i, length);
+    internal::NoiseModes modes(r.white);
+    Eigen::VectorXd row(length);
+    while (modes.Next(*sifter, row.data())) {
+      r.rows.push_back(row);
+      if (modes.last_imf() > 0) r.imfs = modes.last_imf();
+    }
+  });
+}
+
+bool NoiseEmds::Matches(Eigen::Index n, const DecompositionOptions& o) const {
+  return n == length_ && o.seed == seed_ && o.ensemble_size == ensemble_size() &&
+         o.sifting == sifting_ && !o.supplied_noise;
+}
+
+}  // namespace gyrodrift::decomposition

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -412,6 +413,23 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
   // Causal: the lags at t come from decomposing y[t-W .. t-1] alone; windows run in parallel.
   dopt.threads = 1;
   if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
+  // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
+  // computed once here instead of once per window (the same bits; about half of each window's
+  // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
+  decomposition::DecompositionOptions dopt_full = dopt;
+  const decomposition::Method dmethod = dopt.method;
+  const bool noise_family = dmethod == decomposition::Method::kCeemdan ||
+                            dmethod == decomposition::Method::kIceemdan ||
+                            dmethod == decomposition::Method::kBeemdan;
+  const Eigen::Index full_windows = n - std::max<Eigen::Index>(first, causal.window);
+  const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
+                             (std::log2(static_cast<double>(causal.window)) + 2) *
+                             static_cast<double>(causal.window) * sizeof(double);
+  if (noise_family && full_windows > 1 && cache_bytes <= 256e6) {
+    decomposition::DecompositionOptions build = dopt;
+    build.threads = causal.threads;
+    dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
+  }
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
   std::vector<Eigen::MatrixXd> rows(groups, Eigen::MatrixXd(count, p + thermal.cols()));
@@ -424,7 +442,8 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
     const Eigen::Index start = std::max<Eigen::Index>(0, t - causal.window);
     const Eigen::Index length = t - start;
     const Eigen::MatrixXd series =
-        GroupSeries(model, decomposition::Decompose(y.segment(start, length), dopt));
+        GroupSeries(model, decomposition::Decompose(y.segment(start, length),
+                                                    length == causal.window ? dopt_full : dopt));
     for (size_t g = 0; g < groups; ++g) {
       for (int k = 0; k < p; ++k)
         rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));

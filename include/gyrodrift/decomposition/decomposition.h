@@ -75,6 +75,8 @@ enum class NoiseScaling {
 std::string_view ToString(NoiseScaling scaling);
 NoiseScaling NoiseScalingFromString(std::string_view name);  // "colominas2014", "constant-snr"
 
+class NoiseEmds;
+
 struct DecompositionOptions {
   Method method = Method::kBeemdan;
   SiftingOptions sifting;
@@ -105,6 +107,11 @@ struct DecompositionOptions {
   // caller reuse these EMDs instead of computing its own (selection's white-noise level, see
   // selection::NoiseLevelCollector). May be empty; it does not change the result.
   std::function<void(int realisation, int mode, const double* imf)> noise_imf_observer;
+  // CEEMDAN, ICEEMDAN, BEEMDAN: the realisations' white-noise EMDs, computed beforehand for
+  // signals of this length with this seed, ensemble size and sifting (see NoiseEmds); Decompose
+  // refuses a set that does not match. Empty: each decomposition computes its own. The result
+  // is the same bits either way.
+  std::shared_ptr<const NoiseEmds> noise_emds;
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range
 };
@@ -129,6 +136,38 @@ struct Decomposition {
   Eigen::VectorXd residue;  // N
   DecompositionReport report;
   int num_imfs() const { return static_cast<int>(imfs.cols()); }
+};
+
+// The white-noise EMDs of an ensemble (realisation i drawn from stream (seed, i), unit variance)
+// for signals of one length, each computed to the end once and then shared by every CEEMDAN,
+// ICEEMDAN or BEEMDAN decomposition of that length with the same seed, ensemble size and sifting
+// (DecompositionOptions::noise_emds). The causal protocol decomposes thousands of windows of
+// one length, and the noise EMDs are about half of each one's cost. Immutable once built, so
+// one set may serve many threads; it holds ensemble x (IMFs + 1) x length doubles.
+class NoiseEmds {
+ public:
+  // Computes the EMDs with options' seed, ensemble_size, sifting and threads. Throws UsageError
+  // for invalid options or supplied noise (whose EMDs a caller computes itself), DataError for a
+  // length under 4 samples.
+  NoiseEmds(Eigen::Index length, const DecompositionOptions& options);
+
+  struct Realisation {
+    Eigen::VectorXd white;              // the realisation itself
+    std::vector<Eigen::VectorXd> rows;  // its EMD as emd.m lists it: IMF 1, 2, ..., the residue
+                                        // (left out when identically zero)
+    int imfs = 0;                       // how many of the rows are IMFs
+  };
+  Eigen::Index length() const { return length_; }
+  int ensemble_size() const { return static_cast<int>(realisations_.size()); }
+  const Realisation& realisation(int i) const { return realisations_[static_cast<size_t>(i)]; }
+  // True when these EMDs are the ones a decomposition of n samples with o would compute.
+  bool Matches(Eigen::Index n, const DecompositionOptions& o) const;
+
+ private:
+  Eigen::Index length_;
+  std::uint64_t seed_;
+  SiftingOptions sifting_;
+  std::vector<Realisation> realisations_;
 };
 
 // Decomposes x with options.method. Throws UsageError (bad options) or DataError (fewer than 4

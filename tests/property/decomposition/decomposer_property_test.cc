@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <numbers>
+#include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -247,6 +251,106 @@ TEST_P(Decomposer, NoiseImfObserverSeesTheNoiseEmdAndDoesNotChangeTheResult) {
       EXPECT_EQ(modes[k], noise.imfs.col(static_cast<Eigen::Index>(k))) << i << " mode " << k + 1;
     }
   }
+}
+
+// Precomputed white-noise EMDs (the causal protocol's shared set) change nothing: the same bits,
+// the same report and the same observer calls as each decomposition computing its own; other
+// methods refuse them.
+TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
+  const Eigen::VectorXd x = Noisy(700, 8);
+  DecompositionOptions o = Options(GetParam());
+  const bool family = GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
+                      GetParam() == Method::kBeemdan;
+  o.threads = 2;
+  auto shared = std::make_shared<const NoiseEmds>(x.size(), o);
+  if (!family) {
+    o.noise_emds = shared;
+    EXPECT_THROW(Decompose(x, o), UsageError);
+    return;
+  }
+  std::vector<BeemdanBound> bounds = {BeemdanBound::kEnergyBand};
+  if (GetParam() == Method::kBeemdan) {
+    bounds = {BeemdanBound::kEnergyBand, BeemdanBound::kFixedStages, BeemdanBound::kFull};
+  }
+  for (BeemdanBound bound : bounds) {
+    o.beemdan_bound = bound;
+    o.noise_stages = 2;
+    using Calls = std::vector<std::tuple<int, int, double>>;  // realisation, mode, middle sample
+    std::mutex mutex;  // calls for different realisations may come concurrently
+    auto watch = [&](Calls& calls) {
+      return [&calls, &mutex, n = x.size()](int i, int mode, const double* imf) {
+        std::lock_guard<std::mutex> lock(mutex);
+        calls.emplace_back(i, mode, imf[n / 2]);
+      };
+    };
+    Calls own_calls, shared_calls;
+    o.noise_emds = nullptr;
+    o.noise_imf_observer = watch(own_calls);
+    const Decomposition own = Decompose(x, o);
+    o.noise_emds = shared;
+    o.noise_imf_observer = watch(shared_calls);
+    const Decomposition reused = Decompose(x, o);
+    const std::string label(ToString(bound));
+    EXPECT_EQ(own.imfs, reused.imfs) << label;
+    EXPECT_EQ(own.residue, reused.residue) << label;
+    EXPECT_EQ(own.report.Summary(), reused.report.Summary()) << label;
+    std::sort(own_calls.begin(), own_calls.end());
+    std::sort(shared_calls.begin(), shared_calls.end());
+    EXPECT_EQ(own_calls, shared_calls) << label;
+  }
+}
+
+TEST(NoiseEmds, AreEachRealisationsEmdWhateverTheThreadCount) {
+  DecompositionOptions o = Options(Method::kIceemdan);
+  o.ensemble_size = 5;
+  const NoiseEmds one(300, o);
+  o.threads = 2;
+  const NoiseEmds two(300, o);
+  ASSERT_EQ(one.ensemble_size(), 5);
+  for (int i = 0; i < 5; ++i) {
+    const NoiseEmds::Realisation& r = one.realisation(i);
+    Eigen::VectorXd w(300);
+    Rng(o.seed, static_cast<std::uint64_t>(i)).FillNormal(w);
+    EXPECT_EQ(r.white, w) << i;
+    const Decomposition emd = Emd(w, o.sifting);
+    ASSERT_EQ(r.imfs, emd.num_imfs()) << i;
+    ASSERT_EQ(r.rows.size(), static_cast<size_t>(emd.num_imfs() + 1)) << i;
+    for (int k = 0; k < r.imfs; ++k) EXPECT_EQ(r.rows[static_cast<size_t>(k)], emd.imfs.col(k));
+    EXPECT_EQ(r.rows.back(), emd.residue) << i;
+    EXPECT_EQ(two.realisation(i).rows, r.rows) << i;
+  }
+}
+
+TEST(NoiseEmds, AMismatchIsRefused) {
+  const Eigen::VectorXd x = Noisy(400, 3);
+  DecompositionOptions o = Options(Method::kBeemdan);
+  auto shared = std::make_shared<const NoiseEmds>(x.size(), o);
+  auto refused = [&](DecompositionOptions changed, const Eigen::VectorXd& signal) {
+    changed.noise_emds = shared;
+    EXPECT_THROW(Decompose(signal, changed), UsageError);
+  };
+  refused(o, x.head(399));
+  DecompositionOptions c = o;
+  c.seed = 8;
+  refused(c, x);
+  c = o;
+  c.ensemble_size = 15;
+  refused(c, x);
+  c = o;
+  c.sifting.stop_rule = StopRule::kSNumber;
+  refused(c, x);
+  c = o;
+  c.supplied_noise = std::make_shared<const Eigen::MatrixXd>(Eigen::MatrixXd::Ones(400, 16));
+  refused(c, x);
+  c = o;
+  c.noise_emds = shared;
+  EXPECT_NO_THROW(Decompose(x, c));
+  EXPECT_THROW(NoiseEmds(3, o), DataError);
+  c.supplied_noise = std::make_shared<const Eigen::MatrixXd>(Eigen::MatrixXd::Ones(400, 16));
+  EXPECT_THROW(NoiseEmds(400, c), UsageError) << "supplied noise";
+  c = o;
+  c.ensemble_size = 0;
+  EXPECT_THROW(NoiseEmds(400, c), UsageError);
 }
 
 TEST_P(Decomposer, EveryStopRuleTerminatesWithinItsCap) {

@@ -190,6 +190,26 @@ TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
   EXPECT_EQ(seen.back(), 1.0);
 }
 
+// Full windows share one set of white-noise EMDs (computed once, not per window): each
+// prediction is still the one a lone decomposition of its window gives, to the bit.
+TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
+  const Log log = MakeLog(700, 6);
+  const DriftModel model =
+      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  CausalOptions causal;
+  causal.window = 64;
+  causal.threads = 2;
+  const Eigen::VectorXd all =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  for (Eigen::Index t : {500, 563, 699}) {
+    // A record ending at t has a single full window: nothing to share.
+    const Eigen::VectorXd alone = PredictOneStep(model, log.rate.head(t + 1), Eigen::VectorXd(), t,
+                                                 Protocol::kCausal, causal);
+    ASSERT_EQ(alone.size(), 1);
+    EXPECT_EQ(alone[0], all[t - 500]) << t;
+  }
+}
+
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   const Log log = MakeLog(900, 2);
   for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {
