@@ -1,4 +1,5 @@
-// gyrodrift predict: one-step-ahead predictions of a saved predict-mode model on a CSV log.
+// gyrodrift predict: one-step-ahead (or H-step-ahead) predictions of a saved predict-mode model on
+// a CSV log.
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@ struct PredictArgs {
   std::string output;
   std::string protocol = "causal";
   int window = 512;
+  int horizon = 1;
   int threads = 0;
   bool quiet = false;
 };
@@ -33,6 +35,9 @@ void Run(const PredictArgs& a) {
   const drift::Protocol protocol = drift::ProtocolFromString(a.protocol);
   if (a.window < 16 || a.window > 1000000) {
     ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
+  }
+  if (a.horizon < 1 || a.horizon > 100000) {
+    ThrowOption("--horizon", std::to_string(a.horizon), "an integer in [1, 100000]");
   }
   if (a.threads < 0 || a.threads > 1024) {
     ThrowOption("--threads", std::to_string(a.threads), "an integer in [0, 1024] (0 = all cores)");
@@ -51,12 +56,13 @@ void Run(const PredictArgs& a) {
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;
   if (model.uses_temperature()) temperature = table.Column(loaded.info.temperature_column);
-  // The first sample with enough history: p lags, and under the causal protocol a window long
-  // enough to decompose.
+  // The first sample with enough history: p lags (and under the causal protocol a window long
+  // enough to decompose) before the origin, horizon - 1 samples before it.
   const bool decomposes = drift::UsesDecomposition(model.options.method);
-  const Eigen::Index first = protocol == drift::Protocol::kCausal && decomposes
-                                 ? std::max<Eigen::Index>(model.lags, 16)
-                                 : model.lags;
+  const Eigen::Index first =
+      (protocol == drift::Protocol::kCausal && decomposes ? std::max<Eigen::Index>(model.lags, 16)
+                                                          : model.lags) +
+      a.horizon - 1;
   if (y.size() <= first) {
     throw DataError(a.input + " has " + std::to_string(y.size()) +
                     " samples: the model needs more than " + std::to_string(first) +
@@ -72,7 +78,7 @@ void Run(const PredictArgs& a) {
     ProgressBar progress({1.0}, windows && IsTerminal() && !a.quiet);  // Finish() on every path
     progress.BeginStage(0, "causal windows");
     causal.progress = [&progress](double fraction) { progress.Update(fraction, ""); };
-    prediction = drift::PredictOneStep(model, y, temperature, first, protocol, causal);
+    prediction = drift::PredictAhead(model, y, temperature, first, a.horizon, protocol, causal);
   }
 
   const Eigen::Index count = y.size() - first;
@@ -83,11 +89,8 @@ void Run(const PredictArgs& a) {
   columns.push_back({"prediction", prediction});
 
   nlohmann::json sidecar = SidecarHeader("predict");
-  sidecar["options"] = {{"model", a.model},
-                        {"input", a.input},
-                        {"protocol", a.protocol},
-                        {"window", a.window},
-                        {"threads", a.threads}};
+  sidecar["options"] = {{"model", a.model},   {"input", a.input},     {"protocol", a.protocol},
+                        {"window", a.window}, {"horizon", a.horizon}, {"threads", a.threads}};
   sidecar["model"] = {{"summary", model.Summary()},
                       {"method", drift::ToString(model.options.method)},
                       {"target_column", loaded.info.target_column},
@@ -101,26 +104,32 @@ void Run(const PredictArgs& a) {
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
-    fmt::print("{}\npredicted samples {}..{} ({} protocol)\nwrote {} and {}\n", model.Summary(),
-               first + 1, y.size(), a.protocol, a.output, SidecarPath(a.output));
+    const std::string ahead = a.horizon > 1 ? std::to_string(a.horizon) + "-step-ahead, " : "";
+    fmt::print("{}\npredicted samples {}..{} ({}{} protocol)\nwrote {} and {}\n", model.Summary(),
+               first + 1, y.size(), ahead, a.protocol, a.output, SidecarPath(a.output));
   }
 }
 
 const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
   auto args = std::make_shared<PredictArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "predict", "One-step-ahead predictions of a saved predict-mode model on a log.");
+      "predict",
+      "One-step-ahead (or --horizon H steps ahead) predictions of a saved predict-mode model.");
   cmd->footer(
       "Example:\n"
       "  gyrodrift fit train.csv --target rate_dph --mode predict --lags 4 -o model.json\n"
       "  gyrodrift predict model.json test.csv --protocol causal --window 512 -o pred.csv\n"
       "writes pred.csv with columns sample (1-based row of test.csv), time_s (if test.csv has\n"
       "it) and prediction, one row per predicted sample: rows before the model has its p lags\n"
-      "of history (and, for ms-elm/emd-elm under the causal protocol, 16 samples to decompose)\n"
-      "are left out. causal (default): the sub-series at t come from decomposing only the\n"
-      "trailing window y[t-W..t-1], what a running system can do. paper: the whole file is\n"
-      "decomposed once, so predictions see future samples (the literature's protocol, for\n"
-      "comparison only). pred.csv.json records the options and the model.");
+      "of history (for ms-elm/emd-elm under the causal protocol, 16 samples to decompose), and\n"
+      "H-1 more with --horizon H, are left out. causal (default): the sub-series at t come from\n"
+      "decomposing only the trailing window y[t-W..t-1], what a running system can do. paper:\n"
+      "the whole file is decomposed once, so predictions see future samples (the literature's\n"
+      "protocol, for comparison only). --horizon H: each prediction of y[t] is made at t-H+1 from "
+      "the samples\n"
+      "before it, feeding each sub-model its own predictions for the H-1 steps in between\n"
+      "(recursive); a model with temperature inputs reads them from the file at every step.\n"
+      "pred.csv.json records the options and the model.");
   cmd->add_option("model", args->model, "model file written by 'gyrodrift fit'")
       ->required()
       ->check(kInputFile);
@@ -131,6 +140,9 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->required();
   cmd->add_option("--protocol", args->protocol, "causal|paper")->capture_default_str();
   cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
+      ->capture_default_str();
+  cmd->add_option("--horizon,-H", args->horizon,
+                  "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")
       ->capture_default_str();
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();

@@ -361,6 +361,71 @@ Eigen::VectorXd EstimateDrift(const DriftModel& model,
   return estimate;
 }
 
+namespace {
+
+// Causal protocol: the lags of each origin o = origin + r come from decomposing the trailing
+// window y[o-W .. o-1] alone (lags[g](r, k) = s_g[o - 1 - k] of that window's groups); windows
+// run in parallel.
+std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
+                                        const Eigen::Ref<const Eigen::VectorXd>& y,
+                                        Eigen::Index origin, Eigen::Index count,
+                                        const CausalOptions& causal) {
+  decomposition::DecompositionOptions dopt = model.options.decomposition;
+  dopt.seed = model.options.seed;
+  dopt.threads = 1;
+  if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
+  // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
+  // computed once here instead of once per window (the same bits; about half of each window's
+  // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
+  decomposition::DecompositionOptions dopt_full = dopt;
+  const decomposition::Method dmethod = dopt.method;
+  const bool noise_family = dmethod == decomposition::Method::kCeemdan ||
+                            dmethod == decomposition::Method::kIceemdan ||
+                            dmethod == decomposition::Method::kBeemdan;
+  const Eigen::Index last_origin = origin + count - 1;
+  const Eigen::Index full_windows = last_origin - std::max<Eigen::Index>(origin, causal.window) + 1;
+  const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
+                             (std::log2(static_cast<double>(causal.window)) + 2) *
+                             static_cast<double>(causal.window) * sizeof(double);
+  if (noise_family && full_windows > 1 && cache_bytes <= 256e6) {
+    decomposition::DecompositionOptions build = dopt;
+    build.threads = causal.threads;
+    dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
+  }
+  const int p = model.lags;
+  const size_t groups = model.sub_models.size();
+  std::vector<Eigen::MatrixXd> lags(groups, Eigen::MatrixXd(count, p));
+  std::atomic<Eigen::Index> windows_done{0};
+  std::mutex progress_mutex;
+  double reported = 0.0;
+  const Eigen::Index report_every = std::max<Eigen::Index>(1, count / 200);
+  ParallelFor(static_cast<int>(count), causal.threads, [&](int r, int) {
+    const Eigen::Index end = origin + r;  // the window ends just before the origin
+    const Eigen::Index start = std::max<Eigen::Index>(0, end - causal.window);
+    const Eigen::Index length = end - start;
+    const Eigen::MatrixXd series =
+        GroupSeries(model, decomposition::Decompose(y.segment(start, length),
+                                                    length == causal.window ? dopt_full : dopt));
+    for (size_t g = 0; g < groups; ++g) {
+      for (int k = 0; k < p; ++k) {
+        lags[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
+      }
+    }
+    const Eigen::Index done = ++windows_done;
+    if (causal.progress && (done % report_every == 0 || done == count)) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      const double fraction = static_cast<double>(done) / static_cast<double>(count);
+      if (fraction > reported) {
+        reported = fraction;
+        causal.progress(fraction);
+      }
+    }
+  });
+  return lags;
+}
+
+}  // namespace
+
 Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
@@ -373,15 +438,19 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
   return prediction;
 }
 
-Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
-                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
-                               Eigen::Index first, Protocol protocol, const CausalOptions& causal) {
+Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
+                             const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                             Eigen::Index first, int horizon, Protocol protocol,
+                             const CausalOptions& causal) {
   if (model.options.mode != Mode::kPredict) {
     throw UsageError(
-        "model mode = compensate: one-step prediction needs a model fitted with --mode predict");
+        "model mode = compensate: prediction needs a model fitted with --mode predict");
   }
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();
+  if (horizon < 1 || horizon > 100000) {
+    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
+  }
   if (causal.window < 16 || causal.window > 1000000) {
     ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
   }
@@ -389,79 +458,66 @@ Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const E
     ThrowOption("causal ensemble_size", std::to_string(causal.ensemble_size),
                 "an integer in [0, 100000] (0 = the model's)");
   }
-  const Eigen::Index min_first =
+  // The prediction of y[t] starts from the origin t - horizon + 1: the lags end at t - horizon.
+  const Eigen::Index min_origin =
       protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
           ? std::max<Eigen::Index>(model.lags, 16)
           : model.lags;
+  const Eigen::Index min_first = min_origin + horizon - 1;
   if (first < min_first || first >= n) {
-    throw DataError("first predicted sample " + std::to_string(first + 1) + " must be in [" +
-                    std::to_string(min_first + 1) + ", " + std::to_string(n) +
-                    "] (the model needs that much history)");
+    throw DataError(
+        "first predicted sample " + std::to_string(first + 1) + " must be in [" +
+        std::to_string(min_first + 1) + ", " + std::to_string(n) +
+        "] (the model needs that much history" +
+        (horizon > 1 ? " before its " + std::to_string(horizon) + "-step horizon" : "") + ")");
   }
   const Eigen::MatrixXd thermal = ThermalOrEmpty(model, temperature_c, n);
   const Eigen::Index count = n - first;
-  if (!UsesDecomposition(model.options.method)) {
-    return PredictFromSeries(model, y, thermal, first, count);
-  }
-  decomposition::DecompositionOptions dopt = model.options.decomposition;
-  dopt.seed = model.options.seed;
-  if (protocol == Protocol::kPaper) {
-    dopt.threads = model.options.threads;
-    const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
-    return PredictFromSeries(model, series, thermal, first, count);
-  }
-  // Causal: the lags at t come from decomposing y[t-W .. t-1] alone; windows run in parallel.
-  dopt.threads = 1;
-  if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
-  // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
-  // computed once here instead of once per window (the same bits; about half of each window's
-  // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
-  decomposition::DecompositionOptions dopt_full = dopt;
-  const decomposition::Method dmethod = dopt.method;
-  const bool noise_family = dmethod == decomposition::Method::kCeemdan ||
-                            dmethod == decomposition::Method::kIceemdan ||
-                            dmethod == decomposition::Method::kBeemdan;
-  const Eigen::Index full_windows = n - std::max<Eigen::Index>(first, causal.window);
-  const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
-                             (std::log2(static_cast<double>(causal.window)) + 2) *
-                             static_cast<double>(causal.window) * sizeof(double);
-  if (noise_family && full_windows > 1 && cache_bytes <= 256e6) {
-    decomposition::DecompositionOptions build = dopt;
-    build.threads = causal.threads;
-    dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
-  }
+  const Eigen::Index origin = first - (horizon - 1);  // origin of the prediction of y[first]
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
-  std::vector<Eigen::MatrixXd> rows(groups, Eigen::MatrixXd(count, p + thermal.cols()));
-  std::atomic<Eigen::Index> windows_done{0};
-  std::mutex progress_mutex;
-  double reported = 0.0;
-  const Eigen::Index report_every = std::max<Eigen::Index>(1, count / 200);
-  ParallelFor(static_cast<int>(count), causal.threads, [&](int r, int) {
-    const Eigen::Index t = first + r;
-    const Eigen::Index start = std::max<Eigen::Index>(0, t - causal.window);
-    const Eigen::Index length = t - start;
-    const Eigen::MatrixXd series =
-        GroupSeries(model, decomposition::Decompose(y.segment(start, length),
-                                                    length == causal.window ? dopt_full : dopt));
+  // lags[g](r, k) = s_g[origin + r - 1 - k]: each row's own lags at its origin.
+  std::vector<Eigen::MatrixXd> lags(groups);
+  if (!UsesDecomposition(model.options.method)) {
+    lags[0] = LagRows(y, p, origin, count);
+  } else if (protocol == Protocol::kPaper) {
+    decomposition::DecompositionOptions dopt = model.options.decomposition;
+    dopt.seed = model.options.seed;
+    dopt.threads = model.options.threads;
+    const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
     for (size_t g = 0; g < groups; ++g) {
-      for (int k = 0; k < p; ++k)
-        rows[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
-      if (thermal.cols() > 0) rows[g].row(r).tail(thermal.cols()) = thermal.row(t - 1);
+      lags[g] = LagRows(series.col(static_cast<Eigen::Index>(g)), p, origin, count);
     }
-    const Eigen::Index done = ++windows_done;
-    if (causal.progress && (done % report_every == 0 || done == count)) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      const double fraction = static_cast<double>(done) / static_cast<double>(count);
-      if (fraction > reported) {
-        reported = fraction;
-        causal.progress(fraction);
-      }
-    }
-  });
+  } else {
+    lags = CausalLags(model, y, origin, count, causal);
+  }
+  // Recursive prediction: step j predicts s_g[origin + r + j] from the lags (the predictions of
+  // the steps before replacing the samples after the origin) and the thermal inputs at
+  // origin + r + j - 1, read from the log. The last step is the prediction of y[first + r].
   Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
-  for (size_t g = 0; g < groups; ++g) prediction += model.sub_models[g].learner->Predict(rows[g]);
+  for (size_t g = 0; g < groups; ++g) {
+    Eigen::MatrixXd x(count, p + thermal.cols());
+    x.leftCols(p) = lags[g];
+    for (int j = 0; j < horizon; ++j) {
+      if (thermal.cols() > 0) {
+        x.rightCols(thermal.cols()) = thermal.middleRows(origin + j - 1, count);
+      }
+      Eigen::VectorXd step = model.sub_models[g].learner->Predict(x);
+      if (j + 1 == horizon) {
+        prediction += step;
+        break;
+      }
+      for (int k = p - 1; k > 0; --k) x.col(k) = x.col(k - 1);
+      x.col(0) = std::move(step);
+    }
+  }
   return prediction;
+}
+
+Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
+                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               Eigen::Index first, Protocol protocol, const CausalOptions& causal) {
+  return PredictAhead(model, y, temperature_c, first, 1, protocol, causal);
 }
 
 }  // namespace gyrodrift::drift

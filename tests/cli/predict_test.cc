@@ -89,6 +89,24 @@ TEST_F(PredictCli, PaperProtocolMatchesTheLibraryToTheBit) {
   EXPECT_EQ(table.Column("prediction"), expected);
 }
 
+TEST_F(PredictCli, HorizonPredictsRecursivelyAsTheLibrary) {
+  const std::string out = Dir() + "/ahead.csv";
+  const auto r = test::RunCli("predict '" + Dir() + "/ms.json' '" + Dir() +
+                              "/test.csv' --protocol paper --horizon 5 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("predicted samples 8..120 (5-step-ahead, paper protocol)"),
+            std::string::npos)
+      << r.out;
+  const auto table = io::CsvTable::Read(out);
+  ASSERT_EQ(table.rows(), 120 - 7);  // p = 3 lags before the origin, 4 steps after it
+  EXPECT_EQ(table.Column("sample")[0], 8.0);
+  const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
+  const Eigen::VectorXd y = io::CsvTable::Read(Dir() + "/test.csv").Column("rate_dph");
+  EXPECT_EQ(table.Column("prediction"),
+            drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 7, 5, drift::Protocol::kPaper));
+  EXPECT_EQ(nlohmann::json::parse(io::ReadTextFile(out + ".json"))["options"]["horizon"], 5);
+}
+
 TEST_F(PredictCli, SingleModelsAreCausalUnderBothProtocols) {
   const std::string a = Dir() + "/a.csv", b = Dir() + "/b.csv";
   const std::string base = "predict '" + Dir() + "/elm.json' '" + Dir() + "/test.csv' -q ";
@@ -125,6 +143,9 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"bad protocol", "predict %DIR%/ms.json %DIR%/test.csv --protocol future", 2,
        "protocol = 'future'"},
       {"small window", "predict %DIR%/ms.json %DIR%/test.csv -W 8", 2, "--window = 8"},
+      {"zero horizon", "predict %DIR%/ms.json %DIR%/test.csv --horizon 0", 2, "--horizon = 0"},
+      {"horizon past the file", "predict %DIR%/ms.json %DIR%/test.csv --horizon 110", 3,
+       "needs more than 125"},
       {"not a model", "predict %DIR%/test.csv %DIR%/test.csv", 3, "not a gyrodrift model file"},
       {"damaged model", "predict %DIR%/damaged.json %DIR%/test.csv", 3, "checksum mismatch"},
       {"target column missing", "predict %DIR%/ms.json %DIR%/no_rate.csv", 3,

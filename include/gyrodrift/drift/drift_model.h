@@ -163,8 +163,20 @@ struct CausalOptions {
   std::function<void(double fraction)> progress;
 };
 
+// Horizon-step-ahead predictions of y[t] for t = first .. N-1 (N - first entries), each made at
+// the origin t - horizon + 1 from the samples before it: the sub-series' lags there, then
+// recursively, one step at a time, each sub-model's own predictions in place of the samples after
+// the origin. Thermal inputs (models fitted with a temperature) are read from the log at every
+// step, as for a temperature programme known in advance. first >= lags + horizon - 1 (causal
+// protocol with a decomposition: max(lags, 16) + horizon - 1). horizon = 1 is PredictOneStep.
+// Single models need no decomposition and are causal under both protocols.
+Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
+                             const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                             Eigen::Index first, int horizon, Protocol protocol,
+                             const CausalOptions& causal = {});
+
 // One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has
-// N - first entries). Single models need no decomposition and are causal under both protocols.
+// N - first entries): PredictAhead with horizon 1.
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                                const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                Eigen::Index first, Protocol protocol,

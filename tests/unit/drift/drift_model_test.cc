@@ -152,9 +152,11 @@ TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
   // does, and then SelectModes completes the level by the Monte-Carlo (selection_test).
   o.decomposition.method = decomposition::Method::kIceemdan;
   o.seed = 4;
-  ASSERT_EQ(selection::NoiseLevelCache::Global().Size(), 0u);
+  // No level of its own: the process-wide cache (other tests in this process may have filled it)
+  // does not grow.
+  const size_t cached_levels = selection::NoiseLevelCache::Global().Size();
   const DriftModel reused = FitDriftModel(log.rate, Eigen::VectorXd(), o);
-  EXPECT_EQ(selection::NoiseLevelCache::Global().Size(), 0u) << reused.selection_summary;
+  EXPECT_EQ(selection::NoiseLevelCache::Global().Size(), cached_levels) << reused.selection_summary;
   DriftOptions given = o;
   selection::MonteCarloOptions mc = o.selection.monte_carlo;
   mc.seed = o.seed;
@@ -208,6 +210,74 @@ TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
     ASSERT_EQ(alone.size(), 1);
     EXPECT_EQ(alone[0], all[t - 500]) << t;
   }
+}
+
+// Recursive multi-step prediction: a linear autoregression on 4 lags represents a sampled sine
+// exactly, so fed its own predictions it still continues the sine 12 steps ahead; a mistake in
+// the recursion (a lag in the wrong place, the wrong thermal row) would not.
+TEST(DriftModel, PredictAheadContinuesASineFromItsOwnPredictions) {
+  const Eigen::Index n = 600;
+  Eigen::VectorXd y(n);
+  for (Eigen::Index t = 0; t < n; ++t) y[t] = std::sin(2 * std::numbers::pi * t / 37.0);
+  DriftOptions o = Fast(Mode::kPredict, Method::kPoly);
+  o.learner.poly_degree = 1;
+  const DriftModel model = FitDriftModel(y.head(400), Eigen::VectorXd(), o);
+  for (int horizon : {1, 2, 12}) {
+    const Eigen::VectorXd ahead =
+        PredictAhead(model, y, Eigen::VectorXd(), 420, horizon, Protocol::kPaper);
+    ASSERT_EQ(ahead.size(), n - 420);
+    EXPECT_LT((ahead - y.tail(n - 420)).cwiseAbs().maxCoeff(), 1e-6) << horizon;
+  }
+  EXPECT_EQ(PredictAhead(model, y, Eigen::VectorXd(), 420, 1, Protocol::kCausal),
+            PredictOneStep(model, y, Eigen::VectorXd(), 420, Protocol::kCausal));
+  // The 12-step prediction of y[t] starts at t - 11: it needs lags + 11 samples before t.
+  EXPECT_NO_THROW(PredictAhead(model, y, Eigen::VectorXd(), 15, 12, Protocol::kPaper));
+  EXPECT_THROW(PredictAhead(model, y, Eigen::VectorXd(), 14, 12, Protocol::kPaper), DataError);
+  EXPECT_THROW(PredictAhead(model, y, Eigen::VectorXd(), 420, 0, Protocol::kPaper), UsageError);
+}
+
+// With a temperature, every step of the recursion reads the thermal inputs of its own time: an
+// output that is a linear function of the temperature one sample earlier is predicted exactly
+// 6 steps ahead (the inputs of the origin would miss it by the temperature's change).
+TEST(DriftModel, PredictAheadReadsEachStepsThermalInputs) {
+  const Eigen::Index n = 800;
+  Eigen::VectorXd temperature(n), y(n);
+  for (Eigen::Index t = 0; t < n; ++t) {
+    temperature[t] = 20.0 + 10.0 * std::sin(2 * std::numbers::pi * t / 300.0) + 0.02 * t;
+  }
+  y[0] = 0.0;
+  for (Eigen::Index t = 1; t < n; ++t) y[t] = 0.3 * (temperature[t - 1] - 20.0);
+  DriftOptions o = Fast(Mode::kPredict, Method::kPoly);
+  o.learner.poly_degree = 1;
+  o.features.use_temperature = true;
+  const DriftModel model = FitDriftModel(y.head(500), temperature.head(500), o);
+  ASSERT_TRUE(model.uses_temperature());
+  const Eigen::VectorXd ahead = PredictAhead(model, y, temperature, 520, 6, Protocol::kPaper);
+  EXPECT_LT((ahead - y.tail(n - 520)).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// The H-step prediction of y[t] uses samples before t - H + 1 only (causal protocol, with the
+// decomposition of trailing windows and the recursion): changing samples from c on leaves every
+// prediction up to y[c + H - 1] unchanged to the bit.
+TEST(DriftModel, PredictAheadIgnoresSamplesAfterItsOrigin) {
+  const Log log = MakeLog(900, 7);
+  const DriftModel model =
+      FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  CausalOptions causal;
+  causal.window = 128;
+  const int horizon = 5;
+  const Eigen::VectorXd base =
+      PredictAhead(model, log.rate, Eigen::VectorXd(), 600, horizon, Protocol::kCausal, causal);
+  Eigen::VectorXd changed = log.rate;
+  changed.tail(150).array() += 5.0;  // samples 750.. change
+  const Eigen::VectorXd after =
+      PredictAhead(model, changed, Eigen::VectorXd(), 600, horizon, Protocol::kCausal, causal);
+  // y[t] for t <= 754 starts at t - 4 <= 750, from samples up to 749.
+  EXPECT_EQ(base.head(155), after.head(155));
+  EXPECT_NE(base.segment(155, 5), after.segment(155, 5));
+  const Eigen::VectorXd one =
+      PredictAhead(model, log.rate, Eigen::VectorXd(), 600, 1, Protocol::kCausal, causal);
+  EXPECT_NE(base, one);
 }
 
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
