@@ -60,6 +60,7 @@ std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
       {"ensemble_size", {"--ensemble"}},
       {"fixed_sifts", {"--fixed-sifts"}},
       {"hidden_units", {"--hidden"}},
+      {"horizon", {"--horizon"}},
       {"input_rate_dph", {"--input-rate-dph"}},
       {"lags", {"--lags"}},
       {"learner", {"--method"}},

@@ -27,6 +27,8 @@ struct EvaluateArgs : DriftArgs {
   std::string methods = "all";
   int repeats = 1;
   int window = 512;
+  int horizon = 1;
+  CLI::Option* horizon_option = nullptr;
   std::string output;
 };
 
@@ -58,6 +60,12 @@ void Run(const EvaluateArgs& a) {
   e.protocols = ParseProtocols(a.protocol);
   e.causal.window = a.window;
   e.causal.threads = a.threads;
+  e.horizon = a.horizon;
+  if (base.mode == drift::Mode::kCompensate && a.horizon_option->count() > 0) {
+    throw UsageError("--horizon = " + std::to_string(a.horizon) +
+                     ": applies to --mode predict (a compensate-mode estimate is not a "
+                     "prediction ahead)");
+  }
   e.Validate();  // option errors before any file is read
 
   const io::CsvTable table = io::CsvTable::Read(a.input);
@@ -101,6 +109,7 @@ void Run(const EvaluateArgs& a) {
                         {"methods", methods},
                         {"protocols", protocols},
                         {"window", e.causal.window},
+                        {"horizon", e.horizon},
                         {"rate_hz_from", rate_how},
                         {"drift", io::DriftOptionsToJson(base)}};
   nlohmann::json rows = nlohmann::json::array();
@@ -135,9 +144,11 @@ void Run(const EvaluateArgs& a) {
   io::WriteFilesAtomically(
       {{a.output, TableCsv(result)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
+    const std::string ahead =
+        e.horizon > 1 ? fmt::format(" ({}-step-ahead predictions)", e.horizon) : "";
     fmt::print(
-        "{} mode, trained on samples 1..{}, scored on {}..{} against {}\n{}{}wrote {} and {}\n",
-        drift::ToString(result.mode), result.split_index, result.split_index + 1, y.size(),
+        "{} mode{}, trained on samples 1..{}, scored on {}..{} against {}\n{}{}wrote {} and {}\n",
+        drift::ToString(result.mode), ahead, result.split_index, result.split_index + 1, y.size(),
         result.against_truth ? truth_column : target, result.Table(), notes, a.output,
         SidecarPath(a.output));
   }
@@ -157,10 +168,11 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       "Fits each method on the first --split of the record and scores it on the rest: RMSE, its\n"
       "std over --repeats seeds, MAE, max |error| and wall-clock times. Scores are against\n"
       "--truth when given (the simulator's drift), else against the target itself. Predict mode:\n"
-      "one-step-ahead error; compensate mode: error of the drift estimate. paper = decompose the\n"
-      "whole record before splitting (test sub-series see the future, as in the literature);\n"
-      "causal = only past samples reach a prediction. Single models (elm, poly, svr, bp) never\n"
-      "decompose, so their two rows are the same run. Writes table.csv\n"
+      "one-step-ahead error (--horizon H: H steps ahead, recursive); compensate mode: error of\n"
+      "the drift estimate. paper = decompose the whole record before splitting (test sub-series\n"
+      "see the future, as in the literature); causal = only past samples reach a prediction.\n"
+      "Single models (elm, poly, svr, bp) never decompose, so their two rows are the same run.\n"
+      "Writes table.csv\n"
       "(method,protocol,rmse,rmse_std,mae,max_abs,train_s,predict_s) and table.csv.json.");
   AddDriftOptions(cmd, args.get());
   cmd->add_option("--truth", args->truth, "column to score against (e.g. drift_dph)");
@@ -174,6 +186,10 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
       ->capture_default_str();
+  args->horizon_option =
+      cmd->add_option("--horizon,-H", args->horizon,
+                      "predict mode: score H-step-ahead predictions (recursive for H > 1)")
+          ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
   cmd->callback([args] { Run(*args); });

@@ -424,18 +424,54 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   return lags;
 }
 
+// Recursive prediction from each row's lags at its origin (lags[g](r, k) = s_g[origin + r - 1 -
+// k]): step j predicts s_g[origin + r + j] from the lags (the predictions of the steps before
+// standing in for the samples after the origin) and the thermal inputs at origin + r + j - 1, read
+// from the record. The last step, summed over the groups, is the prediction of y[origin + r +
+// horizon - 1].
+Eigen::VectorXd PredictRecursively(const DriftModel& model,
+                                   const std::vector<Eigen::MatrixXd>& lags,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
+                                   Eigen::Index origin, int horizon) {
+  const int p = model.lags;
+  const Eigen::Index count = lags.front().rows();
+  Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    Eigen::MatrixXd x(count, p + thermal.cols());
+    x.leftCols(p) = lags[g];
+    for (int j = 0; j < horizon; ++j) {
+      if (thermal.cols() > 0) {
+        x.rightCols(thermal.cols()) = thermal.middleRows(origin + j - 1, count);
+      }
+      Eigen::VectorXd step = model.sub_models[g].learner->Predict(x);
+      if (j + 1 == horizon) {
+        prediction += step;
+        break;
+      }
+      for (int k = p - 1; k > 0; --k) x.col(k) = x.col(k - 1);
+      x.col(0) = std::move(step);
+    }
+  }
+  return prediction;
+}
+
 }  // namespace
 
 Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
-                                  Eigen::Index first, Eigen::Index count) {
-  Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
-  for (size_t g = 0; g < model.sub_models.size(); ++g) {
-    prediction += model.sub_models[g].learner->Predict(
-        PredictRows(model, series.col(static_cast<Eigen::Index>(g)), thermal, first, count));
+                                  Eigen::Index first, Eigen::Index count, int horizon) {
+  const Eigen::Index origin = first - (horizon - 1);
+  if (horizon < 1 || origin < model.lags) {
+    throw DataError("prediction of sample " + std::to_string(first + 1) + " " +
+                    std::to_string(horizon) + " steps ahead needs " +
+                    std::to_string(model.lags + horizon - 1) + " samples before it");
   }
-  return prediction;
+  std::vector<Eigen::MatrixXd> lags(model.sub_models.size());
+  for (size_t g = 0; g < lags.size(); ++g) {
+    lags[g] = LagRows(series.col(static_cast<Eigen::Index>(g)), model.lags, origin, count);
+  }
+  return PredictRecursively(model, lags, thermal, origin, horizon);
 }
 
 Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
@@ -474,44 +510,18 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
   const Eigen::MatrixXd thermal = ThermalOrEmpty(model, temperature_c, n);
   const Eigen::Index count = n - first;
   const Eigen::Index origin = first - (horizon - 1);  // origin of the prediction of y[first]
-  const int p = model.lags;
-  const size_t groups = model.sub_models.size();
-  // lags[g](r, k) = s_g[origin + r - 1 - k]: each row's own lags at its origin.
-  std::vector<Eigen::MatrixXd> lags(groups);
   if (!UsesDecomposition(model.options.method)) {
-    lags[0] = LagRows(y, p, origin, count);
-  } else if (protocol == Protocol::kPaper) {
+    return PredictFromSeries(model, y, thermal, first, count, horizon);
+  }
+  if (protocol == Protocol::kPaper) {
     decomposition::DecompositionOptions dopt = model.options.decomposition;
     dopt.seed = model.options.seed;
     dopt.threads = model.options.threads;
     const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
-    for (size_t g = 0; g < groups; ++g) {
-      lags[g] = LagRows(series.col(static_cast<Eigen::Index>(g)), p, origin, count);
-    }
-  } else {
-    lags = CausalLags(model, y, origin, count, causal);
+    return PredictFromSeries(model, series, thermal, first, count, horizon);
   }
-  // Recursive prediction: step j predicts s_g[origin + r + j] from the lags (the predictions of
-  // the steps before replacing the samples after the origin) and the thermal inputs at
-  // origin + r + j - 1, read from the log. The last step is the prediction of y[first + r].
-  Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
-  for (size_t g = 0; g < groups; ++g) {
-    Eigen::MatrixXd x(count, p + thermal.cols());
-    x.leftCols(p) = lags[g];
-    for (int j = 0; j < horizon; ++j) {
-      if (thermal.cols() > 0) {
-        x.rightCols(thermal.cols()) = thermal.middleRows(origin + j - 1, count);
-      }
-      Eigen::VectorXd step = model.sub_models[g].learner->Predict(x);
-      if (j + 1 == horizon) {
-        prediction += step;
-        break;
-      }
-      for (int k = p - 1; k > 0; --k) x.col(k) = x.col(k - 1);
-      x.col(0) = std::move(step);
-    }
-  }
-  return prediction;
+  return PredictRecursively(model, CausalLags(model, y, origin, count, causal), thermal, origin,
+                            horizon);
 }
 
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,

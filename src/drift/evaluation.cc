@@ -24,7 +24,7 @@ struct Trial {
 // Fits and scores one (method, protocol, seed) on the split record.
 Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
                const Eigen::Ref<const Eigen::VectorXd>& temperature_c, const DriftOptions& given,
-               Protocol protocol, Eigen::Index split, const CausalOptions& causal) {
+               Protocol protocol, Eigen::Index split, int horizon, const CausalOptions& causal) {
   DriftOptions o = given;
   o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
   const Eigen::Index n = y.size();
@@ -61,11 +61,11 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   } else if (decompose_all) {
     trial.estimate = PredictFromSeries(
         model, series_all, thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
-        split, test);
+        split, test, horizon);
   } else {
-    trial.estimate = PredictOneStep(
-        model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(), split,
-        Protocol::kCausal, causal);
+    trial.estimate =
+        PredictAhead(model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(),
+                     split, horizon, Protocol::kCausal, causal);
   }
   trial.predict_s = Seconds(start);
   return trial;
@@ -91,6 +91,9 @@ void EvaluationOptions::Validate() const {
   if (causal.window < 16 || causal.window > 1000000) {
     ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
   }
+  if (horizon < 1 || horizon > 100000) {
+    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
+  }
 }
 
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
@@ -99,6 +102,11 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                           const EvaluationOptions& options) {
   base.Validate();
   options.Validate();
+  if (base.mode == Mode::kCompensate && options.horizon != 1) {
+    ThrowOption("horizon", std::to_string(options.horizon),
+                "1 in compensate mode (the estimate at t is read from the temperature, not "
+                "predicted ahead)");
+  }
   RequireFiniteSignal("target", y, 64);
   const Eigen::Index n = y.size();
   const bool thermal_needed = base.uses_temperature();
@@ -172,7 +180,7 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
             options.progress((done + fraction) / total, label);
           };
         }
-        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, causal);
+        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.horizon, causal);
         const Metrics m = ComputeMetrics(trial.estimate - result.reference);
         rmse.push_back(m.rmse);
         row.mae += m.mae / options.repeats;

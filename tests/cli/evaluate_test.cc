@@ -61,6 +61,20 @@ TEST_F(EvaluateCli, CompensateTableAgainstTruth) {
   EXPECT_EQ(json["result"]["rows"][0]["rmse"].get<double>(), rmse[0]);
 }
 
+TEST_F(EvaluateCli, HorizonScoresPredictionsAhead) {
+  const std::string one = dir_ + "/h1.csv", ahead = dir_ + "/h8.csv";
+  const std::string run = "evaluate '" + input_ +
+                          "' -t rate_dph --truth drift_dph --mode predict --methods poly "
+                          "--protocol causal ";
+  ASSERT_EQ(test::RunCli(run + "-q -o '" + one + "'").exit_code, 0);
+  const auto r = test::RunCli(run + "--horizon 8 -o '" + ahead + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("predict mode (8-step-ahead predictions)"), std::string::npos) << r.out;
+  EXPECT_NE(io::CsvTable::Read(one).Column("rmse")[0], io::CsvTable::Read(ahead).Column("rmse")[0]);
+  const auto json = nlohmann::json::parse(io::ReadTextFile(ahead + ".json"));
+  EXPECT_EQ(json["options"]["horizon"], 8);
+}
+
 TEST_F(EvaluateCli, RepeatsGiveASpreadOnlyWhereTheSeedMatters) {
   const std::string out = dir_ + "/t.csv";
   const auto r = test::RunCli("evaluate '" + input_ +
@@ -96,6 +110,10 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
   const std::vector<BadCase> cases = {
       {"missing file", "evaluate %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
       {"unknown method", p + "--methods elm,lstm", 2, "method = 'lstm'"},
+      {"zero horizon", p + "--horizon 0", 2, "--horizon = 0"},
+      {"horizon in compensate mode",
+       "evaluate %IN% -t rate_dph -T temperature_c --mode compensate --horizon 2", 2,
+       "--horizon = 2: applies to --mode predict"},
       {"repeated method", p + "--methods elm,elm", 2, "without repeats"},
       {"empty methods", p + "--methods ,", 2, "--methods"},
       {"trailing comma", p + "--methods elm,", 2, "--methods = 'elm,'"},

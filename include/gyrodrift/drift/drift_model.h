@@ -135,11 +135,13 @@ Eigen::VectorXd EstimateDrift(const DriftModel& model,
                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
 
 // Predict mode from given sub-series (N x G, GroupSeries of some decomposition) and thermal
-// features (N x F, or empty): predictions for t = first .. first + count - 1 (first >= lags).
+// features (N x F, or empty): horizon-step-ahead predictions of y[t] for t = first .. first +
+// count - 1, each from the origin t - horizon + 1 as PredictAhead makes them (first >= lags +
+// horizon - 1, else DataError).
 Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
-                                  Eigen::Index first, Eigen::Index count);
+                                  Eigen::Index first, Eigen::Index count, int horizon = 1);
 
 // How a predict-mode model gets its test-time sub-series.
 enum class Protocol {

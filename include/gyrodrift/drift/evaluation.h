@@ -32,6 +32,8 @@ struct EvaluationOptions {
   int repeats = 1;     // seeds seed, seed+1, ...; mean and std over repeats, in [1, 1000]
   std::vector<Method> methods = AllMethods();
   std::vector<Protocol> protocols{Protocol::kPaper, Protocol::kCausal};
+  // Predict mode: score horizon-step-ahead predictions (PredictAhead), in [1, 100000].
+  int horizon = 1;
   CausalOptions causal;
   // Called with the fraction done and a label; may be empty.
   std::function<void(double fraction, const std::string& label)> progress;

@@ -405,6 +405,37 @@ TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
   EXPECT_EQ(r.test_outside_training_temperature_share, 0.0);
 }
 
+// With a horizon, both protocols score PredictAhead's predictions: the causal row is the model
+// fitted on the training block predicting 6 steps ahead, the paper row the same recursion from
+// the whole record's sub-series; compensate mode has no horizon.
+TEST(Evaluation, ScoresPredictionsAheadWithAHorizon) {
+  const Log log = MakeLog(1000, 8);
+  EvaluationOptions eo;
+  eo.methods = {Method::kMsElm, Method::kElm};
+  eo.causal.window = 128;
+  eo.horizon = 6;
+  const DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  const EvaluationResult r = Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo);
+  ASSERT_EQ(r.rows.size(), 4u);
+  DriftOptions elm = o;
+  elm.method = Method::kElm;
+  const DriftModel single = FitDriftModel(log.rate.head(700), Eigen::VectorXd(), elm);
+  EXPECT_EQ(r.rows[2].estimate,
+            PredictAhead(single, log.rate, Eigen::VectorXd(), 700, 6, Protocol::kCausal));
+  const DriftModel ms = FitDriftModel(log.rate.head(700), Eigen::VectorXd(), o);
+  EXPECT_EQ(r.rows[1].estimate,
+            PredictAhead(ms, log.rate, Eigen::VectorXd(), 700, 6, Protocol::kCausal, eo.causal));
+  eo.horizon = 1;
+  const EvaluationResult one = Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo);
+  EXPECT_NE(one.rows[0].estimate, r.rows[0].estimate);  // paper protocol: 1 against 6 steps
+  eo.horizon = 2;
+  EXPECT_THROW(
+      Evaluate(log.rate, log.temperature, log.drift, Fast(Mode::kCompensate, Method::kPoly), eo),
+      UsageError);
+  eo.horizon = 0;
+  EXPECT_THROW(eo.Validate(), UsageError);
+}
+
 TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
   Log log = MakeLog(1000, 9);
   // A slow warming on top of the cycle: the last 300 samples reach above anything before them.

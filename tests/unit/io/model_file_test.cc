@@ -125,7 +125,9 @@ TEST_P(EveryMethod, RoundTripGivesIdenticalPredictions) {
         drift::PredictOneStep(loaded.model, test.rate, t, 20, drift::Protocol::kPaper);
     EXPECT_TRUE(a.allFinite());
     EXPECT_EQ(a, b);
-    drift::CausalOptions causal{.window = 64, .threads = 0};
+    drift::CausalOptions causal;
+    causal.window = 64;
+    causal.threads = 0;
     const Eigen::VectorXd c =
         drift::PredictOneStep(model, test.rate, t, 190, drift::Protocol::kCausal, causal);
     const Eigen::VectorXd d =
