@@ -63,7 +63,6 @@ std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
       {"horizon", {"--horizon"}},
       {"input_rate_dph", {"--input-rate-dph"}},
       {"lags", {"--lags"}},
-      {"learner", {"--method"}},
       {"max_imfs", {"--max-imfs"}},
       {"max_sifts", {"--max-sifts"}},
       {"method", {"--method"}},
@@ -95,11 +94,14 @@ std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
       {"units", {"--units"}},
       {"winding", {"--winding"}},
   };
+  // Only a flag the user gave: a value the command derived (a rate read from time_s, a duration
+  // from a profile file) keeps the library's name rather than blaming a flag nobody typed.
   const auto flags = kFlags.find(error.option());
   if (flags != kFlags.end()) {
     for (const CLI::App* command : app.get_subcommands()) {
       for (const std::string& flag : flags->second) {
-        if (command->get_option_no_throw(flag) != nullptr) {
+        const CLI::Option* option = command->get_option_no_throw(flag);
+        if (option != nullptr && option->count() > 0) {
           return flag + " = " + error.value() + ": must be " + error.rule();
         }
       }
@@ -161,7 +163,13 @@ double ResolveSampleRate(const io::CsvTable& table, double given, std::string* h
                     " s: it must increase to give the sample rate (or pass --rate-hz)");
   }
   *how = "time_s";
-  return 1.0 / median;
+  const double rate = 1.0 / median;
+  if (!(rate >= 1e-9 && rate <= 1e6)) {
+    throw DataError(table.source() + ": column 'time_s' has a median step of " +
+                    FormatValue(median) + " s, a sample rate of " + FormatValue(rate) +
+                    " Hz outside [1e-09, 1e+06] Hz (seconds expected; or pass --rate-hz)");
+  }
+  return rate;
 }
 
 std::string NonUniformTimeNote(const io::CsvTable& table) {

@@ -34,7 +34,7 @@ double ParseDuration(const std::string& text);
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
 // column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
-// its median step is not positive.
+// its median step is not positive or gives a rate outside [1e-9, 1e6] Hz.
 double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how);
 
 // "" for a log without time_s or with a uniform one; otherwise a one-line note that the time axis
@@ -43,7 +43,7 @@ double ResolveSampleRate(const io::CsvTable& table, double given, std::string* h
 std::string NonUniformTimeNote(const io::CsvTable& table);
 
 // The one-line message for an option error: the library names its field (`ensemble_size = 0:
-// must be ...`); when the subcommand that ran has the flag that sets that field, the message
+// must be ...`); when the user gave the subcommand's flag that sets that field, the message
 // names the flag instead (`--ensemble = 0: must be ...`).
 std::string OptionErrorMessage(const CLI::App& app, const OptionError& error);
 

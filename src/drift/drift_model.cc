@@ -196,10 +196,12 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
   report = report && static_cast<bool>(o.progress);
   SubSeries out;
   out.model.options = o;
-  // A model keeps no caller callbacks: it may run later, from other threads, after they are gone.
+  // A model keeps no caller callbacks (it may run later, from other threads, after they are
+  // gone) and no shared noise EMDs (they serve one record length; a model predicts on any).
   out.model.options.progress = nullptr;
   out.model.options.decomposition.progress = nullptr;
   out.model.options.decomposition.noise_imf_observer = nullptr;
+  out.model.options.decomposition.noise_emds = nullptr;
   if (!UsesDecomposition(o.method)) {
     out.model.sub_models.push_back({"signal", {}, true, nullptr});
     out.series = y;
@@ -373,6 +375,7 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   decomposition::DecompositionOptions dopt = model.options.decomposition;
   dopt.seed = model.options.seed;
   dopt.threads = 1;
+  dopt.noise_emds = nullptr;  // built below for this window length
   if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
   // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
   // computed once here instead of once per window (the same bits; about half of each window's
@@ -461,8 +464,11 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
                                   Eigen::Index first, Eigen::Index count, int horizon) {
+  if (horizon < 1 || horizon > 100000) {
+    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
+  }
   const Eigen::Index origin = first - (horizon - 1);
-  if (horizon < 1 || origin < model.lags) {
+  if (origin < model.lags) {
     throw DataError("prediction of sample " + std::to_string(first + 1) + " " +
                     std::to_string(horizon) + " steps ahead needs " +
                     std::to_string(model.lags + horizon - 1) + " samples before it");
@@ -517,6 +523,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
     decomposition::DecompositionOptions dopt = model.options.decomposition;
     dopt.seed = model.options.seed;
     dopt.threads = model.options.threads;
+    dopt.noise_emds = nullptr;  // a set a caller left in the options serves another length
     const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
     return PredictFromSeries(model, series, thermal, first, count, horizon);
   }

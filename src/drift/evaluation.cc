@@ -1,5 +1,6 @@
 #include "gyrodrift/drift/evaluation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -130,6 +131,20 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   if (split < 32 || n - split < 16) {
     throw DataError("split at sample " + std::to_string(split) + " of " + std::to_string(n) +
                     " leaves too little data (at least 32 training and 16 test samples)");
+  }
+  if (base.mode == Mode::kPredict && options.horizon > 1) {
+    // The first test sample's prediction starts horizon - 1 samples before the split, after
+    // the lags (and the causal protocol's 16-sample shortest window): refuse before any fit.
+    const int lags = base.auto_lags
+                         ? *std::max_element(base.lag_candidates.begin(), base.lag_candidates.end())
+                         : base.features.lags;
+    const Eigen::Index history = std::max<Eigen::Index>(lags, 16);
+    if (split - (options.horizon - 1) < history) {
+      ThrowOption("horizon", std::to_string(options.horizon),
+                  "at most " + std::to_string(split - history + 1) + " with the split at sample " +
+                      std::to_string(split) + " (" + std::to_string(history) +
+                      " samples of history before the first origin)");
+    }
   }
   if (temperature_c.size() == n) {
     result.training_temperature_min_c = temperature_c.head(split).minCoeff();

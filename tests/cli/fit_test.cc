@@ -187,10 +187,17 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
   io::WriteFileAtomically(dir_ + "/nan.csv", "rate_dph,temperature_c\n1,2\n2,3\nnan,4\n");
   io::WriteFileAtomically(dir_ + "/short.csv", test::ThermalLogCsv(20, 3));
   io::WriteFileAtomically(dir_ + "/backwards.csv", "time_s,rate_dph\n5,1\n4,2\n3,3\n2,4\n");
+  std::string microseconds = "time_s,rate_dph\n";  // time_s in microseconds, as if seconds
+  for (int i = 0; i < 200; ++i) {
+    microseconds += std::to_string(i) + "e-7," + std::to_string((i * 37) % 11) + "\n";
+  }
+  io::WriteFileAtomically(dir_ + "/microseconds.csv", microseconds);
   const std::string ok = "-t rate_dph -T temperature_c --mode compensate -I 10";
   const std::vector<BadCase> cases = {
       {"missing file", "fit %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
       {"missing mode", "fit %IN% -t rate_dph", 2, "--mode is required"},
+      {"rate from time_s out of range", "fit %DIR%/microseconds.csv -t rate_dph --mode predict", 3,
+       "Hz outside [1e-09, 1e+06] Hz (seconds expected; or pass --rate-hz)"},
       {"missing target", "fit %IN% --mode predict", 2, "--target is required"},
       {"unknown column", "fit %IN% -t gyro --mode predict", 2, "column 'gyro' not found"},
       {"unknown temperature", "fit %IN% -t rate_dph -T temp --mode compensate", 2,

@@ -105,6 +105,21 @@ TEST_F(PredictCli, HorizonPredictsRecursivelyAsTheLibrary) {
   EXPECT_EQ(table.Column("prediction"),
             drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 7, 5, drift::Protocol::kPaper));
   EXPECT_EQ(nlohmann::json::parse(io::ReadTextFile(out + ".json"))["options"]["horizon"], 5);
+
+  // Causal: the first origin needs a 16-sample window, so predictions start at 16 + 5.
+  const std::string causal = Dir() + "/ahead_causal.csv";
+  ASSERT_EQ(test::RunCli("predict '" + Dir() + "/ms.json' '" + Dir() + "/test.csv' -W 64 -H 5 -q " +
+                         "-o '" + causal + "'")
+                .exit_code,
+            0);
+  const auto windows = io::CsvTable::Read(causal);
+  ASSERT_EQ(windows.rows(), 120 - 20);
+  EXPECT_EQ(windows.Column("sample")[0], 21.0);
+  drift::CausalOptions options;
+  options.window = 64;
+  EXPECT_EQ(windows.Column("prediction"),
+            drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 20, 5, drift::Protocol::kCausal,
+                                options));
 }
 
 TEST_F(PredictCli, SingleModelsAreCausalUnderBothProtocols) {

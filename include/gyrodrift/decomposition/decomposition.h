@@ -143,7 +143,8 @@ struct Decomposition {
 // ICEEMDAN or BEEMDAN decomposition of that length with the same seed, ensemble size and sifting
 // (DecompositionOptions::noise_emds). The causal protocol decomposes thousands of windows of
 // one length, and the noise EMDs are about half of each one's cost. Immutable once built, so
-// one set may serve many threads; it holds ensemble x (IMFs + 1) x length doubles.
+// one set may serve many threads; it holds ensemble x (IMFs + 2) x length doubles (the
+// realisation, its IMFs and its residue).
 class NoiseEmds {
  public:
   // Computes the EMDs with options' seed, ensemble_size, sifting and threads. Throws UsageError

@@ -146,7 +146,8 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
 // How a predict-mode model gets its test-time sub-series.
 enum class Protocol {
   kPaper,   // decompose the whole record once (what the literature does; sees the future)
-  kCausal,  // for each t, decompose the trailing window y[t-W .. t-1] only
+  kCausal,  // for each t, decompose the trailing window y[t-W .. t-1] only (H steps ahead:
+            // the window ending at t-H)
 };
 std::string_view ToString(Protocol protocol);
 Protocol ProtocolFromString(std::string_view name);  // "paper", "causal"

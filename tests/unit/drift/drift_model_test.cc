@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "gyrodrift/common/error.h"
@@ -228,8 +229,9 @@ TEST(DriftModel, PredictAheadContinuesASineFromItsOwnPredictions) {
     ASSERT_EQ(ahead.size(), n - 420);
     EXPECT_LT((ahead - y.tail(n - 420)).cwiseAbs().maxCoeff(), 1e-6) << horizon;
   }
+  // Horizon 1 is the classic one-step prediction: the learner on the lag rows, nothing more.
   EXPECT_EQ(PredictAhead(model, y, Eigen::VectorXd(), 420, 1, Protocol::kCausal),
-            PredictOneStep(model, y, Eigen::VectorXd(), 420, Protocol::kCausal));
+            model.sub_models.front().learner->Predict(LagRows(y, model.lags, 420, n - 420)));
   // The 12-step prediction of y[t] starts at t - 11: it needs lags + 11 samples before t.
   EXPECT_NO_THROW(PredictAhead(model, y, Eigen::VectorXd(), 15, 12, Protocol::kPaper));
   EXPECT_THROW(PredictAhead(model, y, Eigen::VectorXd(), 14, 12, Protocol::kPaper), DataError);
@@ -434,6 +436,25 @@ TEST(Evaluation, ScoresPredictionsAheadWithAHorizon) {
       UsageError);
   eo.horizon = 0;
   EXPECT_THROW(eo.Validate(), UsageError);
+  // A horizon reaching back past the training block's history is refused before any fit.
+  eo.horizon = 690;
+  EXPECT_THROW(Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo), OptionError);
+}
+
+// Shared white-noise EMDs serve one record length: a model fitted with a set in its options does
+// not keep it, and predicts on records of any length.
+TEST(DriftModel, AModelKeepsNoSharedNoiseEmds) {
+  const Log log = MakeLog(600, 4);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  decomposition::DecompositionOptions d = o.decomposition;
+  d.seed = o.seed;
+  o.decomposition.noise_emds = std::make_shared<const decomposition::NoiseEmds>(500, d);
+  const DriftModel model = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
+  EXPECT_EQ(model.options.decomposition.noise_emds, nullptr);
+  o.decomposition.noise_emds = nullptr;
+  const DriftModel plain = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
+  EXPECT_EQ(PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper),
+            PredictOneStep(plain, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper));
 }
 
 TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
