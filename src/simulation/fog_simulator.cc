@@ -144,7 +144,7 @@ void SimulationOptions::Validate() const {
   const double samples = std::floor(duration_s * rate_hz * (1.0 + 1e-12));
   // 1e7 samples keep the result (13 vectors) near 1 GB and the CLI's CSV text near 1.3 GB.
   if (!(samples >= 2.0 && samples <= 1e7)) {
-    ThrowOption("duration_s", FormatValue(duration_s),
+    ThrowOption("duration_s", FormatValue(duration_s) + " s",
                 "such that duration * rate gives between 2 and 1e7 samples (rate " +
                     FormatValue(rate_hz) + " Hz)");
   }

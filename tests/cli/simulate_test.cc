@@ -145,7 +145,7 @@ TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--duration 0", 2, "--duration = 0");
   ExpectFailure("--duration 1s", 2, "--duration = 1");  // a single sample
   // The duration was not typed (the profile's 8 h): the message does not blame --duration.
-  ExpectFailure("--rate-hz 1000", 2, ": error: duration_s = 28800: must be");
+  ExpectFailure("--rate-hz 1000", 2, ": error: duration_s = 28800 s: must be");
   ExpectFailure("--duration 1e400", 2, "--duration = 1e400");
   ExpectFailure("--duration 200d", 2, "--duration = 200d");
   ExpectFailure("--duration 3000h", 2, "1e7 samples");
