@@ -141,6 +141,25 @@ std::string DecompositionReport::Summary() const {
   return s;
 }
 
+namespace internal {
+
+void RequireNoiseStateFits(double ensemble, Eigen::Index n, double vectors_per_realisation) {
+  const double state_bytes =
+      ensemble * vectors_per_realisation * static_cast<double>(n) * sizeof(double);
+  const double memory_bytes =
+      static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+  if (memory_bytes > 0 && state_bytes > 0.5 * memory_bytes) {
+    char rule[160];
+    std::snprintf(rule, sizeof rule,
+                  "small enough that its noise state (%.3g GB for %lld samples) fits in half "
+                  "the memory (%.3g GB)",
+                  state_bytes / 1e9, static_cast<long long>(n), memory_bytes / 1e9);
+    ThrowOption("ensemble_size", std::to_string(static_cast<long long>(ensemble)), rule);
+  }
+}
+
+}  // namespace internal
+
 Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
                         const DecompositionOptions& options) {
   options.Validate();
@@ -167,22 +186,11 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
                      "ensemble size and sifting, without supplied noise");
   }
   if (ceemdan_family) {
-    // Each realisation keeps the running residue of its noise EMD (N doubles): refuse an
-    // ensemble whose state alone would not fit in the machine, instead of dying of it.
+    // Each realisation keeps the running residue of its noise EMD (N doubles).
     const double ensemble = options.supplied_noise
                                 ? static_cast<double>(options.supplied_noise->cols())
                                 : static_cast<double>(options.ensemble_size);
-    const double state_bytes = ensemble * static_cast<double>(n) * sizeof(double);
-    const double memory_bytes = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) *
-                                static_cast<double>(::sysconf(_SC_PAGESIZE));
-    if (memory_bytes > 0 && state_bytes > 0.5 * memory_bytes) {
-      char rule[160];
-      std::snprintf(rule, sizeof rule,
-                    "small enough that its noise state (%.3g GB for %lld samples) fits in half "
-                    "the memory (%.3g GB)",
-                    state_bytes / 1e9, static_cast<long long>(n), memory_bytes / 1e9);
-      ThrowOption("ensemble_size", std::to_string(static_cast<long long>(ensemble)), rule);
-    }
+    internal::RequireNoiseStateFits(ensemble, n, 1.0);
   }
   // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.
   if (internal::CountExtrema(x.data(), n).extrema() < 3) {

@@ -424,6 +424,9 @@ NoiseEmds::NoiseEmds(Eigen::Index length, const DecompositionOptions& options)
   if (length < 4) {
     throw DataError("NoiseEmds length " + std::to_string(length) + ": must be >= 4 samples");
   }
+  // The realisation, about log2(N) IMFs and the residue per realisation.
+  internal::RequireNoiseStateFits(options.ensemble_size, length,
+                                  std::log2(static_cast<double>(length)) + 2);
   realisations_.resize(static_cast<size_t>(options.ensemble_size));
   std::vector<std::optional<internal::Sifter>> sifters(
       static_cast<size_t>(ResolveThreads(options.threads)));

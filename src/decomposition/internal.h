@@ -29,6 +29,10 @@ class NoiseModes {
   bool residue_given_ = false;
 };
 
+// Refuses (OptionError naming ensemble_size) an ensemble whose white-noise state, this many
+// N-vectors per realisation, would not fit in half the machine's memory, instead of dying of it.
+void RequireNoiseStateFits(double ensemble, Eigen::Index n, double vectors_per_realisation);
+
 // Sample standard deviation (N - 1), as MATLAB's std.
 double SampleStd(const double* x, Eigen::Index n);
 
@@ -43,6 +47,7 @@ Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decomposi
 Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
 Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
 // ICEEMDAN, and BEEMDAN (o.method == kBeemdan) which bounds its noise-assisted stages.
-Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
+                          const DecompositionOptions& o);
 
 }  // namespace gyrodrift::decomposition::internal

@@ -390,7 +390,9 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
                              (std::log2(static_cast<double>(causal.window)) + 2) *
                              static_cast<double>(causal.window) * sizeof(double);
-  if (noise_family && full_windows > 1 && cache_bytes <= 256e6) {
+  // Shared, the noise EMDs are computed to the end; a window computes only the rows it uses
+  // (few, when BEEMDAN's bound stops early): sharing pays from a few windows on.
+  if (noise_family && full_windows >= 16 && cache_bytes <= 256e6) {
     decomposition::DecompositionOptions build = dopt;
     build.threads = causal.threads;
     dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
