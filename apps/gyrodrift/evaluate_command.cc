@@ -122,11 +122,17 @@ void Run(const EvaluateArgs& a) {
                     {"max_abs", r.max_abs},
                     {"train_s", r.train_s},
                     {"predict_s", r.predict_s},
-                    {"model_summary", r.model_summary}});
+                    {"model_summary", r.model_summary},
+                    {"notes", r.notes}});
   }
   // Test temperatures beyond the training block's make every thermal model extrapolate.
   std::string notes = NonUniformTimeNote(table);
   if (!notes.empty()) notes += "\n";
+  for (const auto& r : result.rows) {
+    for (const std::string& note : r.notes) {
+      notes += std::string(drift::ToString(r.method)) + ", " + note + "\n";
+    }
+  }
   const double outside = result.test_outside_training_temperature_share;
   if (outside > 0.0) {
     notes += fmt::format(

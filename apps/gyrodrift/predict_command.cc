@@ -98,6 +98,10 @@ void Run(const PredictArgs& a) {
                       {"lags", model.lags},
                       {"seed", model.options.seed},
                       {"tool_version", loaded.info.tool_version}};
+  const std::string window_note =
+      protocol == drift::Protocol::kCausal ? drift::CausalWindowNote(model, a.window) : "";
+  sidecar["notes"] =
+      window_note.empty() ? nlohmann::json::array() : nlohmann::json::array({window_note});
   sidecar["samples"] = y.size();
   sidecar["first_predicted_sample"] = first + 1;
   sidecar["predicted"] = count;
@@ -105,8 +109,9 @@ void Run(const PredictArgs& a) {
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
     const std::string ahead = a.horizon > 1 ? std::to_string(a.horizon) + "-step-ahead, " : "";
-    fmt::print("{}\npredicted samples {}..{} ({}{} protocol)\nwrote {} and {}\n", model.Summary(),
-               first + 1, y.size(), ahead, a.protocol, a.output, SidecarPath(a.output));
+    fmt::print("{}\npredicted samples {}..{} ({}{} protocol)\n{}wrote {} and {}\n", model.Summary(),
+               first + 1, y.size(), ahead, a.protocol,
+               window_note.empty() ? "" : window_note + "\n", a.output, SidecarPath(a.output));
   }
 }
 

@@ -533,6 +533,40 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
                             horizon);
 }
 
+std::string CausalWindowNote(const DriftModel& model, int window) {
+  if (!UsesDecomposition(model.options.method) || window < 2) return "";
+  const int resolved = std::max(1, static_cast<int>(std::floor(std::log2(window))) - 1);
+  std::vector<std::string> names;
+  int slowest = 0;
+  for (const SubModel& sub : model.sub_models) {
+    // The noise group's energy sits in its first IMFs (white noise loses about half per mode):
+    // the slow ones it loses to the residue barely change its series.
+    if (sub.has_residue || sub.imfs.empty() || sub.name == "noise") continue;
+    const int last = *std::max_element(sub.imfs.begin(), sub.imfs.end());
+    if (last <= resolved) continue;
+    const int first = *std::min_element(sub.imfs.begin(), sub.imfs.end());
+    names.push_back("'" + sub.name + "'" +
+                    (first == last
+                         ? ""
+                         : " (IMFs " + std::to_string(first) + "-" + std::to_string(last) + ")"));
+    slowest = std::max(slowest, last);
+  }
+  if (names.empty()) return "";
+  std::string list = names.front();
+  if (names.size() == 2) list += " and " + names.back();
+  if (names.size() > 2) list += " ... " + names.back() + " (" + std::to_string(names.size()) + ")";
+  const bool several = names.size() > 1;
+  const long long needed = 1LL << std::min(slowest + 1, 40);
+  return "note: a " + std::to_string(window) + "-sample causal window resolves about " +
+         std::to_string(resolved) + " IMFs; sub-model" + (several ? "s " : " ") + list +
+         (several ? " hold" : " holds") + " slower ones, which fall into the window's residue: " +
+         (several ? "they see" : "it sees") + " another series than in training (" +
+         (needed <= 1000000
+              ? "a window of " + std::to_string(needed) + " samples would resolve them"
+              : "no window up to 1000000 samples resolves them") +
+         ")";
+}
+
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                                const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                Eigen::Index first, Protocol protocol, const CausalOptions& causal) {

@@ -20,6 +20,7 @@ struct Trial {
   Eigen::VectorXd estimate;  // on the test block
   double train_s = 0.0, predict_s = 0.0;
   std::string summary;
+  std::string note;  // CausalWindowNote of a causal trial
 };
 
 // Fits and scores one (method, protocol, seed) on the split record.
@@ -69,6 +70,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
                      split, horizon, Protocol::kCausal, causal);
   }
   trial.predict_s = Seconds(start);
+  if (protocol == Protocol::kCausal) trial.note = CausalWindowNote(model, causal.window);
   return trial;
 }
 
@@ -204,6 +206,9 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
         row.predict_s += trial.predict_s / options.repeats;
         row.estimate = trial.estimate;
         row.model_summary = trial.summary;
+        if (!trial.note.empty()) {
+          row.notes.push_back("seed " + std::to_string(o.seed) + ": " + trial.note);
+        }
         done += 1;
       }
       double mean = 0;

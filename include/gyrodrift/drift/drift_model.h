@@ -178,6 +178,13 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
                              Eigen::Index first, int horizon, Protocol protocol,
                              const CausalOptions& causal = {});
 
+// "" unless, under the causal protocol with `window`-sample windows, some sub-model other than
+// the residue's and MS-ELM's noise group sums IMFs a window cannot resolve (a window of W samples
+// gives about log2(W) - 1 IMFs): then a one-line note naming them. Their content falls into the window's
+// residue, so such a sub-model sees at test time another series than the one it was trained on
+// (docs/drift.md 4.3).
+std::string CausalWindowNote(const DriftModel& model, int window);
+
 // One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has
 // N - first entries): PredictAhead with horizon 1.
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,

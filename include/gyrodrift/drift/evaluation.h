@@ -47,6 +47,7 @@ struct EvaluationRow {
   double train_s = 0.0, predict_s = 0.0;                        // wall-clock means
   Eigen::VectorXd estimate;  // of the last repeat, on the test block
   std::string model_summary;
+  std::vector<std::string> notes;  // causal rows: CausalWindowNote per repeat where it applies
 };
 
 struct EvaluationResult {

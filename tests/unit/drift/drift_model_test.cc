@@ -282,6 +282,28 @@ TEST(DriftModel, PredictAheadIgnoresSamplesAfterItsOrigin) {
   EXPECT_NE(base, one);
 }
 
+// The causal windows cannot resolve slow IMFs: a note names a sub-model that sums them (not the
+// noise group, whose energy is in its first IMFs, nor the residue's), and the window that would.
+TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
+  DriftModel model;
+  model.options.method = Method::kMsElm;
+  model.sub_models = {{"noise", {1, 2, 3}, false, nullptr},
+                      {"mixed", {4, 5, 6, 7, 8, 9, 10, 11, 12}, false, nullptr},
+                      {"drift", {13}, true, nullptr}};
+  const std::string note = CausalWindowNote(model, 512);
+  EXPECT_NE(note.find("resolves about 8 IMFs; sub-model 'mixed' (IMFs 4-12) holds slower ones"),
+            std::string::npos)
+      << note;
+  EXPECT_NE(note.find("a window of 8192 samples would resolve them"), std::string::npos) << note;
+  EXPECT_EQ(CausalWindowNote(model, 8192), "");
+  model.sub_models = {{"noise", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13}, false, nullptr},
+                      {"drift", {}, true, nullptr}};
+  EXPECT_EQ(CausalWindowNote(model, 512), "");  // the default grouping on a 1 Hz FOG log
+  model.options.method = Method::kElm;
+  model.sub_models = {{"signal", {}, true, nullptr}};
+  EXPECT_EQ(CausalWindowNote(model, 16), "");
+}
+
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   const Log log = MakeLog(900, 2);
   for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {
