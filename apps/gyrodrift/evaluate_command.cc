@@ -28,7 +28,6 @@ struct EvaluateArgs : DriftArgs {
   int repeats = 1;
   int window = 512;
   int horizon = 1;
-  CLI::Option* horizon_option = nullptr;
   std::string output;
 };
 
@@ -61,11 +60,6 @@ void Run(const EvaluateArgs& a) {
   e.causal.window = a.window;
   e.causal.threads = a.threads;
   e.horizon = a.horizon;
-  if (base.mode == drift::Mode::kCompensate && a.horizon_option->count() > 0) {
-    throw UsageError("--horizon = " + std::to_string(a.horizon) +
-                     ": applies to --mode predict (a compensate-mode estimate is not a "
-                     "prediction ahead)");
-  }
   e.Validate();  // option errors before any file is read
 
   const io::CsvTable table = io::CsvTable::Read(a.input);
@@ -192,10 +186,9 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
       ->capture_default_str();
-  args->horizon_option =
-      cmd->add_option("--horizon,-H", args->horizon,
-                      "predict mode: score H-step-ahead predictions (recursive for H > 1)")
-          ->capture_default_str();
+  cmd->add_option("--horizon,-H", args->horizon,
+                  "predict mode: score H-step-ahead predictions (recursive for H > 1)")
+      ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
   cmd->callback([args] { Run(*args); });

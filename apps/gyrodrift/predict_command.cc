@@ -36,9 +36,6 @@ void Run(const PredictArgs& a) {
   if (a.window < 16 || a.window > 1000000) {
     ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
   }
-  if (a.horizon < 1 || a.horizon > 100000) {
-    ThrowOption("--horizon", std::to_string(a.horizon), "an integer in [1, 100000]");
-  }
   if (a.threads < 0 || a.threads > 1024) {
     ThrowOption("--threads", std::to_string(a.threads), "an integer in [0, 1024] (0 = all cores)");
   }
@@ -56,13 +53,8 @@ void Run(const PredictArgs& a) {
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;
   if (model.uses_temperature()) temperature = table.Column(loaded.info.temperature_column);
-  // The first sample with enough history: p lags (and under the causal protocol a window long
-  // enough to decompose) before the origin, horizon - 1 samples before it.
   const bool decomposes = drift::UsesDecomposition(model.options.method);
-  const Eigen::Index first =
-      (protocol == drift::Protocol::kCausal && decomposes ? std::max<Eigen::Index>(model.lags, 16)
-                                                          : model.lags) +
-      a.horizon - 1;
+  const Eigen::Index first = drift::FirstPredictable(model, protocol, a.horizon);
   if (y.size() <= first) {
     throw DataError(a.input + " has " + std::to_string(y.size()) +
                     " samples: the model needs more than " + std::to_string(first) +
@@ -130,10 +122,10 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       "H-1 more with --horizon H, are left out. causal (default): the sub-series at t come from\n"
       "decomposing only the trailing window y[t-W..t-1], what a running system can do. paper:\n"
       "the whole file is decomposed once, so predictions see future samples (the literature's\n"
-      "protocol, for comparison only). --horizon H: each prediction of y[t] is made at t-H+1 from "
-      "the samples\n"
-      "before it, feeding each sub-model its own predictions for the H-1 steps in between\n"
-      "(recursive); a model with temperature inputs reads them from the file at every step.\n"
+      "protocol, for comparison only). --horizon H: each prediction of y[t] is made at t-H+1\n"
+      "from the samples before it, feeding each sub-model its own predictions for the H-1\n"
+      "steps in between (recursive); a model with temperature inputs reads them from the file\n"
+      "at every step.\n"
       "pred.csv.json records the options and the model.");
   cmd->add_option("model", args->model, "model file written by 'gyrodrift fit'")
       ->required()

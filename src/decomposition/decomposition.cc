@@ -44,6 +44,9 @@ constexpr std::array<std::pair<NoiseScaling, std::string_view>, 2> kScalings{{
 }  // namespace
 
 std::string_view ToString(Method method) { return EnumName(method, kMethods); }
+bool UsesNoiseEmds(Method method) {
+  return method == Method::kCeemdan || method == Method::kIceemdan || method == Method::kBeemdan;
+}
 Method MethodFromString(std::string_view name) {
   return EnumFromName(name, "decomposition method", kMethods);
 }
@@ -134,7 +137,7 @@ std::string DecompositionReport::Summary() const {
     s += ", ensemble " + std::to_string(ensemble_size) +
          (supplied_noise ? " (supplied noise)" : ", seed " + std::to_string(seed));
   }
-  if (method == Method::kCeemdan || method == Method::kIceemdan || method == Method::kBeemdan) {
+  if (UsesNoiseEmds(method)) {
     s += ", " + std::to_string(noise_assisted_stages) + " noise-assisted stages";
   }
   if (!stop_reason.empty()) s += "; stop: " + stop_reason;
@@ -174,9 +177,7 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
     }
     if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
   }
-  const bool ceemdan_family = options.method == Method::kCeemdan ||
-                              options.method == Method::kIceemdan ||
-                              options.method == Method::kBeemdan;
+  const bool ceemdan_family = UsesNoiseEmds(options.method);
   if (options.noise_emds && !(ceemdan_family && options.noise_emds->Matches(n, options))) {
     throw UsageError("noise_emds (" + std::to_string(options.noise_emds->length()) +
                      " samples, ensemble " + std::to_string(options.noise_emds->ensemble_size()) +

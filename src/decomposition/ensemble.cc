@@ -33,12 +33,19 @@ Eigen::VectorXd DrawNoise(const DecompositionOptions& o, int i, Eigen::Index n) 
   return w;
 }
 
-// Realisation i's noise EMD, row by row: read from the shared NoiseEmds when the options carry
-// one, else computed on demand.
+// Realisation i's white noise and its EMD, row by row: read from the shared NoiseEmds when the
+// options carry one, else drawn and sifted on demand.
 class NoiseRows {
  public:
-  explicit NoiseRows(Eigen::VectorXd white) : modes_(std::in_place, std::move(white)) {}
-  explicit NoiseRows(const NoiseEmds::Realisation& cached) : cached_(&cached) {}
+  NoiseRows(const DecompositionOptions& o, int i, Eigen::Index n) {
+    if (o.noise_emds) {
+      cached_ = &o.noise_emds->realisation(i);
+    } else {
+      modes_.emplace(DrawNoise(o, i, n));
+    }
+  }
+  // The realisation itself (valid before the first Next).
+  const Eigen::VectorXd& white() const { return cached_ ? cached_->white : modes_->residue(); }
   // Writes the next row into out; false when there is none.
   bool Next(Sifter& sifter, double* out) {
     if (modes_) {
@@ -223,15 +230,10 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
-          if (stage == 0 && o.noise_emds) {
-            const NoiseEmds::Realisation& cached = o.noise_emds->realisation(i);
-            wk.input = xn + eps * cached.white;
-            modes_i.emplace(cached);
-          } else if (stage == 0) {
+          if (stage == 0) {
             // Stage 1 adds the realisation itself; its EMD then feeds the later stages.
-            Eigen::VectorXd white = DrawNoise(o, i, n);
-            wk.input = xn + eps * white;
-            modes_i.emplace(std::move(white));
+            modes_i.emplace(o, i, n);
+            wk.input = xn + eps * modes_i->white();
           } else if (NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data())) {
             // Torres et al. 2011, stage k: r_k + eps_k E_k(w); here eps_k keeps the added noise
             // at eps * std(r_k), a constant SNR per stage.
@@ -349,11 +351,7 @@ Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
-          if (stage == 0 && o.noise_emds) {
-            modes_i.emplace(o.noise_emds->realisation(i));
-          } else if (stage == 0) {
-            modes_i.emplace(DrawNoise(o, i, n));
-          }
+          if (stage == 0) modes_i.emplace(o, i, n);
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
           const bool has_noise = NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data());
           if (stage == 0) {
@@ -424,9 +422,7 @@ NoiseEmds::NoiseEmds(Eigen::Index length, const DecompositionOptions& options)
   if (length < 4) {
     throw DataError("NoiseEmds length " + std::to_string(length) + ": must be >= 4 samples");
   }
-  // The realisation, about log2(N) IMFs and the residue per realisation.
-  internal::RequireNoiseStateFits(options.ensemble_size, length,
-                                  std::log2(static_cast<double>(length)) + 2);
+  internal::RequireNoiseStateFits(options.ensemble_size, length, RowsPerRealisation(length));
   realisations_.resize(static_cast<size_t>(options.ensemble_size));
   std::vector<std::optional<internal::Sifter>> sifters(
       static_cast<size_t>(ResolveThreads(options.threads)));

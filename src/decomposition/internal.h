@@ -20,6 +20,8 @@ class NoiseModes {
   bool Next(Sifter& sifter, double* out);
   // The IMF number of the row the last successful Next wrote, 0 if it was the residue.
   int last_imf() const { return residue_given_ ? 0 : imfs_; }
+  // The running residue: the realisation itself before the first Next.
+  const Eigen::VectorXd& residue() const { return residue_; }
 
  private:
   Eigen::VectorXd residue_;

@@ -191,6 +191,13 @@ Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomp
 
 namespace internal {
 
+void RequireHorizon(int horizon) {
+  if (horizon < 1 || horizon > kMaxHorizon) {
+    ThrowOption("horizon", std::to_string(horizon),
+                "an integer in [1, " + std::to_string(kMaxHorizon) + "]");
+  }
+}
+
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
                            bool report) {
   report = report && static_cast<bool>(o.progress);
@@ -365,6 +372,16 @@ Eigen::VectorXd EstimateDrift(const DriftModel& model,
 
 namespace {
 
+// The decomposition a fitted model applies to new data: its options with its seed, and no noise
+// EMDs a caller may have left in them (they serve one record length; the causal windows build
+// their own).
+decomposition::DecompositionOptions DecompositionFor(const DriftModel& model) {
+  decomposition::DecompositionOptions dopt = model.options.decomposition;
+  dopt.seed = model.options.seed;
+  dopt.noise_emds = nullptr;
+  return dopt;
+}
+
 // Causal protocol: the lags of each origin o = origin + r come from decomposing the trailing
 // window y[o-W .. o-1] alone (lags[g](r, k) = s_g[o - 1 - k] of that window's groups); windows
 // run in parallel.
@@ -372,27 +389,21 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                                         const Eigen::Ref<const Eigen::VectorXd>& y,
                                         Eigen::Index origin, Eigen::Index count,
                                         const CausalOptions& causal) {
-  decomposition::DecompositionOptions dopt = model.options.decomposition;
-  dopt.seed = model.options.seed;
+  decomposition::DecompositionOptions dopt = DecompositionFor(model);
   dopt.threads = 1;
-  dopt.noise_emds = nullptr;  // built below for this window length
   if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
   // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
   // computed once here instead of once per window (the same bits; about half of each window's
   // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
   decomposition::DecompositionOptions dopt_full = dopt;
-  const decomposition::Method dmethod = dopt.method;
-  const bool noise_family = dmethod == decomposition::Method::kCeemdan ||
-                            dmethod == decomposition::Method::kIceemdan ||
-                            dmethod == decomposition::Method::kBeemdan;
   const Eigen::Index last_origin = origin + count - 1;
   const Eigen::Index full_windows = last_origin - std::max<Eigen::Index>(origin, causal.window) + 1;
   const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
-                             (std::log2(static_cast<double>(causal.window)) + 2) *
+                             decomposition::NoiseEmds::RowsPerRealisation(causal.window) *
                              static_cast<double>(causal.window) * sizeof(double);
   // Shared, the noise EMDs are computed to the end; a window computes only the rows it uses
   // (few, when BEEMDAN's bound stops early): sharing pays from a few windows on.
-  if (noise_family && full_windows >= 16 && cache_bytes <= 256e6) {
+  if (decomposition::UsesNoiseEmds(dopt.method) && full_windows >= 16 && cache_bytes <= 256e6) {
     decomposition::DecompositionOptions build = dopt;
     build.threads = causal.threads;
     dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
@@ -466,9 +477,7 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
                                   Eigen::Index first, Eigen::Index count, int horizon) {
-  if (horizon < 1 || horizon > 100000) {
-    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
-  }
+  internal::RequireHorizon(horizon);
   const Eigen::Index origin = first - (horizon - 1);
   if (origin < model.lags) {
     throw DataError("prediction of sample " + std::to_string(first + 1) + " " +
@@ -492,9 +501,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
   }
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();
-  if (horizon < 1 || horizon > 100000) {
-    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
-  }
+  internal::RequireHorizon(horizon);
   if (causal.window < 16 || causal.window > 1000000) {
     ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
   }
@@ -502,12 +509,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
     ThrowOption("causal ensemble_size", std::to_string(causal.ensemble_size),
                 "an integer in [0, 100000] (0 = the model's)");
   }
-  // The prediction of y[t] starts from the origin t - horizon + 1: the lags end at t - horizon.
-  const Eigen::Index min_origin =
-      protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
-          ? std::max<Eigen::Index>(model.lags, 16)
-          : model.lags;
-  const Eigen::Index min_first = min_origin + horizon - 1;
+  const Eigen::Index min_first = FirstPredictable(model, protocol, horizon);
   if (first < min_first || first >= n) {
     throw DataError(
         "first predicted sample " + std::to_string(first + 1) + " must be in [" +
@@ -522,15 +524,23 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
     return PredictFromSeries(model, y, thermal, first, count, horizon);
   }
   if (protocol == Protocol::kPaper) {
-    decomposition::DecompositionOptions dopt = model.options.decomposition;
-    dopt.seed = model.options.seed;
+    decomposition::DecompositionOptions dopt = DecompositionFor(model);
     dopt.threads = model.options.threads;
-    dopt.noise_emds = nullptr;  // a set a caller left in the options serves another length
     const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
     return PredictFromSeries(model, series, thermal, first, count, horizon);
   }
   return PredictRecursively(model, CausalLags(model, y, origin, count, causal), thermal, origin,
                             horizon);
+}
+
+Eigen::Index FirstPredictable(const DriftModel& model, Protocol protocol, int horizon) {
+  internal::RequireHorizon(horizon);
+  // The prediction of y[t] starts from the origin t - horizon + 1: the lags end at t - horizon.
+  const Eigen::Index min_origin =
+      protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
+          ? std::max<Eigen::Index>(model.lags, 16)
+          : model.lags;
+  return min_origin + horizon - 1;
 }
 
 std::string CausalWindowNote(const DriftModel& model, int window) {

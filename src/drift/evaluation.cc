@@ -94,9 +94,7 @@ void EvaluationOptions::Validate() const {
   if (causal.window < 16 || causal.window > 1000000) {
     ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
   }
-  if (horizon < 1 || horizon > 100000) {
-    ThrowOption("horizon", std::to_string(horizon), "an integer in [1, 100000]");
-  }
+  internal::RequireHorizon(horizon);
 }
 
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,

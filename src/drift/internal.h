@@ -20,6 +20,9 @@ constexpr double kGroupsDoneShare = 0.85;  // the decomposition and the grouping
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
                            bool report = false);
 
+// Throws OptionError naming `horizon` unless it is in [1, kMaxHorizon].
+void RequireHorizon(int horizon);
+
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,

@@ -185,11 +185,8 @@ NoiseLevelCollector::NoiseLevelCollector(int length, const MonteCarloOptions& mo
 }
 
 bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposition) {
-  using decomposition::Method;
   const auto& d = *decomposition;
-  const bool family =
-      d.method == Method::kCeemdan || d.method == Method::kIceemdan || d.method == Method::kBeemdan;
-  if (!family || d.supplied_noise || d.noise_imf_observer ||
+  if (!decomposition::UsesNoiseEmds(d.method) || d.supplied_noise || d.noise_imf_observer ||
       d.ensemble_size < monte_carlo_.realisations || !(d.sifting == monte_carlo_.sifting) ||
       monte_carlo_.max_imfs != 0 || length_ < 16) {
     return false;

@@ -113,7 +113,7 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"zero horizon", p + "--horizon 0", 2, "--horizon = 0"},
       {"horizon in compensate mode",
        "evaluate %IN% -t rate_dph -T temperature_c --mode compensate --horizon 2", 2,
-       "--horizon = 2: applies to --mode predict"},
+       "--horizon = 2: must be 1 in compensate mode"},
       {"repeated method", p + "--methods elm,elm", 2, "without repeats"},
       {"empty methods", p + "--methods ,", 2, "--methods"},
       {"trailing comma", p + "--methods elm,", 2, "--methods = 'elm,'"},

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -28,6 +29,9 @@ namespace gyrodrift::decomposition {
 
 enum class Method { kEmd, kEemd, kCeemdan, kIceemdan, kBeemdan };
 std::string_view ToString(Method method);
+// CEEMDAN, ICEEMDAN and BEEMDAN: the methods built on their realisations' white-noise EMDs
+// (DecompositionOptions::noise_imf_observer and noise_emds apply to them only).
+bool UsesNoiseEmds(Method method);
 Method MethodFromString(std::string_view name);  // "emd", "eemd", ...; throws UsageError
 
 // When to stop sifting one IMF.
@@ -158,6 +162,11 @@ class NoiseEmds {
                                         // (left out when identically zero)
     int imfs = 0;                       // how many of the rows are IMFs
   };
+  // Rows kept per realisation, as an estimate for memory: the realisation, about log2(length)
+  // IMFs and the residue.
+  static double RowsPerRealisation(Eigen::Index length) {
+    return std::log2(static_cast<double>(length)) + 2.0;
+  }
   Eigen::Index length() const { return length_; }
   int ensemble_size() const { return static_cast<int>(realisations_.size()); }
   const Realisation& realisation(int i) const { return realisations_[static_cast<size_t>(i)]; }

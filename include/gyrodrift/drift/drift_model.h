@@ -166,12 +166,20 @@ struct CausalOptions {
   std::function<void(double fraction)> progress;
 };
 
+// Largest prediction horizon, steps.
+inline constexpr int kMaxHorizon = 100000;
+
+// The first sample (0-based) PredictAhead can predict horizon steps ahead: the model's lags, and
+// under the causal protocol with a decomposition a 16-sample window, before the origin
+// first - horizon + 1. Throws UsageError for a horizon outside [1, kMaxHorizon].
+Eigen::Index FirstPredictable(const DriftModel& model, Protocol protocol, int horizon);
+
 // Horizon-step-ahead predictions of y[t] for t = first .. N-1 (N - first entries), each made at
 // the origin t - horizon + 1 from the samples before it: the sub-series' lags there, then
 // recursively, one step at a time, each sub-model's own predictions in place of the samples after
 // the origin. Thermal inputs (models fitted with a temperature) are read from the log at every
-// step, as for a temperature programme known in advance. first >= lags + horizon - 1 (causal
-// protocol with a decomposition: max(lags, 16) + horizon - 1). horizon = 1 is PredictOneStep.
+// step, as for a temperature programme known in advance. first >= FirstPredictable(model,
+// protocol, horizon). horizon = 1 is PredictOneStep.
 // Single models need no decomposition and are causal under both protocols.
 Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
@@ -180,9 +188,9 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
 
 // "" unless, under the causal protocol with `window`-sample windows, some sub-model other than
 // the residue's and MS-ELM's noise group sums IMFs a window cannot resolve (a window of W samples
-// gives about log2(W) - 1 IMFs): then a one-line note naming them. Their content falls into the window's
-// residue, so such a sub-model sees at test time another series than the one it was trained on
-// (docs/drift.md 4.3).
+// gives about log2(W) - 1 IMFs): then a one-line note naming them. Their content falls into the
+// window's residue, so such a sub-model sees at test time another series than the one it was
+// trained on (docs/drift.md 4.3).
 std::string CausalWindowNote(const DriftModel& model, int window);
 
 // One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has

@@ -179,8 +179,7 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
     spoil(bad);
     EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError) << field;
   }
-  if (GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
-      GetParam() == Method::kBeemdan) {
+  if (UsesNoiseEmds(GetParam())) {
     // 1e5 realisations of 1e7 samples would hold 8 TB of noise state: refused before any work.
     bad = o;
     bad.ensemble_size = 100000;
@@ -233,8 +232,7 @@ TEST_P(Decomposer, NoiseImfObserverSeesTheNoiseEmdAndDoesNotChangeTheResult) {
   const Decomposition watched = Decompose(x, o);
   EXPECT_EQ(plain.imfs, watched.imfs);
   EXPECT_EQ(plain.residue, watched.residue);
-  const bool family = GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
-                      GetParam() == Method::kBeemdan;
+  const bool family = UsesNoiseEmds(GetParam());
   for (int i = 0; i < o.ensemble_size; ++i) {
     const auto& modes = seen[static_cast<size_t>(i)];
     if (!family) {
@@ -259,8 +257,7 @@ TEST_P(Decomposer, NoiseImfObserverSeesTheNoiseEmdAndDoesNotChangeTheResult) {
 TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
   const Eigen::VectorXd x = Noisy(700, 8);
   DecompositionOptions o = Options(GetParam());
-  const bool family = GetParam() == Method::kCeemdan || GetParam() == Method::kIceemdan ||
-                      GetParam() == Method::kBeemdan;
+  const bool family = UsesNoiseEmds(GetParam());
   o.threads = 2;
   auto shared = std::make_shared<const NoiseEmds>(x.size(), o);
   if (!family) {

@@ -173,13 +173,25 @@ TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
             PredictOneStep(reference, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
 }
 
-TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
-  const Log log = MakeLog(700, 5);
-  const DriftModel model =
-      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+// An MS-ELM predict model fitted on the first 500 samples of a 700-sample log, and causal options
+// with 64-sample windows on 2 threads.
+struct CausalCase {
+  Log log;
+  DriftModel model;
   CausalOptions causal;
-  causal.window = 64;
-  causal.threads = 2;
+};
+
+CausalCase MakeCausalCase(std::uint64_t seed) {
+  CausalCase c{MakeLog(700, seed), {}, {}};
+  c.model =
+      FitDriftModel(c.log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  c.causal.window = 64;
+  c.causal.threads = 2;
+  return c;
+}
+
+TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
+  auto [log, model, causal] = MakeCausalCase(5);
   const Eigen::VectorXd quiet =
       PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
   std::vector<double> seen;
@@ -196,12 +208,7 @@ TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
 // Full windows share one set of white-noise EMDs (computed once, not per window): each
 // prediction is still the one a lone decomposition of its window gives, to the bit.
 TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
-  const Log log = MakeLog(700, 6);
-  const DriftModel model =
-      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
-  CausalOptions causal;
-  causal.window = 64;
-  causal.threads = 2;
+  const auto [log, model, causal] = MakeCausalCase(6);
   const Eigen::VectorXd all =
       PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
   for (Eigen::Index t : {500, 563, 699}) {
