@@ -1,6 +1,8 @@
 #include "decomposition/spline.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 
 namespace gyrodrift::decomposition::internal {
 
@@ -30,6 +32,17 @@ EnvelopeSpline::EnvelopeSpline(Eigen::Index max_nodes, int phase) {
 // building them there costs no extra time and nothing but the inverse pivots and the eliminated
 // right-hand side is stored; the cubic coefficients are likewise made in the back substitution.
 // Every quantity is the same expression, in the same order, as the plain three-pass form.
+//
+// Both sweeps are chains of dependent operations (the elimination's through a division), so one
+// sweep runs at the latency of its chain while most of the processor idles. Independent chains
+// are therefore interleaved row by row: the two envelopes' sweeps, and for long systems
+// kChunks pieces of each sweep. A piece cannot know the state the piece before it will hand
+// over, so it starts kWarmUp rows early from a guess. The sweeps of this diagonally dominant
+// system forget their past geometrically (by about 0.27 per row for evenly spaced nodes), so
+// after the warm-up the guessed state is, but for freak cases, the true one to the last bit,
+// and from there every row is the same computation as in one plain sweep. Each piece's start is
+// checked against its predecessor's end once both have run; a piece that started from another
+// state is recomputed from the true one. The result is the plain sweep's, bit for bit.
 namespace {
 
 void DividedDifferences(const double* __restrict t, const double* __restrict y,
@@ -40,149 +53,274 @@ void DividedDifferences(const double* __restrict t, const double* __restrict y,
   }
 }
 
-class Forward {
- public:
-  Forward(const double* t, const double* y, double* inv_dx, double* dd, double* inv_diag,
-          double* rhs, size_t m)
-      : t_(t), dd_(dd), inv_diag_(inv_diag), rhs_(rhs), m_(m) {
-    // The divided differences first, in a separate loop: its divisions are independent and
-    // pipeline there, while inside the sweep they would queue with the pivot divisions.
-    DividedDifferences(t, y, inv_dx, dd, m);
-    const double dx0 = t[1] - t[0], dx1 = t[2] - t[1];
-    const double x31 = t[2] - t[0];
-    inv_prev_ = inv_diag_[0] = 1.0 / dx1;
-    rhs_prev_ = rhs_[0] = ((dx0 + 2 * x31) * dx1 * dd_[0] + dx0 * dx0 * dd_[1]) / x31;
-    sup_prev_ = x31;
-    dd_prev_ = dd_[0];
-    dd_cur_ = dd_[1];
-  }
-  // Interior row j, 1 <= j <= m-2 (in increasing order).
-  inline void Row(size_t j) {
-    const double* t = t_;
-    const double dd_next = dd_[j + 1];
-    const double dx_j = t[j + 1] - t[j];
-    const double dx_prev = t[j] - t[j - 1];
-    const double diag = 2 * (dx_j + dx_prev);
-    const double rhs = 3 * (dx_j * dd_prev_ + dx_prev * dd_cur_);
-    const double w = dx_j * inv_prev_;
-    inv_prev_ = 1.0 / (diag - w * sup_prev_);
-    rhs_prev_ = rhs - w * rhs_prev_;
-    inv_diag_[j] = inv_prev_;
-    rhs_[j] = rhs_prev_;
-    sup_prev_ = dx_prev;
-    dd_prev_ = dd_cur_;
-    dd_cur_ = dd_next;
-  }
-  // Row m-1 (after every interior row).
-  void Last() {
-    const double* t = t_;
-    const size_t m = m_;
-    const double dxl = t[m - 1] - t[m - 2], dxl1 = t[m - 2] - t[m - 3];
-    const double xn = t[m - 1] - t[m - 3];
-    const double rhs = (dxl * dxl * dd_[m - 3] + (2 * xn + dxl) * dxl1 * dd_[m - 2]) / xn;
-    const double w = xn * inv_prev_;
-    inv_diag_[m - 1] = 1.0 / (dxl1 - w * sup_prev_);
-    rhs_[m - 1] = rhs - w * rhs_prev_;
-  }
-
- private:
-  const double* t_;
-  const double* dd_;
-  double* inv_diag_;
-  double* rhs_;
-  size_t m_;
-  double inv_prev_, rhs_prev_, sup_prev_, dd_prev_, dd_cur_;
+// The per-node arrays of one spline's system.
+struct System {
+  size_t m;
+  const double* t;
+  const double* dd;
+  const double* inv_dx;
+  double* inv_diag;  // inverse pivots
+  double* rhs;       // eliminated right-hand side
+  double* slope;
+  double* c1;
+  double* c2;
 };
 
-// Back substitution s[j] = (rhs[j] - sup[j] s[j+1]) inv_diag[j] for j = m-2 .. 0, with the
-// cubic coefficients of piece j (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y.
-class Backward {
- public:
-  Backward(const double* t, const double* inv_dx, const double* dd, const double* inv_diag,
-           const double* rhs, double* slope, double* c1, double* c2, size_t m)
-      : t_(t),
-        inv_dx_(inv_dx),
-        dd_(dd),
-        inv_diag_(inv_diag),
-        rhs_(rhs),
-        slope_(slope),
-        c1_(c1),
-        c2_(c2) {
-    next_ = slope_[m - 1] = rhs_[m - 1] * inv_diag_[m - 1];
-  }
-  inline void Row(size_t j) {
-    const double sup = j > 0 ? t_[j] - t_[j - 1] : t_[2] - t_[0];
-    const double s = (rhs_[j] - sup * next_) * inv_diag_[j];
-    slope_[j] = s;
-    const double dzzdx = (dd_[j] - s) * inv_dx_[j];
-    const double dzdxdx = (next_ - dd_[j]) * inv_dx_[j];
-    c1_[j] = (dzdxdx - dzzdx) * inv_dx_[j];
-    c2_[j] = 2 * dzzdx - dzdxdx;
-    next_ = s;
-  }
-
- private:
-  const double* t_;
-  const double* inv_dx_;
-  const double* dd_;
-  const double* inv_diag_;
-  const double* rhs_;
-  double* slope_;
-  double* c1_;
-  double* c2_;
-  double next_;
+// What the elimination carries from row j-1 to row j.
+struct Elimination {
+  double inv, rhs;
 };
+
+// Equal to the last bit (0.0 == -0.0, but the rows after them can differ).
+bool SameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+bool SameBits(const Elimination& a, const Elimination& b) {
+  return SameBits(a.inv, b.inv) && SameBits(a.rhs, b.rhs);
+}
+
+// Rows 0 and 1 (row 1's super-diagonal is row 0's not-a-knot one); returns the state after row 1.
+Elimination FirstRows(const System& s) {
+  const double* t = s.t;
+  const double* dd = s.dd;
+  const double dx0 = t[1] - t[0], dx1 = t[2] - t[1];
+  const double x31 = t[2] - t[0];
+  const double inv0 = s.inv_diag[0] = 1.0 / dx1;
+  const double rhs0 = s.rhs[0] = ((dx0 + 2 * x31) * dx1 * dd[0] + dx0 * dx0 * dd[1]) / x31;
+  const double dx_j = t[2] - t[1];
+  const double dx_prev = t[1] - t[0];
+  const double diag = 2 * (dx_j + dx_prev);
+  const double rhs = 3 * (dx_j * dd[0] + dx_prev * dd[1]);
+  const double w = dx_j * inv0;
+  Elimination e{1.0 / (diag - w * x31), rhs - w * rhs0};
+  s.inv_diag[1] = e.inv;
+  s.rhs[1] = e.rhs;
+  return e;
+}
+
+// Interior rows row[k], row[k] + 1, ... (2 <= row, up to m-2) of K chains, `steps` rows each,
+// interleaved; state[k] goes in as the state before the first row and comes out after the last.
+template <size_t K>
+void EliminateRows(const System* const (&system)[K], size_t (&row)[K], Elimination (&state)[K],
+                   size_t steps) {
+  Elimination carried[K];  // a local copy: the stores below could alias `state` for the compiler
+  std::copy(state, state + K, carried);
+  for (size_t r = 0; r < steps; ++r) {
+#pragma GCC unroll 4
+    for (size_t k = 0; k < K; ++k) {
+      const size_t j = row[k] + r;
+      const double* t = system[k]->t;
+      const double* dd = system[k]->dd;
+      const double dx_j = t[j + 1] - t[j];
+      const double dx_prev = t[j] - t[j - 1];
+      const double sup_prev = t[j - 1] - t[j - 2];
+      const double diag = 2 * (dx_j + dx_prev);
+      const double rhs = 3 * (dx_j * dd[j - 1] + dx_prev * dd[j]);
+      const double w = dx_j * carried[k].inv;
+      carried[k].inv = 1.0 / (diag - w * sup_prev);
+      carried[k].rhs = rhs - w * carried[k].rhs;
+      system[k]->inv_diag[j] = carried[k].inv;
+      system[k]->rhs[j] = carried[k].rhs;
+    }
+  }
+  std::copy(carried, carried + K, state);
+  for (size_t k = 0; k < K; ++k) row[k] += steps;
+}
+
+// Row m-1, from the state after row m-2.
+void LastRow(const System& s, const Elimination& e) {
+  const double* t = s.t;
+  const size_t m = s.m;
+  const double dxl = t[m - 1] - t[m - 2], dxl1 = t[m - 2] - t[m - 3];
+  const double xn = t[m - 1] - t[m - 3];
+  const double rhs = (dxl * dxl * s.dd[m - 3] + (2 * xn + dxl) * dxl1 * s.dd[m - 2]) / xn;
+  const double w = xn * e.inv;
+  s.inv_diag[m - 1] = 1.0 / (dxl1 - w * (t[m - 2] - t[m - 3]));
+  s.rhs[m - 1] = rhs - w * e.rhs;
+}
+
+// Back substitution s[j] = (rhs[j] - sup[j] s[j+1]) inv_diag[j] with the cubic coefficients of
+// piece j (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y. Rows row[k], row[k] - 1, ... (down
+// to 1 at the lowest) of K chains, `steps` each, interleaved; next[k] is s[row + 1] going in and
+// the last slope made coming out.
+template <size_t K>
+void SubstituteRows(const System* const (&system)[K], size_t (&row)[K], double (&next)[K],
+                    size_t steps) {
+  double slope_after[K];  // a local copy, as in EliminateRows
+  std::copy(next, next + K, slope_after);
+  for (size_t r = 0; r < steps; ++r) {
+#pragma GCC unroll 4
+    for (size_t k = 0; k < K; ++k) {
+      const System& s = *system[k];
+      const size_t j = row[k] - r;
+      const double sup = s.t[j] - s.t[j - 1];
+      const double slope = (s.rhs[j] - sup * slope_after[k]) * s.inv_diag[j];
+      s.slope[j] = slope;
+      const double dzzdx = (s.dd[j] - slope) * s.inv_dx[j];
+      const double dzdxdx = (slope_after[k] - s.dd[j]) * s.inv_dx[j];
+      s.c1[j] = (dzdxdx - dzzdx) * s.inv_dx[j];
+      s.c2[j] = 2 * dzzdx - dzdxdx;
+      slope_after[k] = slope;
+    }
+  }
+  std::copy(slope_after, slope_after + K, next);
+  for (size_t k = 0; k < K; ++k) row[k] -= steps;
+}
+
+// Slope m-1 (the start of the back substitution) and piece 0 (row 0's super-diagonal is its
+// not-a-knot one), from s[1].
+double LastSlope(const System& s) {
+  return s.slope[s.m - 1] = s.rhs[s.m - 1] * s.inv_diag[s.m - 1];
+}
+void FirstPiece(const System& s, double next) {
+  const double sup = s.t[2] - s.t[0];
+  const double slope = (s.rhs[0] - sup * next) * s.inv_diag[0];
+  s.slope[0] = slope;
+  const double dzzdx = (s.dd[0] - slope) * s.inv_dx[0];
+  const double dzdxdx = (next - s.dd[0]) * s.inv_dx[0];
+  s.c1[0] = (dzdxdx - dzzdx) * s.inv_dx[0];
+  s.c2[0] = 2 * dzzdx - dzdxdx;
+}
+
+// The two sweeps as policies for RunSweep: the elimination runs over rows 2 .. m-2 upwards, the
+// substitution over rows m-2 .. 1 downwards; `Row(s, k)` is the k-th row in sweep order.
+struct EliminationSweep {
+  using State = Elimination;
+  static size_t Rows(const System& s) { return s.m - 3; }
+  static size_t Row(const System&, size_t k) { return 2 + k; }
+  // A state to start a warm-up at row j from: that of evenly spaced nodes, whose pivot is
+  // (2 + sqrt 3) / 2 times the diagonal and whose eliminated right-hand side is the raw one over
+  // 1 + (2 - sqrt 3).
+  static State Guess(const System& s, size_t j) {
+    const double dx = s.t[j] - s.t[j - 1], dx_prev = s.t[j - 1] - s.t[j - 2];
+    return {1.0 / (1.866 * (dx + dx_prev)), 3 * (dx * s.dd[j - 2] + dx_prev * s.dd[j - 1]) / 1.27};
+  }
+  template <size_t K>
+  static void Run(const System* const (&system)[K], size_t (&row)[K], State (&state)[K],
+                  size_t steps) {
+    EliminateRows(system, row, state, steps);
+  }
+};
+
+struct SubstitutionSweep {
+  using State = double;
+  static size_t Rows(const System& s) { return s.m - 2; }
+  static size_t Row(const System& s, size_t k) { return s.m - 2 - k; }
+  static State Guess(const System& s, size_t j) { return s.dd[j + 1]; }  // the secant slope
+  template <size_t K>
+  static void Run(const System* const (&system)[K], size_t (&row)[K], State (&state)[K],
+                  size_t steps) {
+    SubstituteRows(system, row, state, steps);
+  }
+};
+
+template <class Sweep>
+void RunOne(const System& s, size_t row, typename Sweep::State& state, size_t steps) {
+  const System* const one[1] = {&s};
+  size_t r[1] = {row};
+  typename Sweep::State st[1] = {state};
+  Sweep::Run(one, r, st, steps);
+  state = st[0];
+}
+
+// A system's sweep cut into kChunks pieces of equal cost, counted in sweep order: piece 0 starts
+// from the true state and has warm_up more rows; piece c > 0 first runs over the last warm_up rows
+// of piece c-1 (writing values that piece c-1 overwrites later, as it reaches them after that).
+constexpr size_t kChunks = 4;
+
+template <class Sweep>
+void RunChunked(const System& s, typename Sweep::State& state, size_t warm_up) {
+  using State = typename Sweep::State;
+  const size_t rows = Sweep::Rows(s);
+  const size_t each = (rows - warm_up) / kChunks;
+  size_t first[kChunks + 1] = {0, each + warm_up};  // piece c: rows [first[c], first[c+1])
+  for (size_t c = 2; c < kChunks; ++c) first[c] = first[c - 1] + each;
+  first[kChunks] = rows;
+  size_t row[kChunks];
+  State st[kChunks];
+  for (size_t c = 0; c < kChunks; ++c) {
+    row[c] = Sweep::Row(s, c == 0 ? 0 : first[c] - warm_up);
+    st[c] = c == 0 ? state : Sweep::Guess(s, row[c]);
+  }
+  const System* const same[kChunks] = {&s, &s, &s, &s};
+  Sweep::Run(same, row, st, warm_up);
+  State start[kChunks];
+  size_t start_row[kChunks];
+  std::copy(st, st + kChunks, start);
+  std::copy(row, row + kChunks, start_row);
+  const size_t common = each;  // rows left after the warm-up: each, and more for the last piece
+  Sweep::Run(same, row, st, common);
+  RunOne<Sweep>(s, row[kChunks - 1], st[kChunks - 1], rows - first[kChunks - 1] - common);
+  for (size_t c = 1; c < kChunks; ++c) {
+    if (SameBits(st[c - 1], start[c])) continue;
+    st[c] = st[c - 1];  // piece c again, from the state piece c-1 ended with
+    RunOne<Sweep>(s, start_row[c], st[c], first[c + 1] - first[c]);
+  }
+  state = st[kChunks - 1];
+}
+
+// One sweep of every system: the long ones in pieces, the others side by side while both have
+// rows.
+template <class Sweep>
+void RunSweep(const System* system, size_t count, typename Sweep::State* state,
+              size_t warm_up) {
+  const size_t chunked = ChunkedSweepNodes(warm_up);
+  const System* plain[2];
+  size_t plain_count = 0;
+  typename Sweep::State* plain_state[2];
+  for (size_t i = 0; i < count; ++i) {
+    if (system[i].m >= chunked) {
+      RunChunked<Sweep>(system[i], state[i], warm_up);
+    } else {
+      plain_state[plain_count] = &state[i];
+      plain[plain_count++] = &system[i];
+    }
+  }
+  size_t done = 0;
+  if (plain_count == 2) {
+    const System* const both[2] = {plain[0], plain[1]};
+    size_t row[2] = {Sweep::Row(*plain[0], 0), Sweep::Row(*plain[1], 0)};
+    typename Sweep::State st[2] = {*plain_state[0], *plain_state[1]};
+    done = std::min(Sweep::Rows(*plain[0]), Sweep::Rows(*plain[1]));
+    Sweep::Run(both, row, st, done);
+    *plain_state[0] = st[0];
+    *plain_state[1] = st[1];
+  }
+  for (size_t i = 0; i < plain_count; ++i) {
+    RunOne<Sweep>(*plain[i], Sweep::Row(*plain[i], done), *plain_state[i],
+                  Sweep::Rows(*plain[i]) - done);
+  }
+}
 
 }  // namespace
+
+size_t ChunkedSweepNodes(size_t warm_up) { return 8 * std::max<size_t>(warm_up, 1); }
 
 // Divided differences for the 2- and 3-node cases (a line, a parabola).
 void EnvelopeSpline::Prepare() {
   DividedDifferences(t_.data(), y_.data(), inv_dx_, dd_, t_.size());
 }
 
-void FitPair(EnvelopeSpline& a, EnvelopeSpline& b) {
-  const size_t ma = a.t_.size(), mb = b.t_.size();
-  if (ma < 4) a.Prepare();
-  if (mb < 4) b.Prepare();
-  auto forward = [](EnvelopeSpline& s) {
-    return Forward(s.t_.data(), s.y_.data(), s.inv_dx_, s.dd_, s.diag_, s.rhs_, s.t_.size());
-  };
-  auto backward = [](EnvelopeSpline& s) {
-    return Backward(s.t_.data(), s.inv_dx_, s.dd_, s.diag_, s.rhs_, s.slope_, s.c1_, s.c2_,
-                    s.t_.size());
-  };
-  if (ma >= 4 && mb >= 4) {
-    // Both systems in one loop: two independent division chains overlap in the processor.
-    Forward fa = forward(a), fb = forward(b);
-    const size_t common = std::min(ma, mb) - 1;
-    size_t j = 1;
-    for (; j < common; ++j) {
-      fa.Row(j);
-      fb.Row(j);
-    }
-    for (size_t k = j; k + 1 < ma; ++k) fa.Row(k);
-    for (size_t k = j; k + 1 < mb; ++k) fb.Row(k);
-    fa.Last();
-    fb.Last();
-    Backward ba = backward(a), bb = backward(b);
-    size_t ja = ma - 1, jb = mb - 1;
-    while (ja > 0 && jb > 0) {
-      ba.Row(--ja);
-      bb.Row(--jb);
-    }
-    while (ja > 0) ba.Row(--ja);
-    while (jb > 0) bb.Row(--jb);
-    return;
+void FitPair(EnvelopeSpline& a, EnvelopeSpline& b, size_t warm_up) {
+  System system[2];
+  size_t count = 0;  // the systems of 4 or more nodes; 2 and 3 need only divided differences
+  for (EnvelopeSpline* e : {&a, &b}) {
+    e->Prepare();
+    if (e->t_.size() < 4) continue;
+    system[count++] = {e->t_.size(), e->t_.data(), e->dd_, e->inv_dx_, e->diag_,
+                       e->rhs_,      e->slope_,    e->c1_, e->c2_};
   }
-  for (EnvelopeSpline* s : {&a, &b}) {
-    const size_t m = s->t_.size();
-    if (m < 4) continue;
-    Forward f = forward(*s);
-    for (size_t j = 1; j + 1 < m; ++j) f.Row(j);
-    f.Last();
-    Backward back = backward(*s);
-    for (size_t j = m - 1; j-- > 0;) back.Row(j);
+  warm_up = std::max<size_t>(warm_up, 1);
+  Elimination eliminated[2];
+  double slope[2];
+  for (size_t i = 0; i < count; ++i) eliminated[i] = FirstRows(system[i]);
+  RunSweep<EliminationSweep>(system, count, eliminated, warm_up);
+  for (size_t i = 0; i < count; ++i) {
+    LastRow(system[i], eliminated[i]);
+    slope[i] = LastSlope(system[i]);
   }
+  RunSweep<SubstitutionSweep>(system, count, slope, warm_up);
+  for (size_t i = 0; i < count; ++i) FirstPiece(system[i], slope[i]);
 }
 
 SplineView EnvelopeSpline::view() const {

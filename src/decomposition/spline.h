@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 #include "decomposition/simd_kernels.h"
@@ -34,8 +35,7 @@ class EnvelopeSpline {
   void EvaluateSift(Eigen::Index n, const double* lower, const double* h, double* next) const;
   static constexpr Eigen::Index kPadding = kSimdPadding;
 
-  // Solves the slopes of both splines.
-  friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
+  friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b, size_t warm_up);
 
  private:
   void Prepare();
@@ -45,6 +45,13 @@ class EnvelopeSpline {
   double *inv_dx_, *dd_, *slope_, *diag_, *rhs_, *c1_, *c2_;  // diag_: inverse pivots
 };
 
-void FitPair(EnvelopeSpline& a, EnvelopeSpline& b);
+// Rows each piece of a long sweep runs before its own (see the .cc).
+inline constexpr size_t kSplineWarmUp = 48;
+// The smallest system whose sweeps are cut into pieces, for a given warm-up.
+size_t ChunkedSweepNodes(size_t warm_up);
+
+// Solves the slopes of both splines. warm_up only changes the speed (tests use it to force the
+// recomputation of pieces); the result is that of one plain sweep per spline, bit for bit.
+void FitPair(EnvelopeSpline& a, EnvelopeSpline& b, size_t warm_up = kSplineWarmUp);
 
 }  // namespace gyrodrift::decomposition::internal
