@@ -549,6 +549,28 @@ void WriteModelFile(const std::string& path, const drift::DriftModel& model,
   WriteFileAtomically(path, RenderModelFile(model, info));
 }
 
+// The dotted path of the first field of `file` that `known` (the same model written back by
+// this version) lacks, or "" when there is none. Values are not compared, only field names, so
+// a misspelt or invented field, which reading would silently ignore, is caught.
+std::string FirstUnknownField(const json& file, const json& known, const std::string& path) {
+  if (file.is_object() && known.is_object()) {
+    for (const auto& [key, value] : file.items()) {
+      const std::string here = path.empty() ? key : path + "." + key;
+      const auto it = known.find(key);
+      if (it == known.end()) return here;
+      const std::string inner = FirstUnknownField(value, *it, here);
+      if (!inner.empty()) return inner;
+    }
+  } else if (file.is_array() && known.is_array()) {
+    for (size_t i = 0; i < file.size() && i < known.size(); ++i) {
+      const std::string inner =
+          FirstUnknownField(file[i], known[i], path + "[" + std::to_string(i) + "]");
+      if (!inner.empty()) return inner;
+    }
+  }
+  return "";
+}
+
 LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
   json j;
   try {
@@ -590,6 +612,13 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
   }
   if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
     training["temperature_column"].Fail("is empty but the model uses temperature");
+  }
+  json known = json::parse(RenderModelFile(out.model, out.info));
+  known["options"]["learner"]["elm"]["threads"] = 0;  // older files' field, checked above
+  const std::string unknown = FirstUnknownField(j, known, "");
+  if (!unknown.empty()) {
+    throw DataError(source + ": field '" + unknown +
+                    "' is not part of a gyrodrift model file (misspelt, or from another tool)");
   }
   return out;
 }

@@ -319,6 +319,21 @@ TEST_F(Refusal, MissingFieldsAreNamed) {
   ExpectRefused(Reseal(j), "output_weights");
 }
 
+// Reading ignores what it does not look for, so a field it does not know would be dropped
+// without a word: a misspelt option (its default then used instead) or another tool's field.
+TEST_F(Refusal, UnknownFieldsAreNamed) {
+  json j = Json();
+  j["options"]["seeds"] = 7;
+  ExpectRefused(Reseal(j), "field 'options.seeds' is not part of a gyrodrift model file");
+  j = Json();
+  j["model"]["sub_models"][0]["learner"]["arrays"]["bias"] = j["model"]["sub_models"][0]
+                                                                ["learner"]["arrays"]["biases"];
+  ExpectRefused(Reseal(j), "field 'model.sub_models[0].learner.arrays.bias' is not part");
+  j = Json();
+  j["comment"] = "fitted on the March chamber run";
+  ExpectRefused(Reseal(j), "field 'comment' is not part");
+}
+
 TEST_F(Refusal, WrongTypesShapesAndValuesAreNamed) {
   json j = Json();
   j["options"]["seed"] = -3;
