@@ -100,17 +100,17 @@ Elimination FirstRows(const System& s) {
 
 // Interior rows row[k], row[k] + 1, ... (2 <= row, up to m-2) of K chains, `steps` rows each,
 // interleaved; state[k] goes in as the state before the first row and comes out after the last.
-template <size_t K>
-void EliminateRows(const System* const (&system)[K], size_t (&row)[K], Elimination (&state)[K],
-                   size_t steps) {
+template <size_t K, class At>
+void EliminateRows(At at, size_t (&row)[K], Elimination (&state)[K], size_t steps) {
   Elimination carried[K];  // a local copy: the stores below could alias `state` for the compiler
   std::copy(state, state + K, carried);
   for (size_t r = 0; r < steps; ++r) {
 #pragma GCC unroll 4
     for (size_t k = 0; k < K; ++k) {
       const size_t j = row[k] + r;
-      const double* t = system[k]->t;
-      const double* dd = system[k]->dd;
+      const System& s = at(k);
+      const double* t = s.t;
+      const double* dd = s.dd;
       const double dx_j = t[j + 1] - t[j];
       const double dx_prev = t[j] - t[j - 1];
       const double sup_prev = t[j - 1] - t[j - 2];
@@ -119,8 +119,8 @@ void EliminateRows(const System* const (&system)[K], size_t (&row)[K], Eliminati
       const double w = dx_j * carried[k].inv;
       carried[k].inv = 1.0 / (diag - w * sup_prev);
       carried[k].rhs = rhs - w * carried[k].rhs;
-      system[k]->inv_diag[j] = carried[k].inv;
-      system[k]->rhs[j] = carried[k].rhs;
+      s.inv_diag[j] = carried[k].inv;
+      s.rhs[j] = carried[k].rhs;
     }
   }
   std::copy(carried, carried + K, state);
@@ -143,15 +143,14 @@ void LastRow(const System& s, const Elimination& e) {
 // piece j (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y. Rows row[k], row[k] - 1, ... (down
 // to 1 at the lowest) of K chains, `steps` each, interleaved; next[k] is s[row + 1] going in and
 // the last slope made coming out.
-template <size_t K>
-void SubstituteRows(const System* const (&system)[K], size_t (&row)[K], double (&next)[K],
-                    size_t steps) {
+template <size_t K, class At>
+void SubstituteRows(At at, size_t (&row)[K], double (&next)[K], size_t steps) {
   double slope_after[K];  // a local copy, as in EliminateRows
   std::copy(next, next + K, slope_after);
   for (size_t r = 0; r < steps; ++r) {
 #pragma GCC unroll 4
     for (size_t k = 0; k < K; ++k) {
-      const System& s = *system[k];
+      const System& s = at(k);
       const size_t j = row[k] - r;
       const double sup = s.t[j] - s.t[j - 1];
       const double slope = (s.rhs[j] - sup * slope_after[k]) * s.inv_diag[j];
@@ -195,10 +194,9 @@ struct EliminationSweep {
     const double dx = s.t[j] - s.t[j - 1], dx_prev = s.t[j - 1] - s.t[j - 2];
     return {1.0 / (1.866 * (dx + dx_prev)), 3 * (dx * s.dd[j - 2] + dx_prev * s.dd[j - 1]) / 1.27};
   }
-  template <size_t K>
-  static void Run(const System* const (&system)[K], size_t (&row)[K], State (&state)[K],
-                  size_t steps) {
-    EliminateRows(system, row, state, steps);
+  template <size_t K, class At>
+  static void Run(At at, size_t (&row)[K], State (&state)[K], size_t steps) {
+    EliminateRows(at, row, state, steps);
   }
 };
 
@@ -207,19 +205,17 @@ struct SubstitutionSweep {
   static size_t Rows(const System& s) { return s.m - 2; }
   static size_t Row(const System& s, size_t k) { return s.m - 2 - k; }
   static State Guess(const System& s, size_t j) { return s.dd[j + 1]; }  // the secant slope
-  template <size_t K>
-  static void Run(const System* const (&system)[K], size_t (&row)[K], State (&state)[K],
-                  size_t steps) {
-    SubstituteRows(system, row, state, steps);
+  template <size_t K, class At>
+  static void Run(At at, size_t (&row)[K], State (&state)[K], size_t steps) {
+    SubstituteRows(at, row, state, steps);
   }
 };
 
 template <class Sweep>
 void RunOne(const System& s, size_t row, typename Sweep::State& state, size_t steps) {
-  const System* const one[1] = {&s};
   size_t r[1] = {row};
   typename Sweep::State st[1] = {state};
-  Sweep::Run(one, r, st, steps);
+  Sweep::Run([&s](size_t) -> const System& { return s; }, r, st, steps);
   state = st[0];
 }
 
@@ -242,7 +238,8 @@ void RunChunked(const System& s, typename Sweep::State& state, size_t warm_up) {
     row[c] = Sweep::Row(s, c == 0 ? 0 : first[c] - warm_up);
     st[c] = c == 0 ? state : Sweep::Guess(s, row[c]);
   }
-  const System* const same[kChunks] = {&s, &s, &s, &s};
+  // One system for every chain: the compiler keeps its arrays' addresses in registers.
+  const auto same = [&s](size_t) -> const System& { return s; };
   Sweep::Run(same, row, st, warm_up);
   State start[kChunks];
   size_t start_row[kChunks];
@@ -278,7 +275,7 @@ void RunSweep(const System* system, size_t count, typename Sweep::State* state,
   }
   size_t done = 0;
   if (plain_count == 2) {
-    const System* const both[2] = {plain[0], plain[1]};
+    const auto both = [&plain](size_t k) -> const System& { return *plain[k]; };
     size_t row[2] = {Sweep::Row(*plain[0], 0), Sweep::Row(*plain[1], 0)};
     typename Sweep::State st[2] = {*plain_state[0], *plain_state[1]};
     done = std::min(Sweep::Rows(*plain[0]), Sweep::Rows(*plain[1]));
