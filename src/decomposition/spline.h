@@ -2,9 +2,10 @@
 // spline.m / interp1(..., 'spline') computes it: a line through 2 nodes, the parabola through 3,
 // and for 4 or more nodes the C2 piecewise cubic whose first and last two pieces are one cubic
 // (slopes from a tridiagonal system solved in O(nodes)). Buffers are sized once; fitting and
-// evaluating allocate nothing. Two splines (the lower and upper envelope) are fitted together so
-// their sequential eliminations overlap in the processor; evaluation runs in the vector kernels
-// of simd_kernels.h (SSE2 or AVX2, the same bits).
+// evaluating allocate nothing. Two splines (the lower and upper envelope) are fitted together,
+// long systems in pieces, so that independent sequential sweeps overlap in the processor (the
+// result is one plain sweep's, bit for bit); evaluation runs in the vector kernels of
+// simd_kernels.h (SSE2 or AVX2, the same bits).
 #pragma once
 
 #include <Eigen/Core>
