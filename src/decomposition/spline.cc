@@ -79,7 +79,25 @@ bool SameBits(const Elimination& a, const Elimination& b) {
   return SameBits(a.inv, b.inv) && SameBits(a.rhs, b.rhs);
 }
 
-// Rows 0 and 1 (row 1's super-diagonal is row 0's not-a-knot one); returns the state after row 1.
+// Row j of the elimination (1 <= j <= m-2; sup_prev is row j-1's super-diagonal) from the
+// state after row j-1; stores the row's inverse pivot and right-hand side, returns the state.
+[[gnu::always_inline]] inline Elimination EliminateRow(const System& s, size_t j, double sup_prev,
+                                                       Elimination e) {
+  const double* t = s.t;
+  const double* dd = s.dd;
+  const double dx_j = t[j + 1] - t[j];
+  const double dx_prev = t[j] - t[j - 1];
+  const double diag = 2 * (dx_j + dx_prev);
+  const double rhs = 3 * (dx_j * dd[j - 1] + dx_prev * dd[j]);
+  const double w = dx_j * e.inv;
+  e.inv = 1.0 / (diag - w * sup_prev);
+  e.rhs = rhs - w * e.rhs;
+  s.inv_diag[j] = e.inv;
+  s.rhs[j] = e.rhs;
+  return e;
+}
+
+// Rows 0 and 1 (row 0 carries the not-a-knot condition); returns the state after row 1.
 Elimination FirstRows(const System& s) {
   const double* t = s.t;
   const double* dd = s.dd;
@@ -87,15 +105,7 @@ Elimination FirstRows(const System& s) {
   const double x31 = t[2] - t[0];
   const double inv0 = s.inv_diag[0] = 1.0 / dx1;
   const double rhs0 = s.rhs[0] = ((dx0 + 2 * x31) * dx1 * dd[0] + dx0 * dx0 * dd[1]) / x31;
-  const double dx_j = t[2] - t[1];
-  const double dx_prev = t[1] - t[0];
-  const double diag = 2 * (dx_j + dx_prev);
-  const double rhs = 3 * (dx_j * dd[0] + dx_prev * dd[1]);
-  const double w = dx_j * inv0;
-  Elimination e{1.0 / (diag - w * x31), rhs - w * rhs0};
-  s.inv_diag[1] = e.inv;
-  s.rhs[1] = e.rhs;
-  return e;
+  return EliminateRow(s, 1, x31, {inv0, rhs0});
 }
 
 // Interior rows row[k], row[k] + 1, ... (2 <= row, up to m-2) of K chains, `steps` rows each,
@@ -107,27 +117,16 @@ void EliminateRows(At at, size_t (&row)[K], Elimination (&state)[K], size_t step
   for (size_t r = 0; r < steps; ++r) {
 #pragma GCC unroll 4
     for (size_t k = 0; k < K; ++k) {
-      const size_t j = row[k] + r;
       const System& s = at(k);
-      const double* t = s.t;
-      const double* dd = s.dd;
-      const double dx_j = t[j + 1] - t[j];
-      const double dx_prev = t[j] - t[j - 1];
-      const double sup_prev = t[j - 1] - t[j - 2];
-      const double diag = 2 * (dx_j + dx_prev);
-      const double rhs = 3 * (dx_j * dd[j - 1] + dx_prev * dd[j]);
-      const double w = dx_j * carried[k].inv;
-      carried[k].inv = 1.0 / (diag - w * sup_prev);
-      carried[k].rhs = rhs - w * carried[k].rhs;
-      s.inv_diag[j] = carried[k].inv;
-      s.rhs[j] = carried[k].rhs;
+      const size_t j = row[k] + r;
+      carried[k] = EliminateRow(s, j, s.t[j - 1] - s.t[j - 2], carried[k]);
     }
   }
   std::copy(carried, carried + K, state);
   for (size_t k = 0; k < K; ++k) row[k] += steps;
 }
 
-// Row m-1, from the state after row m-2.
+// Row m-1 (the other not-a-knot condition), from the state after row m-2.
 void LastRow(const System& s, const Elimination& e) {
   const double* t = s.t;
   const size_t m = s.m;
@@ -139,10 +138,22 @@ void LastRow(const System& s, const Elimination& e) {
   s.rhs[m - 1] = rhs - w * e.rhs;
 }
 
-// Back substitution s[j] = (rhs[j] - sup[j] s[j+1]) inv_diag[j] with the cubic coefficients of
-// piece j (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y. Rows row[k], row[k] - 1, ... (down
-// to 1 at the lowest) of K chains, `steps` each, interleaved; next[k] is s[row + 1] going in and
-// the last slope made coming out.
+// Row j of the back substitution s[j] = (rhs[j] - sup[j] s[j+1]) inv_diag[j], with piece j's
+// cubic coefficients (MATLAB pwch): v = ((c1 h + c2) h + slope) h + y. next is s[j+1]; returns
+// s[j].
+[[gnu::always_inline]] inline double SubstituteRow(const System& s, size_t j, double sup,
+                                                   double next) {
+  const double slope = (s.rhs[j] - sup * next) * s.inv_diag[j];
+  s.slope[j] = slope;
+  const double dzzdx = (s.dd[j] - slope) * s.inv_dx[j];
+  const double dzdxdx = (next - s.dd[j]) * s.inv_dx[j];
+  s.c1[j] = (dzdxdx - dzzdx) * s.inv_dx[j];
+  s.c2[j] = 2 * dzzdx - dzdxdx;
+  return slope;
+}
+
+// Rows row[k], row[k] - 1, ... (down to 1 at the lowest) of K chains, `steps` each,
+// interleaved; next[k] is s[row + 1] going in and the last slope made coming out.
 template <size_t K, class At>
 void SubstituteRows(At at, size_t (&row)[K], double (&next)[K], size_t steps) {
   double slope_after[K];  // a local copy, as in EliminateRows
@@ -152,34 +163,19 @@ void SubstituteRows(At at, size_t (&row)[K], double (&next)[K], size_t steps) {
     for (size_t k = 0; k < K; ++k) {
       const System& s = at(k);
       const size_t j = row[k] - r;
-      const double sup = s.t[j] - s.t[j - 1];
-      const double slope = (s.rhs[j] - sup * slope_after[k]) * s.inv_diag[j];
-      s.slope[j] = slope;
-      const double dzzdx = (s.dd[j] - slope) * s.inv_dx[j];
-      const double dzdxdx = (slope_after[k] - s.dd[j]) * s.inv_dx[j];
-      s.c1[j] = (dzdxdx - dzzdx) * s.inv_dx[j];
-      s.c2[j] = 2 * dzzdx - dzdxdx;
-      slope_after[k] = slope;
+      slope_after[k] = SubstituteRow(s, j, s.t[j] - s.t[j - 1], slope_after[k]);
     }
   }
   std::copy(slope_after, slope_after + K, next);
   for (size_t k = 0; k < K; ++k) row[k] -= steps;
 }
 
-// Slope m-1 (the start of the back substitution) and piece 0 (row 0's super-diagonal is its
-// not-a-knot one), from s[1].
+// Slope m-1, where the back substitution starts.
 double LastSlope(const System& s) {
   return s.slope[s.m - 1] = s.rhs[s.m - 1] * s.inv_diag[s.m - 1];
 }
-void FirstPiece(const System& s, double next) {
-  const double sup = s.t[2] - s.t[0];
-  const double slope = (s.rhs[0] - sup * next) * s.inv_diag[0];
-  s.slope[0] = slope;
-  const double dzzdx = (s.dd[0] - slope) * s.inv_dx[0];
-  const double dzdxdx = (next - s.dd[0]) * s.inv_dx[0];
-  s.c1[0] = (dzdxdx - dzzdx) * s.inv_dx[0];
-  s.c2[0] = 2 * dzzdx - dzdxdx;
-}
+// Row 0, whose super-diagonal is the not-a-knot one, from s[1].
+void FirstPiece(const System& s, double next) { SubstituteRow(s, 0, s.t[2] - s.t[0], next); }
 
 // The two sweeps as policies for RunSweep: the elimination runs over rows 2 .. m-2 upwards, the
 // substitution over rows m-2 .. 1 downwards; `Row(s, k)` is the k-th row in sweep order.
