@@ -198,6 +198,13 @@ void RequireHorizon(int horizon) {
   }
 }
 
+Eigen::Index FirstPredictable(int lags, bool windowed, int horizon) {
+  RequireHorizon(horizon);
+  constexpr Eigen::Index kShortestWindow = 16;
+  const Eigen::Index min_origin = windowed ? std::max<Eigen::Index>(lags, kShortestWindow) : lags;
+  return min_origin + horizon - 1;
+}
+
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
                            bool report) {
   report = report && static_cast<bool>(o.progress);
@@ -477,13 +484,13 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                                   const Eigen::Ref<const Eigen::MatrixXd>& series,
                                   const Eigen::Ref<const Eigen::MatrixXd>& thermal,
                                   Eigen::Index first, Eigen::Index count, int horizon) {
-  internal::RequireHorizon(horizon);
-  const Eigen::Index origin = first - (horizon - 1);
-  if (origin < model.lags) {
+  const Eigen::Index needed = internal::FirstPredictable(model.lags, false, horizon);
+  if (first < needed) {
     throw DataError("prediction of sample " + std::to_string(first + 1) + " " +
-                    std::to_string(horizon) + " steps ahead needs " +
-                    std::to_string(model.lags + horizon - 1) + " samples before it");
+                    std::to_string(horizon) + " steps ahead needs " + std::to_string(needed) +
+                    " samples before it");
   }
+  const Eigen::Index origin = first - (horizon - 1);
   std::vector<Eigen::MatrixXd> lags(model.sub_models.size());
   for (size_t g = 0; g < lags.size(); ++g) {
     lags[g] = LagRows(series.col(static_cast<Eigen::Index>(g)), model.lags, origin, count);
@@ -501,14 +508,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
   }
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();
-  internal::RequireHorizon(horizon);
-  if (causal.window < 16 || causal.window > 1000000) {
-    ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
-  }
-  if (causal.ensemble_size < 0 || causal.ensemble_size > 100000) {
-    ThrowOption("causal ensemble_size", std::to_string(causal.ensemble_size),
-                "an integer in [0, 100000] (0 = the model's)");
-  }
+  causal.Validate();
   const Eigen::Index min_first = FirstPredictable(model, protocol, horizon);
   if (first < min_first || first >= n) {
     throw DataError(
@@ -533,14 +533,20 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
                             horizon);
 }
 
+void CausalOptions::Validate() const {
+  if (window < 16 || window > 1000000) {
+    ThrowOption("causal window", std::to_string(window), "an integer in [16, 1000000]");
+  }
+  if (ensemble_size < 0 || ensemble_size > 100000) {
+    ThrowOption("causal ensemble_size", std::to_string(ensemble_size),
+                "an integer in [0, 100000] (0 = the model's)");
+  }
+}
+
 Eigen::Index FirstPredictable(const DriftModel& model, Protocol protocol, int horizon) {
-  internal::RequireHorizon(horizon);
-  // The prediction of y[t] starts from the origin t - horizon + 1: the lags end at t - horizon.
-  const Eigen::Index min_origin =
-      protocol == Protocol::kCausal && UsesDecomposition(model.options.method)
-          ? std::max<Eigen::Index>(model.lags, 16)
-          : model.lags;
-  return min_origin + horizon - 1;
+  return internal::FirstPredictable(
+      model.lags, protocol == Protocol::kCausal && UsesDecomposition(model.options.method),
+      horizon);
 }
 
 std::string CausalWindowNote(const DriftModel& model, int window) {

@@ -91,9 +91,7 @@ void EvaluationOptions::Validate() const {
     ThrowOption("repeats", std::to_string(repeats), "an integer in [1, 1000]");
   if (methods.empty()) ThrowOption("methods", "(empty)", "at least one method");
   if (protocols.empty()) ThrowOption("protocols", "(empty)", "at least one protocol");
-  if (causal.window < 16 || causal.window > 1000000) {
-    ThrowOption("causal window", std::to_string(causal.window), "an integer in [16, 1000000]");
-  }
+  causal.Validate();
   internal::RequireHorizon(horizon);
 }
 
@@ -133,17 +131,17 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                     " leaves too little data (at least 32 training and 16 test samples)");
   }
   if (base.mode == Mode::kPredict && options.horizon > 1) {
-    // The first test sample's prediction starts horizon - 1 samples before the split, after
-    // the lags (and the causal protocol's 16-sample shortest window): refuse before any fit.
+    // The first test sample must be predictable with the most lags the fit may choose, under
+    // the causal protocol's rule (the stricter one): refuse before any fit.
     const int lags = base.auto_lags
                          ? *std::max_element(base.lag_candidates.begin(), base.lag_candidates.end())
                          : base.features.lags;
-    const Eigen::Index history = std::max<Eigen::Index>(lags, 16);
-    if (split - (options.horizon - 1) < history) {
+    const Eigen::Index first = internal::FirstPredictable(lags, true, options.horizon);
+    if (split < first) {
       ThrowOption("horizon", std::to_string(options.horizon),
-                  "at most " + std::to_string(split - history + 1) + " with the split at sample " +
-                      std::to_string(split) + " (" + std::to_string(history) +
-                      " samples of history before the first origin)");
+                  "at most " + std::to_string(options.horizon - (first - split)) +
+                      " with the split at sample " + std::to_string(split) +
+                      " (the lags and the shortest causal window before the first origin)");
     }
   }
   if (temperature_c.size() == n) {

@@ -23,6 +23,11 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
 // Throws OptionError naming `horizon` unless it is in [1, kMaxHorizon].
 void RequireHorizon(int horizon);
 
+// The one history rule of prediction: the first sample (0-based) predictable `horizon` steps
+// ahead with `lags` lags, its origin first - horizon + 1 needing the lags before it and, when
+// `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
+Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
+
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,

@@ -524,7 +524,10 @@ drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::
   return ReadOptions(Node(json, "options", source));
 }
 
-std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info) {
+namespace {
+
+// The file's content but the checksum.
+json ModelFileJson(const drift::DriftModel& model, const ModelFileInfo& info) {
   if (model.options.decomposition.supplied_noise) {
     throw UsageError(
         "model options hold supplied decomposition noise, which a model file cannot store; fit "
@@ -540,6 +543,13 @@ std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo&
               {"source", info.source}}},
             {"options", DriftOptionsToJson(model.options)},
             {"model", ModelJson(model)}};
+  return j;
+}
+
+}  // namespace
+
+std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info) {
+  json j = ModelFileJson(model, info);
   j["checksum"] = ChecksumText(j);
   return j.dump(1, ' ', false, json::error_handler_t::replace) + "\n";
 }
@@ -613,7 +623,8 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
   if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
     training["temperature_column"].Fail("is empty but the model uses temperature");
   }
-  json known = json::parse(RenderModelFile(out.model, out.info));
+  json known = ModelFileJson(out.model, out.info);
+  known["checksum"] = stored;
   known["options"]["learner"]["elm"]["threads"] = 0;  // older files' field, checked above
   const std::string unknown = FirstUnknownField(j, known, "");
   if (!unknown.empty()) {

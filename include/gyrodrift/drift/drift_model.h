@@ -164,6 +164,8 @@ struct CausalOptions {
   // Called with the fraction of windows decomposed, increasing, never concurrently (from whichever
   // worker finished one); may be empty. For progress displays: it does not change the result.
   std::function<void(double fraction)> progress;
+
+  void Validate() const;  // throws OptionError for a window or ensemble size out of range
 };
 
 // Largest prediction horizon, steps.

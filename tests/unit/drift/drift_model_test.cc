@@ -468,6 +468,10 @@ TEST(Evaluation, ScoresPredictionsAheadWithAHorizon) {
   // A horizon reaching back past the training block's history is refused before any fit.
   eo.horizon = 690;
   EXPECT_THROW(Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo), OptionError);
+  // The causal options are checked as PredictAhead checks them.
+  eo.horizon = 1;
+  eo.causal.ensemble_size = -1;
+  EXPECT_THROW(eo.Validate(), OptionError);
 }
 
 // Shared white-noise EMDs serve one record length: a model fitted with a set in its options does
