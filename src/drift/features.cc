@@ -24,10 +24,10 @@ constexpr std::array<std::pair<ThermalSet, std::string_view>, 4> kSets{{
 // centre spans the same space together with T and the constant.
 constexpr double kQuadraticCentreC = 20.0;
 
-// The first-order lag of temperature_c with time constant tau_s, into out (N).
+}  // namespace
+
 void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
                    double dt_s, Eigen::Ref<Eigen::VectorXd> out) {
-  // Exact step response of a first-order lag over one sample (stable for any dt / tau).
   const double gain = -std::expm1(-dt_s / tau_s);
   double state = temperature_c[0];
   for (Eigen::Index t = 0; t < temperature_c.size(); ++t) {
@@ -35,8 +35,6 @@ void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, doubl
     out[t] = state;
   }
 }
-
-}  // namespace
 
 std::string_view ToString(ThermalSet set) {
   for (const auto& [v, name] : kSets) {

@@ -64,6 +64,12 @@ Eigen::MatrixXd ThermalFeatures(const Eigen::Ref<const Eigen::VectorXd>& tempera
 // options.rate_hz (and the flag cleared).
 FeatureOptions ForTrainingRecord(FeatureOptions options, Eigen::Index samples);
 
+// The first-order lag of temperature_c with time constant tau_s at sample spacing dt_s, into out
+// (N): out[t] = out[t-1] + (1 - exp(-dt/tau)) (T[t] - out[t-1]), started in equilibrium at T[0]
+// (the exact one-sample step response; stable for any dt / tau).
+void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
+                   double dt_s, Eigen::Ref<Eigen::VectorXd> out);
+
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,
                         Eigen::Index count);

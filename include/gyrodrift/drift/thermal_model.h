@@ -1,0 +1,134 @@
+// Identification of a gyro's thermal drift model from its calibration run: which thermal states
+// of the temperature channel(s) the drift follows, with their time constants, chosen from the
+// data by cross-validation that holds out whole thermal regimes.
+//
+// Model [choice, measured in docs/drift.md section 4.5]. For temperature channels T_c (degC,
+// c = 1..C), standardised z_c = (T_c - mean_c) / sd_c over the calibration run, and S chosen
+// thermal states s_j = L^q(T_c(j); tau_j) (q cascaded first-order lags of one channel: the
+// temperature at some depth of a winding pack, or of a board behind the case),
+//   drift(t) = b0 + sum_c a_c z_c(t) + sum_j [ sum_{p=1..P} g_jp zs_j(t)^p + r_j ds_j/dt (t) ]
+// where zs_j is s_j standardised like its channel and ds_j/dt = (L^(q-1) - L^q)(T; tau_j) / tau_j
+// the state's rate (K/s). The levels and their powers carry the stress and static-bias
+// curvature (the coating stress follows the coil's mean temperature, the electronics their own),
+// the rates the Shupe drift (temperature rates inside the pack), the difference of two levels
+// the static gradient; METHOD.md section 1. The intercept b0 is the unit's repeatable bias.
+//
+// Identification: every candidate state (channel, tau) with tau on a geometric grid
+// (shortest_tau_s .. longest_tau_s, taus_per_octave per factor 2, and at most
+// longest_tau_share of the run: a slower lag cannot be told from the run's slow noise) gives
+// P + 1 columns; every subset of at most max_states candidates, with or without the channels'
+// linear terms (the intercept alone included), is scored by K-fold cross-validation whose folds
+// are contiguous groups of whole thermal regimes (ramps and dwells, Segments below), and the
+// subset of least cross-validated error is refitted on the whole run by least squares (QR).
+// The search works on per-fold Gram matrices, so it costs one pass over the data
+// (O(N M^2), M = all candidate columns) plus a small solve per subset and fold.
+//
+// Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x): s_cv is the
+// slow part of the cross-validated residual (its 10-min block means, less what the white noise
+// contributes to them: the drift error a held-out regime saw), V the coefficient covariance of
+// the fit, inflated by the residual's correlation (batch means over 10-min blocks), which grows
+// where the temperature leaves the calibration's range.
+//
+// Calibration sufficiency (CalibrationReport): temperature span, heating and cooling rates,
+// dwells, regimes, cross-validated skill against the intercept alone and the conditioning of the
+// chosen regressors, with warnings where the run cannot identify the model.
+// Cost: O(N (C G (q + P)) + N M^2 K) for G grid constants; a 16-h 1 Hz run with one channel
+// takes about 0.3 s.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace gyrodrift::drift {
+
+struct ThermalModelOptions {
+  double shortest_tau_s = 30.0;   // first grid constant, s, in [1, 1e6]
+  double longest_tau_s = 7680.0;  // last grid constant, s, in [shortest_tau_s, 1e6]
+  int taus_per_octave = 2;        // grid density (constants per factor 2), in [1, 8]
+  // Constants longer than this share of the calibration run are not candidates, in (0, 1]: a
+  // slower lag is a trend over the run, which its rate random walk imitates (1 h of a 16-h run).
+  double longest_tau_share = 0.0625;
+  int max_states = 2;  // thermal states per model, in [0, 4]
+  int state_order = 2;  // cascaded lags per state, in [1, 4]
+  int max_power = 3;    // powers of each state's level, in [1, 3]
+  // Cross-validation folds, in [2, 64]: contiguous blocks of equal duration (2 h of a 16-h run),
+  // each holding whole ramps and dwells, or, with folds_at_regimes, cut at the regime boundaries
+  // nearest to those (measured worse on the family: docs/drift.md 4.5).
+  int folds = 8;
+  bool folds_at_regimes = false;
+  // A sample belongs to a ramp when its 60-s smoothed rate exceeds this, K/min, in (0, 100].
+  double ramp_rate_k_per_min = 0.1;
+  bool operator==(const ThermalModelOptions&) const = default;
+  void Validate() const;  // throws OptionError naming the field
+  // The candidate constants for a run of `duration_s` seconds.
+  std::vector<double> Grid(double duration_s) const;
+};
+
+// One thermal state: `order` cascaded first-order lags of channel `channel` with constant tau_s.
+struct ThermalState {
+  int channel = 0;
+  double tau_s = 0.0;
+  bool operator==(const ThermalState&) const = default;
+};
+
+// A contiguous stretch of one thermal regime of the calibration run.
+struct ThermalSegment {
+  Eigen::Index begin = 0, end = 0;  // samples [begin, end)
+  bool ramp = false;                 // |rate| above ramp_rate_k_per_min (else a dwell)
+};
+
+// Ramps and dwells of channel 0 (the smoothed rate against the threshold), stretches shorter than
+// 5 minutes merged into the one before.
+std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                     double rate_hz, double ramp_rate_k_per_min);
+
+// What the calibration run offers for identification, and what the fit found.
+struct CalibrationReport {
+  double duration_s = 0.0;
+  std::vector<double> span_k;                  // max - min per channel
+  double max_heating_k_per_min = 0.0;          // of channel 0, 60-s smoothed
+  double max_cooling_k_per_min = 0.0;          // positive number
+  int ramps = 0, dwells = 0;                   // regimes (dwells of at least 10 min)
+  int folds = 0;                               // cross-validation folds used
+  double cv_rmse = 0.0;                        // of the chosen model, target units
+  double cv_rmse_constant = 0.0;               // of the intercept alone
+  // 1 - slow cross-validated error / that of the intercept alone (10-min block means less the
+  // white noise's share): how much of the drift the temperature explains on held-out regimes.
+  double skill = 0.0;
+  double condition = 0.0;                      // of the chosen regressors' scaled Gram matrix
+  std::vector<std::string> warnings;           // empty: the run identifies the model
+  std::string Summary() const;                 // one line
+};
+
+// A fitted thermal drift model (see the header comment).
+struct ThermalRegression {
+  double rate_hz = 1.0;
+  int order = 2, max_power = 3;
+  std::vector<double> centre_c, scale_k;  // per channel
+  std::vector<bool> linear;               // per channel: z_c is a regressor
+  std::vector<ThermalState> states;
+  Eigen::VectorXd coefficients;  // b0, the linear terms, then per state its powers and rate
+  Eigen::MatrixXd covariance;    // of the coefficients
+  double cv_slow_sd = 0.0;       // s_cv above, target units
+  CalibrationReport report;
+
+  int channels() const { return static_cast<int>(centre_c.size()); }
+  // N x coefficients() design of temperatures (N x channels()).
+  Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  std::vector<std::string> RegressorNames() const;  // "1", "T1", "L2(T1; 480 s)^2", "rate ..."
+  Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  // Estimate and its standard deviation (columns 0 and 1).
+  Eigen::MatrixXd EstimateWithSd(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  std::string Summary() const;  // the chosen states and the cross-validated error
+  void Validate() const;        // throws DataError when the stored fields do not fit together
+};
+
+// Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz.
+// Throws DataError for a record the cross-validation cannot split (fewer than 2 folds of at least
+// 16 samples) or non-finite samples; UsageError for bad options.
+ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                       const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
+                                       const ThermalModelOptions& options);
+
+}  // namespace gyrodrift::drift

@@ -1,0 +1,595 @@
+#include "gyrodrift/drift/thermal_model.h"
+
+#include <fmt/core.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/features.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+constexpr double kRateSmoothingS = 60.0;  // smoothing of the rate that tells ramps from dwells
+constexpr double kShortestSegmentS = 300.0;
+constexpr double kShortestDwellS = 600.0;
+constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
+constexpr Eigen::Index kShortestFold = 16;   // samples
+constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a subset
+
+// Standard deviation about the mean (population).
+double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return std::sqrt((x.array() - x.mean()).square().mean());
+}
+
+// The state of `order` cascaded lags of t (and the lag before the last, for its rate).
+void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order, double dt_s,
+             Eigen::VectorXd& previous, Eigen::VectorXd& state) {
+  state = t;
+  for (int o = 0; o < order; ++o) {
+    previous = state;
+    FirstOrderLag(previous, tau_s, dt_s, state);
+  }
+}
+
+// Columns of one state: its standardised level to the powers 1..max_power, then its rate (K/s).
+void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order,
+                  int max_power, double dt_s, double centre, double scale,
+                  Eigen::Ref<Eigen::MatrixXd> out) {
+  Eigen::VectorXd previous, state;
+  StateOf(t, tau_s, order, dt_s, previous, state);
+  const Eigen::ArrayXd z = (state.array() - centre) / scale;
+  Eigen::ArrayXd power = z;
+  for (int p = 0; p < max_power; ++p) {
+    out.col(p) = power.matrix();
+    power *= z;
+  }
+  out.col(max_power) = (previous - state) / tau_s;
+}
+
+// A partition of the run into folds: contiguous groups of whole units (regimes or time blocks),
+// cut at the unit boundaries nearest to i N / K, i = 1..K-1; each fold a range [first, last) of
+// unit indices. Fewer folds when units are few.
+std::vector<std::pair<int, int>> Partition(const std::vector<ThermalSegment>& segments,
+                                           Eigen::Index n, int k) {
+  std::vector<int> cuts{0};
+  const int count = static_cast<int>(segments.size());
+  for (int i = 1; i < k; ++i) {
+    const double ideal = static_cast<double>(n) * i / k;
+    int best = 0;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (int j = 1; j < count; ++j) {
+      const double d = std::abs(static_cast<double>(segments[static_cast<size_t>(j)].begin) - ideal);
+      if (d < best_distance) {
+        best_distance = d;
+        best = j;
+      }
+    }
+    if (best > cuts.back()) cuts.push_back(best);
+  }
+  cuts.push_back(count);
+  std::vector<std::pair<int, int>> folds;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) folds.emplace_back(cuts[i], cuts[i + 1]);
+  return folds;
+}
+
+// Equal time blocks as segments, for a run with too few regimes.
+std::vector<ThermalSegment> TimeBlocks(Eigen::Index n, int k) {
+  std::vector<ThermalSegment> blocks;
+  k = static_cast<int>(std::min<Eigen::Index>(k, n / kShortestFold));
+  for (int i = 0; i < k; ++i) blocks.push_back({n * i / k, n * (i + 1) / k, false});
+  return blocks;
+}
+
+// Least squares on the columns `cols` of Gram G and moment b, solved with unit-diagonal scaling
+// and a tiny ridge (the subsets' columns can be close to collinear).
+Eigen::VectorXd SolveSubset(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
+                            const std::vector<int>& cols) {
+  const Eigen::Index m = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd a(m, m);
+  Eigen::VectorXd rhs(m), d(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    d[i] = 1.0 / std::sqrt(std::max(g(cols[i], cols[i]), std::numeric_limits<double>::min()));
+  }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    rhs[i] = b[cols[i]] * d[i];
+    for (Eigen::Index j = 0; j < m; ++j) a(i, j) = g(cols[i], cols[j]) * d[i] * d[j];
+    a(i, i) += kRelativeRidge;
+  }
+  Eigen::VectorXd w = a.ldlt().solve(rhs);
+  return w.cwiseProduct(d);
+}
+
+// Mean of squares of the block means of x over blocks of `block` samples.
+double BlockMeanSquare(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block) {
+  const Eigen::Index blocks = x.size() / block;
+  if (blocks == 0) return x.mean() * x.mean();
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < blocks; ++i) {
+    const double m = x.segment(i * block, block).mean();
+    sum += m * m;
+  }
+  return sum / static_cast<double>(blocks);
+}
+
+std::string Seconds(double s) { return fmt::format("{:g} s", s); }
+
+}  // namespace
+
+void ThermalModelOptions::Validate() const {
+  RequireInRange("shortest_tau_s", shortest_tau_s, 1.0, 1e6);
+  RequireInRange("longest_tau_s", longest_tau_s, shortest_tau_s, 1e6);
+  if (taus_per_octave < 1 || taus_per_octave > 8) {
+    ThrowOption("taus_per_octave", std::to_string(taus_per_octave), "an integer in [1, 8]");
+  }
+  if (!(longest_tau_share > 0.0 && longest_tau_share <= 1.0)) {
+    ThrowOption("longest_tau_share", FormatValue(longest_tau_share), "in (0, 1]");
+  }
+  if (max_states < 0 || max_states > 4) {
+    ThrowOption("max_states", std::to_string(max_states), "an integer in [0, 4]");
+  }
+  if (state_order < 1 || state_order > 4) {
+    ThrowOption("state_order", std::to_string(state_order), "an integer in [1, 4]");
+  }
+  if (max_power < 1 || max_power > 3) {
+    ThrowOption("max_power", std::to_string(max_power), "an integer in [1, 3]");
+  }
+  if (folds < 2 || folds > 64) ThrowOption("folds", std::to_string(folds), "an integer in [2, 64]");
+  if (!(ramp_rate_k_per_min > 0.0 && ramp_rate_k_per_min <= 100.0)) {
+    ThrowOption("ramp_rate_k_per_min", FormatValue(ramp_rate_k_per_min), "in (0, 100]");
+  }
+}
+
+std::vector<double> ThermalModelOptions::Grid(double duration_s) const {
+  const double longest = std::min(longest_tau_s, longest_tau_share * duration_s);
+  std::vector<double> grid;
+  for (int k = 0;; ++k) {
+    const double tau = shortest_tau_s * std::exp2(static_cast<double>(k) / taus_per_octave);
+    if (tau > longest * (1.0 + 1e-12)) break;
+    grid.push_back(tau);
+  }
+  return grid;
+}
+
+std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                     double rate_hz, double ramp_rate_k_per_min) {
+  const Eigen::Index n = temperature_c.size();
+  std::vector<ThermalSegment> segments;
+  if (n == 0) return segments;
+  Eigen::VectorXd smooth(n);
+  FirstOrderLag(temperature_c, kRateSmoothingS, 1.0 / rate_hz, smooth);
+  const double threshold = ramp_rate_k_per_min / 60.0 * kRateSmoothingS;  // K of lag
+  const Eigen::Index shortest =
+      std::max<Eigen::Index>(1, static_cast<Eigen::Index>(kShortestSegmentS * rate_hz));
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const bool ramp = std::abs(temperature_c[t] - smooth[t]) > threshold;
+    if (!segments.empty() && segments.back().ramp == ramp) {
+      segments.back().end = t + 1;
+    } else {
+      segments.push_back({t, t + 1, ramp});
+    }
+  }
+  // Merge short stretches into the one before (the first into the one after), then join
+  // neighbours of one kind.
+  std::vector<ThermalSegment> merged;
+  for (const ThermalSegment& s : segments) {
+    if (!merged.empty() && (s.end - s.begin < shortest || merged.back().ramp == s.ramp)) {
+      merged.back().end = s.end;
+    } else if (!merged.empty() && merged.back().end - merged.back().begin < shortest) {
+      merged.back().end = s.end;
+      merged.back().ramp = s.ramp;
+    } else {
+      merged.push_back(s);
+    }
+  }
+  return merged;
+}
+
+std::string CalibrationReport::Summary() const {
+  std::string span;
+  for (size_t c = 0; c < span_k.size(); ++c) span += fmt::format("{}{:.3g}", c ? "/" : "", span_k[c]);
+  return fmt::format(
+      "{:.3g} h, span {} K, rates +{:.2g}/-{:.2g} K/min, {} ramps, {} dwells, {} folds; "
+      "cross-validated RMSE {:.4g} (constant {:.4g}, skill {:.1f} %), condition {:.2g}",
+      duration_s / 3600.0, span, max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells,
+      folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition);
+}
+
+Eigen::MatrixXd ThermalRegression::Regressors(
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
+  if (temperatures_c.cols() != channels()) {
+    throw DataError("the thermal model takes " + std::to_string(channels()) +
+                    " temperature channel(s), " + std::to_string(temperatures_c.cols()) +
+                    " given");
+  }
+  const Eigen::Index n = temperatures_c.rows();
+  for (int c = 0; c < channels(); ++c) {
+    RequireFiniteSignal("temperature", temperatures_c.col(c), 1);
+  }
+  Eigen::MatrixXd x(n, coefficients.size());
+  Eigen::Index col = 0;
+  x.col(col++).setOnes();
+  for (int c = 0; c < channels(); ++c) {
+    if (!linear[static_cast<size_t>(c)]) continue;
+    x.col(col++) = (temperatures_c.col(c).array() - centre_c[static_cast<size_t>(c)]) /
+                   scale_k[static_cast<size_t>(c)];
+  }
+  for (const ThermalState& s : states) {
+    const auto c = static_cast<size_t>(s.channel);
+    StateColumns(temperatures_c.col(s.channel), s.tau_s, order, max_power, 1.0 / rate_hz,
+                 centre_c[c], scale_k[c], x.middleCols(col, max_power + 1));
+    col += max_power + 1;
+  }
+  return x;
+}
+
+std::vector<std::string> ThermalRegression::RegressorNames() const {
+  std::vector<std::string> names{"1"};
+  for (int c = 0; c < channels(); ++c) {
+    if (linear[static_cast<size_t>(c)]) names.push_back(fmt::format("T{}", c + 1));
+  }
+  for (const ThermalState& s : states) {
+    const std::string state = fmt::format("L{}(T{}; {:.4g} s)", order, s.channel + 1, s.tau_s);
+    names.push_back(state);
+    for (int p = 2; p <= max_power; ++p) names.push_back(fmt::format("{}^{}", state, p));
+    names.push_back("d/dt " + state);
+  }
+  return names;
+}
+
+Eigen::VectorXd ThermalRegression::Estimate(
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
+  return Regressors(temperatures_c) * coefficients;
+}
+
+Eigen::MatrixXd ThermalRegression::EstimateWithSd(
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
+  const Eigen::MatrixXd x = Regressors(temperatures_c);
+  Eigen::MatrixXd out(x.rows(), 2);
+  out.col(0) = x * coefficients;
+  const Eigen::MatrixXd xv = x * covariance;
+  out.col(1) = ((xv.cwiseProduct(x)).rowwise().sum().array().max(0.0) + cv_slow_sd * cv_slow_sd)
+                   .sqrt()
+                   .matrix();
+  return out;
+}
+
+std::string ThermalRegression::Summary() const {
+  std::string chosen;
+  for (const ThermalState& s : states) {
+    chosen += fmt::format("{}{:.4g} s", chosen.empty() ? "" : ", ", s.tau_s);
+    if (channels() > 1) chosen += fmt::format(" (T{})", s.channel + 1);
+  }
+  return fmt::format("thermal states [{}] of order {} to power {}{}, cross-validated RMSE {:.4g}",
+                     chosen.empty() ? "none" : chosen, order, max_power,
+                     std::any_of(linear.begin(), linear.end(), [](bool b) { return b; })
+                         ? ", linear in T"
+                         : "",
+                     report.cv_rmse);
+}
+
+void ThermalRegression::Validate() const {
+  const size_t c = centre_c.size();
+  if (c == 0 || scale_k.size() != c || linear.size() != c) {
+    throw DataError("thermal model: channel fields of unequal length (or none)");
+  }
+  for (size_t i = 0; i < c; ++i) {
+    if (!std::isfinite(centre_c[i]) || !(scale_k[i] > 0.0) || !std::isfinite(scale_k[i])) {
+      throw DataError("thermal model: channel " + std::to_string(i + 1) +
+                      " needs a finite centre and a positive scale");
+    }
+  }
+  if (!(rate_hz > 0.0) || order < 1 || order > 4 || max_power < 1 || max_power > 3) {
+    throw DataError("thermal model: rate_hz, order or max_power out of range");
+  }
+  for (const ThermalState& s : states) {
+    if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) || !std::isfinite(s.tau_s)) {
+      throw DataError("thermal model: a state names a channel or time constant out of range");
+    }
+  }
+  const Eigen::Index m = static_cast<Eigen::Index>(
+      1 + std::count(linear.begin(), linear.end(), true) +
+      static_cast<long>(states.size()) * (max_power + 1));
+  if (coefficients.size() != m || covariance.rows() != m || covariance.cols() != m ||
+      !coefficients.allFinite() || !covariance.allFinite() || !(cv_slow_sd >= 0.0)) {
+    throw DataError("thermal model: " + std::to_string(coefficients.size()) +
+                    " coefficients (and covariance) for " + std::to_string(m) +
+                    " regressors, or non-finite values");
+  }
+}
+
+ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                       const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
+                                       const ThermalModelOptions& options) {
+  options.Validate();
+  RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
+  const Eigen::Index n = y.size();
+  const int channels = static_cast<int>(temperatures_c.cols());
+  if (channels < 1 || temperatures_c.rows() != n) {
+    throw DataError("thermal identification needs temperature columns of " + std::to_string(n) +
+                    " samples (the target's), got " + std::to_string(temperatures_c.rows()) +
+                    " x " + std::to_string(channels));
+  }
+  RequireFiniteSignal("target", y, 2 * kShortestFold);
+  const double dt = 1.0 / rate_hz;
+  const double duration_s = static_cast<double>(n) * dt;
+  const int powers = options.max_power;
+  const int per_state = powers + 1;
+
+  ThermalRegression model;
+  model.rate_hz = rate_hz;
+  model.order = options.state_order;
+  model.max_power = powers;
+  CalibrationReport& report = model.report;
+  report.duration_s = duration_s;
+  for (int c = 0; c < channels; ++c) {
+    const auto t = temperatures_c.col(c);
+    RequireFiniteSignal("temperature", t, n);
+    RequireVaryingSignal("temperature", t,
+                         "a thermal model needs a calibration run whose temperature changes");
+    model.centre_c.push_back(t.mean());
+    model.scale_k.push_back(Sd(t));
+    report.span_k.push_back(t.maxCoeff() - t.minCoeff());
+  }
+
+  // Regimes of channel 0 and the folds.
+  const std::vector<ThermalSegment> segments =
+      Segments(temperatures_c.col(0), rate_hz, options.ramp_rate_k_per_min);
+  for (const ThermalSegment& s : segments) {
+    if (s.ramp) {
+      ++report.ramps;
+    } else if (static_cast<double>(s.end - s.begin) * dt >= kShortestDwellS) {
+      ++report.dwells;
+    }
+  }
+  {
+    Eigen::VectorXd smooth(n);
+    FirstOrderLag(temperatures_c.col(0), kRateSmoothingS, dt, smooth);
+    const Eigen::VectorXd rate = (temperatures_c.col(0) - smooth) * (60.0 / kRateSmoothingS);
+    report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
+    report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
+  }
+  // Folds: contiguous blocks of equal duration, or groups of whole regimes; time blocks when
+  // the run has too few regimes.
+  const std::vector<ThermalSegment> time_blocks = TimeBlocks(n, options.folds);
+  std::vector<ThermalSegment> units = time_blocks;
+  if (options.folds_at_regimes && Partition(segments, n, options.folds).size() >= 3) {
+    units = segments;
+  }
+  const std::vector<std::pair<int, int>> folds = Partition(units, n, options.folds);
+  if (folds.size() < 2) {
+    throw DataError("calibration run of " + std::to_string(n) +
+                    " samples is too short to cross-validate a thermal model (at least " +
+                    std::to_string(2 * kShortestFold) + " needed)");
+  }
+  report.folds = static_cast<int>(folds.size());
+
+  // Every candidate column: intercept, the channels' linear terms, then per candidate state its
+  // powers and rate.
+  const std::vector<double> grid = options.Grid(duration_s);
+  std::vector<ThermalState> candidates;
+  for (int c = 0; c < channels; ++c) {
+    for (double tau : grid) candidates.push_back({c, tau});
+  }
+  const Eigen::Index first_state = 1 + channels;
+  const Eigen::Index m = first_state + static_cast<Eigen::Index>(candidates.size()) * per_state;
+  Eigen::MatrixXd x(n, m);
+  x.col(0).setOnes();
+  for (int c = 0; c < channels; ++c) {
+    x.col(1 + c) = (temperatures_c.col(c).array() - model.centre_c[static_cast<size_t>(c)]) /
+                   model.scale_k[static_cast<size_t>(c)];
+  }
+  for (size_t j = 0; j < candidates.size(); ++j) {
+    const auto c = static_cast<size_t>(candidates[j].channel);
+    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j].tau_s, model.order,
+                 powers, dt, model.centre_c[c], model.scale_k[c],
+                 x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
+  }
+  // Centred target: the intercept absorbs the mean, and the moments stay well scaled.
+  const double y_mean = y.mean();
+  const Eigen::VectorXd yc = y.array() - y_mean;
+  // Moments per unit (segment or block); a fold's are sums of its units', the training part's
+  // the total less the fold's.
+  const size_t u_count = units.size();
+  std::vector<Eigen::MatrixXd> g(u_count);
+  std::vector<Eigen::VectorXd> b(u_count);
+  std::vector<double> yy(u_count);
+  Eigen::MatrixXd g_total = Eigen::MatrixXd::Zero(m, m);
+  Eigen::VectorXd b_total = Eigen::VectorXd::Zero(m);
+  for (size_t i = 0; i < u_count; ++i) {
+    const Eigen::Index begin = units[i].begin, length = units[i].end - units[i].begin;
+    const auto xu = x.middleRows(begin, length);
+    g[i] = Eigen::MatrixXd::Zero(m, m);
+    g[i].selfadjointView<Eigen::Lower>().rankUpdate(xu.transpose());
+    g[i] = g[i].selfadjointView<Eigen::Lower>();
+    b[i] = xu.transpose() * yc.segment(begin, length);
+    yy[i] = yc.segment(begin, length).squaredNorm();
+    g_total += g[i];
+    b_total += b[i];
+  }
+  // A fold's moments, and those of its training part (the total less the fold's).
+  struct Fold {
+    Eigen::MatrixXd g, g_train;
+    Eigen::VectorXd b, b_train;
+    double yy = 0.0;
+    Eigen::Index begin = 0, end = 0;
+  };
+  std::vector<Fold> fold_moments;
+  for (const auto& [first, last] : folds) {
+    Fold f{Eigen::MatrixXd::Zero(m, m), {}, Eigen::VectorXd::Zero(m), {}, 0.0,
+           units[static_cast<size_t>(first)].begin, units[static_cast<size_t>(last - 1)].end};
+    for (int i = first; i < last; ++i) {
+      f.g += g[static_cast<size_t>(i)];
+      f.b += b[static_cast<size_t>(i)];
+      f.yy += yy[static_cast<size_t>(i)];
+    }
+    f.g_train = g_total - f.g;
+    f.b_train = b_total - f.b;
+    fold_moments.push_back(std::move(f));
+  }
+  // Cross-validated mean square error of the columns `cols`.
+  auto cv_mse = [&](const std::vector<int>& cols) {
+    double sum = 0.0;
+    for (const Fold& f : fold_moments) {
+      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, cols);
+      double e = f.yy;
+      for (size_t i = 0; i < cols.size(); ++i) {
+        e -= 2.0 * w[static_cast<Eigen::Index>(i)] * f.b[cols[i]];
+        for (size_t j = 0; j < cols.size(); ++j) {
+          e += w[static_cast<Eigen::Index>(i)] * f.g(cols[i], cols[j]) *
+               w[static_cast<Eigen::Index>(j)];
+        }
+      }
+      sum += std::max(0.0, e);
+    }
+    return sum / static_cast<double>(n);
+  };
+
+  // Every subset: the channels' linear terms or not, and up to max_states candidate states in
+  // increasing order (combinations).
+  const int max_states = std::min<int>(options.max_states, static_cast<int>(candidates.size()));
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<int> best_cols;
+  std::vector<int> best_states;
+  bool best_linear = false;
+  std::vector<int> chosen;  // candidate indices of the current combination
+  const double constant_mse = cv_mse({0});
+  auto visit = [&](auto&& self, int next) -> void {
+    for (bool with_linear : {false, true}) {
+      std::vector<int> cols{0};
+      if (with_linear) {
+        for (int c = 0; c < channels; ++c) cols.push_back(1 + c);
+      }
+      for (int j : chosen) {
+        for (int p = 0; p < per_state; ++p) {
+          cols.push_back(static_cast<int>(first_state) + j * per_state + p);
+        }
+      }
+      const double e = cols.size() == 1 ? constant_mse : cv_mse(cols);
+      if (e < best) {
+        best = e;
+        best_cols = cols;
+        best_states = chosen;
+        best_linear = with_linear;
+      }
+    }
+    if (static_cast<int>(chosen.size()) == max_states) return;
+    for (int j = next; j < static_cast<int>(candidates.size()); ++j) {
+      chosen.push_back(j);
+      self(self, j + 1);
+      chosen.pop_back();
+    }
+  };
+  visit(visit, 0);
+
+  // Refit the chosen columns on the whole run (QR of the unit-scaled design).
+  const Eigen::Index p = static_cast<Eigen::Index>(best_cols.size());
+  Eigen::MatrixXd xs(n, p);
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    xs.col(i) = x.col(best_cols[static_cast<size_t>(i)]);
+    scale[i] = 1.0 / std::max(xs.col(i).norm(), std::numeric_limits<double>::min());
+  }
+  const Eigen::MatrixXd xn = xs * scale.asDiagonal();
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(xn);
+  model.coefficients = scale.asDiagonal() * qr.solve(y);
+  model.linear.assign(static_cast<size_t>(channels), best_linear);
+  for (int j : best_states) model.states.push_back(candidates[static_cast<size_t>(j)]);
+
+  // Uncertainty: residual variance inflated by its correlation (batch means), and the slow part
+  // of the cross-validated residual.
+  const Eigen::VectorXd residual = y - xs * model.coefficients;
+  const double variance = residual.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, n - p));
+  const Eigen::Index block = std::clamp<Eigen::Index>(
+      static_cast<Eigen::Index>(std::round(kBlockS * rate_hz)), 1, std::max<Eigen::Index>(1, n / 4));
+  const Eigen::VectorXd centred = residual.array() - residual.mean();
+  const double inflation =
+      variance > 0.0 ? std::max(1.0, static_cast<double>(block) * BlockMeanSquare(centred, block) /
+                                         variance)
+                     : 1.0;
+  Eigen::MatrixXd gram_n = xn.transpose() * xn;
+  const Eigen::MatrixXd gram_inv =
+      gram_n.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
+  model.covariance = scale.asDiagonal() * gram_inv * scale.asDiagonal() * (variance * inflation);
+  // Residual of the cross-validated predictions of each held-out fold, from the per-fold solves.
+  auto cv_residual_of = [&](const std::vector<int>& cols) {
+    Eigen::VectorXd r(n);
+    for (const Fold& f : fold_moments) {
+      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, cols);
+      Eigen::MatrixXd xf(f.end - f.begin, static_cast<Eigen::Index>(cols.size()));
+      for (size_t i = 0; i < cols.size(); ++i) {
+        xf.col(static_cast<Eigen::Index>(i)) = x.col(cols[i]).segment(f.begin, f.end - f.begin);
+      }
+      r.segment(f.begin, f.end - f.begin) = yc.segment(f.begin, f.end - f.begin) - xf * w;
+    }
+    return r;
+  };
+  const Eigen::VectorXd cv_residual = cv_residual_of(best_cols);
+  double white = 0.0;  // variance of the residual's white part, from its first differences
+  for (Eigen::Index t = 1; t < n; ++t) {
+    const double d = residual[t] - residual[t - 1];
+    white += d * d;
+  }
+  white /= 2.0 * static_cast<double>(n - 1);
+  const double white_share = white / static_cast<double>(block);
+  const double slow_ms = std::max(0.0, BlockMeanSquare(cv_residual, block) - white_share);
+  model.cv_slow_sd = std::sqrt(slow_ms);
+
+  // Report.
+  report.cv_rmse = std::sqrt(best);
+  report.cv_rmse_constant = std::sqrt(constant_mse);
+  // Skill on the slow part (block means less the white noise's share): the white noise, which no
+  // thermal model explains, would otherwise hide it.
+  const double constant_slow_ms =
+      std::max(0.0, BlockMeanSquare(cv_residual_of({0}), block) - white_share);
+  report.skill = constant_slow_ms > 0.0 ? 1.0 - slow_ms / constant_slow_ms : 0.0;
+  {
+    const Eigen::VectorXd d = gram_n.diagonal().cwiseSqrt().cwiseInverse();
+    const Eigen::MatrixXd unit = d.asDiagonal() * gram_n * d.asDiagonal();
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(unit).eigenvalues();
+    report.condition = ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
+  }
+  auto& w = report.warnings;
+  for (int c = 0; c < channels; ++c) {
+    if (report.span_k[static_cast<size_t>(c)] < 15.0) {
+      w.push_back(fmt::format(
+          "temperature {} spans only {:.3g} K: the model is not identified beyond it",
+          channels > 1 ? fmt::format("T{}", c + 1) : std::string(), report.span_k[static_cast<size_t>(c)]));
+    }
+  }
+  if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min)
+    w.push_back("no heating ramp: the response to rising temperature is not identified");
+  if (report.max_cooling_k_per_min < 2.0 * options.ramp_rate_k_per_min)
+    w.push_back("no cooling ramp: the response to falling temperature is not identified");
+  if (report.dwells == 0) {
+    w.push_back(
+        "no dwell of 10 min or more: the level response cannot be told from the rate response");
+  }
+  if (report.ramps + report.dwells < 3) {
+    w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
+  }
+  if (!model.states.empty() && duration_s < 8.0 * model.states.back().tau_s) {
+    w.push_back("the run is shorter than 8 times the slowest chosen time constant (" +
+                Seconds(model.states.back().tau_s) + ")");
+  }
+  if (report.skill < 0.2) {
+    w.push_back(fmt::format(
+        "cross-validation confirms no temperature dependence (skill {:.1f} %): the estimate is "
+        "close to a constant bias",
+        100.0 * report.skill));
+  }
+  if (report.condition > 1e10) {
+    w.push_back(fmt::format("the chosen regressors are nearly collinear (condition {:.2g})",
+                            report.condition));
+  }
+  model.Validate();
+  return model;
+}
+
+}  // namespace gyrodrift::drift
