@@ -42,16 +42,26 @@ void Run(const CompensateArgs& a) {
     }
   }
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
-  const Eigen::VectorXd temperature = table.Column(loaded.info.temperature_column);
+  const Eigen::MatrixXd temperature =
+      ReadTemperatureColumns(table, loaded.info.temperature_column).values;
   Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
   if (!a.truth.empty()) truth = table.Column(a.truth);
-  const Eigen::VectorXd estimate = drift::EstimateDrift(model, temperature);
+  for (const char* name : {"drift_sd"}) {
+    if (table.HasColumn(name) && model.identified()) {
+      throw DataError(a.input + " already has a column '" + name +
+                      "': compensate an uncompensated log");
+    }
+  }
+  const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature);
+  const Eigen::VectorXd estimate = estimate_sd.col(0);
 
   std::vector<io::CsvColumn> columns;
   for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
     columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
   }
   columns.push_back({"drift_est", estimate});
+  // Identified models give each estimate a standard deviation (thermal_model.h).
+  if (model.identified()) columns.push_back({"drift_sd", estimate_sd.col(1)});
   const Eigen::VectorXd compensated = y - estimate;
   columns.push_back({"compensated", compensated});
 
@@ -89,8 +99,8 @@ void Run(const CompensateArgs& a) {
                              ColumnName(table, a.truth), truth_rms, residual_rms, share);
   }
   // A thermal model beyond the temperatures it was fitted on extrapolates: say where.
-  const double outside =
-      drift::ShareOutsideRange(temperature, model.temperature_min_c, model.temperature_max_c);
+  const double outside = drift::ShareOutsideRange(temperature.col(0), model.temperature_min_c,
+                                                 model.temperature_max_c);
   sidecar["outside_training_temperature_share"] = outside;
   std::string outside_line;
   if (outside > 0.0) {
@@ -98,6 +108,16 @@ void Run(const CompensateArgs& a) {
         "note: {:.1f} % of the samples lie outside the training temperature range [{:.4g}, {:.4g}] "
         "degC: the estimate extrapolates there\n",
         100.0 * outside, model.temperature_min_c, model.temperature_max_c);
+  }
+  // A model the calibration run could not identify says so every time it is used.
+  for (const auto& sub : model.sub_models) {
+    if (!sub.thermal) continue;
+    for (const std::string& w : sub.thermal->report.warnings) {
+      outside_line += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
+    }
+  }
+  if (model.identified()) {
+    sidecar["drift_sd_mean"] = estimate_sd.col(1).mean();
   }
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
@@ -120,7 +140,8 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       "      -o model.json\n"
       "  gyrodrift compensate model.json test.csv -o out.csv\n"
       "writes out.csv: every column of test.csv, then drift_est (the model's drift estimate,\n"
-      "from the temperature history only) and compensated (= target column - drift_est), one\n"
+      "from the temperature history only), drift_sd (its standard deviation, for identified\n"
+      "models: thermal, ms-elm, emd-elm) and compensated (= target column - drift_est), one\n"
       "row per input row; out.csv.json records the model and the std before and after.\n"
       "With --truth drift_dph (a simulated log) it also reports how much of the true drift's\n"
       "RMS the estimate removes: 1 - RMS(truth - drift_est) / RMS(truth).\n"

@@ -1032,7 +1032,7 @@ void Run(const DemoArgs& a) {
   } catch (const UsageError&) {
     ThrowOption("--units", a.units, "one of dph, dps, rads");
   }
-  const std::vector<drift::Method> methods = ParseMethods(a.methods);
+  const std::vector<drift::Method> methods = ParseMethods(a.methods, drift::Mode::kCompensate);
   const double duration_s = ParseDuration(a.duration);
   // Run A must show the model a ramp and a dwell at a new level: the chamber programme ramps from
   // 30 to 70 min. On shorter runs the level and rate responses cannot be told apart, and every
@@ -1128,11 +1128,14 @@ void Run(const DemoArgs& a) {
     drift::DriftOptions o = BaseOptions(a, s.rate_hz);
     o.mode = drift::Mode::kPredict;
     drift::EvaluationOptions e;
-    e.methods = methods;
+    e.methods.clear();
+    for (drift::Method m : methods) {
+      if (drift::SupportsMode(m, drift::Mode::kPredict)) e.methods.push_back(m);
+    }
     e.causal.window = a.window;
     e.causal.threads = a.threads;
     e.causal.ensemble_size = a.ensemble;
-    e.progress = TrialProgress(bar, methods, drift::Mode::kPredict, "predict: ");
+    e.progress = TrialProgress(bar, e.methods, drift::Mode::kPredict, "predict: ");
     s.predict = drift::Evaluate(s.y, s.temperature, s.truth, o, e);
   }
   stage_done("predict mode (both protocols)", t0);

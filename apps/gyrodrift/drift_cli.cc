@@ -41,8 +41,14 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
   cmd->add_option("--target,-t", a->target, "column of the gyro output (name or 1-based index)")
       ->required();
   cmd->add_option("--temperature,-T", a->temperature,
-                  "temperature column, degC (needed by --mode compensate; in predict mode it adds "
-                  "the thermal history to the lags)");
+                  "temperature column(s), degC, comma-separated (needed by --mode compensate, "
+                  "where the thermal, ms-elm and emd-elm methods take several; in predict mode "
+                  "one column adds the thermal history to the lags)");
+  a->reference_option = cmd->add_option(
+      "--reference-temperature", a->reference_c,
+      "compensate mode: reference the estimate to thermal equilibrium at this temperature, degC "
+      "(for a bias calibrated separately); default: keep the fitted intercept, the unit's "
+      "repeatable bias");
   cmd->add_option(
          "--mode", a->mode,
          "predict (one-step-ahead from past samples) | compensate (drift from temperature)")
@@ -113,6 +119,13 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
         "alone)");
   }
   o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
+  if (a.reference_option != nullptr && a.reference_option->count() > 0) {
+    if (o.mode != drift::Mode::kCompensate) {
+      throw UsageError("--reference-temperature applies to --mode compensate");
+    }
+    RequireInRange("--reference-temperature", a.reference_c, -100.0, 200.0);
+    o.reference_c = a.reference_c;
+  }
   if (a.rate_option != nullptr && a.rate_option->count() > 0) o.features.rate_hz = a.rate_hz;
   o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
   if (!a.time_constants_s.empty()) {
@@ -135,13 +148,49 @@ void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& tabl
                     "); " + table.source() + " has: " + Columns(table));
   };
   require(loaded.info.target_column, "--target");
-  if (loaded.model.uses_temperature()) require(loaded.info.temperature_column, "--temperature");
+  if (loaded.model.uses_temperature()) {
+    for (const std::string& c : SplitColumns(loaded.info.temperature_column)) {
+      require(c, "--temperature");
+    }
+  }
+}
+
+std::vector<std::string> SplitColumns(const std::string& names) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= names.size()) {
+    const size_t comma = names.find(',', start);
+    out.push_back(names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+TemperatureColumns ReadTemperatureColumns(const io::CsvTable& table, const std::string& spec) {
+  const std::vector<std::string> items = SplitColumns(spec);
+  TemperatureColumns out;
+  out.values.resize(0, static_cast<Eigen::Index>(items.size()));
+  std::vector<std::string> seen;
+  for (size_t c = 0; c < items.size(); ++c) {
+    if (items[c].empty()) ThrowOption("--temperature", "'" + spec + "'", "column names without empty items");
+    const std::string name = ColumnName(table, items[c]);
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      ThrowOption("--temperature", "'" + spec + "'", "a list without repeats");
+    }
+    seen.push_back(name);
+    const Eigen::VectorXd column = table.Column(items[c]);
+    if (c == 0) out.values.resize(column.size(), static_cast<Eigen::Index>(items.size()));
+    out.values.col(static_cast<Eigen::Index>(c)) = column;
+    out.names += (c ? "," : "") + name;
+  }
+  return out;
 }
 
 // "all" or a comma-separated list; an empty item (a trailing comma) or a repeat is an error: a
 // repeated method would give two model files of one name in the demo.
-std::vector<drift::Method> ParseMethods(const std::string& text) {
-  if (text == "all") return drift::AllMethods();
+std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode) {
+  if (text == "all") return drift::AllMethods(mode);
   std::vector<drift::Method> methods;
   size_t start = 0;
   while (start <= text.size()) {

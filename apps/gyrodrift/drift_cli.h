@@ -20,7 +20,9 @@ namespace gyrodrift::cli {
 struct DriftArgs {
   std::string input;
   std::string target;
-  std::string temperature;  // "" = none
+  std::string temperature;  // "" = none; several columns comma-separated
+  double reference_c = 0.0;
+  CLI::Option* reference_option = nullptr;  // "--reference-temperature given"
   std::string mode;
   std::string decomposition = "beemdan";
   std::string lags = "4";       // "auto" or p
@@ -56,8 +58,19 @@ double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::stri
 // the table has the model's target column and, when the model uses it, its temperature column.
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);
 
-// --methods: "all" (every drift::Method) or a comma-separated list without repeats or empty
-// items. Throws UsageError naming --methods.
-std::vector<drift::Method> ParseMethods(const std::string& text);
+// --methods: "all" (every drift::Method of `mode`) or a comma-separated list without repeats or
+// empty items. Throws UsageError naming --methods.
+std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode);
+
+// The temperature columns of `spec` ("a" or "a,b"): their names joined by commas, and the
+// N x C matrix. Throws UsageError for an unknown, empty or repeated column.
+struct TemperatureColumns {
+  std::string names;
+  Eigen::MatrixXd values;
+};
+TemperatureColumns ReadTemperatureColumns(const io::CsvTable& table, const std::string& spec);
+
+// The comma-separated names of a model file's temperature_column.
+std::vector<std::string> SplitColumns(const std::string& names);
 
 }  // namespace gyrodrift::cli

@@ -55,7 +55,7 @@ void Run(const EvaluateArgs& a) {
   drift::EvaluationOptions e;
   e.split = a.split;
   e.repeats = a.repeats;
-  e.methods = ParseMethods(a.methods);
+  e.methods = ParseMethods(a.methods, base.mode);
   e.protocols = ParseProtocols(a.protocol);
   e.causal.window = a.window;
   e.causal.threads = a.threads;

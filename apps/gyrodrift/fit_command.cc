@@ -1,6 +1,7 @@
 // gyrodrift fit: fit a drift model (MS-ELM or a baseline) on a CSV log and save it as a model file.
 #include <fmt/core.h>
 
+#include <cmath>
 #include <memory>
 
 #include "cli_util.h"
@@ -15,20 +16,54 @@
 namespace gyrodrift::cli {
 namespace {
 
+// The chosen regressors with their coefficients, the calibration report and its warnings; "T1"
+// in the names is the first temperature column, and so on.
+void PrintThermalModel(const std::string& name, const drift::ThermalRegression& t,
+                       const std::vector<std::string>& channels) {
+  fmt::print("  {:<8} {}\n", name, t.Summary());
+  const std::vector<std::string> names = t.RegressorNames();
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::string label = names[i];
+    for (size_t c = channels.size(); c-- > 0;) {
+      const std::string key = "T" + std::to_string(c + 1);
+      for (size_t at = label.find(key); at != std::string::npos; at = label.find(key, at)) {
+        label.replace(at, key.size(), channels[c]);
+        at += channels[c].size();
+      }
+    }
+    const auto k = static_cast<Eigen::Index>(i);
+    fmt::print("           {:<40} {:>12.6g} +- {:.2g}\n", label, t.coefficients[k],
+               std::sqrt(t.covariance(k, k)));
+  }
+  fmt::print("           calibration: {}\n", t.report.Summary());
+  for (const std::string& w : t.report.warnings) {
+    fmt::print("warning: calibration run ({}): {}\n", name, w);
+  }
+}
+
 struct FitArgs : DriftArgs {
-  std::string method = "ms-elm";
+  std::string method = "auto";
   std::string output;
 };
 
+// "auto": ms-elm in predict mode (the paper's model); in compensate mode the identified thermal
+// model of the whole output, which beat the per-group identification of ms-elm on the gyro family
+// and on the simulator (docs/drift.md 4.5).
+drift::Method ResolveMethod(const FitArgs& a) {
+  if (a.method != "auto") return drift::MethodFromString(a.method);
+  return drift::ModeFromString(a.mode) == drift::Mode::kCompensate ? drift::Method::kThermal
+                                                                   : drift::Method::kMsElm;
+}
+
 void Run(const FitArgs& a) {
-  const drift::Method method = drift::MethodFromString(a.method);
+  const drift::Method method = ResolveMethod(a);
   drift::DriftOptions o = MakeDriftOptions(a, method);
   const bool elm_based = method == drift::Method::kMsElm || method == drift::Method::kEmdElm ||
                          method == drift::Method::kElm;
   if (!elm_based && a.hidden_option->count() > 0 && a.hidden != "auto") {
     throw UsageError("--hidden = " + a.hidden +
                      ": applies to the ELM methods (ms-elm, emd-elm, elm), not --method " +
-                     a.method);
+                     std::string(drift::ToString(method)));
   }
   if (o.mode == drift::Mode::kCompensate && o.linear_compensation &&
       method != drift::Method::kElm && elm_based && a.hidden_option->count() > 0 &&
@@ -45,18 +80,22 @@ void Run(const FitArgs& a) {
   info.source = a.input;
   info.target_column = ColumnName(table, a.target);
   const Eigen::VectorXd y = table.Column(a.target);
-  Eigen::VectorXd temperature;
+  Eigen::MatrixXd temperature;
   if (!a.temperature.empty()) {
-    info.temperature_column = ColumnName(table, a.temperature);
-    if (info.temperature_column == info.target_column) {
-      throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+    TemperatureColumns t = ReadTemperatureColumns(table, a.temperature);
+    for (const std::string& name : SplitColumns(t.names)) {
+      if (name == info.target_column) {
+        throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+      }
     }
-    temperature = table.Column(a.temperature);
+    info.temperature_column = t.names;
+    temperature = std::move(t.values);
   }
   ProgressBar progress({1.0}, IsTerminal() && !a.quiet);
-  progress.BeginStage(0, a.method);
-  o.progress = [&progress, &a](double fraction, const std::string& step) {
-    progress.Update(fraction, a.method + ": " + step);
+  const std::string method_name(drift::ToString(method));
+  progress.BeginStage(0, method_name);
+  o.progress = [&progress, &method_name](double fraction, const std::string& step) {
+    progress.Update(fraction, method_name + ": " + step);
   };
   const drift::DriftModel model = drift::FitDriftModel(y, temperature, o);
   progress.Finish();
@@ -74,7 +113,12 @@ void Run(const FitArgs& a) {
     }
     fmt::print("lags: {} chosen by validation RMSE ({})\n", model.lags, rmse);
   }
+  const std::vector<std::string> channels = SplitColumns(info.temperature_column);
   for (const auto& sub : model.sub_models) {
+    if (sub.thermal) {
+      PrintThermalModel(sub.name, *sub.thermal, channels);
+      continue;
+    }
     fmt::print(
         "  {:<8} {}\n", sub.name,
         sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");
@@ -97,13 +141,17 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "  gyrodrift compensate model.json test.csv -o compensated.csv\n"
       "Modes: predict = one-step-ahead prediction of the output from its own past (the paper's\n"
       "task; --temperature adds the thermal history); compensate = drift estimated from the\n"
-      "temperature alone, what a navigation computer runs. ms-elm decomposes the record\n"
+      "temperature alone, what a navigation computer runs: the thermal method identifies which\n"
+      "thermal states (lags of the temperature with their time constants, powers and rates) the\n"
+      "drift follows, by cross-validation over the calibration run. ms-elm decomposes the record\n"
       "(BEEMDAN), groups the IMFs into noise/mixed/drift and fits one ELM per group; emd-elm\n"
       "fits one ELM per IMF; elm, poly, svr, bp are single models on the raw signal.\n"
       "model.json holds every option, the training column names and the fitted parameters\n"
       "(exact doubles, checksummed). See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get());
-  cmd->add_option("--method,-m", args->method, "ms-elm|elm|emd-elm|poly|svr|bp")
+  cmd->add_option("--method,-m", args->method,
+                  "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in predict mode, "
+                  "thermal in compensate mode)")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "model file to write (JSON)")->required();
   cmd->callback([args] { Run(*args); });

@@ -23,13 +23,14 @@ constexpr std::array<std::pair<Mode, std::string_view>, 2> kModes{{
     {Mode::kPredict, "predict"},
     {Mode::kCompensate, "compensate"},
 }};
-constexpr std::array<std::pair<Method, std::string_view>, 6> kMethods{{
+constexpr std::array<std::pair<Method, std::string_view>, 7> kMethods{{
     {Method::kMsElm, "ms-elm"},
     {Method::kElm, "elm"},
     {Method::kEmdElm, "emd-elm"},
     {Method::kPoly, "poly"},
     {Method::kSvr, "svr"},
     {Method::kBp, "bp"},
+    {Method::kThermal, "thermal"},
 }};
 constexpr std::array<std::pair<Protocol, std::string_view>, 2> kProtocols{{
     {Protocol::kPaper, "paper"},
@@ -52,20 +53,36 @@ LearnerKind KindOf(Method method) {
   }
 }
 
-void RequireTemperatureFor(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, Eigen::Index n) {
-  if (temperature_c.size() != n) {
-    throw DataError("temperature has " + std::to_string(temperature_c.size()) +
+void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, Eigen::Index n) {
+  if (temperature_c.rows() != n || temperature_c.cols() < 1) {
+    throw DataError("temperature has " + std::to_string(temperature_c.rows()) +
                     " samples, the target " + std::to_string(n) + ": they must match");
   }
-  RequireFiniteSignal("temperature", temperature_c, n);
+  for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+    RequireFiniteSignal("temperature", temperature_c.col(c), n);
+  }
+}
+
+// The single temperature channel of the feature-based models.
+void RequireOneChannel(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                       const DriftOptions& o) {
+  if (temperature_c.cols() > 1) {
+    ThrowOption("temperature channels", std::to_string(temperature_c.cols()),
+                "one for method " + std::string(ToString(o.method)) + " in " +
+                    std::string(ToString(o.mode)) +
+                    " mode (several channels: compensate mode with thermal, ms-elm or emd-elm)");
+  }
 }
 
 Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
-                               const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                               const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                                Eigen::Index n) {
-  if (!model.uses_temperature()) return Eigen::MatrixXd(n, 0);
+  if (!model.uses_temperature() || IdentifiesThermalModel(model.options)) {
+    return Eigen::MatrixXd(n, 0);
+  }
   RequireTemperatureFor(temperature_c, n);
-  return ThermalFeatures(temperature_c, EffectiveFeatures(model.options));
+  RequireOneChannel(temperature_c, model.options);
+  return ThermalFeatures(temperature_c.col(0), EffectiveFeatures(model.options));
 }
 
 // Rows of inputs of sub-model g for t = first .. first + count - 1 (predict mode).
@@ -104,10 +121,21 @@ Protocol ProtocolFromString(std::string_view name) {
   return EnumFromName(name, "protocol", kProtocols);
 }
 
-std::vector<Method> AllMethods() {
+bool SupportsMode(Method method, Mode mode) {
+  return method != Method::kThermal || mode == Mode::kCompensate;
+}
+
+std::vector<Method> AllMethods(Mode mode) {
   std::vector<Method> all;
-  for (const auto& [m, name] : kMethods) all.push_back(m);
+  for (const auto& [m, name] : kMethods) {
+    if (SupportsMode(m, mode)) all.push_back(m);
+  }
   return all;
+}
+
+bool IdentifiesThermalModel(const DriftOptions& o) {
+  return o.mode == Mode::kCompensate && o.linear_compensation &&
+         (o.method == Method::kThermal || UsesDecomposition(o.method));
 }
 
 FeatureOptions EffectiveFeatures(const DriftOptions& options) {
@@ -132,6 +160,12 @@ void DriftOptions::Validate() const {
   selection.Validate();
   EffectiveFeatures(*this).Validate();
   if (!std::isnan(reference_c)) RequireInRange("reference_c", reference_c, -100.0, 200.0);
+  if (!SupportsMode(method, mode)) {
+    ThrowOption("method", std::string(ToString(method)),
+                "a method of " + std::string(ToString(mode)) +
+                    " mode (thermal identifies a compensation model: --mode compensate)");
+  }
+  thermal.Validate();
   LearnerOptions l = learner;
   l.kind = KindOf(method);
   l.Validate();
@@ -151,6 +185,18 @@ bool DriftOptions::uses_temperature() const {
   return mode == Mode::kCompensate || features.use_temperature;
 }
 
+int DriftModel::temperature_channels() const {
+  for (const SubModel& sub : sub_models) {
+    if (sub.thermal) return sub.thermal->channels();
+  }
+  return uses_temperature() ? 1 : 0;
+}
+
+bool DriftModel::identified() const {
+  return std::any_of(sub_models.begin(), sub_models.end(),
+                     [](const SubModel& sub) { return sub.thermal != nullptr; });
+}
+
 int DriftModel::num_inputs() const {
   const int thermal = uses_temperature() ? EffectiveFeatures(options).NumThermalFeatures() : 0;
   return options.mode == Mode::kCompensate ? thermal : lags + thermal;
@@ -161,7 +207,11 @@ std::string DriftModel::Summary() const {
                   std::string(ToString(options.mode)) + "): " + std::to_string(sub_models.size()) +
                   " sub-model" + (sub_models.size() == 1 ? "" : "s") + " [";
   for (size_t g = 0; g < sub_models.size(); ++g) s += (g ? " " : "") + sub_models[g].name;
-  s += "], " + std::to_string(num_inputs()) + " inputs";
+  s += "], ";
+  s += identified()
+           ? std::to_string(temperature_channels()) + " temperature channel" +
+                 (temperature_channels() == 1 ? "" : "s") + ", identified"
+           : std::to_string(num_inputs()) + " inputs";
   if (options.mode == Mode::kPredict) s += ", " + std::to_string(lags) + " lags";
   s += ", trained on " + std::to_string(training_samples) + " samples";
   return s;
@@ -261,10 +311,22 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
 
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
-                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end) {
+                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
   const DriftOptions& o = model.options;
   model.training_samples = fit_end;
   const size_t groups = model.sub_models.size();
+  if (IdentifiesThermalModel(o)) {
+    // Every sub-series chooses its own thermal states: fast rate terms for the noise and mixed
+    // groups, slow levels for the drift group, if the data say so.
+    for (size_t g = 0; g < groups; ++g) {
+      model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
+          IdentifyThermalModel(temperature_c.topRows(fit_end),
+                               series.col(static_cast<Eigen::Index>(g)).head(fit_end),
+                               o.features.rate_hz, o.thermal));
+    }
+    return;
+  }
   if (o.mode == Mode::kCompensate) {
     const bool linear = o.linear_compensation && UsesDecomposition(o.method);
     for (size_t g = 0; g < groups; ++g) {
@@ -320,7 +382,7 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
 }  // namespace internal
 
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
-                         const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                         const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options) {
   options.Validate();
   RequireFiniteSignal("target", y, 32);
@@ -328,8 +390,11 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   if (options.uses_temperature()) {
     // Checked before the decomposition, which is the slow part.
     RequireTemperatureFor(temperature_c, y.size());
-    RequireVaryingSignal("temperature", temperature_c,
-                         "a drift model on temperature needs a record whose temperature changes");
+    if (!IdentifiesThermalModel(options)) RequireOneChannel(temperature_c, options);
+    for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+      RequireVaryingSignal("temperature", temperature_c.col(c),
+                           "a drift model on temperature needs a record whose temperature changes");
+    }
   }
   DriftOptions o = options;
   o.features = ForTrainingRecord(o.features, y.size());
@@ -338,10 +403,10 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decomposed = UsesDecomposition(options.method);
   if (options.progress)
     options.progress(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
-  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size());
+  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c);
   if (prepared.model.uses_temperature()) {
-    prepared.model.temperature_min_c = temperature_c.minCoeff();
-    prepared.model.temperature_max_c = temperature_c.maxCoeff();
+    prepared.model.temperature_min_c = temperature_c.col(0).minCoeff();
+    prepared.model.temperature_max_c = temperature_c.col(0).maxCoeff();
   }
   if (options.progress) options.progress(1.0, "fit sub-models");
   return std::move(prepared.model);
@@ -354,27 +419,55 @@ double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
   return static_cast<double>(outside.count()) / static_cast<double>(temperature_c.size());
 }
 
-Eigen::VectorXd EstimateDrift(const DriftModel& model,
-                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c) {
+Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
   if (model.options.mode != Mode::kCompensate) {
     throw UsageError(
         "model mode = predict: drift estimation needs a model fitted with --mode compensate");
   }
-  const FeatureOptions features = EffectiveFeatures(model.options);
-  const Eigen::MatrixXd f = ThermalFeatures(temperature_c, features);
+  const Eigen::Index n = temperature_c.rows();
+  if (temperature_c.cols() != model.temperature_channels()) {
+    throw DataError("the model takes " + std::to_string(model.temperature_channels()) +
+                    " temperature channel(s), " + std::to_string(temperature_c.cols()) +
+                    " given");
+  }
   // Equilibrium at the reference: a one-sample record starts (and stays) in equilibrium.
   const bool referenced = !std::isnan(model.options.reference_c);
-  const Eigen::MatrixXd f_ref =
-      referenced
-          ? ThermalFeatures(Eigen::VectorXd::Constant(1, model.options.reference_c), features)
-          : Eigen::MatrixXd();
-  Eigen::VectorXd estimate = Eigen::VectorXd::Zero(temperature_c.size());
+  const Eigen::MatrixXd t_ref =
+      Eigen::MatrixXd::Constant(1, temperature_c.cols(), model.options.reference_c);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, 2);
+  bool every_band = true;
+  Eigen::MatrixXd f;
+  Eigen::MatrixXd f_ref;
   for (const auto& sub : model.sub_models) {
+    if (sub.thermal) {
+      const Eigen::MatrixXd e = sub.thermal->EstimateWithSd(temperature_c);
+      out.col(0) += e.col(0);
+      out.col(1) += e.col(1).cwiseAbs2();
+      if (referenced) out.col(0).array() -= sub.thermal->Estimate(t_ref)[0];
+      continue;
+    }
+    every_band = false;
     if (!sub.learner) continue;
-    estimate += sub.learner->Predict(f);
-    if (referenced) estimate.array() -= sub.learner->Predict(f_ref)[0];
+    if (f.size() == 0) {
+      const FeatureOptions features = EffectiveFeatures(model.options);
+      f = ThermalFeatures(temperature_c.col(0), features);
+      if (referenced) f_ref = ThermalFeatures(t_ref.col(0), features);
+    }
+    out.col(0) += sub.learner->Predict(f);
+    if (referenced) out.col(0).array() -= sub.learner->Predict(f_ref)[0];
   }
-  return estimate;
+  if (every_band) {
+    out.col(1) = out.col(1).cwiseSqrt();
+  } else {
+    out.col(1).setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+  return out;
+}
+
+Eigen::VectorXd EstimateDrift(const DriftModel& model,
+                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
+  return EstimateDriftWithSd(model, temperature_c).col(0);
 }
 
 namespace {

@@ -39,14 +39,17 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decompose_all = protocol == Protocol::kPaper && UsesDecomposition(o.method);
   Eigen::MatrixXd series_all;
   Eigen::MatrixXd thermal_all;
-  if (thermal_needed) thermal_all = ThermalFeatures(temperature_c, EffectiveFeatures(o));
+  if (thermal_needed && !IdentifiesThermalModel(o)) {
+    thermal_all = ThermalFeatures(temperature_c, EffectiveFeatures(o));
+  } else {
+    thermal_all.resize(n, 0);
+  }
   if (decompose_all) {
     internal::SubSeries prepared = internal::PrepareSubSeries(y, o);
     series_all = std::move(prepared.series);
     model = std::move(prepared.model);
-    internal::FitLearners(model, series_all, y,
-                          thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
-                          split);
+    internal::FitLearners(model, series_all, y, thermal_all, split,
+                          thermal_needed ? Eigen::MatrixXd(temperature_c) : Eigen::MatrixXd(n, 0));
   } else {
     model = FitDriftModel(
         y.head(split),
@@ -62,8 +65,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
     trial.estimate = EstimateDrift(model, temperature_c).tail(test);
   } else if (decompose_all) {
     trial.estimate = PredictFromSeries(
-        model, series_all, thermal_needed ? Eigen::MatrixXd(thermal_all) : Eigen::MatrixXd(n, 0),
-        split, test, horizon);
+        model, series_all, thermal_all, split, test, horizon);
   } else {
     trial.estimate =
         PredictAhead(model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(),

@@ -28,9 +28,11 @@ void RequireHorizon(int horizon);
 // `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
 Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 
-// Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty).
+// Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
+// identified sub-models read the temperature channels, N x C, instead).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
-                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end);
+                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
 
 }  // namespace gyrodrift::drift::internal

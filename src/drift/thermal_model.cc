@@ -1,12 +1,12 @@
 #include "gyrodrift/drift/thermal_model.h"
 
-#include <fmt/core.h>
-
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <limits>
 
 #include "gyrodrift/common/check.h"
@@ -118,7 +118,15 @@ double BlockMeanSquare(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index 
   return sum / static_cast<double>(blocks);
 }
 
-std::string Seconds(double s) { return fmt::format("{:g} s", s); }
+// printf-style formatting for the report's texts (the core library has no fmt dependency).
+std::string Format(const char* format, ...) {
+  char buffer[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_end(args);
+  return buffer;
+}
 
 }  // namespace
 
@@ -193,12 +201,12 @@ std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& te
 
 std::string CalibrationReport::Summary() const {
   std::string span;
-  for (size_t c = 0; c < span_k.size(); ++c) span += fmt::format("{}{:.3g}", c ? "/" : "", span_k[c]);
-  return fmt::format(
-      "{:.3g} h, span {} K, rates +{:.2g}/-{:.2g} K/min, {} ramps, {} dwells, {} folds; "
-      "cross-validated RMSE {:.4g} (constant {:.4g}, skill {:.1f} %), condition {:.2g}",
-      duration_s / 3600.0, span, max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells,
-      folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition);
+  for (size_t c = 0; c < span_k.size(); ++c) span += Format("%s%.3g", c ? "/" : "", span_k[c]);
+  return Format(
+      "%.3g h, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d folds; "
+      "cross-validated RMSE %.4g (constant %.4g), skill %.1f %% of the slow drift, condition %.2g",
+      duration_s / 3600.0, span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps,
+      dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition);
 }
 
 Eigen::MatrixXd ThermalRegression::Regressors(
@@ -232,12 +240,12 @@ Eigen::MatrixXd ThermalRegression::Regressors(
 std::vector<std::string> ThermalRegression::RegressorNames() const {
   std::vector<std::string> names{"1"};
   for (int c = 0; c < channels(); ++c) {
-    if (linear[static_cast<size_t>(c)]) names.push_back(fmt::format("T{}", c + 1));
+    if (linear[static_cast<size_t>(c)]) names.push_back(Format("T%d", c + 1));
   }
   for (const ThermalState& s : states) {
-    const std::string state = fmt::format("L{}(T{}; {:.4g} s)", order, s.channel + 1, s.tau_s);
+    const std::string state = Format("L%d(T%d; %.4g s)", order, s.channel + 1, s.tau_s);
     names.push_back(state);
-    for (int p = 2; p <= max_power; ++p) names.push_back(fmt::format("{}^{}", state, p));
+    for (int p = 2; p <= max_power; ++p) names.push_back(Format("%s^%d", state.c_str(), p));
     names.push_back("d/dt " + state);
   }
   return names;
@@ -263,15 +271,13 @@ Eigen::MatrixXd ThermalRegression::EstimateWithSd(
 std::string ThermalRegression::Summary() const {
   std::string chosen;
   for (const ThermalState& s : states) {
-    chosen += fmt::format("{}{:.4g} s", chosen.empty() ? "" : ", ", s.tau_s);
-    if (channels() > 1) chosen += fmt::format(" (T{})", s.channel + 1);
+    chosen += Format("%s%.4g s", chosen.empty() ? "" : ", ", s.tau_s);
+    if (channels() > 1) chosen += Format(" (T%d)", s.channel + 1);
   }
-  return fmt::format("thermal states [{}] of order {} to power {}{}, cross-validated RMSE {:.4g}",
-                     chosen.empty() ? "none" : chosen, order, max_power,
-                     std::any_of(linear.begin(), linear.end(), [](bool b) { return b; })
-                         ? ", linear in T"
-                         : "",
-                     report.cv_rmse);
+  const bool any_linear = std::any_of(linear.begin(), linear.end(), [](bool b) { return b; });
+  return Format("thermal states [%s] of order %d to power %d%s, cross-validated RMSE %.4g",
+                chosen.empty() ? "none" : chosen.c_str(), order, max_power,
+                any_linear ? ", linear in T" : "", report.cv_rmse);
 }
 
 void ThermalRegression::Validate() const {
@@ -558,9 +564,9 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   auto& w = report.warnings;
   for (int c = 0; c < channels; ++c) {
     if (report.span_k[static_cast<size_t>(c)] < 15.0) {
-      w.push_back(fmt::format(
-          "temperature {} spans only {:.3g} K: the model is not identified beyond it",
-          channels > 1 ? fmt::format("T{}", c + 1) : std::string(), report.span_k[static_cast<size_t>(c)]));
+      w.push_back(Format("temperature %sspans only %.3g K: the model is not identified beyond it",
+                         channels > 1 ? Format("T%d ", c + 1).c_str() : "",
+                         report.span_k[static_cast<size_t>(c)]));
     }
   }
   if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min)
@@ -575,18 +581,18 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
   }
   if (!model.states.empty() && duration_s < 8.0 * model.states.back().tau_s) {
-    w.push_back("the run is shorter than 8 times the slowest chosen time constant (" +
-                Seconds(model.states.back().tau_s) + ")");
+    w.push_back(Format("the run is shorter than 8 times the slowest chosen time constant (%g s)",
+                       model.states.back().tau_s));
   }
   if (report.skill < 0.2) {
-    w.push_back(fmt::format(
-        "cross-validation confirms no temperature dependence (skill {:.1f} %): the estimate is "
-        "close to a constant bias",
+    w.push_back(Format(
+        "cross-validation confirms little temperature dependence (skill %.1f %%): the estimate "
+        "is close to a constant bias",
         100.0 * report.skill));
   }
   if (report.condition > 1e10) {
-    w.push_back(fmt::format("the chosen regressors are nearly collinear (condition {:.2g})",
-                            report.condition));
+    w.push_back(Format("the chosen regressors are nearly collinear (condition %.2g)",
+                       report.condition));
   }
   model.Validate();
   return model;

@@ -131,6 +131,51 @@ json LearnerJson(const drift::Learner& learner) {
           {"texts", std::move(texts)}};
 }
 
+json ThermalOptionsJson(const drift::ThermalModelOptions& t) {
+  return {{"shortest_tau_s", Number(t.shortest_tau_s)},
+          {"longest_tau_s", Number(t.longest_tau_s)},
+          {"taus_per_octave", t.taus_per_octave},
+          {"longest_tau_share", Number(t.longest_tau_share)},
+          {"max_states", t.max_states},
+          {"state_order", t.state_order},
+          {"max_power", t.max_power},
+          {"folds", t.folds},
+          {"folds_at_regimes", t.folds_at_regimes},
+          {"ramp_rate_k_per_min", Number(t.ramp_rate_k_per_min)}};
+}
+
+json ThermalJson(const drift::ThermalRegression& t) {
+  json states = json::array();
+  for (const auto& s : t.states) states.push_back({{"channel", s.channel}, {"tau_s", Number(s.tau_s)}});
+  json linear = json::array();
+  for (bool b : t.linear) linear.push_back(b);
+  const drift::CalibrationReport& r = t.report;
+  return {{"rate_hz", Number(t.rate_hz)},
+          {"order", t.order},
+          {"max_power", t.max_power},
+          {"centre_c", Numbers(t.centre_c)},
+          {"scale_k", Numbers(t.scale_k)},
+          {"linear", std::move(linear)},
+          {"states", std::move(states)},
+          {"regressors", t.RegressorNames()},
+          {"coefficients", Array(t.coefficients)},
+          {"covariance", Array(t.covariance)},
+          {"cv_slow_sd", Number(t.cv_slow_sd)},
+          {"report",
+           {{"duration_s", Number(r.duration_s)},
+            {"span_k", Numbers(r.span_k)},
+            {"max_heating_k_per_min", Number(r.max_heating_k_per_min)},
+            {"max_cooling_k_per_min", Number(r.max_cooling_k_per_min)},
+            {"ramps", r.ramps},
+            {"dwells", r.dwells},
+            {"folds", r.folds},
+            {"cv_rmse", Number(r.cv_rmse)},
+            {"cv_rmse_constant", Number(r.cv_rmse_constant)},
+            {"skill", Number(r.skill)},
+            {"condition", Number(r.condition)},
+            {"warnings", r.warnings}}}};
+}
+
 json ModelJson(const drift::DriftModel& model) {
   json subs = json::array();
   for (const auto& sub : model.sub_models) {
@@ -141,7 +186,8 @@ json ModelJson(const drift::DriftModel& model) {
     subs.push_back({{"name", sub.name},
                     {"imfs", sub.imfs},
                     {"has_residue", sub.has_residue},
-                    {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)}});
+                    {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)},
+                    {"thermal", sub.thermal ? ThermalJson(*sub.thermal) : json(nullptr)}});
   }
   return {{"lags", model.lags},
           {"training_imfs", model.training_imfs},
@@ -378,6 +424,62 @@ drift::LearnerOptions ReadLearnerOptions(const Node& n) {
   return l;
 }
 
+drift::ThermalModelOptions ReadThermalOptions(const Node& n) {
+  drift::ThermalModelOptions t;
+  t.shortest_tau_s = n["shortest_tau_s"].Double();
+  t.longest_tau_s = n["longest_tau_s"].Double();
+  t.taus_per_octave = n["taus_per_octave"].Int();
+  t.longest_tau_share = n["longest_tau_share"].Double();
+  t.max_states = n["max_states"].Int();
+  t.state_order = n["state_order"].Int();
+  t.max_power = n["max_power"].Int();
+  t.folds = n["folds"].Int();
+  t.folds_at_regimes = n["folds_at_regimes"].Bool();
+  t.ramp_rate_k_per_min = n["ramp_rate_k_per_min"].Double();
+  return t;
+}
+
+std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
+  auto t = std::make_shared<drift::ThermalRegression>();
+  t->rate_hz = n["rate_hz"].Double();
+  t->order = n["order"].Int(1, 4);
+  t->max_power = n["max_power"].Int(1, 3);
+  t->centre_c = n["centre_c"].Doubles();
+  t->scale_k = n["scale_k"].Doubles();
+  for (const Node& b : n["linear"].Items()) t->linear.push_back(b.Bool());
+  for (const Node& s : n["states"].Items()) {
+    t->states.push_back({s["channel"].Int(0, 1024), s["tau_s"].Double()});
+  }
+  const Eigen::MatrixXd coefficients = n["coefficients"].Matrix();
+  if (coefficients.cols() != 1) n["coefficients"].Fail("must be a column (cols = 1)");
+  t->coefficients = coefficients.col(0);
+  t->covariance = n["covariance"].Matrix();
+  t->cv_slow_sd = n["cv_slow_sd"].Double();
+  const Node r = n["report"];
+  drift::CalibrationReport& report = t->report;
+  report.duration_s = r["duration_s"].Double();
+  report.span_k = r["span_k"].Doubles();
+  report.max_heating_k_per_min = r["max_heating_k_per_min"].Double();
+  report.max_cooling_k_per_min = r["max_cooling_k_per_min"].Double();
+  report.ramps = r["ramps"].Int();
+  report.dwells = r["dwells"].Int();
+  report.folds = r["folds"].Int();
+  report.cv_rmse = r["cv_rmse"].Double();
+  report.cv_rmse_constant = r["cv_rmse_constant"].Double();
+  report.skill = r["skill"].Double();
+  report.condition = r["condition"].Double();
+  for (const Node& w : r["warnings"].Items()) report.warnings.push_back(w.String());
+  try {
+    t->Validate();
+  } catch (const DataError& e) {
+    n.Fail(std::string("does not rebuild: ") + e.what());
+  }
+  if (n["regressors"].raw() != json(t->RegressorNames())) {
+    n["regressors"].Fail("does not match the states and channels stored");
+  }
+  return t;
+}
+
 drift::DriftOptions ReadOptions(const Node& n) {
   drift::DriftOptions o;
   o.mode = n["mode"].Enum(drift::ModeFromString);
@@ -403,6 +505,8 @@ drift::DriftOptions ReadOptions(const Node& n) {
   o.validation_fraction = n["validation_fraction"].Double();
   o.linear_compensation = n["linear_compensation"].Bool();
   o.reference_c = n["reference_c"].Double();  // NaN is allowed: keep the fitted intercept
+  // Files written before identification (format 2) have the defaults.
+  if (n.raw().contains("thermal")) o.thermal = ReadThermalOptions(n["thermal"]);
   o.seed = n["seed"].U64();
   o.threads = n["threads"].Int();
   try {
@@ -481,7 +585,19 @@ drift::DriftModel ReadModel(const Node& root) {
                      " inputs, the model's options give " + std::to_string(model.num_inputs()));
       }
     }
+    if (s.raw().contains("thermal") && !s["thermal"].IsNull()) {
+      if (predict) s["thermal"].Fail("is a thermal model, which only a compensate-mode model has");
+      sub.thermal = ReadThermal(s["thermal"]);
+    }
     model.sub_models.push_back(std::move(sub));
+  }
+  int channels = 0;
+  for (const drift::SubModel& sub : model.sub_models) {
+    if (!sub.thermal) continue;
+    if (channels != 0 && sub.thermal->channels() != channels) {
+      m["sub_models"].Fail("holds thermal models of different channel counts");
+    }
+    channels = sub.thermal->channels();
   }
   return model;
 }
@@ -516,6 +632,7 @@ nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
           {"validation_fraction", Number(o.validation_fraction)},
           {"linear_compensation", o.linear_compensation},
           {"reference_c", Number(o.reference_c)},
+          {"thermal", ThermalOptionsJson(o.thermal)},
           {"seed", o.seed},
           {"threads", o.threads}};
 }

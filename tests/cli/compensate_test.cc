@@ -46,10 +46,12 @@ TEST_F(CompensateCli, AddsTheEstimateAndTheCompensatedOutput) {
   const auto r =
       test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() + "/test.csv' -o '" + out + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("ms-elm (compensate)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("thermal (compensate)"), std::string::npos) << r.out;
   const auto table = io::CsvTable::Read(out);
-  EXPECT_EQ(table.header(), (std::vector<std::string>{"time_s", "rate_dph", "temperature_c",
-                                                      "drift_dph", "drift_est", "compensated"}));
+  EXPECT_EQ(table.header(),
+            (std::vector<std::string>{"time_s", "rate_dph", "temperature_c", "drift_dph",
+                                      "drift_est", "drift_sd", "compensated"}));
+  EXPECT_GT(table.Column("drift_sd").minCoeff(), 0.0);
   ASSERT_EQ(table.rows(), 600);
   const auto input = io::CsvTable::Read(Dir() + "/test.csv");
   for (const char* c : {"time_s", "rate_dph", "temperature_c", "drift_dph"}) {
@@ -127,7 +129,7 @@ TEST_F(CompensateCli, RunsOnALogWithOnlyTheModelsColumns) {
                 .exit_code,
             0);
   const auto table = io::CsvTable::Read(out);
-  EXPECT_EQ(table.header().size(), 4u);
+  EXPECT_EQ(table.header().size(), 5u);  // and drift_est, drift_sd, compensated
   const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/ms.json");
   EXPECT_EQ(table.Column("drift_est"),
             drift::EstimateDrift(loaded.model, input.Column("temperature_c")));

@@ -84,9 +84,10 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
     EXPECT_TRUE(predict.count(std::string(m) + "/causal")) << m;
   }
   const std::set<std::string> compensate = Pairs(dir + "/compensate_table.csv");
-  EXPECT_EQ(compensate.size(), 6u);
+  EXPECT_EQ(compensate.size(), 7u);  // and the compensate-only thermal method
   for (const char* m : kMethods)
     EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
+  EXPECT_TRUE(compensate.count("thermal/train A test B"));
   // Data: one row per simulated second.
   EXPECT_EQ(io::CsvTable::Read(dir + "/run_a.csv").rows(), 7200);
   EXPECT_EQ(io::CsvTable::Read(dir + "/imfs.csv").rows(), 7200);

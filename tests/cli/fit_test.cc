@@ -39,8 +39,8 @@ class FitCli : public ::testing::Test {
 TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   const std::string model = dir_ + "/m.json";
   const auto r =
-      Fit("--target rate_dph --temperature temperature_c --mode compensate -I 10 --realisations 20 "
-          "--seed 4",
+      Fit("--target rate_dph --temperature temperature_c --mode compensate -m ms-elm -I 10 "
+          "--realisations 20 --seed 4",
           model);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
@@ -50,7 +50,7 @@ TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   EXPECT_NE(r.out.find("wrote " + model), std::string::npos) << r.out;
   const auto json = nlohmann::json::parse(io::ReadTextFile(model));
   EXPECT_EQ(json["format"], "gyrodrift-model");
-  EXPECT_EQ(json["format_version"], 2);
+  EXPECT_EQ(json["format_version"], 3);
   EXPECT_EQ(json["training"]["target_column"], "rate_dph");
   EXPECT_EQ(json["training"]["temperature_column"], "temperature_c");
   EXPECT_EQ(json["training"]["samples"], 400);
@@ -218,7 +218,7 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"hidden for linear compensation",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--hidden 20",
-       2, "fits linear sub-models"},
+       2, "not --method thermal"},
       {"lags in compensate mode",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--lags 8",

@@ -8,12 +8,14 @@
 //   kPredict    the paper's task: one-step-ahead prediction of y[t] from the sub-series' own
 //               lags s_g[t-1..t-p] (optionally with the thermal history at t-1).
 //   kCompensate what a navigation computer runs: each sub-series is modelled from the thermal
-//               history of the temperature channel at t only (features.h), so the model needs
-//               nothing but temperature at run time; compensated output = y - estimate.
-// Methods: kMsElm (groups), kEmdElm (one ELM per IMF and one for the residue), and the single
-// models kElm, kPoly, kSvr, kBp trained on y itself (thermal features: features.h; poly uses the
-// classic T and dT/dt). Compensate mode fits linear ELM sub-models and references the estimate
-// to equilibrium at 20 degC by default (docs/drift.md, with the measurements behind both).
+//               history of the temperature channel(s) only, so the model needs nothing but
+//               temperature at run time; compensated output = y - estimate.
+// Methods: kMsElm (groups), kEmdElm (one ELM per IMF and one for the residue), kThermal (compensate
+// mode only: one identified thermal model of y itself), and the single models kElm, kPoly, kSvr,
+// kBp trained on y itself (thermal features: features.h; poly uses the classic T and dT/dt).
+// In compensate mode kThermal, kMsElm and kEmdElm identify a thermal model per sub-series from
+// the calibration run (thermal_model.h: states, time constants and terms chosen by blocked
+// cross-validation); the fitted intercept keeps the unit's repeatable bias (docs/drift.md 1.2).
 // Cost: one decomposition of the training record plus one learner fit per sub-series.
 #pragma once
 
@@ -28,6 +30,7 @@
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/drift/learner.h"
+#include "gyrodrift/drift/thermal_model.h"
 #include "gyrodrift/selection/selection.h"
 
 namespace gyrodrift::drift {
@@ -36,10 +39,13 @@ enum class Mode { kPredict, kCompensate };
 std::string_view ToString(Mode mode);
 Mode ModeFromString(std::string_view name);  // "predict", "compensate"
 
-enum class Method { kMsElm, kElm, kEmdElm, kPoly, kSvr, kBp };
+enum class Method { kMsElm, kElm, kEmdElm, kPoly, kSvr, kBp, kThermal };
 std::string_view ToString(Method method);
-Method MethodFromString(std::string_view name);  // "ms-elm", "elm", "emd-elm", "poly", "svr", "bp"
-std::vector<Method> AllMethods();
+// "ms-elm", "elm", "emd-elm", "poly", "svr", "bp", "thermal"
+Method MethodFromString(std::string_view name);
+// The methods that run in `mode` (kThermal is compensate-only), in the order above.
+std::vector<Method> AllMethods(Mode mode);
+bool SupportsMode(Method method, Mode mode);
 bool UsesDecomposition(Method method);  // kMsElm, kEmdElm
 
 struct DriftOptions {
@@ -57,18 +63,17 @@ struct DriftOptions {
   bool auto_lags = false;
   std::vector<int> lag_candidates{1, 2, 4, 8, 16};
   double validation_fraction = 0.2;  // in [0.05, 0.5]
-  // Compensate mode, kMsElm and kEmdElm: each sub-model is an ELM of linear neurons (hpelm's
-  // 'lin' type: activation linear, L = inputs + 1, C = 1e6, i.e. ridge-free linear regression on
-  // the thermal features) instead of `learner`. Measured in docs/drift.md: fitted on one chamber
-  // programme, sigmoid sub-models extrapolate badly to another; linear ones in the ladder
-  // features generalise. false = use `learner` as given.
+  // Compensate mode, kThermal, kMsElm and kEmdElm: each sub-model is a thermal model identified
+  // from the calibration run (`thermal`), linear in its regressors. false = the earlier nonlinear
+  // sub-models: `learner` on the ladder features, the noise group the zero function (measured
+  // worse on a new programme: docs/drift.md 4.2).
   bool linear_compensation = true;
-  // Compensate mode: the estimate is referenced to thermal equilibrium at this temperature
-  // (degC, in [-100, 200]): the model's output there is subtracted, so the estimate is the
-  // thermal change of the bias relative to its value at the calibration temperature, and the
-  // training run's turn-on bias and mean noise do not pass into it as a constant. NaN = keep the
-  // fitted intercept. Default 20 degC (the usual bias-calibration temperature).
-  double reference_c = 20.0;
+  ThermalModelOptions thermal;  // the identification of those sub-models
+  // Compensate mode: NaN (default) keeps the fitted intercept, the unit's repeatable bias, which a
+  // calibration is expected to remove. A temperature (degC, in [-100, 200]) references the
+  // estimate to thermal equilibrium there instead: the model's output for a record that sits at
+  // that temperature is subtracted, for users who calibrate the bias separately.
+  double reference_c = std::numeric_limits<double>::quiet_NaN();
   std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
   int threads = 0;         // 0 = every core
   // FitDriftModel reports its progress here (fraction of the whole fit in [0, 1], and the step:
@@ -87,8 +92,9 @@ struct SubModel {
   std::vector<int> imfs;     // IMF indices (1-based) of the training decomposition it sums
   bool has_residue = false;  // it also holds the residue (and any IMF beyond the last listed)
   // Null = the zero function: the noise group in compensate mode with nonlinear sub-models
-  // (linear_compensation = false); with the default linear sub-models every group has a learner.
+  // (linear_compensation = false). Identified compensate-mode sub-models have `thermal` instead.
   std::shared_ptr<const Learner> learner;
+  std::shared_ptr<const ThermalRegression> thermal;
 };
 
 struct DriftModel {
@@ -105,7 +111,10 @@ struct DriftModel {
   double temperature_min_c = std::numeric_limits<double>::quiet_NaN();
   double temperature_max_c = std::numeric_limits<double>::quiet_NaN();
   bool uses_temperature() const { return options.uses_temperature(); }
-  int num_inputs() const;       // inputs of each sub-model
+  // Temperature channels the model takes (1 unless identified on several).
+  int temperature_channels() const;
+  bool identified() const;  // its sub-models are identified thermal models
+  int num_inputs() const;   // inputs of each learner (not of identified sub-models)
   std::string Summary() const;  // one line
 };
 
@@ -118,10 +127,15 @@ FeatureOptions EffectiveFeatures(const DriftOptions& options);
 // residue go to the sub-model that holds the residue. Single models: one column, y itself.
 Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomposition& d);
 
+// Compensate mode with linear sub-models of kThermal, kMsElm or kEmdElm: sub-models identified
+// from the calibration run (thermal_model.h).
+bool IdentifiesThermalModel(const DriftOptions& options);
+
 // Fits a model on target y (N samples) and, where the mode or options need it, temperature
-// (N samples, empty otherwise). Throws UsageError / DataError.
+// (N x C, degC; C > 1 only for identified models; empty otherwise). Throws UsageError /
+// DataError.
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
-                         const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                         const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options);
 
 // Share of temperature samples outside [min_c, max_c] (0 when the range is NaN: no temperature),
@@ -129,10 +143,14 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
 double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double min_c,
                          double max_c);
 
-// Compensate mode: the drift estimate at every sample of a temperature record (relative to
-// equilibrium at options.reference_c unless that is NaN).
+// Compensate mode: the drift estimate at every sample of a temperature record (N x channels;
+// relative to equilibrium at options.reference_c unless that is NaN).
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
-                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c);
+                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
+// The estimate (column 0) and its standard deviation (column 1): identified sub-models' bands
+// added in quadrature; NaN for models without one (learners on features).
+Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
 
 // Predict mode from given sub-series (N x G, GroupSeries of some decomposition) and thermal
 // features (N x F, or empty): horizon-step-ahead predictions of y[t] for t = first .. first +

@@ -30,7 +30,7 @@ Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error);
 struct EvaluationOptions {
   double split = 0.7;  // training share, in [0.1, 0.95]
   int repeats = 1;     // seeds seed, seed+1, ...; mean and std over repeats, in [1, 1000]
-  std::vector<Method> methods = AllMethods();
+  std::vector<Method> methods = AllMethods(Mode::kPredict);
   std::vector<Protocol> protocols{Protocol::kPaper, Protocol::kCausal};
   // Predict mode: score horizon-step-ahead predictions (PredictAhead), in [1, 100000].
   int horizon = 1;

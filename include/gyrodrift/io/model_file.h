@@ -38,13 +38,16 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // Version 2 stores the thermal feature set, whether the time constants were limited, and the
 // training temperature range; version-1 files (all fitted with the "auto" set) still load. A
 // version-1 reader refuses version 2, which it would otherwise misread.
-inline constexpr int kModelFormatVersion = 2;
+// Version 3 adds identified thermal sub-models ("thermal" beside "learner") and the options of
+// their identification; older files read with the defaults.
+inline constexpr int kModelFormatVersion = 3;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 
 // What the model was trained on, beside the model itself.
 struct ModelFileInfo {
   std::string target_column;       // CSV column of the gyro output the model was fitted on
-  std::string temperature_column;  // CSV column of the temperature, "" when the model has none
+  // CSV column(s) of the temperature, comma-separated in channel order; "" when the model has none
+  std::string temperature_column;
   std::string source;              // training file, informative only
   std::string tool_version;        // ignored on writing (the running version is written)
 };

@@ -352,39 +352,62 @@ TEST(DriftModel, CompensateModeNeedsOnlyTemperatureAtRunTime) {
   }
 }
 
-TEST(DriftModel, CompensateModeIsLinearPerGroupReferencedAndThreadCountFree) {
+TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThreadCountFree) {
   const Log train = MakeLog(3000, 8);
   DriftOptions o = Fast(Mode::kCompensate, Method::kMsElm);
-  o.features.limit_time_constants = false;  // all five lags on this 50-minute log
   const DriftModel model = FitDriftModel(train.rate, train.temperature, o);
   ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
-  EXPECT_EQ(model.num_inputs(), 7);  // the ladder: 5 rungs, the slowest lag, (T - 20)^2
+  EXPECT_TRUE(model.identified());
   for (const SubModel& sub : model.sub_models) {
-    ASSERT_TRUE(sub.learner) << sub.name << ": every group is modelled with linear sub-models";
-    EXPECT_EQ(sub.learner->Save().texts.at("activation"), "linear") << sub.name;
+    ASSERT_TRUE(sub.thermal) << sub.name << ": every group has its own identified thermal model";
+    EXPECT_FALSE(sub.learner) << sub.name;
   }
-  // Referenced: a record in equilibrium at 20 degC has no thermal drift.
-  const Eigen::VectorXd at_reference = EstimateDrift(model, Eigen::VectorXd::Constant(500, 20.0));
-  EXPECT_LE(at_reference.cwiseAbs().maxCoeff(), 1e-12);
+  // The fitted intercept is kept by default: the estimate in equilibrium is the unit's bias.
+  EXPECT_TRUE(std::isnan(o.reference_c));
   const Eigen::VectorXd estimate = EstimateDrift(model, train.temperature);
-  o.reference_c = std::nan("");
-  const DriftModel unreferenced = FitDriftModel(train.rate, train.temperature, o);
-  const Eigen::VectorXd raw = EstimateDrift(unreferenced, train.temperature);
-  // Referencing only shifts the estimate by a constant.
-  EXPECT_LE(((raw - estimate).array() - (raw - estimate).mean()).abs().maxCoeff(), 1e-10);
-  // One thread or two: the same bits.
+  // Referenced: a record in equilibrium at 20 degC has no thermal drift, and referencing only
+  // shifts the estimate by a constant.
   o.reference_c = 20.0;
+  const DriftModel referenced = FitDriftModel(train.rate, train.temperature, o);
+  const Eigen::VectorXd at_reference =
+      EstimateDrift(referenced, Eigen::VectorXd::Constant(500, 20.0));
+  EXPECT_LE(at_reference.cwiseAbs().maxCoeff(), 1e-12);
+  const Eigen::VectorXd shifted = EstimateDrift(referenced, train.temperature);
+  EXPECT_LE(((shifted - estimate).array() - (shifted - estimate).mean()).abs().maxCoeff(), 1e-10);
+  // One thread or two: the same bits.
+  o.reference_c = std::nan("");
   o.threads = 1;
   EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o), train.temperature),
             estimate);
-  // Nonlinear sub-models: the noise group is the zero function.
+  // Nonlinear sub-models (the earlier learners on the ladder): the noise group is the zero
+  // function.
   o.linear_compensation = false;
   const DriftModel sigmoid = FitDriftModel(train.rate, train.temperature, o);
+  EXPECT_FALSE(sigmoid.identified());
   for (const SubModel& sub : sigmoid.sub_models) {
     EXPECT_EQ(sub.learner == nullptr, sub.name == "noise") << sub.name;
   }
   o.reference_c = 300.0;
   EXPECT_THROW(o.Validate(), UsageError);
+}
+
+TEST(DriftModel, ThermalMethodIsCompensateOnlyAndTakesSeveralChannels) {
+  const Log train = MakeLog(3000, 8);
+  DriftOptions o = Fast(Mode::kPredict, Method::kThermal);
+  EXPECT_THROW(o.Validate(), UsageError);
+  o.mode = Mode::kCompensate;
+  Eigen::MatrixXd two(train.temperature.size(), 2);
+  two.col(0) = train.temperature;
+  Eigen::VectorXd lagged(train.temperature.size());
+  FirstOrderLag(train.temperature, 400.0, 1.0, lagged);
+  two.col(1) = lagged;
+  const DriftModel model = FitDriftModel(train.rate, two, o);
+  EXPECT_EQ(model.temperature_channels(), 2);
+  EXPECT_EQ(EstimateDrift(model, two).size(), two.rows());
+  EXPECT_THROW(EstimateDrift(model, train.temperature), DataError);
+  // Feature-based methods take one channel and say so.
+  o.method = Method::kPoly;
+  EXPECT_THROW(FitDriftModel(train.rate, two, o), UsageError);
 }
 
 TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {

@@ -282,9 +282,9 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 3;
+  j["format_version"] = 4;
   ExpectRefused(Reseal(j),
-                "format_version 3 is not supported (this gyrodrift reads versions 1 to 2)");
+                "format_version 4 is not supported (this gyrodrift reads versions 1 to 3)");
   j["format_version"] = 0;
   ExpectRefused(Reseal(j), "format_version 0 is not supported");
   // A version-1 file (before the feature set, the limit flag and the range were stored) loads,
