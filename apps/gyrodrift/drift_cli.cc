@@ -49,6 +49,9 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
       "compensate mode: reference the estimate to thermal equilibrium at this temperature, degC "
       "(for a bias calibrated separately); default: keep the fitted intercept, the unit's "
       "repeatable bias");
+  cmd->add_flag("--nonlinear", a->nonlinear,
+                "compensate mode, identified methods: each thermal model may add a sigmoid ELM "
+                "of its regressors, kept only where the blocked cross-validation says it helps");
   cmd->add_option(
          "--mode", a->mode,
          "predict (one-step-ahead from past samples) | compensate (drift from temperature)")
@@ -119,6 +122,13 @@ drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
         "alone)");
   }
   o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
+  if (a.nonlinear) {
+    if (!drift::IdentifiesThermalModel(o)) {
+      throw UsageError(
+          "--nonlinear applies to --mode compensate with --method thermal, ms-elm or emd-elm");
+    }
+    o.linear_compensation = false;
+  }
   if (a.reference_option != nullptr && a.reference_option->count() > 0) {
     if (o.mode != drift::Mode::kCompensate) {
       throw UsageError("--reference-temperature applies to --mode compensate");

@@ -22,6 +22,7 @@ struct DriftArgs {
   std::string target;
   std::string temperature;  // "" = none; several columns comma-separated
   double reference_c = 0.0;
+  bool nonlinear = false;  // --nonlinear: identified sub-models may add a nonlinear correction
   CLI::Option* reference_option = nullptr;  // "--reference-temperature given"
   std::string mode;
   std::string decomposition = "beemdan";

@@ -95,16 +95,9 @@ Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eige
   return x;
 }
 
-LearnerOptions SubModelLearner(const DriftOptions& o, size_t g, int inputs) {
+LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
   LearnerOptions l = o.learner;
   l.kind = KindOf(o.method);
-  if (o.mode == Mode::kCompensate && o.linear_compensation && UsesDecomposition(o.method)) {
-    l.elm.activation = elm::Activation::kLinear;
-    l.elm.selection = elm::Selection::kFixed;
-    l.elm.hidden_units = inputs + 1;  // spans the inputs and the constant
-    l.elm.ridge_c = 1e6;
-    l.elm.solver = elm::Solver::kCholesky;
-  }
   l.seed = o.seed + g;
   l.threads = o.threads;
   return l;
@@ -134,7 +127,7 @@ std::vector<Method> AllMethods(Mode mode) {
 }
 
 bool IdentifiesThermalModel(const DriftOptions& o) {
-  return o.mode == Mode::kCompensate && o.linear_compensation &&
+  return o.mode == Mode::kCompensate &&
          (o.method == Method::kThermal || UsesDecomposition(o.method));
 }
 
@@ -323,23 +316,14 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-                               o.features.rate_hz, o.thermal));
+                               o.features.rate_hz, o.thermal, !o.linear_compensation, o.seed));
     }
     return;
   }
-  if (o.mode == Mode::kCompensate) {
-    const bool linear = o.linear_compensation && UsesDecomposition(o.method);
-    for (size_t g = 0; g < groups; ++g) {
-      // A nonlinear learner fitted to the noise group from temperature only extrapolates noise
-      // into new thermal histories, so with nonlinear sub-models the noise group is the zero
-      // function. Linear sub-models keep it: at 1 Hz the white-noise test puts IMFs with periods
-      // up to tens of minutes in the noise group, and those carry the Shupe and bias response
-      // (docs/drift.md: zeroing it cost most of the removal on chamber-b -> chamber).
-      if (model.sub_models[g].name == "noise" && !linear) continue;
-      model.sub_models[g].learner = FitLearner(
-          thermal.topRows(fit_end), series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-          SubModelLearner(o, g, static_cast<int>(thermal.cols())));
-    }
+  if (o.mode == Mode::kCompensate) {  // a single learner on the thermal features
+    model.sub_models.front().learner =
+        FitLearner(thermal.topRows(fit_end), series.col(0).head(fit_end),
+                   SubModelLearner(o, 0));
     return;
   }
   auto fit_with_lags = [&](int p, Eigen::Index end) {
@@ -352,7 +336,7 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       const auto s = series.col(static_cast<Eigen::Index>(g));
       model.sub_models[g].learner =
           FitLearner(PredictRows(model, s, thermal, p, end - p), s.segment(p, end - p),
-                     SubModelLearner(o, g, p + static_cast<int>(thermal.cols())));
+                     SubModelLearner(o, g));
     }
   };
   if (!o.auto_lags) {

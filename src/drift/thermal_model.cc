@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -11,7 +12,9 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/features.h"
+#include "gyrodrift/elm/elm.h"
 
 namespace gyrodrift::drift {
 namespace {
@@ -22,6 +25,9 @@ constexpr double kShortestDwellS = 600.0;
 constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
 constexpr Eigen::Index kShortestFold = 16;   // samples
 constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a subset
+// Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
+constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
+constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
 
 // Standard deviation about the mean (population).
 double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
@@ -206,7 +212,14 @@ std::string CalibrationReport::Summary() const {
       "%.3g h, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d folds; "
       "cross-validated RMSE %.4g (constant %.4g), skill %.1f %% of the slow drift, condition %.2g",
       duration_s / 3600.0, span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps,
-      dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition);
+      dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition) +
+         (std::isnan(cv_rmse_nonlinear)
+              ? std::string()
+              : nonlinear_units > 0
+                    ? Format("; nonlinear correction %d units, C %g (cross-validated RMSE %.4g)",
+                             nonlinear_units, nonlinear_ridge_c, cv_rmse_nonlinear)
+                    : Format("; no nonlinear correction (best cross-validated RMSE %.4g)",
+                             cv_rmse_nonlinear));
 }
 
 Eigen::MatrixXd ThermalRegression::Regressors(
@@ -253,7 +266,7 @@ std::vector<std::string> ThermalRegression::RegressorNames() const {
 
 Eigen::VectorXd ThermalRegression::Estimate(
     const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
-  return Regressors(temperatures_c) * coefficients;
+  return EstimateWithSd(temperatures_c).col(0);
 }
 
 Eigen::MatrixXd ThermalRegression::EstimateWithSd(
@@ -261,6 +274,7 @@ Eigen::MatrixXd ThermalRegression::EstimateWithSd(
   const Eigen::MatrixXd x = Regressors(temperatures_c);
   Eigen::MatrixXd out(x.rows(), 2);
   out.col(0) = x * coefficients;
+  if (correction) out.col(0) += correction->Predict(x.rightCols(x.cols() - 1));
   const Eigen::MatrixXd xv = x * covariance;
   out.col(1) = ((xv.cwiseProduct(x)).rowwise().sum().array().max(0.0) + cv_slow_sd * cv_slow_sd)
                    .sqrt()
@@ -302,6 +316,11 @@ void ThermalRegression::Validate() const {
   const Eigen::Index m = static_cast<Eigen::Index>(
       1 + std::count(linear.begin(), linear.end(), true) +
       static_cast<long>(states.size()) * (max_power + 1));
+  if (correction && correction->num_inputs() != m - 1) {
+    throw DataError("thermal model: the nonlinear correction takes " +
+                    std::to_string(correction->num_inputs()) + " inputs, not the " +
+                    std::to_string(m - 1) + " regressors");
+  }
   if (coefficients.size() != m || covariance.rows() != m || covariance.cols() != m ||
       !coefficients.allFinite() || !covariance.allFinite() || !(cv_slow_sd >= 0.0)) {
     throw DataError("thermal model: " + std::to_string(coefficients.size()) +
@@ -312,7 +331,8 @@ void ThermalRegression::Validate() const {
 
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
-                                       const ThermalModelOptions& options) {
+                                       const ThermalModelOptions& options, bool nonlinear,
+                                       std::uint64_t seed) {
   options.Validate();
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
   const Eigen::Index n = y.size();
@@ -546,6 +566,64 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   const double white_share = white / static_cast<double>(block);
   const double slow_ms = std::max(0.0, BlockMeanSquare(cv_residual, block) - white_share);
   model.cv_slow_sd = std::sqrt(slow_ms);
+
+  if (nonlinear && p > 1) {
+    // The correction's candidates on one shared hidden layer of the regressors (intercept left
+    // out), each fold's linear fit first.
+    const Eigen::MatrixXd z = xs.rightCols(p - 1);
+    elm::ElmOptions eo;
+    eo.hidden_units = kCorrectionUnits.back();
+    eo.ridge_c = 1.0;
+    eo.seed = Rng(seed, StreamId("thermal-correction")).NextU64();
+    eo.threads = 1;
+    const elm::ElmFit widest = elm::Fit(z, yc, eo);
+    const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);
+    const Eigen::MatrixXd hth = h.transpose() * h;
+    std::vector<double> error(kCorrectionUnits.size() * kCorrectionRidge.size(), 0.0);
+    double linear_error = 0.0;
+    for (const Fold& f : fold_moments) {
+      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, best_cols);
+      const Eigen::VectorXd r = yc - xs * w;
+      const Eigen::Index len = f.end - f.begin;
+      const auto r_fold = r.segment(f.begin, len);
+      const double mean = (r.sum() - r_fold.sum()) / static_cast<double>(n - len);
+      const double sd = std::sqrt(std::max(
+          ((r.array() - mean).square().sum() - (r_fold.array() - mean).square().sum()) /
+              static_cast<double>(n - len),
+          std::numeric_limits<double>::min()));
+      const Eigen::VectorXd t = (r.array() - mean) / sd;
+      const auto h_fold = h.middleRows(f.begin, len);
+      const Eigen::MatrixXd hth_train = hth - h_fold.transpose() * h_fold;
+      const Eigen::VectorXd ht_train = h.transpose() * t - h_fold.transpose() * t.segment(f.begin, len);
+      linear_error += r_fold.squaredNorm();
+      size_t i = 0;
+      for (int units : kCorrectionUnits) {
+        for (double c : kCorrectionRidge) {
+          Eigen::MatrixXd a = hth_train.topLeftCorner(units, units);
+          a.diagonal().array() += 1.0 / c;
+          const Eigen::VectorXd beta = a.ldlt().solve(ht_train.head(units));
+          const Eigen::VectorXd predicted =
+              (h_fold.leftCols(units) * beta).array() * sd + mean;
+          error[i++] += (r_fold - predicted).squaredNorm();
+        }
+      }
+    }
+    const size_t chosen_index = static_cast<size_t>(
+        std::min_element(error.begin(), error.end()) - error.begin());
+    report.cv_rmse_nonlinear = std::sqrt(error[chosen_index] / static_cast<double>(n));
+    if (error[chosen_index] < linear_error) {
+      LearnerOptions lo;
+      lo.kind = LearnerKind::kElm;
+      lo.elm.selection = elm::Selection::kFixed;
+      lo.elm.hidden_units = kCorrectionUnits[chosen_index / kCorrectionRidge.size()];
+      lo.elm.ridge_c = kCorrectionRidge[chosen_index % kCorrectionRidge.size()];
+      lo.seed = eo.seed;
+      lo.threads = 1;
+      report.nonlinear_units = lo.elm.hidden_units;
+      report.nonlinear_ridge_c = lo.elm.ridge_c;
+      model.correction = FitLearner(z, residual, lo);
+    }
+  }
 
   // Report.
   report.cv_rmse = std::sqrt(best);

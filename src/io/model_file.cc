@@ -161,6 +161,7 @@ json ThermalJson(const drift::ThermalRegression& t) {
           {"coefficients", Array(t.coefficients)},
           {"covariance", Array(t.covariance)},
           {"cv_slow_sd", Number(t.cv_slow_sd)},
+          {"correction", t.correction ? LearnerJson(*t.correction) : json(nullptr)},
           {"report",
            {{"duration_s", Number(r.duration_s)},
             {"span_k", Numbers(r.span_k)},
@@ -173,6 +174,9 @@ json ThermalJson(const drift::ThermalRegression& t) {
             {"cv_rmse_constant", Number(r.cv_rmse_constant)},
             {"skill", Number(r.skill)},
             {"condition", Number(r.condition)},
+            {"nonlinear_units", r.nonlinear_units},
+            {"nonlinear_ridge_c", Number(r.nonlinear_ridge_c)},
+            {"cv_rmse_nonlinear", Number(r.cv_rmse_nonlinear)},
             {"warnings", r.warnings}}}};
 }
 
@@ -424,6 +428,28 @@ drift::LearnerOptions ReadLearnerOptions(const Node& n) {
   return l;
 }
 
+std::shared_ptr<const drift::Learner> ReadLearner(const Node& n, const std::string& sub_name) {
+  const drift::LearnerKind kind = n["kind"].Enum(drift::LearnerKindFromString);
+  for (const char* key : {"arrays", "scalars", "texts"}) {
+    if (!n[key].raw().is_object()) n[key].Fail("must be an object");
+  }
+  drift::Parameters p;
+  for (const auto& [name, value] : n["arrays"].raw().items()) {
+    p.arrays[name] = n["arrays"][name].Matrix();
+  }
+  for (const auto& [name, value] : n["scalars"].raw().items()) {
+    p.scalars[name] = n["scalars"][name].Double();
+  }
+  for (const auto& [name, value] : n["texts"].raw().items()) {
+    p.texts[name] = n["texts"][name].String();
+  }
+  try {
+    return drift::LoadLearner(kind, p);
+  } catch (const Error& e) {
+    n.Fail("(learner of sub-model '" + sub_name + "') does not rebuild: " + e.what());
+  }
+}
+
 drift::ThermalModelOptions ReadThermalOptions(const Node& n) {
   drift::ThermalModelOptions t;
   t.shortest_tau_s = n["shortest_tau_s"].Double();
@@ -468,7 +494,11 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   report.cv_rmse_constant = r["cv_rmse_constant"].Double();
   report.skill = r["skill"].Double();
   report.condition = r["condition"].Double();
+  report.nonlinear_units = r["nonlinear_units"].Int(0, 100000);
+  report.nonlinear_ridge_c = r["nonlinear_ridge_c"].Double();
+  report.cv_rmse_nonlinear = r["cv_rmse_nonlinear"].Double();
   for (const Node& w : r["warnings"].Items()) report.warnings.push_back(w.String());
+  if (!n["correction"].IsNull()) t->correction = ReadLearner(n["correction"], "correction");
   try {
     t->Validate();
   } catch (const DataError& e) {
@@ -515,28 +545,6 @@ drift::DriftOptions ReadOptions(const Node& n) {
     n.Fail("holds an invalid option: " + std::string(e.what()));
   }
   return o;
-}
-
-std::shared_ptr<const drift::Learner> ReadLearner(const Node& n, const std::string& sub_name) {
-  const drift::LearnerKind kind = n["kind"].Enum(drift::LearnerKindFromString);
-  for (const char* key : {"arrays", "scalars", "texts"}) {
-    if (!n[key].raw().is_object()) n[key].Fail("must be an object");
-  }
-  drift::Parameters p;
-  for (const auto& [name, value] : n["arrays"].raw().items()) {
-    p.arrays[name] = n["arrays"][name].Matrix();
-  }
-  for (const auto& [name, value] : n["scalars"].raw().items()) {
-    p.scalars[name] = n["scalars"][name].Double();
-  }
-  for (const auto& [name, value] : n["texts"].raw().items()) {
-    p.texts[name] = n["texts"][name].String();
-  }
-  try {
-    return drift::LoadLearner(kind, p);
-  } catch (const Error& e) {
-    n.Fail("(learner of sub-model '" + sub_name + "') does not rebuild: " + e.what());
-  }
 }
 
 drift::DriftModel ReadModel(const Node& root) {

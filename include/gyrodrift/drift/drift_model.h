@@ -64,9 +64,9 @@ struct DriftOptions {
   std::vector<int> lag_candidates{1, 2, 4, 8, 16};
   double validation_fraction = 0.2;  // in [0.05, 0.5]
   // Compensate mode, kThermal, kMsElm and kEmdElm: each sub-model is a thermal model identified
-  // from the calibration run (`thermal`), linear in its regressors. false = the earlier nonlinear
-  // sub-models: `learner` on the ladder features, the noise group the zero function (measured
-  // worse on a new programme: docs/drift.md 4.2).
+  // from the calibration run (`thermal`), linear in its regressors. false = each may add a
+  // nonlinear correction (a sigmoid ELM of its regressors), kept only where the same blocked
+  // cross-validation says it helps (thermal_model.h; docs/drift.md 4.5).
   bool linear_compensation = true;
   ThermalModelOptions thermal;  // the identification of those sub-models
   // Compensate mode: NaN (default) keeps the fitted intercept, the unit's repeatable bias, which a
@@ -91,8 +91,8 @@ struct SubModel {
   std::string name;          // "noise", "mixed", "drift", "imf3", "residue", "signal"
   std::vector<int> imfs;     // IMF indices (1-based) of the training decomposition it sums
   bool has_residue = false;  // it also holds the residue (and any IMF beyond the last listed)
-  // Null = the zero function: the noise group in compensate mode with nonlinear sub-models
-  // (linear_compensation = false). Identified compensate-mode sub-models have `thermal` instead.
+  // Null for identified compensate-mode sub-models, which have `thermal` instead (and in model
+  // files written before identification, the zero function of a noise group).
   std::shared_ptr<const Learner> learner;
   std::shared_ptr<const ThermalRegression> thermal;
 };
@@ -127,8 +127,8 @@ FeatureOptions EffectiveFeatures(const DriftOptions& options);
 // residue go to the sub-model that holds the residue. Single models: one column, y itself.
 Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomposition& d);
 
-// Compensate mode with linear sub-models of kThermal, kMsElm or kEmdElm: sub-models identified
-// from the calibration run (thermal_model.h).
+// Compensate mode with kThermal, kMsElm or kEmdElm: sub-models identified from the calibration
+// run (thermal_model.h).
 bool IdentifiesThermalModel(const DriftOptions& options);
 
 // Fits a model on target y (N samples) and, where the mode or options need it, temperature

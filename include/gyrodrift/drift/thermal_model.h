@@ -29,6 +29,12 @@
 // the fit, inflated by the residual's correlation (batch means over 10-min blocks), which grows
 // where the temperature leaves the calibration's range.
 //
+// Nonlinear option: a sigmoid ELM (elm.h) of the chosen regressors fitted to the linear model's
+// residual, its hidden units L in {5, 10, 20, 40} and ridge C in {0.01, 1, 100, 10^4} chosen by
+// the same folds (each fold's linear fit, then the network on the training part's residual,
+// scored on the held-out fold; all candidates share one hidden layer, as the first L units of a
+// network are those of any larger one), kept only when it lowers the cross-validated error.
+//
 // Calibration sufficiency (CalibrationReport): temperature span, heating and cooling rates,
 // dwells, regimes, cross-validated skill against the intercept alone and the conditioning of the
 // chosen regressors, with warnings where the run cannot identify the model.
@@ -37,8 +43,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "gyrodrift/drift/learner.h"
 
 namespace gyrodrift::drift {
 
@@ -97,6 +108,11 @@ struct CalibrationReport {
   // white noise's share): how much of the drift the temperature explains on held-out regimes.
   double skill = 0.0;
   double condition = 0.0;                      // of the chosen regressors' scaled Gram matrix
+  // Nonlinear option: the correction's hidden units (0 = none kept) and ridge C, and the
+  // cross-validated RMSE with it (NaN when not tried).
+  int nonlinear_units = 0;
+  double nonlinear_ridge_c = 0.0;
+  double cv_rmse_nonlinear = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::string> warnings;           // empty: the run identifies the model
   std::string Summary() const;                 // one line
 };
@@ -111,6 +127,9 @@ struct ThermalRegression {
   Eigen::VectorXd coefficients;  // b0, the linear terms, then per state its powers and rate
   Eigen::MatrixXd covariance;    // of the coefficients
   double cv_slow_sd = 0.0;       // s_cv above, target units
+  // Nonlinear option: an ELM of the regressors but the intercept (columns 1.. of Regressors),
+  // added to the linear estimate; null = linear. The standard deviation ignores it.
+  std::shared_ptr<const Learner> correction;
   CalibrationReport report;
 
   int channels() const { return static_cast<int>(centre_c.size()); }
@@ -124,11 +143,14 @@ struct ThermalRegression {
   void Validate() const;        // throws DataError when the stored fields do not fit together
 };
 
-// Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz.
+// Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz; with
+// `nonlinear`, also tries the correction above (its hidden weights drawn from a seed derived from
+// `seed` through the named stream "thermal-correction").
 // Throws DataError for a record the cross-validation cannot split (fewer than 2 folds of at least
 // 16 samples) or non-finite samples; UsageError for bad options.
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
-                                       const ThermalModelOptions& options);
+                                       const ThermalModelOptions& options, bool nonlinear = false,
+                                       std::uint64_t seed = 1);
 
 }  // namespace gyrodrift::drift

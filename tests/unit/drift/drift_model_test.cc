@@ -379,13 +379,17 @@ TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThrea
   o.threads = 1;
   EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o), train.temperature),
             estimate);
-  // Nonlinear sub-models (the earlier learners on the ladder): the noise group is the zero
-  // function.
+  // The nonlinear option: each group is still identified, and the blocked cross-validation
+  // decides whether it keeps a correction (one only where it lowered the error).
   o.linear_compensation = false;
-  const DriftModel sigmoid = FitDriftModel(train.rate, train.temperature, o);
-  EXPECT_FALSE(sigmoid.identified());
-  for (const SubModel& sub : sigmoid.sub_models) {
-    EXPECT_EQ(sub.learner == nullptr, sub.name == "noise") << sub.name;
+  const DriftModel nonlinear = FitDriftModel(train.rate, train.temperature, o);
+  ASSERT_TRUE(nonlinear.identified());
+  for (const SubModel& sub : nonlinear.sub_models) {
+    const CalibrationReport& r = sub.thermal->report;
+    // (tried wherever there is a regressor beside the intercept)
+    EXPECT_EQ(std::isnan(r.cv_rmse_nonlinear), sub.thermal->coefficients.size() == 1) << sub.name;
+    EXPECT_EQ(sub.thermal->correction != nullptr, r.nonlinear_units > 0) << sub.name;
+    if (sub.thermal->correction) EXPECT_LT(r.cv_rmse_nonlinear, r.cv_rmse) << sub.name;
   }
   o.reference_c = 300.0;
   EXPECT_THROW(o.Validate(), UsageError);

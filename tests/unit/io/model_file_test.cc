@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -141,6 +142,7 @@ INSTANTIATE_TEST_SUITE_P(ModelFile, EveryMethod,
                                             ::testing::Values(Method::kMsElm, Method::kElm,
                                                               Method::kEmdElm, Method::kPoly,
                                                               Method::kSvr, Method::kBp)),
+                         // (kThermal is compensate-only: the test above)
                          [](const auto& info) {
                            std::string name =
                                std::string(drift::ToString(std::get<0>(info.param))) + "_" +
@@ -150,6 +152,47 @@ INSTANTIATE_TEST_SUITE_P(ModelFile, EveryMethod,
                            }
                            return name;
                          });
+
+TEST(ModelFile, IdentifiedModelsOfTwoChannelsWithACorrectionComeBackExactly) {
+  const Log log = MakeLog(4000, 13);
+  Eigen::MatrixXd two(log.temperature.size(), 2);
+  two.col(0) = log.temperature;
+  Eigen::VectorXd board(log.temperature.size());
+  drift::FirstOrderLag(log.temperature, 200.0, 1.0, board);
+  two.col(1) = board.array() + 5.0;
+  for (Method method : {Method::kThermal, Method::kMsElm}) {
+    drift::DriftOptions o = Small(Mode::kCompensate, method);
+    o.linear_compensation = false;  // try the nonlinear correction
+    o.thermal.max_states = 1;
+    const drift::DriftModel model = drift::FitDriftModel(log.rate, two, o);
+    ASSERT_TRUE(model.identified());
+    // (a group the cross-validation fits by its mean alone has no regressor to correct)
+    EXPECT_TRUE(std::any_of(model.sub_models.begin(), model.sub_models.end(), [](const auto& sub) {
+      return !std::isnan(sub.thermal->report.cv_rmse_nonlinear);
+    })) << model.Summary();
+    ModelFileInfo info = Info();
+    info.temperature_column = "case_c,board_c";
+    const std::string text = RenderModelFile(model, info);
+    const LoadedModel loaded = ParseModelFile(text, "m.json");
+    EXPECT_EQ(loaded.info.temperature_column, "case_c,board_c");
+    EXPECT_EQ(loaded.model.temperature_channels(), 2);
+    EXPECT_EQ(RenderModelFile(loaded.model, loaded.info), text);
+    const Eigen::MatrixXd test = two.topRows(900);
+    EXPECT_EQ(drift::EstimateDriftWithSd(model, test), drift::EstimateDriftWithSd(loaded.model, test))
+        << ToString(method);
+  }
+  // A stored regressor list that does not match the states is refused by name.
+  const drift::DriftModel model =
+      drift::FitDriftModel(log.rate, log.temperature, Small(Mode::kCompensate, Method::kThermal));
+  json j = json::parse(RenderModelFile(model, Info()));
+  j["model"]["sub_models"][0]["thermal"]["regressors"][0] = "2";
+  try {
+    ParseModelFile(Reseal(j), "m.json");
+    ADD_FAILURE() << "accepted a regressor list that does not match the states";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("regressors"), std::string::npos) << e.what();
+  }
+}
 
 TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   drift::DriftOptions o;
@@ -198,6 +241,11 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.validation_fraction = 0.25;
   o.linear_compensation = false;
   o.reference_c = std::numeric_limits<double>::quiet_NaN();  // keep the fitted intercept
+  o.thermal.shortest_tau_s = 17.0;
+  o.thermal.taus_per_octave = 3;
+  o.thermal.longest_tau_share = 0.1 + 0.2;
+  o.thermal.max_states = 3;
+  o.thermal.folds_at_regimes = true;
   o.seed = 123456789012345ULL;
   o.threads = 3;
   const json j = DriftOptionsToJson(o);
@@ -225,6 +273,7 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   EXPECT_EQ(r.seed, o.seed);
   EXPECT_FALSE(r.linear_compensation);
   EXPECT_TRUE(std::isnan(r.reference_c));
+  EXPECT_EQ(r.thermal, o.thermal);
   EXPECT_EQ(j["learner"]["elm"]["ridge_c"], "inf");
 }
 
