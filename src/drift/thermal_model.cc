@@ -23,6 +23,7 @@ constexpr double kRateSmoothingS = 60.0;  // smoothing of the rate that tells ra
 constexpr double kShortestSegmentS = 300.0;
 constexpr double kShortestDwellS = 600.0;
 constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
+constexpr double kShortBlockS = 10.0;        // blocks that measure the residual's fast noise
 constexpr Eigen::Index kShortestFold = 16;   // samples
 constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a subset
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
@@ -44,19 +45,28 @@ void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order
   }
 }
 
-// Columns of one state: its standardised level to the powers 1..max_power, then its rate (K/s).
-void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order,
-                  int max_power, double dt_s, double centre, double scale,
+// Columns of one state: its standardised level to the powers 1..max_power (the powers >= 2
+// continued along their tangent beyond [s.level_min, s.level_max]), then its rate (K/s). With
+// `learn_range` the range is first set to the level's own (the calibration run).
+void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
+                  int max_power, double dt_s, double centre, double scale, bool learn_range,
                   Eigen::Ref<Eigen::MatrixXd> out) {
   Eigen::VectorXd previous, state;
-  StateOf(t, tau_s, order, dt_s, previous, state);
+  StateOf(t, s.tau_s, order, dt_s, previous, state);
   const Eigen::ArrayXd z = (state.array() - centre) / scale;
-  Eigen::ArrayXd power = z;
-  for (int p = 0; p < max_power; ++p) {
-    out.col(p) = power.matrix();
-    power *= z;
+  if (learn_range) {
+    s.level_min = z.minCoeff();
+    s.level_max = z.maxCoeff();
   }
-  out.col(max_power) = (previous - state) / tau_s;
+  out.col(0) = z.matrix();
+  for (int p = 2; p <= max_power; ++p) {
+    auto col = out.col(p - 1);
+    for (Eigen::Index i = 0; i < z.size(); ++i) {
+      const double edge = std::clamp(z[i], s.level_min, s.level_max);
+      col[i] = std::pow(edge, p) + p * std::pow(edge, p - 1) * (z[i] - edge);
+    }
+  }
+  out.col(max_power) = (previous - state) / s.tau_s;
 }
 
 // A partition of the run into folds: contiguous groups of whole units (regimes or time blocks),
@@ -241,10 +251,10 @@ Eigen::MatrixXd ThermalRegression::Regressors(
     x.col(col++) = (temperatures_c.col(c).array() - centre_c[static_cast<size_t>(c)]) /
                    scale_k[static_cast<size_t>(c)];
   }
-  for (const ThermalState& s : states) {
+  for (ThermalState s : states) {
     const auto c = static_cast<size_t>(s.channel);
-    StateColumns(temperatures_c.col(s.channel), s.tau_s, order, max_power, 1.0 / rate_hz,
-                 centre_c[c], scale_k[c], x.middleCols(col, max_power + 1));
+    StateColumns(temperatures_c.col(s.channel), s, order, max_power, 1.0 / rate_hz, centre_c[c],
+                 scale_k[c], /*learn_range=*/false, x.middleCols(col, max_power + 1));
     col += max_power + 1;
   }
   return x;
@@ -309,8 +319,11 @@ void ThermalRegression::Validate() const {
     throw DataError("thermal model: rate_hz, order or max_power out of range");
   }
   for (const ThermalState& s : states) {
-    if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) || !std::isfinite(s.tau_s)) {
-      throw DataError("thermal model: a state names a channel or time constant out of range");
+    if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) ||
+        !std::isfinite(s.tau_s) || !(s.level_min <= s.level_max) || !std::isfinite(s.level_min) ||
+        !std::isfinite(s.level_max)) {
+      throw DataError(
+          "thermal model: a state names a channel, time constant or level range out of range");
     }
   }
   const Eigen::Index m = static_cast<Eigen::Index>(
@@ -413,8 +426,8 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   }
   for (size_t j = 0; j < candidates.size(); ++j) {
     const auto c = static_cast<size_t>(candidates[j].channel);
-    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j].tau_s, model.order,
-                 powers, dt, model.centre_c[c], model.scale_k[c],
+    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order, powers,
+                 dt, model.centre_c[c], model.scale_k[c], /*learn_range=*/true,
                  x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
   }
   // Centred target: the intercept absorbs the mean, and the moments stay well scaled.
@@ -557,13 +570,13 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
     return r;
   };
   const Eigen::VectorXd cv_residual = cv_residual_of(best_cols);
-  double white = 0.0;  // variance of the residual's white part, from its first differences
-  for (Eigen::Index t = 1; t < n; ++t) {
-    const double d = residual[t] - residual[t - 1];
-    white += d * d;
-  }
-  white /= 2.0 * static_cast<double>(n - 1);
-  const double white_share = white / static_cast<double>(block);
+  // What the fast noise contributes to a block mean, from the means of 10-s blocks scaled to the
+  // block: exact for white noise, and not fooled by the anti-correlated quantization noise that
+  // first differences would count as white.
+  const Eigen::Index short_block =
+      std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::round(kShortBlockS * rate_hz)), 1, block);
+  const double white_share = BlockMeanSquare(centred, short_block) *
+                             static_cast<double>(short_block) / static_cast<double>(block);
   const double slow_ms = std::max(0.0, BlockMeanSquare(cv_residual, block) - white_share);
   model.cv_slow_sd = std::sqrt(slow_ms);
 

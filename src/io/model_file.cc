@@ -146,7 +146,11 @@ json ThermalOptionsJson(const drift::ThermalModelOptions& t) {
 
 json ThermalJson(const drift::ThermalRegression& t) {
   json states = json::array();
-  for (const auto& s : t.states) states.push_back({{"channel", s.channel}, {"tau_s", Number(s.tau_s)}});
+  for (const auto& s : t.states) {
+    states.push_back({{"channel", s.channel},
+                      {"tau_s", Number(s.tau_s)},
+                      {"level_range", Numbers({s.level_min, s.level_max})}});
+  }
   json linear = json::array();
   for (bool b : t.linear) linear.push_back(b);
   const drift::CalibrationReport& r = t.report;
@@ -474,7 +478,9 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   t->scale_k = n["scale_k"].Doubles();
   for (const Node& b : n["linear"].Items()) t->linear.push_back(b.Bool());
   for (const Node& s : n["states"].Items()) {
-    t->states.push_back({s["channel"].Int(0, 1024), s["tau_s"].Double()});
+    const std::vector<double> range = s["level_range"].Doubles();
+    if (range.size() != 2) s["level_range"].Fail("must hold [min, max]");
+    t->states.push_back({s["channel"].Int(0, 1024), s["tau_s"].Double(), range[0], range[1]});
   }
   const Eigen::MatrixXd coefficients = n["coefficients"].Matrix();
   if (coefficients.cols() != 1) n["coefficients"].Fail("must be a column (cols = 1)");

@@ -23,9 +23,11 @@
 // The search works on per-fold Gram matrices, so it costs one pass over the data
 // (O(N M^2), M = all candidate columns) plus a small solve per subset and fold.
 //
+// Beyond the calibration's range the level powers continue linearly (ThermalState).
+//
 // Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x): s_cv is the
-// slow part of the cross-validated residual (its 10-min block means, less what the white noise
-// contributes to them: the drift error a held-out regime saw), V the coefficient covariance of
+// slow part of the cross-validated residual (its 10-min block means, less what the fast noise
+// contributes to them, measured on 10-s blocks: the drift error a held-out regime saw), V the coefficient covariance of
 // the fit, inflated by the residual's correlation (batch means over 10-min blocks), which grows
 // where the temperature leaves the calibration's range.
 //
@@ -77,9 +79,14 @@ struct ThermalModelOptions {
 };
 
 // One thermal state: `order` cascaded first-order lags of channel `channel` with constant tau_s.
+// Its standardised level spanned [level_min, level_max] over the calibration run; beyond that the
+// powers >= 2 continue along their tangent at the nearer end (a model does not extrapolate a
+// curvature it never saw: a cubic fitted over 40 K, evaluated 20 K beyond, is what made a short
+// calibration's estimate absurd; docs/drift.md 4.5).
 struct ThermalState {
   int channel = 0;
   double tau_s = 0.0;
+  double level_min = 0.0, level_max = 0.0;
   bool operator==(const ThermalState&) const = default;
 };
 

@@ -3,7 +3,7 @@
 // winding, board self-heating, the sensor on the case or the board, cubic stress, a gradient
 // term). Per unit: identify the thermal model on the 16-h calibration run with the defaults,
 // compensate the 8-h mission run, score against its truth (drift_dph, the unit's repeatable bias
-// included). Measured (docs/drift.md 4.5, the same defaults): 89.8, 84.0, 96.9, 81.0 % of the
+// included). Measured (docs/drift.md 4.5, the same defaults): 88.3, 84.0, 96.9, 81.1 % of the
 // true drift's RMS removed; the floors keep most of each margin above the 75 %, and the
 // identified model must beat the classic polynomial on every unit.
 #include <gtest/gtest.h>
@@ -69,7 +69,7 @@ TEST_P(FamilyUnit, IdentifiedModelRemovesMostOfTheMissionDriftAndBeatsThePolynom
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, FamilyUnit,
-                         ::testing::Values(UnitCase{1, 85.0}, UnitCase{2, 78.0},
+                         ::testing::Values(UnitCase{1, 84.0}, UnitCase{2, 78.0},
                                            UnitCase{3, 92.0}, UnitCase{4, 76.0}),
                          [](const auto& info) { return "unit" + std::to_string(info.param.unit); });
 
