@@ -156,7 +156,7 @@ void DriftOptions::Validate() const {
   if (!SupportsMode(method, mode)) {
     ThrowOption("method", std::string(ToString(method)),
                 "a method of " + std::string(ToString(mode)) +
-                    " mode (thermal identifies a compensation model: --mode compensate)");
+                    " mode (thermal identifies a compensation model: mode = compensate)");
   }
   thermal.Validate();
   LearnerOptions l = learner;
