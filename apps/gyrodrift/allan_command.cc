@@ -109,6 +109,7 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
 }
 
 void Run(const AllanArgs& a) {
+  RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
   // Beyond this range the averages under- or overflow (1e308 Hz gave all-zero deviations).
   RequireInRange("--rate-hz", a.rate_hz, 1e-9, 1e9);
   al::AllanOptions o;
@@ -134,7 +135,7 @@ void Run(const AllanArgs& a) {
   const al::NoiseFitOptions fit_options{.tau_min_s = a.fit_tau_min_s, .tau_max_s = a.fit_tau_max_s};
   fit_options.Validate();  // every option error before any file is read
 
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   const Eigen::VectorXd data = table.Column(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
                        "its Allan deviation is zero at every tau (a logging fault?)");

@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <regex>
 #include <vector>
@@ -37,6 +38,41 @@ const CLI::Validator kSeed(
     "SEED");
 
 std::string SidecarPath(const std::string& output_path) { return output_path + ".json"; }
+
+void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
+                                const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    for (const std::string& out : outputs) {
+      if (out.empty() || !fs::exists(out, ec)) continue;
+      if (fs::equivalent(in, out, ec) && !ec) {
+        throw UsageError("output " + out + " is the input " + in +
+                         ": gyrodrift never overwrites its input (choose another output path)");
+      }
+    }
+  }
+}
+
+void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (folder.empty() || !fs::exists(folder, ec)) return;
+  const fs::path root = fs::canonical(folder, ec);
+  if (ec) return;
+  for (const std::string& in : inputs) {
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    const fs::path file = fs::canonical(in, ec);
+    if (ec) continue;
+    for (fs::path p = file; !p.empty() && p != p.root_path(); p = p.parent_path()) {
+      if (fs::equivalent(p, root, ec) && !ec) {
+        throw UsageError("input " + in + " lies inside the output folder " + folder +
+                         ": gyrodrift never overwrites its input (choose another folder)");
+      }
+    }
+  }
+}
 
 nlohmann::json SidecarHeader(const std::string& command) {
   return {{"tool", "gyrodrift"}, {"version", kVersion}, {"command", command}};
@@ -146,6 +182,25 @@ double MedianStep(const Eigen::VectorXd& t) {
 }
 
 }  // namespace
+
+io::CsvTable ReadLog(const std::string& path) {
+  io::CsvTable table = io::CsvTable::Read(path);
+  if (!table.HasColumn("time_s")) return table;
+  Eigen::VectorXd t;
+  try {
+    t = table.Column("time_s");
+  } catch (const Error&) {
+    return table;  // unreadable: refused where the rate is read from it (ResolveSampleRate)
+  }
+  for (Eigen::Index i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) continue;
+    throw DataError(fmt::format(
+        "{}: time_s {} at data row {} ({:g} s after {:g} s): time stamps must increase (sort "
+        "the log or split it where the clock jumped)",
+        path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
+  }
+  return table;
+}
 
 double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how) {
   if (given > 0.0) {

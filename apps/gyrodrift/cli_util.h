@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
@@ -22,6 +23,16 @@ extern const CLI::Validator kSeed;
 // The sidecar path of an output file: OUT.csv -> OUT.csv.json.
 std::string SidecarPath(const std::string& output_path);
 
+// The user's files are never overwritten: throws UsageError naming both paths when an output
+// (each output's sidecar included: pass both) is one of the inputs, however spelled (relative,
+// "./", a symbolic or a hard link: the same file by device and inode). Inputs that do not exist
+// or are empty strings are skipped. Called before any work.
+void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
+                                const std::vector<std::string>& outputs);
+
+// The same for an output folder: no input may lie inside it (or be it).
+void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder);
+
 // Common metadata of every sidecar: tool name, version and subcommand.
 nlohmann::json SidecarHeader(const std::string& command);
 
@@ -31,6 +42,13 @@ bool IsTerminal();
 // --duration text: "30s", "10min", "8h", "1.5h", "3600" (seconds), "1e4s". Anything else, or a
 // value that is not positive and finite, is a UsageError naming --duration.
 double ParseDuration(const std::string& text);
+
+// Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
+// increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row (the log
+// was merged, sorted wrongly or its clock jumped; every model and the Allan analysis would
+// otherwise take the samples as equally spaced, silently). Gaps and jitter stay a note
+// (NonUniformTimeNote).
+io::CsvTable ReadLog(const std::string& path);
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
 // column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when

@@ -26,6 +26,7 @@ struct CompensateArgs {
 };
 
 void Run(const CompensateArgs& a) {
+  RequireOutputsAreNotInputs({a.model, a.input}, {a.output, SidecarPath(a.output)});
   const io::LoadedModel loaded = io::ReadModelFile(a.model);
   const drift::DriftModel& model = loaded.model;
   if (model.options.mode != drift::Mode::kCompensate) {
@@ -33,7 +34,7 @@ void Run(const CompensateArgs& a) {
                      " is a predict-mode model: use 'gyrodrift predict' (compensate "
                      "needs a model fitted with --mode compensate)");
   }
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   RequireModelColumns(loaded, table);
   for (const char* name : {"drift_est", "compensated"}) {
     if (table.HasColumn(name)) {

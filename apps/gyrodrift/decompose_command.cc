@@ -68,6 +68,7 @@ nlohmann::json OptionsJson(const DecomposeArgs& a, const dec::DecompositionOptio
 }
 
 void Run(const DecomposeArgs& a) {
+  RequireOutputsAreNotInputs({a.input, a.noise_file}, {a.output, SidecarPath(a.output)});
   dec::DecompositionOptions o;
   o.method = dec::MethodFromString(a.method);
   o.sifting.stop_rule = dec::StopRuleFromString(a.stop);
@@ -86,7 +87,7 @@ void Run(const DecomposeArgs& a) {
   o.noise_stages = a.noise_stages;
   o.Validate();  // option errors before any file is read
 
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   const Eigen::VectorXd x = table.Column(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", x,
                        "it has no oscillation to decompose");

@@ -1006,6 +1006,7 @@ std::string RenderReport(const Study& s, const io::DygraphsAssets& assets) {
 // ---- the command -------------------------------------------------------------------------------
 
 void Run(const DemoArgs& a) {
+  RequireInputsOutsideFolder({a.input}, a.output);
   const auto wall_start = std::chrono::steady_clock::now();
   // Options first: every mistake is reported before any work.
   const bool user = !a.input.empty();
@@ -1087,7 +1088,7 @@ void Run(const DemoArgs& a) {
     say(fmt::format("1. simulated run A: {}\n   simulated run B: {}\n", s.a.Summary(),
                     s.b.Summary()));
   } else {
-    const io::CsvTable table = io::CsvTable::Read(a.input);
+    const io::CsvTable table = ReadLog(a.input);
     s.y = table.Column(a.target);
     s.temperature = table.Column(a.temperature);
     s.source = a.input;

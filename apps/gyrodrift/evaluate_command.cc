@@ -51,6 +51,7 @@ std::string TableCsv(const drift::EvaluationResult& result) {
 }
 
 void Run(const EvaluateArgs& a) {
+  RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
   drift::DriftOptions base = MakeDriftOptions(a, drift::Method::kMsElm);
   drift::EvaluationOptions e;
   e.split = a.split;
@@ -62,7 +63,7 @@ void Run(const EvaluateArgs& a) {
   e.horizon = a.horizon;
   e.Validate();  // option errors before any file is read
 
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   std::string rate_how;
   base.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   const std::string target = ColumnName(table, a.target);

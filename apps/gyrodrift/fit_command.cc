@@ -56,6 +56,7 @@ drift::Method ResolveMethod(const FitArgs& a) {
 }
 
 void Run(const FitArgs& a) {
+  RequireOutputsAreNotInputs({a.input}, {a.output});
   const drift::Method method = ResolveMethod(a);
   drift::DriftOptions o = MakeDriftOptions(a, method);
   const bool elm_based = method == drift::Method::kMsElm || method == drift::Method::kEmdElm ||
@@ -73,7 +74,7 @@ void Run(const FitArgs& a) {
                      "mode and to --method elm");
   }
 
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   std::string rate_how;
   o.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   io::ModelFileInfo info;

@@ -32,6 +32,7 @@ struct PredictArgs {
 };
 
 void Run(const PredictArgs& a) {
+  RequireOutputsAreNotInputs({a.model, a.input}, {a.output, SidecarPath(a.output)});
   const drift::Protocol protocol = drift::ProtocolFromString(a.protocol);
   if (a.window < 16 || a.window > 1000000) {
     ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
@@ -48,7 +49,7 @@ void Run(const PredictArgs& a) {
   }
   model.options.threads = a.threads;  // the thread count never changes the result
 
-  const io::CsvTable table = io::CsvTable::Read(a.input);
+  const io::CsvTable table = ReadLog(a.input);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;

@@ -131,6 +131,8 @@ nlohmann::json ParametersJson(const sim::FogParameters& p) {
 }
 
 void Run(const SimulateArgs& a) {
+  // A --profile FILE is an input (the builtin names are not files unless one exists by that name).
+  RequireOutputsAreNotInputs({a.profile}, {a.output, SidecarPath(a.output)});
   sim::FogParameters params = sim::PresetParameters(sim::PresetFromString(a.preset));
   if (!a.winding.empty()) params.coil.winding = sim::WindingPatternFromString(a.winding);
   if (a.asymmetry_option->count() > 0) params.coil.winding_asymmetry = a.asymmetry;
