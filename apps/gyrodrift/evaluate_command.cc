@@ -68,11 +68,13 @@ void Run(const EvaluateArgs& a) {
   base.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   const std::string target = ColumnName(table, a.target);
   const Eigen::VectorXd y = table.Column(a.target);
-  Eigen::VectorXd temperature, truth;
+  Eigen::MatrixXd temperature;
+  Eigen::VectorXd truth;
   std::string temperature_column, truth_column;
   if (!a.temperature.empty()) {
-    temperature_column = ColumnName(table, a.temperature);
-    temperature = table.Column(a.temperature);
+    TemperatureColumns t = ReadTemperatureColumns(table, a.temperature);
+    temperature_column = t.names;
+    temperature = std::move(t.values);
   }
   if (!a.truth.empty()) {
     truth_column = ColumnName(table, a.truth);

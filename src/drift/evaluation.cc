@@ -25,7 +25,7 @@ struct Trial {
 
 // Fits and scores one (method, protocol, seed) on the split record.
 Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
-               const Eigen::Ref<const Eigen::VectorXd>& temperature_c, const DriftOptions& given,
+               const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, const DriftOptions& given,
                Protocol protocol, Eigen::Index split, int horizon, const CausalOptions& causal) {
   DriftOptions o = given;
   o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
@@ -40,7 +40,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   Eigen::MatrixXd series_all;
   Eigen::MatrixXd thermal_all;
   if (thermal_needed && !IdentifiesThermalModel(o)) {
-    thermal_all = ThermalFeatures(temperature_c, EffectiveFeatures(o));
+    thermal_all = ThermalFeatures(temperature_c.col(0), EffectiveFeatures(o));
   } else {
     thermal_all.resize(n, 0);
   }
@@ -53,7 +53,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   } else {
     model = FitDriftModel(
         y.head(split),
-        thermal_needed ? Eigen::VectorXd(temperature_c.head(split)) : Eigen::VectorXd(), o);
+        thermal_needed ? Eigen::MatrixXd(temperature_c.topRows(split)) : Eigen::MatrixXd(), o);
   }
   trial.train_s = Seconds(start);
   trial.summary = model.Summary();
@@ -68,7 +68,8 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
         model, series_all, thermal_all, split, test, horizon);
   } else {
     trial.estimate =
-        PredictAhead(model, y, thermal_needed ? Eigen::VectorXd(temperature_c) : Eigen::VectorXd(),
+        PredictAhead(model, y,
+                     thermal_needed ? Eigen::VectorXd(temperature_c.col(0)) : Eigen::VectorXd(),
                      split, horizon, Protocol::kCausal, causal);
   }
   trial.predict_s = Seconds(start);
@@ -98,7 +99,7 @@ void EvaluationOptions::Validate() const {
 }
 
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
-                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                           const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
                           const EvaluationOptions& options) {
   base.Validate();
@@ -112,12 +113,26 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   const Eigen::Index n = y.size();
   const bool thermal_needed = base.uses_temperature();
   if (thermal_needed) {
-    if (temperature_c.size() != n) {
+    if (temperature_c.rows() != n || temperature_c.cols() < 1) {
       throw DataError(std::string(ToString(base.mode)) + " mode" +
                       (base.features.use_temperature ? " with temperature features" : "") +
                       " needs a temperature column of the same length as the target");
     }
-    RequireFiniteSignal("temperature", temperature_c, n);
+    for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+      RequireFiniteSignal("temperature", temperature_c.col(c), n);
+    }
+    // Several channels serve only identified models: refused before any fit.
+    for (Method method : options.methods) {
+      DriftOptions o = base;
+      o.method = method;
+      if (temperature_c.cols() > 1 && !IdentifiesThermalModel(o)) {
+        ThrowOption("temperature channels", std::to_string(temperature_c.cols()),
+                    "one for method " + std::string(ToString(method)) + " in " +
+                        std::string(ToString(base.mode)) +
+                        " mode (several channels: compensate mode with thermal, ms-elm or "
+                        "emd-elm)");
+      }
+    }
   }
   if (truth.size() != 0) {
     if (truth.size() != n) throw DataError("truth column length differs from the target's");
@@ -146,11 +161,12 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                       " (the lags and the shortest causal window before the first origin)");
     }
   }
-  if (temperature_c.size() == n) {
-    result.training_temperature_min_c = temperature_c.head(split).minCoeff();
-    result.training_temperature_max_c = temperature_c.head(split).maxCoeff();
+  if (temperature_c.rows() == n && temperature_c.cols() > 0) {
+    const auto t = temperature_c.col(0);
+    result.training_temperature_min_c = t.head(split).minCoeff();
+    result.training_temperature_max_c = t.head(split).maxCoeff();
     result.test_outside_training_temperature_share =
-        ShareOutsideRange(temperature_c.tail(n - split), result.training_temperature_min_c,
+        ShareOutsideRange(t.tail(n - split), result.training_temperature_min_c,
                           result.training_temperature_max_c);
   }
   result.against_truth = truth.size() != 0;

@@ -186,3 +186,56 @@ TEST(CompensateHelp, ShowsAWorkedExample) {
 
 }  // namespace
 }  // namespace gyrodrift
+
+namespace gyrodrift {
+namespace {
+
+TEST(CompensateCliChannels, TwoTemperatureColumnsFitCompensateAndEvaluate) {
+  const std::string dir = test::TempDir("cli_compensate_channels");
+  const io::CsvTable log = io::CsvTable::Parse(test::ThermalLogCsv(3000, 5), "log");
+  Eigen::VectorXd board(log.rows());
+  drift::FirstOrderLag(log.Column("temperature_c"), 150.0, 1.0, board);
+  board.array() += 3.0;
+  io::WriteCsv(dir + "/two.csv", {{"time_s", log.Column("time_s")},
+                                  {"rate_dph", log.Column("rate_dph")},
+                                  {"temperature_c", log.Column("temperature_c")},
+                                  {"board_c", board},
+                                  {"drift_dph", log.Column("drift_dph")}});
+  io::WriteCsv(dir + "/one.csv", {{"rate_dph", log.Column("rate_dph")},
+                                  {"temperature_c", log.Column("temperature_c")}});
+  const std::string fit = "fit '" + dir + "/two.csv' -t rate_dph -T temperature_c,board_c " +
+                          "--mode compensate ";
+  auto r = test::RunCli(fit + "-o '" + dir + "/m.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 temperature channels"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("calibration:"), std::string::npos) << r.out;
+  const io::LoadedModel loaded = io::ReadModelFile(dir + "/m.json");
+  EXPECT_EQ(loaded.info.temperature_column, "temperature_c,board_c");
+  r = test::RunCli("compensate '" + dir + "/m.json' '" + dir + "/two.csv' --truth drift_dph -o '" +
+                   dir + "/c.csv'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::CsvTable out = io::CsvTable::Read(dir + "/c.csv");
+  EXPECT_TRUE(out.HasColumn("drift_sd"));
+  // The second column is required by name.
+  r = test::RunCli("compensate '" + dir + "/m.json' '" + dir + "/one.csv' -o '" + dir + "/c1.csv'");
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("board_c"), std::string::npos) << r.err;
+  // A method of one channel says so; a repeated column too.
+  r = test::RunCli(fit + "-m poly -o '" + dir + "/p.json'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  r = test::RunCli("fit '" + dir + "/two.csv' -t rate_dph -T temperature_c,temperature_c " +
+                   "--mode compensate -o '" + dir + "/r.json'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  // evaluate takes both channels for the identified methods, and refuses a one-channel method
+  // before any fit.
+  const std::string evaluate = "evaluate '" + dir + "/two.csv' -t rate_dph -T temperature_c,board_c " +
+                               "--truth drift_dph --mode compensate ";
+  r = test::RunCli(evaluate + "--methods thermal -o '" + dir + "/e.csv'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  r = test::RunCli(evaluate + "--methods thermal,poly -o '" + dir + "/e2.csv'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_FALSE(test::FileExists(dir + "/e2.csv"));
+}
+
+}  // namespace
+}  // namespace gyrodrift

@@ -64,9 +64,11 @@ struct EvaluationResult {
   std::string Table() const;  // aligned text table
 };
 
-// Evaluates options.methods on (y, temperature_c, truth); temperature and truth may be empty.
+// Evaluates options.methods on (y, temperature_c, truth); temperature (N x channels; several only
+// for identified compensate-mode models, else a UsageError before any fit) and truth may be
+// empty. The training temperature range and the share outside it are of the first channel.
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
-                          const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                           const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
                           const EvaluationOptions& options);
 
