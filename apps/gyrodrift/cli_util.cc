@@ -235,13 +235,7 @@ std::string NonUniformTimeNote(const io::CsvTable& table) {
   } catch (const Error&) {
     return "";  // a note never fails a command; where time_s is needed it is read and refused
   }
-  const double median = MedianStep(t);
-  if (!(median > 0.0)) {
-    return fmt::format(
-        "note: time_s does not increase (median step {:g} s); the samples are taken as equally "
-        "spaced",
-        median);
-  }
+  const double median = MedianStep(t);  // > 0: ReadLog refused a time_s that does not increase
   long off = 0;
   double largest = t[1] - t[0];
   Eigen::Index largest_row = 2;  // 1-based data row of the sample after the step

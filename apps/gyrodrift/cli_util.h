@@ -55,7 +55,8 @@ io::CsvTable ReadLog(const std::string& path);
 // its median step is not positive or gives a rate outside [1e-9, 1e6] Hz.
 double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how);
 
-// "" for a log without time_s or with a uniform one; otherwise a one-line note that the time axis
+// "" for a log without time_s or with a uniform one (read by ReadLog, so time_s increases);
+// otherwise a one-line note that the time axis
 // has gaps or jitter (steps more than half the median step away from it: how many, the largest
 // and its row), since every model and the Allan analysis assume uniform sampling.
 std::string NonUniformTimeNote(const io::CsvTable& table);
