@@ -24,6 +24,10 @@ constexpr double kShortestSegmentS = 300.0;
 constexpr double kShortestDwellS = 600.0;
 constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
 constexpr double kShortBlockS = 10.0;        // blocks that measure the residual's fast noise
+// Calibration sufficiency: warnings below these (docs/drift.md 4.5).
+constexpr double kShortestSpanK = 15.0;
+constexpr double kLeastSkill = 0.2;
+constexpr double kLargestCondition = 1e10;
 constexpr Eigen::Index kShortestFold = 16;   // samples
 constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a subset
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
@@ -142,6 +146,290 @@ std::string Format(const char* format, ...) {
   std::vsnprintf(buffer, sizeof(buffer), format, args);
   va_end(args);
   return buffer;
+}
+
+// ---- identification, step by step ------------------------------------------------------------
+
+// Span of every channel, heating and cooling rates, ramps and dwells (channel 0 for the latter).
+void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
+                 const std::vector<ThermalSegment>& segments, CalibrationReport& report) {
+  const double dt = 1.0 / rate_hz;
+  for (Eigen::Index c = 0; c < temperatures_c.cols(); ++c) {
+    report.span_k.push_back(temperatures_c.col(c).maxCoeff() - temperatures_c.col(c).minCoeff());
+  }
+  for (const ThermalSegment& s : segments) {
+    if (s.ramp) {
+      ++report.ramps;
+    } else if (static_cast<double>(s.end - s.begin) * dt >= kShortestDwellS) {
+      ++report.dwells;
+    }
+  }
+  Eigen::VectorXd smooth(temperatures_c.rows());
+  FirstOrderLag(temperatures_c.col(0), kRateSmoothingS, dt, smooth);
+  const Eigen::VectorXd rate = (temperatures_c.col(0) - smooth) * (60.0 / kRateSmoothingS);
+  report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
+  report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
+}
+
+// Every candidate column: the intercept, the channels' standardised linear terms, then per
+// candidate state its powers and rate (each candidate learning its level's range).
+Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                double rate_hz, const ThermalRegression& model,
+                                std::vector<ThermalState>& candidates) {
+  const int channels = static_cast<int>(temperatures_c.cols());
+  const int per_state = model.max_power + 1;
+  const Eigen::Index first_state = 1 + channels;
+  Eigen::MatrixXd x(temperatures_c.rows(),
+                    first_state + static_cast<Eigen::Index>(candidates.size()) * per_state);
+  x.col(0).setOnes();
+  for (int c = 0; c < channels; ++c) {
+    x.col(1 + c) = (temperatures_c.col(c).array() - model.centre_c[static_cast<size_t>(c)]) /
+                   model.scale_k[static_cast<size_t>(c)];
+  }
+  for (size_t j = 0; j < candidates.size(); ++j) {
+    const auto c = static_cast<size_t>(candidates[j].channel);
+    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
+                 model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
+                 /*learn_range=*/true,
+                 x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
+  }
+  return x;
+}
+
+// K-fold cross-validation of least squares on column subsets of a design, from moments: per unit
+// (time block or regime) Gram matrices summed into each fold's, the training part's being the
+// total less the fold's. One pass over the data, then a small solve per subset and fold.
+class CrossValidation {
+ public:
+  struct Fold {
+    Eigen::MatrixXd g, g_train;
+    Eigen::VectorXd b, b_train;
+    double yy = 0.0;
+    Eigen::Index begin = 0, end = 0;
+  };
+
+  // x: N x M design; yc: the centred target; folds: [first, last) ranges of `units`.
+  CrossValidation(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
+                  const std::vector<ThermalSegment>& units,
+                  const std::vector<std::pair<int, int>>& folds)
+      : x_(x), yc_(yc) {
+    const Eigen::Index m = x.cols();
+    std::vector<Eigen::MatrixXd> g(units.size());
+    std::vector<Eigen::VectorXd> b(units.size());
+    std::vector<double> yy(units.size());
+    Eigen::MatrixXd g_total = Eigen::MatrixXd::Zero(m, m);
+    Eigen::VectorXd b_total = Eigen::VectorXd::Zero(m);
+    for (size_t i = 0; i < units.size(); ++i) {
+      const Eigen::Index begin = units[i].begin, length = units[i].end - units[i].begin;
+      const auto xu = x.middleRows(begin, length);
+      g[i] = Eigen::MatrixXd::Zero(m, m);
+      g[i].selfadjointView<Eigen::Lower>().rankUpdate(xu.transpose());
+      g[i] = g[i].selfadjointView<Eigen::Lower>();
+      b[i] = xu.transpose() * yc.segment(begin, length);
+      yy[i] = yc.segment(begin, length).squaredNorm();
+      g_total += g[i];
+      b_total += b[i];
+    }
+    for (const auto& [first, last] : folds) {
+      Fold f{Eigen::MatrixXd::Zero(m, m), {}, Eigen::VectorXd::Zero(m), {}, 0.0,
+             units[static_cast<size_t>(first)].begin, units[static_cast<size_t>(last - 1)].end};
+      for (int i = first; i < last; ++i) {
+        f.g += g[static_cast<size_t>(i)];
+        f.b += b[static_cast<size_t>(i)];
+        f.yy += yy[static_cast<size_t>(i)];
+      }
+      f.g_train = g_total - f.g;
+      f.b_train = b_total - f.b;
+      folds_.push_back(std::move(f));
+    }
+  }
+
+  const std::vector<Fold>& folds() const { return folds_; }
+  // The training part's least-squares weights of fold f on the columns `cols`.
+  Eigen::VectorXd Weights(const Fold& f, const std::vector<int>& cols) const {
+    return SolveSubset(f.g_train, f.b_train, cols);
+  }
+
+  // Cross-validated mean square error of the columns `cols`.
+  double Mse(const std::vector<int>& cols) const {
+    double sum = 0.0;
+    for (const Fold& f : folds_) {
+      const Eigen::VectorXd w = Weights(f, cols);
+      double e = f.yy;
+      for (size_t i = 0; i < cols.size(); ++i) {
+        e -= 2.0 * w[static_cast<Eigen::Index>(i)] * f.b[cols[i]];
+        for (size_t j = 0; j < cols.size(); ++j) {
+          e += w[static_cast<Eigen::Index>(i)] * f.g(cols[i], cols[j]) *
+               w[static_cast<Eigen::Index>(j)];
+        }
+      }
+      sum += std::max(0.0, e);
+    }
+    return sum / static_cast<double>(yc_.size());
+  }
+
+  // Residual of every held-out fold's cross-validated prediction.
+  Eigen::VectorXd Residual(const std::vector<int>& cols) const {
+    Eigen::VectorXd r(yc_.size());
+    for (const Fold& f : folds_) {
+      const Eigen::VectorXd w = Weights(f, cols);
+      Eigen::MatrixXd xf(f.end - f.begin, static_cast<Eigen::Index>(cols.size()));
+      for (size_t i = 0; i < cols.size(); ++i) {
+        xf.col(static_cast<Eigen::Index>(i)) = x_.col(cols[i]).segment(f.begin, f.end - f.begin);
+      }
+      r.segment(f.begin, f.end - f.begin) = yc_.segment(f.begin, f.end - f.begin) - xf * w;
+    }
+    return r;
+  }
+
+ private:
+  const Eigen::MatrixXd& x_;
+  const Eigen::VectorXd& yc_;
+  std::vector<Fold> folds_;
+};
+
+// A subset of the candidate design's columns.
+struct Subset {
+  std::vector<int> cols{0};  // the intercept first
+  std::vector<int> states;   // candidate indices
+  bool linear = false;       // the channels' linear terms
+  double mse = std::numeric_limits<double>::infinity();
+};
+
+// Every subset of at most max_states candidates (combinations in increasing order), with or
+// without the channels' linear terms, the intercept alone included: the one of least
+// cross-validated error.
+Subset BestSubset(const CrossValidation& cv, int channels, int candidates, int per_state,
+                  int max_states) {
+  max_states = std::min(max_states, candidates);
+  Subset best;
+  std::vector<int> chosen;
+  auto visit = [&](auto&& self, int next) -> void {
+    for (bool with_linear : {false, true}) {
+      Subset s;
+      s.states = chosen;
+      s.linear = with_linear;
+      if (with_linear) {
+        for (int c = 0; c < channels; ++c) s.cols.push_back(1 + c);
+      }
+      for (int j : chosen) {
+        for (int p = 0; p < per_state; ++p) s.cols.push_back(1 + channels + j * per_state + p);
+      }
+      s.mse = cv.Mse(s.cols);
+      if (s.mse < best.mse) best = std::move(s);
+    }
+    if (static_cast<int>(chosen.size()) == max_states) return;
+    for (int j = next; j < candidates; ++j) {
+      chosen.push_back(j);
+      self(self, j + 1);
+      chosen.pop_back();
+    }
+  };
+  visit(visit, 0);
+  return best;
+}
+
+// The nonlinear correction of the header comment: its candidates on one shared hidden layer of
+// the chosen regressors xs (intercept left out), scored against each fold's linear fit on the
+// same folds. Null when none lowers the cross-validated error; the report says what was tried.
+std::shared_ptr<const Learner> FitCorrection(const CrossValidation& cv, const Eigen::MatrixXd& xs,
+                                             const Eigen::VectorXd& yc, const Subset& subset,
+                                             const Eigen::VectorXd& residual, std::uint64_t seed,
+                                             CalibrationReport& report) {
+  const Eigen::Index n = xs.rows();
+  const Eigen::MatrixXd z = xs.rightCols(xs.cols() - 1);
+  elm::ElmOptions eo;
+  eo.hidden_units = kCorrectionUnits.back();
+  eo.ridge_c = 1.0;
+  eo.seed = Rng(seed, StreamId("thermal-correction")).NextU64();
+  eo.threads = 1;
+  const elm::ElmFit widest = elm::Fit(z, yc, eo);
+  const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);
+  const Eigen::MatrixXd hth = h.transpose() * h;
+  std::vector<double> error(kCorrectionUnits.size() * kCorrectionRidge.size(), 0.0);
+  double linear_error = 0.0;
+  for (const CrossValidation::Fold& f : cv.folds()) {
+    const Eigen::VectorXd r = yc - xs * cv.Weights(f, subset.cols);
+    const Eigen::Index len = f.end - f.begin;
+    const auto r_fold = r.segment(f.begin, len);
+    // The network's target: the training part's residual, standardised as elm::Fit does.
+    const double mean = (r.sum() - r_fold.sum()) / static_cast<double>(n - len);
+    const double sd = std::sqrt(std::max(
+        ((r.array() - mean).square().sum() - (r_fold.array() - mean).square().sum()) /
+            static_cast<double>(n - len),
+        std::numeric_limits<double>::min()));
+    const Eigen::VectorXd t = (r.array() - mean) / sd;
+    const auto h_fold = h.middleRows(f.begin, len);
+    const Eigen::MatrixXd hth_train = hth - h_fold.transpose() * h_fold;
+    const Eigen::VectorXd ht_train =
+        h.transpose() * t - h_fold.transpose() * t.segment(f.begin, len);
+    linear_error += r_fold.squaredNorm();
+    size_t i = 0;
+    for (int units : kCorrectionUnits) {
+      for (double c : kCorrectionRidge) {
+        Eigen::MatrixXd a = hth_train.topLeftCorner(units, units);
+        a.diagonal().array() += 1.0 / c;
+        const Eigen::VectorXd beta = a.ldlt().solve(ht_train.head(units));
+        const Eigen::VectorXd predicted = (h_fold.leftCols(units) * beta).array() * sd + mean;
+        error[i++] += (r_fold - predicted).squaredNorm();
+      }
+    }
+  }
+  const size_t chosen =
+      static_cast<size_t>(std::min_element(error.begin(), error.end()) - error.begin());
+  report.cv_rmse_nonlinear = std::sqrt(error[chosen] / static_cast<double>(n));
+  if (!(error[chosen] < linear_error)) return nullptr;
+  LearnerOptions lo;
+  lo.kind = LearnerKind::kElm;
+  lo.elm.selection = elm::Selection::kFixed;
+  lo.elm.hidden_units = kCorrectionUnits[chosen / kCorrectionRidge.size()];
+  lo.elm.ridge_c = kCorrectionRidge[chosen % kCorrectionRidge.size()];
+  lo.seed = eo.seed;
+  lo.threads = 1;
+  report.nonlinear_units = lo.elm.hidden_units;
+  report.nonlinear_ridge_c = lo.elm.ridge_c;
+  return FitLearner(z, residual, lo);
+}
+
+// What the run cannot identify (docs/drift.md 4.5, "Calibration sufficiency").
+void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
+                 CalibrationReport& report) {
+  auto& w = report.warnings;
+  const int channels = model.channels();
+  for (int c = 0; c < channels; ++c) {
+    if (report.span_k[static_cast<size_t>(c)] < kShortestSpanK) {
+      w.push_back(Format("temperature %sspans only %.3g K: the model is not identified beyond it",
+                         channels > 1 ? Format("T%d ", c + 1).c_str() : "",
+                         report.span_k[static_cast<size_t>(c)]));
+    }
+  }
+  if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min)
+    w.push_back("no heating ramp: the response to rising temperature is not identified");
+  if (report.max_cooling_k_per_min < 2.0 * options.ramp_rate_k_per_min)
+    w.push_back("no cooling ramp: the response to falling temperature is not identified");
+  if (report.dwells == 0) {
+    w.push_back(
+        "no dwell of 10 min or more: the level response cannot be told from the rate response");
+  }
+  if (report.ramps + report.dwells < 3) {
+    w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
+  }
+  double slowest = 0.0;
+  for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);
+  if (slowest > 0.0 && report.duration_s < 8.0 * slowest) {
+    w.push_back(Format("the run is shorter than 8 times the slowest chosen time constant (%g s)",
+                       slowest));
+  }
+  if (report.skill < kLeastSkill) {
+    w.push_back(Format(
+        "cross-validation confirms little temperature dependence (skill %.1f %%): the estimate "
+        "is close to a constant bias",
+        100.0 * report.skill));
+  }
+  if (report.condition > kLargestCondition) {
+    w.push_back(Format("the chosen regressors are nearly collinear (condition %.2g)",
+                       report.condition));
+  }
 }
 
 }  // namespace
@@ -356,17 +644,10 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
                     " x " + std::to_string(channels));
   }
   RequireFiniteSignal("target", y, 2 * kShortestFold);
-  const double dt = 1.0 / rate_hz;
-  const double duration_s = static_cast<double>(n) * dt;
-  const int powers = options.max_power;
-  const int per_state = powers + 1;
-
   ThermalRegression model;
   model.rate_hz = rate_hz;
   model.order = options.state_order;
-  model.max_power = powers;
-  CalibrationReport& report = model.report;
-  report.duration_s = duration_s;
+  model.max_power = options.max_power;
   for (int c = 0; c < channels; ++c) {
     const auto t = temperatures_c.col(c);
     RequireFiniteSignal("temperature", t, n);
@@ -374,30 +655,15 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
                          "a thermal model needs a calibration run whose temperature changes");
     model.centre_c.push_back(t.mean());
     model.scale_k.push_back(Sd(t));
-    report.span_k.push_back(t.maxCoeff() - t.minCoeff());
   }
-
-  // Regimes of channel 0 and the folds.
+  CalibrationReport& report = model.report;
+  report.duration_s = static_cast<double>(n) / rate_hz;
   const std::vector<ThermalSegment> segments =
       Segments(temperatures_c.col(0), rate_hz, options.ramp_rate_k_per_min);
-  for (const ThermalSegment& s : segments) {
-    if (s.ramp) {
-      ++report.ramps;
-    } else if (static_cast<double>(s.end - s.begin) * dt >= kShortestDwellS) {
-      ++report.dwells;
-    }
-  }
-  {
-    Eigen::VectorXd smooth(n);
-    FirstOrderLag(temperatures_c.col(0), kRateSmoothingS, dt, smooth);
-    const Eigen::VectorXd rate = (temperatures_c.col(0) - smooth) * (60.0 / kRateSmoothingS);
-    report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
-    report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
-  }
-  // Folds: contiguous blocks of equal duration, or groups of whole regimes; time blocks when
-  // the run has too few regimes.
-  const std::vector<ThermalSegment> time_blocks = TimeBlocks(n, options.folds);
-  std::vector<ThermalSegment> units = time_blocks;
+  DescribeRun(temperatures_c, rate_hz, segments, report);
+
+  // Folds: contiguous blocks of equal duration, or groups of whole regimes.
+  std::vector<ThermalSegment> units = TimeBlocks(n, options.folds);
   if (options.folds_at_regimes && Partition(segments, n, options.folds).size() >= 3) {
     units = segments;
   }
@@ -409,282 +675,73 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   }
   report.folds = static_cast<int>(folds.size());
 
-  // Every candidate column: intercept, the channels' linear terms, then per candidate state its
-  // powers and rate.
-  const std::vector<double> grid = options.Grid(duration_s);
+  // The search over the candidates' subsets. The target is centred: the intercept absorbs the
+  // mean, and the moments stay well scaled.
   std::vector<ThermalState> candidates;
   for (int c = 0; c < channels; ++c) {
-    for (double tau : grid) candidates.push_back({c, tau});
+    for (double tau : options.Grid(report.duration_s)) candidates.push_back({c, tau});
   }
-  const Eigen::Index first_state = 1 + channels;
-  const Eigen::Index m = first_state + static_cast<Eigen::Index>(candidates.size()) * per_state;
-  Eigen::MatrixXd x(n, m);
-  x.col(0).setOnes();
-  for (int c = 0; c < channels; ++c) {
-    x.col(1 + c) = (temperatures_c.col(c).array() - model.centre_c[static_cast<size_t>(c)]) /
-                   model.scale_k[static_cast<size_t>(c)];
-  }
-  for (size_t j = 0; j < candidates.size(); ++j) {
-    const auto c = static_cast<size_t>(candidates[j].channel);
-    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order, powers,
-                 dt, model.centre_c[c], model.scale_k[c], /*learn_range=*/true,
-                 x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
-  }
-  // Centred target: the intercept absorbs the mean, and the moments stay well scaled.
-  const double y_mean = y.mean();
-  const Eigen::VectorXd yc = y.array() - y_mean;
-  // Moments per unit (segment or block); a fold's are sums of its units', the training part's
-  // the total less the fold's.
-  const size_t u_count = units.size();
-  std::vector<Eigen::MatrixXd> g(u_count);
-  std::vector<Eigen::VectorXd> b(u_count);
-  std::vector<double> yy(u_count);
-  Eigen::MatrixXd g_total = Eigen::MatrixXd::Zero(m, m);
-  Eigen::VectorXd b_total = Eigen::VectorXd::Zero(m);
-  for (size_t i = 0; i < u_count; ++i) {
-    const Eigen::Index begin = units[i].begin, length = units[i].end - units[i].begin;
-    const auto xu = x.middleRows(begin, length);
-    g[i] = Eigen::MatrixXd::Zero(m, m);
-    g[i].selfadjointView<Eigen::Lower>().rankUpdate(xu.transpose());
-    g[i] = g[i].selfadjointView<Eigen::Lower>();
-    b[i] = xu.transpose() * yc.segment(begin, length);
-    yy[i] = yc.segment(begin, length).squaredNorm();
-    g_total += g[i];
-    b_total += b[i];
-  }
-  // A fold's moments, and those of its training part (the total less the fold's).
-  struct Fold {
-    Eigen::MatrixXd g, g_train;
-    Eigen::VectorXd b, b_train;
-    double yy = 0.0;
-    Eigen::Index begin = 0, end = 0;
-  };
-  std::vector<Fold> fold_moments;
-  for (const auto& [first, last] : folds) {
-    Fold f{Eigen::MatrixXd::Zero(m, m), {}, Eigen::VectorXd::Zero(m), {}, 0.0,
-           units[static_cast<size_t>(first)].begin, units[static_cast<size_t>(last - 1)].end};
-    for (int i = first; i < last; ++i) {
-      f.g += g[static_cast<size_t>(i)];
-      f.b += b[static_cast<size_t>(i)];
-      f.yy += yy[static_cast<size_t>(i)];
-    }
-    f.g_train = g_total - f.g;
-    f.b_train = b_total - f.b;
-    fold_moments.push_back(std::move(f));
-  }
-  // Cross-validated mean square error of the columns `cols`.
-  auto cv_mse = [&](const std::vector<int>& cols) {
-    double sum = 0.0;
-    for (const Fold& f : fold_moments) {
-      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, cols);
-      double e = f.yy;
-      for (size_t i = 0; i < cols.size(); ++i) {
-        e -= 2.0 * w[static_cast<Eigen::Index>(i)] * f.b[cols[i]];
-        for (size_t j = 0; j < cols.size(); ++j) {
-          e += w[static_cast<Eigen::Index>(i)] * f.g(cols[i], cols[j]) *
-               w[static_cast<Eigen::Index>(j)];
-        }
-      }
-      sum += std::max(0.0, e);
-    }
-    return sum / static_cast<double>(n);
-  };
-
-  // Every subset: the channels' linear terms or not, and up to max_states candidate states in
-  // increasing order (combinations).
-  const int max_states = std::min<int>(options.max_states, static_cast<int>(candidates.size()));
-  double best = std::numeric_limits<double>::infinity();
-  std::vector<int> best_cols;
-  std::vector<int> best_states;
-  bool best_linear = false;
-  std::vector<int> chosen;  // candidate indices of the current combination
-  const double constant_mse = cv_mse({0});
-  auto visit = [&](auto&& self, int next) -> void {
-    for (bool with_linear : {false, true}) {
-      std::vector<int> cols{0};
-      if (with_linear) {
-        for (int c = 0; c < channels; ++c) cols.push_back(1 + c);
-      }
-      for (int j : chosen) {
-        for (int p = 0; p < per_state; ++p) {
-          cols.push_back(static_cast<int>(first_state) + j * per_state + p);
-        }
-      }
-      const double e = cols.size() == 1 ? constant_mse : cv_mse(cols);
-      if (e < best) {
-        best = e;
-        best_cols = cols;
-        best_states = chosen;
-        best_linear = with_linear;
-      }
-    }
-    if (static_cast<int>(chosen.size()) == max_states) return;
-    for (int j = next; j < static_cast<int>(candidates.size()); ++j) {
-      chosen.push_back(j);
-      self(self, j + 1);
-      chosen.pop_back();
-    }
-  };
-  visit(visit, 0);
+  const Eigen::MatrixXd x = CandidateDesign(temperatures_c, rate_hz, model, candidates);
+  const Eigen::VectorXd yc = y.array() - y.mean();
+  const CrossValidation cv(x, yc, units, folds);
+  const Subset best = BestSubset(cv, channels, static_cast<int>(candidates.size()),
+                                 options.max_power + 1, options.max_states);
+  model.linear.assign(static_cast<size_t>(channels), best.linear);
+  for (int j : best.states) model.states.push_back(candidates[static_cast<size_t>(j)]);
 
   // Refit the chosen columns on the whole run (QR of the unit-scaled design).
-  const Eigen::Index p = static_cast<Eigen::Index>(best_cols.size());
+  const Eigen::Index p = static_cast<Eigen::Index>(best.cols.size());
   Eigen::MatrixXd xs(n, p);
   Eigen::VectorXd scale(p);
   for (Eigen::Index i = 0; i < p; ++i) {
-    xs.col(i) = x.col(best_cols[static_cast<size_t>(i)]);
+    xs.col(i) = x.col(best.cols[static_cast<size_t>(i)]);
     scale[i] = 1.0 / std::max(xs.col(i).norm(), std::numeric_limits<double>::min());
   }
   const Eigen::MatrixXd xn = xs * scale.asDiagonal();
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(xn);
-  model.coefficients = scale.asDiagonal() * qr.solve(y);
-  model.linear.assign(static_cast<size_t>(channels), best_linear);
-  for (int j : best_states) model.states.push_back(candidates[static_cast<size_t>(j)]);
+  model.coefficients = scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xn).solve(y);
 
-  // Uncertainty: residual variance inflated by its correlation (batch means), and the slow part
-  // of the cross-validated residual.
+  // Uncertainty: the residual variance inflated by its correlation (batch means), and the slow
+  // part of the cross-validated residual.
   const Eigen::VectorXd residual = y - xs * model.coefficients;
-  const double variance = residual.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, n - p));
+  const double variance =
+      residual.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, n - p));
   const Eigen::Index block = std::clamp<Eigen::Index>(
       static_cast<Eigen::Index>(std::round(kBlockS * rate_hz)), 1, std::max<Eigen::Index>(1, n / 4));
   const Eigen::VectorXd centred = residual.array() - residual.mean();
   const double inflation =
-      variance > 0.0 ? std::max(1.0, static_cast<double>(block) * BlockMeanSquare(centred, block) /
-                                         variance)
-                     : 1.0;
-  Eigen::MatrixXd gram_n = xn.transpose() * xn;
-  const Eigen::MatrixXd gram_inv =
-      gram_n.ldlt().solve(Eigen::MatrixXd::Identity(p, p));
-  model.covariance = scale.asDiagonal() * gram_inv * scale.asDiagonal() * (variance * inflation);
-  // Residual of the cross-validated predictions of each held-out fold, from the per-fold solves.
-  auto cv_residual_of = [&](const std::vector<int>& cols) {
-    Eigen::VectorXd r(n);
-    for (const Fold& f : fold_moments) {
-      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, cols);
-      Eigen::MatrixXd xf(f.end - f.begin, static_cast<Eigen::Index>(cols.size()));
-      for (size_t i = 0; i < cols.size(); ++i) {
-        xf.col(static_cast<Eigen::Index>(i)) = x.col(cols[i]).segment(f.begin, f.end - f.begin);
-      }
-      r.segment(f.begin, f.end - f.begin) = yc.segment(f.begin, f.end - f.begin) - xf * w;
-    }
-    return r;
-  };
-  const Eigen::VectorXd cv_residual = cv_residual_of(best_cols);
+      variance > 0.0
+          ? std::max(1.0, static_cast<double>(block) * BlockMeanSquare(centred, block) / variance)
+          : 1.0;
+  const Eigen::MatrixXd gram = xn.transpose() * xn;
+  model.covariance = scale.asDiagonal() * gram.ldlt().solve(Eigen::MatrixXd::Identity(p, p)) *
+                     scale.asDiagonal() * (variance * inflation);
   // What the fast noise contributes to a block mean, from the means of 10-s blocks scaled to the
   // block: exact for white noise, and not fooled by the anti-correlated quantization noise that
   // first differences would count as white.
-  const Eigen::Index short_block =
-      std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::round(kShortBlockS * rate_hz)), 1, block);
+  const Eigen::Index short_block = std::clamp<Eigen::Index>(
+      static_cast<Eigen::Index>(std::round(kShortBlockS * rate_hz)), 1, block);
   const double white_share = BlockMeanSquare(centred, short_block) *
                              static_cast<double>(short_block) / static_cast<double>(block);
-  const double slow_ms = std::max(0.0, BlockMeanSquare(cv_residual, block) - white_share);
+  const double slow_ms = std::max(0.0, BlockMeanSquare(cv.Residual(best.cols), block) - white_share);
   model.cv_slow_sd = std::sqrt(slow_ms);
 
   if (nonlinear && p > 1) {
-    // The correction's candidates on one shared hidden layer of the regressors (intercept left
-    // out), each fold's linear fit first.
-    const Eigen::MatrixXd z = xs.rightCols(p - 1);
-    elm::ElmOptions eo;
-    eo.hidden_units = kCorrectionUnits.back();
-    eo.ridge_c = 1.0;
-    eo.seed = Rng(seed, StreamId("thermal-correction")).NextU64();
-    eo.threads = 1;
-    const elm::ElmFit widest = elm::Fit(z, yc, eo);
-    const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);
-    const Eigen::MatrixXd hth = h.transpose() * h;
-    std::vector<double> error(kCorrectionUnits.size() * kCorrectionRidge.size(), 0.0);
-    double linear_error = 0.0;
-    for (const Fold& f : fold_moments) {
-      const Eigen::VectorXd w = SolveSubset(f.g_train, f.b_train, best_cols);
-      const Eigen::VectorXd r = yc - xs * w;
-      const Eigen::Index len = f.end - f.begin;
-      const auto r_fold = r.segment(f.begin, len);
-      const double mean = (r.sum() - r_fold.sum()) / static_cast<double>(n - len);
-      const double sd = std::sqrt(std::max(
-          ((r.array() - mean).square().sum() - (r_fold.array() - mean).square().sum()) /
-              static_cast<double>(n - len),
-          std::numeric_limits<double>::min()));
-      const Eigen::VectorXd t = (r.array() - mean) / sd;
-      const auto h_fold = h.middleRows(f.begin, len);
-      const Eigen::MatrixXd hth_train = hth - h_fold.transpose() * h_fold;
-      const Eigen::VectorXd ht_train = h.transpose() * t - h_fold.transpose() * t.segment(f.begin, len);
-      linear_error += r_fold.squaredNorm();
-      size_t i = 0;
-      for (int units : kCorrectionUnits) {
-        for (double c : kCorrectionRidge) {
-          Eigen::MatrixXd a = hth_train.topLeftCorner(units, units);
-          a.diagonal().array() += 1.0 / c;
-          const Eigen::VectorXd beta = a.ldlt().solve(ht_train.head(units));
-          const Eigen::VectorXd predicted =
-              (h_fold.leftCols(units) * beta).array() * sd + mean;
-          error[i++] += (r_fold - predicted).squaredNorm();
-        }
-      }
-    }
-    const size_t chosen_index = static_cast<size_t>(
-        std::min_element(error.begin(), error.end()) - error.begin());
-    report.cv_rmse_nonlinear = std::sqrt(error[chosen_index] / static_cast<double>(n));
-    if (error[chosen_index] < linear_error) {
-      LearnerOptions lo;
-      lo.kind = LearnerKind::kElm;
-      lo.elm.selection = elm::Selection::kFixed;
-      lo.elm.hidden_units = kCorrectionUnits[chosen_index / kCorrectionRidge.size()];
-      lo.elm.ridge_c = kCorrectionRidge[chosen_index % kCorrectionRidge.size()];
-      lo.seed = eo.seed;
-      lo.threads = 1;
-      report.nonlinear_units = lo.elm.hidden_units;
-      report.nonlinear_ridge_c = lo.elm.ridge_c;
-      model.correction = FitLearner(z, residual, lo);
-    }
+    model.correction = FitCorrection(cv, xs, yc, best, residual, seed, report);
   }
 
-  // Report.
-  report.cv_rmse = std::sqrt(best);
-  report.cv_rmse_constant = std::sqrt(constant_mse);
-  // Skill on the slow part (block means less the white noise's share): the white noise, which no
-  // thermal model explains, would otherwise hide it.
+  report.cv_rmse = std::sqrt(best.mse);
+  report.cv_rmse_constant = std::sqrt(cv.Mse({0}));
+  // Skill on the slow part: the white noise, which no thermal model explains, would hide it.
   const double constant_slow_ms =
-      std::max(0.0, BlockMeanSquare(cv_residual_of({0}), block) - white_share);
+      std::max(0.0, BlockMeanSquare(cv.Residual({0}), block) - white_share);
   report.skill = constant_slow_ms > 0.0 ? 1.0 - slow_ms / constant_slow_ms : 0.0;
-  {
-    const Eigen::VectorXd d = gram_n.diagonal().cwiseSqrt().cwiseInverse();
-    const Eigen::MatrixXd unit = d.asDiagonal() * gram_n * d.asDiagonal();
-    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(unit).eigenvalues();
-    report.condition = ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
-  }
-  auto& w = report.warnings;
-  for (int c = 0; c < channels; ++c) {
-    if (report.span_k[static_cast<size_t>(c)] < 15.0) {
-      w.push_back(Format("temperature %sspans only %.3g K: the model is not identified beyond it",
-                         channels > 1 ? Format("T%d ", c + 1).c_str() : "",
-                         report.span_k[static_cast<size_t>(c)]));
-    }
-  }
-  if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min)
-    w.push_back("no heating ramp: the response to rising temperature is not identified");
-  if (report.max_cooling_k_per_min < 2.0 * options.ramp_rate_k_per_min)
-    w.push_back("no cooling ramp: the response to falling temperature is not identified");
-  if (report.dwells == 0) {
-    w.push_back(
-        "no dwell of 10 min or more: the level response cannot be told from the rate response");
-  }
-  if (report.ramps + report.dwells < 3) {
-    w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
-  }
-  if (!model.states.empty() && duration_s < 8.0 * model.states.back().tau_s) {
-    w.push_back(Format("the run is shorter than 8 times the slowest chosen time constant (%g s)",
-                       model.states.back().tau_s));
-  }
-  if (report.skill < 0.2) {
-    w.push_back(Format(
-        "cross-validation confirms little temperature dependence (skill %.1f %%): the estimate "
-        "is close to a constant bias",
-        100.0 * report.skill));
-  }
-  if (report.condition > 1e10) {
-    w.push_back(Format("the chosen regressors are nearly collinear (condition %.2g)",
-                       report.condition));
-  }
+  const Eigen::VectorXd unit = gram.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                                 unit.asDiagonal() * gram * unit.asDiagonal())
+                                 .eigenvalues();
+  report.condition =
+      ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
+  AddWarnings(model, options, report);
   model.Validate();
   return model;
 }
