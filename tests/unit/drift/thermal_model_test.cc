@@ -1,0 +1,159 @@
+// The identification of a thermal drift model (thermal_model.h): it finds the state a synthetic
+// drift was built from, among the grid's candidates, by cross-validation; regimes are told
+// apart; beyond the calibration's range the powers continue along their tangent; bad options and
+// runs too short to cross-validate are refused; a run without cooling or dwells is flagged.
+#include "gyrodrift/drift/thermal_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/features.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+// A chamber programme: dwells and ramps between -20 and 60 degC, 1 Hz, `hours` long.
+Eigen::VectorXd Programme(double hours) {
+  const Eigen::Index n = static_cast<Eigen::Index>(hours * 3600);
+  Eigen::VectorXd t(n);
+  const double levels[] = {20, 60, -20, 40, 0, 50, -10, 30};
+  double now = 20.0;
+  Eigen::Index i = 0;
+  for (int k = 0; i < n; ++k) {
+    const double target = levels[k % 8];
+    for (; i < n && std::abs(now - target) > 1e-9; ++i) {  // 1 K/min ramp
+      now += std::copysign(std::min(1.0 / 60.0, std::abs(target - now)), target - now);
+      t[i] = now;
+    }
+    for (Eigen::Index d = 0; i < n && d < 2400; ++d, ++i) t[i] = now;  // 40-min dwell
+  }
+  return t;
+}
+
+Eigen::VectorXd State(const Eigen::VectorXd& t, double tau) {
+  Eigen::VectorXd a(t.size()), b(t.size());
+  FirstOrderLag(t, tau, 1.0, a);
+  FirstOrderLag(a, tau, 1.0, b);
+  return b;
+}
+
+TEST(ThermalModel, FindsTheStateADriftWasBuiltFrom) {
+  const Eigen::VectorXd t = Programme(16.0);
+  const Eigen::VectorXd s = State(t, 480.0);
+  Eigen::VectorXd a(t.size());
+  FirstOrderLag(t, 480.0, 1.0, a);
+  const Eigen::VectorXd rate = (a - s) / 480.0;  // K/s
+  Rng rng(3, 0);
+  Eigen::VectorXd drift(t.size()), y(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double d = s[i] - 20.0;
+    drift[i] = 0.1 + 2e-3 * d + 4e-5 * d * d + 30.0 * rate[i];
+    y[i] = drift[i] + 0.2 * rng.Normal();
+  }
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  ASSERT_FALSE(m.states.empty()) << m.Summary();
+  bool found = false;
+  for (const ThermalState& st : m.states) found = found || std::abs(st.tau_s - 480.0) < 1e-9;
+  EXPECT_TRUE(found) << m.Summary();
+  EXPECT_TRUE(m.report.warnings.empty()) << m.report.Summary();
+  EXPECT_EQ(m.report.folds, 8);
+  EXPECT_GT(m.report.skill, 0.9);
+  const Eigen::MatrixXd e = m.EstimateWithSd(t);
+  const double rms = std::sqrt((e.col(0) - drift).squaredNorm() / static_cast<double>(t.size()));
+  EXPECT_LT(rms, 0.01) << m.Summary();
+  EXPECT_GT(e.col(1).minCoeff(), 0.0);
+  EXPECT_EQ(m.RegressorNames().size(), static_cast<size_t>(m.coefficients.size()));
+  // The same data, the same model (no randomness without the nonlinear option).
+  EXPECT_EQ(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}).coefficients, m.coefficients);
+}
+
+TEST(ThermalModel, SegmentsTellRampsFromDwells) {
+  Eigen::VectorXd t(7200);
+  for (Eigen::Index i = 0; i < 7200; ++i) {
+    t[i] = i < 2400 ? 20.0 : i < 4800 ? 20.0 + (i - 2400) / 60.0 : 60.0;  // dwell, ramp, dwell
+  }
+  const std::vector<ThermalSegment> s = Segments(t, 1.0, 0.1);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_FALSE(s[0].ramp);
+  EXPECT_TRUE(s[1].ramp);
+  EXPECT_FALSE(s[2].ramp);
+  EXPECT_EQ(s.front().begin, 0);
+  EXPECT_EQ(s.back().end, 7200);
+  EXPECT_NEAR(static_cast<double>(s[1].begin), 2400.0, 30.0);
+}
+
+TEST(ThermalModel, PowersContinueAlongTheirTangentBeyondTheCalibrationRange) {
+  const Eigen::VectorXd t = Programme(8.0);
+  Rng rng(4, 0);
+  Eigen::VectorXd y(t.size());
+  const Eigen::VectorXd s = State(t, 240.0);
+  for (Eigen::Index i = 0; i < t.size(); ++i) y[i] = 1e-4 * std::pow(s[i] - 20.0, 2) + 0.05 * rng.Normal();
+  ThermalModelOptions o;
+  o.max_states = 1;
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, o);
+  ASSERT_EQ(m.states.size(), 1u) << m.Summary();
+  const ThermalState& st = m.states[0];
+  // A record in equilibrium far above the range: the state's standardised level is z; its
+  // square column is the tangent at the range's top, not z^2.
+  const double hot = 150.0;
+  const Eigen::MatrixXd x = m.Regressors(Eigen::VectorXd::Constant(10, hot));
+  const double z = (hot - m.centre_c[0]) / m.scale_k[0];
+  ASSERT_GT(z, st.level_max);
+  const Eigen::Index first = m.linear[0] ? 2 : 1;
+  EXPECT_NEAR(x(9, first), z, 1e-12);
+  EXPECT_NEAR(x(9, first + 1), st.level_max * st.level_max + 2 * st.level_max * (z - st.level_max),
+              1e-9);
+  // Inside the range the columns are the plain powers.
+  const double mid = 0.5 * (st.level_min + st.level_max);
+  const Eigen::MatrixXd inside =
+      m.Regressors(Eigen::VectorXd::Constant(10, m.centre_c[0] + mid * m.scale_k[0]));
+  EXPECT_NEAR(inside(9, first + 1), mid * mid, 1e-9);
+}
+
+TEST(ThermalModel, ARunWithoutCoolingOrDwellsIsFlaggedAndBadInputRefused) {
+  Eigen::VectorXd t(3600), y(3600);
+  Rng rng(5, 0);
+  for (Eigen::Index i = 0; i < 3600; ++i) {
+    t[i] = 20.0 + i / 360.0;  // one slow ramp, 10 K
+    y[i] = 0.01 * t[i] + 0.1 * rng.Normal();
+  }
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  const std::string all = [&] {
+    std::string s;
+    for (const std::string& w : m.report.warnings) s += w + "\n";
+    return s;
+  }();
+  EXPECT_NE(all.find("spans only"), std::string::npos) << all;
+  EXPECT_NE(all.find("no cooling ramp"), std::string::npos) << all;
+  EXPECT_NE(all.find("no dwell"), std::string::npos) << all;
+
+  ThermalModelOptions bad;
+  bad.max_states = 5;
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, bad), OptionError);
+  bad = {};
+  bad.longest_tau_s = 10.0;  // below the shortest
+  EXPECT_THROW(bad.Validate(), OptionError);
+  EXPECT_THROW(IdentifyThermalModel(t.head(20), y.head(20), 1.0, ThermalModelOptions{}),
+               DataError);
+  EXPECT_THROW(IdentifyThermalModel(Eigen::VectorXd::Constant(3600, 20.0), y, 1.0,
+                                    ThermalModelOptions{}),
+               DataError);
+  Eigen::VectorXd with_nan = y;
+  with_nan[100] = std::nan("");
+  EXPECT_THROW(IdentifyThermalModel(t, with_nan, 1.0, ThermalModelOptions{}), DataError);
+}
+
+TEST(ThermalModel, GridFollowsTheRunLength) {
+  const ThermalModelOptions o;
+  const std::vector<double> grid16 = o.Grid(16 * 3600.0);
+  EXPECT_DOUBLE_EQ(grid16.front(), 30.0);
+  EXPECT_LE(grid16.back(), 3600.0);  // 1/16 of the run
+  EXPECT_GT(grid16.back() * std::sqrt(2.0), 3600.0);
+  EXPECT_LT(o.Grid(3600.0).size(), grid16.size());
+}
+
+}  // namespace
+}  // namespace gyrodrift::drift
