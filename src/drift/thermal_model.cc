@@ -28,6 +28,9 @@ constexpr double kShortBlockS = 10.0;        // blocks that measure the residual
 constexpr double kShortestSpanK = 15.0;
 constexpr double kLeastSkill = 0.2;
 constexpr double kLargestCondition = 1e10;
+// A coil lags its case sensor by up to about an hour (our simulator: 40 min; the family's layer
+// chains: 10-60 min): a run whose slowest candidate state lags less cannot identify such a gyro.
+constexpr double kSlowLagS = 1800.0;
 constexpr Eigen::Index kShortestFold = 16;   // samples
 constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a subset
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
@@ -413,6 +416,15 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
   }
   if (report.ramps + report.dwells < 3) {
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
+  }
+  // The slowest candidate state's mean delay: order x tau.
+  const std::vector<double> grid = options.Grid(report.duration_s);
+  const double longest_delay = grid.empty() ? 0.0 : options.state_order * grid.back();
+  if (longest_delay < kSlowLagS) {
+    w.push_back(Format(
+        "thermal states could lag the sensor by at most %.0f s (time constants up to %g of the "
+        "run): a gyro whose coil lags its sensor by more needs a longer calibration run",
+        longest_delay, options.longest_tau_share));
   }
   double slowest = 0.0;
   for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);
