@@ -10,6 +10,11 @@ first=${1:-1}; last=${2:-20}; hours=${3:-16}; methods=${4:-thermal,poly}
 top=$(cd "$(dirname "$0")/.." && pwd)
 B=${GYRODRIFT:-$top/build/apps/gyrodrift/gyrodrift}
 G=$top/../shared/testdata/gyro_thermal_family/generate.py
+if ! /usr/bin/python3 -c 'import numpy' 2>/dev/null; then
+  echo "family-table.sh: the family generator needs Debian's python3-numpy (apt-get install python3-numpy)" >&2
+  exit 2
+fi
+[ -x "$B" ] || { echo "family-table.sh: no gyrodrift at $B (run make build first)" >&2; exit 2; }
 work=${WORK:-$(mktemp -d)}
 mkdir -p "$work"
 printf "unit"; for m in ${methods//,/ }; do printf ",%s" "$m"; done; printf "\n"
