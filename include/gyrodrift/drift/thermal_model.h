@@ -1,6 +1,6 @@
 // Identification of a gyro's thermal drift model from its calibration run: which thermal states
 // of the temperature channel(s) the drift follows, with their time constants, chosen from the
-// data by cross-validation that holds out whole thermal regimes.
+// data by cross-validation that holds out contiguous stretches of whole ramps and dwells.
 //
 // Model [choice, measured in docs/drift.md section 4.5]. For temperature channels T_c (degC,
 // c = 1..C), standardised z_c = (T_c - mean_c) / sd_c over the calibration run, and S chosen
@@ -17,19 +17,19 @@
 // (shortest_tau_s .. longest_tau_s, taus_per_octave per factor 2, and at most
 // longest_tau_share of the run: a slower lag cannot be told from the run's slow noise) gives
 // P + 1 columns; every subset of at most max_states candidates, with or without the channels'
-// linear terms (the intercept alone included), is scored by K-fold cross-validation whose folds
-// are contiguous groups of whole thermal regimes (ramps and dwells, Segments below), and the
-// subset of least cross-validated error is refitted on the whole run by least squares (QR).
-// The search works on per-fold Gram matrices, so it costs one pass over the data
-// (O(N M^2), M = all candidate columns) plus a small solve per subset and fold.
+// linear terms (the intercept alone included), is scored by K-fold cross-validation over
+// contiguous blocks of the run (or groups of whole regimes: Segments below), and the subset of
+// least cross-validated error is refitted on the whole run by least squares (QR). The search
+// works on per-block Gram matrices, so it costs one pass over the data (O(N M^2), M = all
+// candidate columns) plus a small solve per subset and fold.
 //
 // Beyond the calibration's range the level powers continue linearly (ThermalState).
 //
 // Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x): s_cv is the
 // slow part of the cross-validated residual (its 10-min block means, less what the fast noise
-// contributes to them, measured on 10-s blocks: the drift error a held-out regime saw), V the coefficient covariance of
-// the fit, inflated by the residual's correlation (batch means over 10-min blocks), which grows
-// where the temperature leaves the calibration's range.
+// contributes to them, measured on 10-s blocks: the drift error a held-out stretch saw), V the
+// coefficient covariance of the fit, inflated by the residual's correlation (batch means over
+// 10-min blocks), which grows where the temperature leaves the calibration's range.
 //
 // Nonlinear option: a sigmoid ELM (elm.h) of the chosen regressors fitted to the linear model's
 // residual, its hidden units L in {5, 10, 20, 40} and ridge C in {0.01, 1, 100, 10^4} chosen by
@@ -38,10 +38,11 @@
 // network are those of any larger one), kept only when it lowers the cross-validated error.
 //
 // Calibration sufficiency (CalibrationReport): temperature span, heating and cooling rates,
-// dwells, regimes, cross-validated skill against the intercept alone and the conditioning of the
-// chosen regressors, with warnings where the run cannot identify the model.
-// Cost: O(N (C G (q + P)) + N M^2 K) for G grid constants; a 16-h 1 Hz run with one channel
-// takes about 0.3 s.
+// dwells, regimes, cross-validated skill against the intercept alone, the conditioning of the
+// chosen regressors and how far the candidate states can lag, with warnings where the run cannot
+// identify the model.
+// Cost: O(N (C G (q + P)) + N M^2) for G grid constants and M = 1 + C + C G (P + 1) columns; a
+// 16-h 1 Hz run with one channel takes about 0.12 s (bench_drift's BM_ThermalFit).
 #pragma once
 
 #include <Eigen/Core>
