@@ -22,12 +22,21 @@ std::string_view Unquote(std::string_view s) {
   return s;
 }
 
-// Splits one line at commas (no quoted commas: numeric files do not need them).
-void SplitLine(std::string_view line, std::vector<std::string_view>& cells) {
+// The delimiter of a file, from its header line: a comma where there is one, else a tab, else a
+// semicolon (what instrument and spreadsheet exports write), else a comma (one column).
+char DetectDelimiter(std::string_view header) {
+  for (char d : {',', '\t', ';'}) {
+    if (header.find(d) != std::string_view::npos) return d;
+  }
+  return ',';
+}
+
+// Splits one line at the delimiter (no quoted delimiters: numeric files do not need them).
+void SplitLine(std::string_view line, char delimiter, std::vector<std::string_view>& cells) {
   cells.clear();
   size_t start = 0;
   for (;;) {
-    const size_t comma = line.find(',', start);
+    const size_t comma = line.find(delimiter, start);
     if (comma == std::string_view::npos) {
       cells.push_back(Trim(line.substr(start)));
       return;
@@ -61,6 +70,7 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
   if (rest.size() >= 3 && rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // BOM
   std::vector<std::string_view> cells;
   bool have_header = false;
+  char delimiter = ',';
   Eigen::Index line_number = 0;
   while (!rest.empty()) {
     const size_t eol = rest.find('\n');
@@ -68,7 +78,8 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
     rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 1);
     ++line_number;
     if (IsSkippable(line)) continue;
-    SplitLine(line, cells);
+    if (!have_header) delimiter = DetectDelimiter(line);
+    SplitLine(line, delimiter, cells);
     if (!have_header) {
       for (auto cell : cells) table.header_.emplace_back(Unquote(cell));
       for (size_t i = 0; i < table.header_.size(); ++i) {

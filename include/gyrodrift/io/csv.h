@@ -1,7 +1,9 @@
 // CSV input and output.
 //
-// Input: a header row, then one row per sample, comma separated. Lines starting with '#' and
-// blank lines are skipped; CRLF endings and quoted header names are accepted. Every cell is parsed
+// Input: a header row, then one row per sample, separated by commas, or by tabs or semicolons
+// when the header has no comma (instrument and spreadsheet exports; decimal commas are not read).
+// Lines starting with '#' and blank lines are skipped; CRLF endings, a UTF-8 byte-order mark and
+// quoted header names are accepted. Every cell is parsed
 // as a number up front; a column with a non-numeric cell can still be loaded as long as nobody
 // asks for it, and asking for it names the first bad cell.
 // Output: full double precision (shortest text that reads back to the same double), written to a

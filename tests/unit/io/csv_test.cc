@@ -21,6 +21,20 @@ TEST(CsvTable, ParsesHeaderCommentsCrlfAndQuotedNames) {
   EXPECT_EQ(t.Column("1")[1], 1.0);
 }
 
+TEST(CsvTable, TabAndSemicolonFilesAreReadWhenTheHeaderHasNoComma) {
+  const CsvTable tab = CsvTable::Parse("time_s\trate_dph\n0\t1.5\n1\t-2\n", "tab");
+  EXPECT_EQ(tab.header(), (std::vector<std::string>{"time_s", "rate_dph"}));
+  EXPECT_EQ(tab.Column("rate_dph"), (Eigen::VectorXd(2) << 1.5, -2.0).finished());
+  const CsvTable semi = CsvTable::Parse("\xEF\xBB\xBFa;b\r\n1;2\r\n3;4\r\n", "semi");
+  EXPECT_EQ(semi.Column("b"), (Eigen::VectorXd(2) << 2.0, 4.0).finished());
+  // Decimal commas are not read: the cell is named, not silently split.
+  const CsvTable decimal = CsvTable::Parse("a;b\n1,5;2\n", "decimal");
+  EXPECT_THROW(decimal.Column("a"), DataError);
+  // A comma in the header wins: a tab inside a comma file is a cell's padding.
+  const CsvTable comma = CsvTable::Parse("a,\tb\n1,\t2\n", "comma");
+  EXPECT_EQ(comma.header(), (std::vector<std::string>{"a", "b"}));
+}
+
 TEST(CsvTable, NamesMissingColumn) {
   const auto t = CsvTable::Parse("a,b\n1,2\n", "f.csv");
   try {
