@@ -36,31 +36,6 @@ struct AllanArgs {
   bool quiet = false;
 };
 
-// "all" | "octave" | "decade" | "1,10,100" (seconds).
-void ParseTaus(const std::string& text, al::AllanOptions* o) {
-  if (text == "all" || text == "octave" || text == "decade") {
-    o->grid = al::TauGridFromString(text);
-    return;
-  }
-  o->grid = al::TauGrid::kList;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    const bool blank_tail =
-        end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
-    if (!blank_tail || !(v > 0.0) || !std::isfinite(v)) {
-      ThrowOption(
-          "--taus", text,
-          "all, octave, decade or a comma-separated list of positive taus in s (bad item '" + item +
-              "')");
-    }
-    o->tau_list_s.push_back(v);
-  }
-  if (o->tau_list_s.empty()) ThrowOption("--taus", text, "all, octave, decade or a list of taus");
-}
-
 nlohmann::json TermJson(const al::NoiseTerm& t, const char* unit) {
   return {{"unit", unit},
           {"identified", t.identified},

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <regex>
+#include <sstream>
 #include <vector>
 
 #include "gyrodrift/common/check.h"
@@ -200,6 +201,31 @@ io::CsvTable ReadLog(const std::string& path) {
         path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
   }
   return table;
+}
+
+// "all" | "octave" | "decade" | "1,10,100" (seconds).
+void ParseTaus(const std::string& text, allan::AllanOptions* o) {
+  if (text == "all" || text == "octave" || text == "decade") {
+    o->grid = allan::TauGridFromString(text);
+    return;
+  }
+  o->grid = allan::TauGrid::kList;
+  std::stringstream s(text);
+  std::string item;
+  while (std::getline(s, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    const bool blank_tail =
+        end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
+    if (!blank_tail || !(v > 0.0) || !std::isfinite(v)) {
+      ThrowOption(
+          "--taus", text,
+          "all, octave, decade or a comma-separated list of positive taus in s (bad item '" + item +
+              "')");
+    }
+    o->tau_list_s.push_back(v);
+  }
+  if (o->tau_list_s.empty()) ThrowOption("--taus", text, "all, octave, decade or a list of taus");
 }
 
 double ResolveSampleRate(const io::CsvTable& table, double given, std::string* how) {

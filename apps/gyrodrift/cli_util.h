@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
 
@@ -42,6 +43,10 @@ bool IsTerminal();
 // --duration text: "30s", "10min", "8h", "1.5h", "3600" (seconds), "1e4s". Anything else, or a
 // value that is not positive and finite, is a UsageError naming --duration.
 double ParseDuration(const std::string& text);
+
+// --taus: "all" | "octave" | "decade" | "1,10,100" (seconds) into o->grid and o->tau_list_s.
+// Throws OptionError naming --taus and the bad item.
+void ParseTaus(const std::string& text, allan::AllanOptions* o);
 
 // Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
 // increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row (the log

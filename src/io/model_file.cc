@@ -480,7 +480,8 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   for (const Node& s : n["states"].Items()) {
     const std::vector<double> range = s["level_range"].Doubles();
     if (range.size() != 2) s["level_range"].Fail("must hold [min, max]");
-    t->states.push_back({s["channel"].Int(0, 1024), s["tau_s"].Double(), range[0], range[1]});
+    t->states.push_back(
+        {static_cast<int>(s["channel"].Int(0, 1024)), s["tau_s"].Double(), range[0], range[1]});
   }
   const Eigen::MatrixXd coefficients = n["coefficients"].Matrix();
   if (coefficients.cols() != 1) n["coefficients"].Fail("must be a column (cols = 1)");
