@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
 
-.PHONY: deps configure build demo test bench clean
+.PHONY: deps configure build demo test fuzz bench clean
 
 deps:
 	@./scripts/setup-deps.sh
@@ -19,6 +19,24 @@ demo: build
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# libFuzzer on the CSV reader, the model-file loader and the option parsers, FUZZ_SECONDS each,
+# with AddressSanitizer and UndefinedBehaviorSanitizer; the corpora grow in build-fuzz/ (issue 14).
+FUZZ_SECONDS ?= 30
+FUZZ_SEED ?= 1
+FUZZ_FLAGS = -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
+fuzz: deps
+	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE= \
+		-DGYRODRIFT_BUILD_TESTS=OFF -DGYRODRIFT_BUILD_APPS=OFF -DGYRODRIFT_BUILD_FUZZ=ON \
+		"-DCMAKE_CXX_FLAGS=$(FUZZ_FLAGS)" >/dev/null
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_csv fuzz_model_file fuzz_options
+	@for h in csv model_file options; do \
+		mkdir -p build-fuzz/corpus/$$h && cp tests/fuzz/corpus/$$h/* build-fuzz/corpus/$$h/ && \
+		./build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -seed=$(FUZZ_SEED) -artifact_prefix=build-fuzz/ \
+			-print_final_stats=1 build-fuzz/corpus/$$h > build-fuzz/fuzz_$$h.log 2>&1 \
+			|| { tail -n 40 build-fuzz/fuzz_$$h.log; exit 1; }; \
+		echo "fuzz_$$h: $$(grep -E 'number_of_executed_units' build-fuzz/fuzz_$$h.log)"; \
+	done
 
 # Full benchmark runs (the figures quoted in docs and closing notes come from these).
 bench: build

@@ -6,6 +6,7 @@ packages=(
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libsvm-dev libfann-dev libjs-dygraphs
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do

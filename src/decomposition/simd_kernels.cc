@@ -79,8 +79,14 @@ struct V {  // portable scalar build
 #endif
 
 #if GYRODRIFT_HAS_AVX2_PATH
+// Every function of the AVX2 path is compiled for AVX2 (chosen at run time by the CPU); clang
+// spells GCC's target pragma as an attribute applied to each function.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace avx2 {
 struct V {
   using R = __m256d;
@@ -114,7 +120,11 @@ struct V {
 };
 #include "decomposition/simd_kernels.inc"
 }  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif
 
 std::atomic<int> requested_path{static_cast<int>(SimdPath::kAuto)};

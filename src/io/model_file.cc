@@ -720,6 +720,9 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
   } catch (const json::parse_error& e) {
     throw DataError(source + ": not a gyrodrift model file (not valid JSON: byte " +
                     std::to_string(e.byte) + ")");
+  } catch (const json::exception& e) {
+    // A number out of double's range and the like (found by tests/fuzz/fuzz_model_file).
+    throw DataError(source + ": not a gyrodrift model file (" + e.what() + ")");
   }
   if (!j.is_object() || !j.contains("format") || !j["format"].is_string() ||
       j["format"].get<std::string>() != kModelFormat) {

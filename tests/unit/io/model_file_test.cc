@@ -320,6 +320,13 @@ TEST_F(Refusal, DamagedNumberFailsTheChecksum) {
   ExpectRefused(damaged, "checksum mismatch");
 }
 
+TEST_F(Refusal, NumbersBeyondDoubleAreADataError) {
+  // Found by tests/fuzz/fuzz_model_file: the JSON parser's out_of_range escaped as an internal
+  // error.
+  ExpectRefused("{\"format\": \"gyrodrift-model\", \"x\": -3.7e5958811599461}",
+                "number overflow");
+}
+
 TEST_F(Refusal, TruncatedFileIsNotJson) {
   ExpectRefused(text_->substr(0, text_->size() / 2), "not valid JSON");
 }

@@ -1,0 +1,38 @@
+// libFuzzer harness: the CLI's option parsers on any text: durations, tau lists, method lists,
+// temperature column lists. Each accepts or throws a gyrodrift::Error (a usage error naming the
+// option); nothing else may happen.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "cli_util.h"
+#include "drift_cli.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/csv.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  namespace cli = gyrodrift::cli;
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    (void)cli::ParseDuration(text);
+  } catch (const gyrodrift::Error&) {
+  }
+  try {
+    gyrodrift::allan::AllanOptions o;
+    cli::ParseTaus(text, &o);
+  } catch (const gyrodrift::Error&) {
+  }
+  for (auto mode : {gyrodrift::drift::Mode::kPredict, gyrodrift::drift::Mode::kCompensate}) {
+    try {
+      (void)cli::ParseMethods(text, mode);
+    } catch (const gyrodrift::Error&) {
+    }
+  }
+  try {
+    static const gyrodrift::io::CsvTable table = gyrodrift::io::CsvTable::Parse(
+        "time_s,temperature_c,board_c\n0,20,21\n1,20.5,21.2\n", "log");
+    (void)cli::ReadTemperatureColumns(table, text);
+  } catch (const gyrodrift::Error&) {
+  }
+  return 0;
+}
