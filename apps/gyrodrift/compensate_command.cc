@@ -36,7 +36,7 @@ void Run(const CompensateArgs& a) {
   }
   const io::CsvTable table = ReadLog(a.input);
   RequireModelColumns(loaded, table);
-  for (const char* name : {"drift_est", "compensated"}) {
+  for (const char* name : {"drift_est", "drift_sd", "compensated"}) {
     if (table.HasColumn(name)) {
       throw DataError(a.input + " already has a column '" + name +
                       "': compensate an uncompensated log");
@@ -47,12 +47,6 @@ void Run(const CompensateArgs& a) {
       ReadTemperatureColumns(table, loaded.info.temperature_column).values;
   Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
   if (!a.truth.empty()) truth = table.Column(a.truth);
-  for (const char* name : {"drift_sd"}) {
-    if (table.HasColumn(name) && model.identified()) {
-      throw DataError(a.input + " already has a column '" + name +
-                      "': compensate an uncompensated log");
-    }
-  }
   const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature);
   const Eigen::VectorXd estimate = estimate_sd.col(0);
 

@@ -63,17 +63,6 @@ void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_
   }
 }
 
-// The single temperature channel of the feature-based models.
-void RequireOneChannel(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                       const DriftOptions& o) {
-  if (temperature_c.cols() > 1) {
-    ThrowOption("temperature channels", std::to_string(temperature_c.cols()),
-                "one for method " + std::string(ToString(o.method)) + " in " +
-                    std::string(ToString(o.mode)) +
-                    " mode (several channels: compensate mode with thermal, ms-elm or emd-elm)");
-  }
-}
-
 Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
                                const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                                Eigen::Index n) {
@@ -81,7 +70,7 @@ Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
     return Eigen::MatrixXd(n, 0);
   }
   RequireTemperatureFor(temperature_c, n);
-  RequireOneChannel(temperature_c, model.options);
+  internal::RequireChannelsFor(model.options, temperature_c.cols());
   return ThermalFeatures(temperature_c.col(0), EffectiveFeatures(model.options));
 }
 
@@ -234,6 +223,14 @@ Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomp
 
 namespace internal {
 
+void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels) {
+  if (channels <= 1 || IdentifiesThermalModel(o)) return;
+  ThrowOption("temperature channels", std::to_string(channels),
+              "one for method " + std::string(ToString(o.method)) + " in " +
+                  std::string(ToString(o.mode)) +
+                  " mode (several channels: compensate mode with thermal, ms-elm or emd-elm)");
+}
+
 void RequireHorizon(int horizon) {
   if (horizon < 1 || horizon > kMaxHorizon) {
     ThrowOption("horizon", std::to_string(horizon),
@@ -374,7 +371,7 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   if (options.uses_temperature()) {
     // Checked before the decomposition, which is the slow part.
     RequireTemperatureFor(temperature_c, y.size());
-    if (!IdentifiesThermalModel(options)) RequireOneChannel(temperature_c, options);
+    internal::RequireChannelsFor(options, temperature_c.cols());
     for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
       RequireVaryingSignal("temperature", temperature_c.col(c),
                            "a drift model on temperature needs a record whose temperature changes");

@@ -125,13 +125,7 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
     for (Method method : options.methods) {
       DriftOptions o = base;
       o.method = method;
-      if (temperature_c.cols() > 1 && !IdentifiesThermalModel(o)) {
-        ThrowOption("temperature channels", std::to_string(temperature_c.cols()),
-                    "one for method " + std::string(ToString(method)) + " in " +
-                        std::string(ToString(base.mode)) +
-                        " mode (several channels: compensate mode with thermal, ms-elm or "
-                        "emd-elm)");
-      }
+      internal::RequireChannelsFor(o, temperature_c.cols());
     }
   }
   if (truth.size() != 0) {

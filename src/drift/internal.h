@@ -28,6 +28,10 @@ void RequireHorizon(int horizon);
 // `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
 Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 
+// Throws OptionError when `channels` temperature columns are given to the options' method, which
+// takes one unless it identifies thermal models.
+void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels);
+
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
 // identified sub-models read the temperature channels, N x C, instead).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,

@@ -576,15 +576,21 @@ std::vector<std::string> ThermalRegression::RegressorNames() const {
 
 Eigen::VectorXd ThermalRegression::Estimate(
     const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
-  return EstimateWithSd(temperatures_c).col(0);
+  const Eigen::MatrixXd x = Regressors(temperatures_c);
+  return EstimateOf(x);
+}
+
+Eigen::VectorXd ThermalRegression::EstimateOf(const Eigen::Ref<const Eigen::MatrixXd>& x) const {
+  Eigen::VectorXd estimate = x * coefficients;
+  if (correction) estimate += correction->Predict(x.rightCols(x.cols() - 1));
+  return estimate;
 }
 
 Eigen::MatrixXd ThermalRegression::EstimateWithSd(
     const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
   const Eigen::MatrixXd x = Regressors(temperatures_c);
   Eigen::MatrixXd out(x.rows(), 2);
-  out.col(0) = x * coefficients;
-  if (correction) out.col(0) += correction->Predict(x.rightCols(x.cols() - 1));
+  out.col(0) = EstimateOf(x);
   const Eigen::MatrixXd xv = x * covariance;
   out.col(1) = ((xv.cwiseProduct(x)).rowwise().sum().array().max(0.0) + cv_slow_sd * cv_slow_sd)
                    .sqrt()

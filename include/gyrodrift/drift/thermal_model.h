@@ -149,6 +149,9 @@ struct ThermalRegression {
   Eigen::MatrixXd EstimateWithSd(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
   std::string Summary() const;  // the chosen states and the cross-validated error
   void Validate() const;        // throws DataError when the stored fields do not fit together
+
+ private:
+  Eigen::VectorXd EstimateOf(const Eigen::Ref<const Eigen::MatrixXd>& regressors) const;
 };
 
 // Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz; with
