@@ -25,81 +25,72 @@ struct CompensateArgs {
   bool quiet = false;
 };
 
-void Run(const CompensateArgs& a) {
-  RequireOutputsAreNotInputs({a.model, a.input}, {a.output, SidecarPath(a.output)});
-  const io::LoadedModel loaded = io::ReadModelFile(a.model);
+double Rms(const Eigen::VectorXd& v) {
+  const Eigen::VectorXd centred = v.array() - v.mean();
+  return std::sqrt(centred.squaredNorm() / static_cast<double>(v.size()));
+}
+
+// One axis compensated: the columns it adds, its part of the sidecar, its console lines.
+struct AxisResult {
+  std::vector<io::CsvColumn> columns;
+  nlohmann::json sidecar;
+  std::string text;
+};
+
+// `suffix` is "" for a one-axis model (drift_est, drift_sd, compensated), "_<target>" otherwise.
+AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& table,
+                          const Eigen::VectorXd& truth, const std::string& truth_column,
+                          const std::string& suffix) {
   const drift::DriftModel& model = loaded.model;
-  if (model.options.mode != drift::Mode::kCompensate) {
-    throw UsageError(a.model +
-                     " is a predict-mode model: use 'gyrodrift predict' (compensate "
-                     "needs a model fitted with --mode compensate)");
-  }
-  const io::CsvTable table = ReadLog(a.input);
-  RequireModelColumns(loaded, table);
-  for (const char* name : {"drift_est", "drift_sd", "compensated"}) {
-    if (table.HasColumn(name)) {
-      throw DataError(a.input + " already has a column '" + name +
-                      "': compensate an uncompensated log");
-    }
-  }
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   const Eigen::MatrixXd temperature =
-      ReadTemperatureColumns(table, loaded.info.temperature_column).values;
-  Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
-  if (!a.truth.empty()) truth = table.Column(a.truth);
+      ReadColumns(table, loaded.info.temperature_column, "--temperature").values;
   const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature);
   const Eigen::VectorXd estimate = estimate_sd.col(0);
-
-  std::vector<io::CsvColumn> columns;
-  for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
-    columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
-  }
-  columns.push_back({"drift_est", estimate});
-  // Identified models give each estimate a standard deviation (thermal_model.h).
-  if (model.identified()) columns.push_back({"drift_sd", estimate_sd.col(1)});
   const Eigen::VectorXd compensated = y - estimate;
-  columns.push_back({"compensated", compensated});
 
-  auto rms = [](const Eigen::VectorXd& v) {
-    const Eigen::VectorXd centred = v.array() - v.mean();
-    return std::sqrt(centred.squaredNorm() / static_cast<double>(v.size()));
-  };
-  nlohmann::json sidecar = SidecarHeader("compensate");
-  sidecar["options"] = {{"model", a.model}, {"input", a.input}};
-  sidecar["model"] = {{"summary", model.Summary()},
-                      {"method", drift::ToString(model.options.method)},
-                      {"target_column", loaded.info.target_column},
-                      {"temperature_column", loaded.info.temperature_column},
-                      {"seed", model.options.seed},
-                      {"tool_version", loaded.info.tool_version}};
-  sidecar["samples"] = y.size();
-  sidecar["std_before"] = rms(y);
-  sidecar["std_after"] = rms(compensated);
+  AxisResult r;
+  r.columns.push_back({"drift_est" + suffix, estimate});
+  // Identified models give each estimate a standard deviation (thermal_model.h).
+  if (model.identified()) r.columns.push_back({"drift_sd" + suffix, estimate_sd.col(1)});
+  r.columns.push_back({"compensated" + suffix, compensated});
+
+  nlohmann::json& j = r.sidecar;
+  j["model"] = {{"summary", model.Summary()},
+                {"method", drift::ToString(model.options.method)},
+                {"target_column", loaded.info.target_column},
+                {"temperature_column", loaded.info.temperature_column},
+                {"seed", model.options.seed},
+                {"tool_version", loaded.info.tool_version}};
+  j["samples"] = y.size();
+  j["std_before"] = Rms(y);
+  j["std_after"] = Rms(compensated);
+  r.text = fmt::format("{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n",
+                       model.Summary(), loaded.info.target_column, Rms(y), Rms(compensated),
+                       y.size());
   // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
   // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
-  std::string truth_line;
   if (truth.size() > 0) {
     const double truth_rms = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
     const double residual_rms =
         std::sqrt((truth - estimate).squaredNorm() / static_cast<double>(truth.size()));
     const double removed = truth_rms > 0.0 ? 100.0 * (1.0 - residual_rms / truth_rms) : NAN;
-    sidecar["truth"] = {{"column", ColumnName(table, a.truth)},
-                        {"rms", truth_rms},
-                        {"residual_rms", residual_rms},
-                        {"removed_percent", removed}};
+    j["truth"] = {{"column", truth_column},
+                  {"rms", truth_rms},
+                  {"residual_rms", residual_rms},
+                  {"removed_percent", removed}};
     // A zero truth has no share to remove: say so instead of printing "nan %".
     const std::string share =
         truth_rms > 0.0 ? fmt::format("{:.1f} % removed", removed) : "no drift to remove";
-    truth_line = fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({})\n",
-                             ColumnName(table, a.truth), truth_rms, residual_rms, share);
+    r.text += fmt::format("{}: RMS {:.6g}, residual after compensation {:.6g} ({})\n",
+                          truth_column, truth_rms, residual_rms, share);
   }
   // A thermal model beyond the temperatures it was fitted on extrapolates: say where.
   const double outside = drift::ShareOutsideRange(temperature.col(0), model.temperature_min_c,
                                                  model.temperature_max_c);
-  sidecar["outside_training_temperature_share"] = outside;
-  std::string outside_line;
+  j["outside_training_temperature_share"] = outside;
   if (outside > 0.0) {
-    outside_line = fmt::format(
+    r.text += fmt::format(
         "note: {:.1f} % of the samples lie outside the training temperature range [{:.4g}, {:.4g}] "
         "degC: the estimate extrapolates there\n",
         100.0 * outside, model.temperature_min_c, model.temperature_max_c);
@@ -108,20 +99,68 @@ void Run(const CompensateArgs& a) {
   for (const auto& sub : model.sub_models) {
     if (!sub.thermal) continue;
     for (const std::string& w : sub.thermal->report.warnings) {
-      outside_line += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
+      r.text += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
     }
   }
-  if (model.identified()) {
-    sidecar["drift_sd_mean"] = estimate_sd.col(1).mean();
+  if (model.identified()) j["drift_sd_mean"] = estimate_sd.col(1).mean();
+  return r;
+}
+
+void Run(const CompensateArgs& a) {
+  RequireOutputsAreNotInputs({a.model, a.input}, {a.output, SidecarPath(a.output)});
+  const std::vector<io::LoadedModel> axes = io::ReadModelFileAxes(a.model);
+  for (const io::LoadedModel& axis : axes) {
+    if (axis.model.options.mode != drift::Mode::kCompensate) {
+      throw UsageError(a.model +
+                       " is a predict-mode model: use 'gyrodrift predict' (compensate "
+                       "needs a model fitted with --mode compensate)");
+    }
+  }
+  const io::CsvTable table = ReadLog(a.input);
+  for (const io::LoadedModel& axis : axes) RequireModelColumns(axis, table);
+  std::vector<std::string> suffixes;
+  for (const io::LoadedModel& axis : axes) {
+    suffixes.push_back(axes.size() == 1 ? "" : "_" + axis.info.target_column);
+    for (const char* name : {"drift_est", "drift_sd", "compensated"}) {
+      if (table.HasColumn(name + suffixes.back())) {
+        throw DataError(a.input + " already has a column '" + name + suffixes.back() +
+                        "': compensate an uncompensated log");
+      }
+    }
+  }
+  Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
+  std::string truth_column;
+  if (!a.truth.empty()) {
+    if (axes.size() > 1) {
+      throw UsageError("--truth = " + a.truth + ": " + a.model + " holds " +
+                       std::to_string(axes.size()) +
+                       " axes; a true drift column scores a one-axis model");
+    }
+    truth_column = ColumnName(table, a.truth);
+    truth = table.Column(a.truth);
+  }
+
+  std::vector<io::CsvColumn> columns;
+  for (int c = 0; c < static_cast<int>(table.header().size()); ++c) {
+    columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
+  }
+  nlohmann::json sidecar = SidecarHeader("compensate");
+  sidecar["options"] = {{"model", a.model}, {"input", a.input}};
+  std::string text;
+  for (size_t i = 0; i < axes.size(); ++i) {
+    AxisResult r = CompensateAxis(axes[i], table, truth, truth_column, suffixes[i]);
+    for (io::CsvColumn& column : r.columns) columns.push_back(std::move(column));
+    // One axis: its fields at the top level (the layout of one-axis models); several: "axes".
+    if (axes.size() == 1) {
+      sidecar.update(r.sidecar);
+    } else {
+      sidecar["axes"].push_back(std::move(r.sidecar));
+    }
+    text += r.text;
   }
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
-  if (!a.quiet) {
-    fmt::print(
-        "{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n{}{}wrote {} and {}\n",
-        model.Summary(), loaded.info.target_column, rms(y), rms(compensated), y.size(), truth_line,
-        outside_line, a.output, SidecarPath(a.output));
-  }
+  if (!a.quiet) fmt::print("{}wrote {} and {}\n", text, a.output, SidecarPath(a.output));
 }
 
 const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
@@ -138,6 +177,8 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       "from the temperature history only), drift_sd (its standard deviation, for identified\n"
       "models: thermal, ms-elm, emd-elm) and compensated (= target column - drift_est), one\n"
       "row per input row; out.csv.json records the model and the std before and after.\n"
+      "A model of several axes (fit --target gyro_x,gyro_y,gyro_z) adds drift_est_<target>,\n"
+      "drift_sd_<target> and compensated_<target> for each.\n"
       "With --truth drift_dph (a simulated log) it also reports how much of the true drift's\n"
       "RMS the estimate removes: 1 - RMS(truth - drift_est) / RMS(truth).\n"
       "test.csv needs the columns the model was trained with (here rate_dph and temperature_c).");

@@ -38,7 +38,9 @@ std::string Columns(const io::CsvTable& table) {
 
 void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
   cmd->add_option("input", a->input, "CSV file with a header row")->required()->check(kInputFile);
-  cmd->add_option("--target,-t", a->target, "column of the gyro output (name or 1-based index)")
+  cmd->add_option("--target,-t", a->target,
+                  "column of the gyro output (name or 1-based index); fit takes several, "
+                  "comma-separated: one model per axis in one file")
       ->required();
   cmd->add_option("--temperature,-T", a->temperature,
                   "temperature column(s), degC, comma-separated (needed by --mode compensate, "
@@ -177,22 +179,24 @@ std::vector<std::string> SplitColumns(const std::string& names) {
   return out;
 }
 
-TemperatureColumns ReadTemperatureColumns(const io::CsvTable& table, const std::string& spec) {
+SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
+                            const std::string& option) {
   const std::vector<std::string> items = SplitColumns(spec);
-  TemperatureColumns out;
+  SelectedColumns out;
   out.values.resize(0, static_cast<Eigen::Index>(items.size()));
   std::vector<std::string> seen;
   for (size_t c = 0; c < items.size(); ++c) {
-    if (items[c].empty()) ThrowOption("--temperature", "'" + spec + "'", "column names without empty items");
+    if (items[c].empty()) ThrowOption(option, "'" + spec + "'", "column names without empty items");
     const std::string name = ColumnName(table, items[c]);
     if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
-      ThrowOption("--temperature", "'" + spec + "'", "a list without repeats");
+      ThrowOption(option, "'" + spec + "'", "a list without repeats");
     }
     seen.push_back(name);
     const Eigen::VectorXd column = table.Column(items[c]);
     if (c == 0) out.values.resize(column.size(), static_cast<Eigen::Index>(items.size()));
     out.values.col(static_cast<Eigen::Index>(c)) = column;
-    out.names += (c ? "," : "") + name;
+    out.joined += (c ? "," : "") + name;
+    out.names.push_back(name);
   }
   return out;
 }

@@ -63,13 +63,16 @@ void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& tabl
 // empty items. Throws UsageError naming --methods.
 std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode);
 
-// The temperature columns of `spec` ("a" or "a,b"): their names joined by commas, and the
-// N x C matrix. Throws UsageError for an unknown, empty or repeated column.
-struct TemperatureColumns {
-  std::string names;
+// The columns of `spec` ("a" or "a,b", names or 1-based indices), the value of `option`: their
+// names, the names joined by commas, and the N x C matrix. Throws UsageError naming `option` for
+// an unknown, empty or repeated column.
+struct SelectedColumns {
+  std::vector<std::string> names;
+  std::string joined;
   Eigen::MatrixXd values;
 };
-TemperatureColumns ReadTemperatureColumns(const io::CsvTable& table, const std::string& spec);
+SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
+                            const std::string& option);
 
 // The comma-separated names of a model file's temperature_column.
 std::vector<std::string> SplitColumns(const std::string& names);

@@ -62,6 +62,10 @@ void Run(const EvaluateArgs& a) {
   e.causal.threads = a.threads;
   e.horizon = a.horizon;
   e.Validate();  // option errors before any file is read
+  if (a.target.find(',') != std::string::npos) {
+    throw UsageError("--target = " + a.target +
+                     ": evaluate scores one axis at a time (fit takes several targets)");
+  }
 
   const io::CsvTable table = ReadLog(a.input);
   std::string rate_how;
@@ -72,8 +76,8 @@ void Run(const EvaluateArgs& a) {
   Eigen::VectorXd truth;
   std::string temperature_column, truth_column;
   if (!a.temperature.empty()) {
-    TemperatureColumns t = ReadTemperatureColumns(table, a.temperature);
-    temperature_column = t.names;
+    SelectedColumns t = ReadColumns(table, a.temperature, "--temperature");
+    temperature_column = t.joined;
     temperature = std::move(t.values);
   }
   if (!a.truth.empty()) {

@@ -41,6 +41,34 @@ void PrintThermalModel(const std::string& name, const drift::ThermalRegression& 
   }
 }
 
+// What fit learnt about one axis: the model, its decomposition and grouping reports, the lag
+// choice and each sub-model.
+void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
+  const drift::DriftModel& model = axis.model;
+  fmt::print("{}\n", model.Summary());
+  if (!model.decomposition_summary.empty())
+    fmt::print("decomposition: {}\n", model.decomposition_summary);
+  if (!model.selection_summary.empty()) fmt::print("selection: {}\n", model.selection_summary);
+  if (o.auto_lags) {
+    std::string rmse;
+    for (size_t i = 0; i < model.lag_validation_rmse.size(); ++i) {
+      rmse += fmt::format("{}p={}: {:.4g}", i ? ", " : "", o.lag_candidates[i],
+                          model.lag_validation_rmse[i]);
+    }
+    fmt::print("lags: {} chosen by validation RMSE ({})\n", model.lags, rmse);
+  }
+  const std::vector<std::string> channels = SplitColumns(axis.info.temperature_column);
+  for (const auto& sub : model.sub_models) {
+    if (sub.thermal) {
+      PrintThermalModel(sub.name, *sub.thermal, channels);
+      continue;
+    }
+    fmt::print(
+        "  {:<8} {}\n", sub.name,
+        sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");
+  }
+}
+
 struct FitArgs : DriftArgs {
   std::string method = "auto";
   std::string output;
@@ -77,52 +105,47 @@ void Run(const FitArgs& a) {
   const io::CsvTable table = ReadLog(a.input);
   std::string rate_how;
   o.features.rate_hz = ResolveRateHz(a, table, &rate_how);
-  io::ModelFileInfo info;
-  info.source = a.input;
-  info.target_column = ColumnName(table, a.target);
-  const Eigen::VectorXd y = table.Column(a.target);
-  Eigen::MatrixXd temperature;
+  // Every axis is fitted as if alone (same options, same seed): a file of several axes holds the
+  // models one-axis fits of each target would give.
+  const SelectedColumns targets = ReadColumns(table, a.target, "--target");
+  SelectedColumns temperature;
   if (!a.temperature.empty()) {
-    TemperatureColumns t = ReadTemperatureColumns(table, a.temperature);
-    for (const std::string& name : SplitColumns(t.names)) {
-      if (name == info.target_column) {
-        throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+    temperature = ReadColumns(table, a.temperature, "--temperature");
+    for (const std::string& name : temperature.names) {
+      for (const std::string& target : targets.names) {
+        if (name == target) {
+          throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+        }
       }
     }
-    info.temperature_column = t.names;
-    temperature = std::move(t.values);
   }
-  ProgressBar progress({1.0}, IsTerminal() && !a.quiet);
-  const std::string method_name(drift::ToString(method));
-  progress.BeginStage(0, method_name);
-  o.progress = [&progress, &method_name](double fraction, const std::string& step) {
-    progress.Update(fraction, method_name + ": " + step);
-  };
-  const drift::DriftModel model = drift::FitDriftModel(y, temperature, o);
-  progress.Finish();
-  io::WriteModelFile(a.output, model, info);
+  const auto axes = static_cast<int>(targets.names.size());
+  std::vector<io::LoadedModel> fitted;
+  {
+    ProgressBar progress(std::vector<double>(static_cast<size_t>(axes), 1.0),
+                         IsTerminal() && !a.quiet);
+    for (int i = 0; i < axes; ++i) {
+      io::LoadedModel axis;
+      axis.info.source = a.input;
+      axis.info.target_column = targets.names[static_cast<size_t>(i)];
+      axis.info.temperature_column = temperature.joined;
+      const std::string label = axes > 1 ? axis.info.target_column + ": " + std::string(drift::ToString(method))
+                                         : std::string(drift::ToString(method));
+      progress.BeginStage(i, label);
+      drift::DriftOptions axis_options = o;
+      axis_options.progress = [&progress, &label](double fraction, const std::string& step) {
+        progress.Update(fraction, label + ": " + step);
+      };
+      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, axis_options);
+      axis.model.options.progress = nullptr;
+      fitted.push_back(std::move(axis));
+    }
+  }
+  io::WriteModelFile(a.output, fitted);
   if (a.quiet) return;
-  fmt::print("{}\n", model.Summary());
-  if (!model.decomposition_summary.empty())
-    fmt::print("decomposition: {}\n", model.decomposition_summary);
-  if (!model.selection_summary.empty()) fmt::print("selection: {}\n", model.selection_summary);
-  if (o.auto_lags) {
-    std::string rmse;
-    for (size_t i = 0; i < model.lag_validation_rmse.size(); ++i) {
-      rmse += fmt::format("{}p={}: {:.4g}", i ? ", " : "", o.lag_candidates[i],
-                          model.lag_validation_rmse[i]);
-    }
-    fmt::print("lags: {} chosen by validation RMSE ({})\n", model.lags, rmse);
-  }
-  const std::vector<std::string> channels = SplitColumns(info.temperature_column);
-  for (const auto& sub : model.sub_models) {
-    if (sub.thermal) {
-      PrintThermalModel(sub.name, *sub.thermal, channels);
-      continue;
-    }
-    fmt::print(
-        "  {:<8} {}\n", sub.name,
-        sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");
+  for (const io::LoadedModel& axis : fitted) {
+    if (axes > 1) fmt::print("axis {}:\n", axis.info.target_column);
+    PrintModel(axis, o);
   }
   const std::string time_note = NonUniformTimeNote(table);
   fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", o.features.rate_hz,
@@ -148,13 +171,17 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "(BEEMDAN), groups the IMFs into noise/mixed/drift and fits one ELM per group; emd-elm\n"
       "fits one ELM per IMF; elm, poly, svr, bp are single models on the raw signal.\n"
       "model.json holds every option, the training column names and the fitted parameters\n"
-      "(exact doubles, checksummed). See docs/cli.md and docs/drift.md.");
+      "(exact doubles, checksummed). Several targets (--target gyro_x,gyro_y,gyro_z) are fitted\n"
+      "one by one with the same options into one model file, one model per axis.\n"
+      "See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get());
   cmd->add_option("--method,-m", args->method,
                   "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in predict mode, "
                   "thermal in compensate mode)")
       ->capture_default_str();
-  cmd->add_option("-o,--output", args->output, "model file to write (JSON)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "model file to write (JSON; one model per --target column)")
+      ->required();
   cmd->callback([args] { Run(*args); });
 });
 

@@ -658,32 +658,65 @@ drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::
 
 namespace {
 
-// The file's content but the checksum.
-json ModelFileJson(const drift::DriftModel& model, const ModelFileInfo& info) {
+// One axis: what it was trained on, its options and its parameters.
+json AxisJson(const LoadedModel& axis) {
+  const drift::DriftModel& model = axis.model;
   if (model.options.decomposition.supplied_noise) {
     throw UsageError(
         "model options hold supplied decomposition noise, which a model file cannot store; fit "
         "with drawn noise (a seed) to save the model");
   }
+  return {{"training",
+           {{"target_column", axis.info.target_column},
+            {"temperature_column", axis.info.temperature_column},
+            {"samples", model.training_samples},
+            {"source", axis.info.source}}},
+          {"options", DriftOptionsToJson(model.options)},
+          {"model", ModelJson(model)}};
+}
+
+// The file's content but the checksum: one axis at the top level (the layout of every version),
+// several under "axes".
+json ModelFileJson(const std::vector<LoadedModel>& axes) {
+  if (axes.empty()) throw UsageError("a model file needs at least one axis");
+  if (static_cast<int>(axes.size()) > kMaxModelAxes) {
+    throw UsageError("a model file holds at most " + std::to_string(kMaxModelAxes) + " axes, not " +
+                     std::to_string(axes.size()));
+  }
+  for (size_t i = 0; i < axes.size(); ++i) {
+    for (size_t k = 0; k < i; ++k) {
+      if (axes[i].info.target_column == axes[k].info.target_column) {
+        throw UsageError("two axes of one model file share the target column '" +
+                         axes[i].info.target_column + "'");
+      }
+    }
+  }
   json j = {{"format", kModelFormat},
             {"format_version", kModelFormatVersion},
-            {"tool_version", kVersion},
-            {"training",
-             {{"target_column", info.target_column},
-              {"temperature_column", info.temperature_column},
-              {"samples", model.training_samples},
-              {"source", info.source}}},
-            {"options", DriftOptionsToJson(model.options)},
-            {"model", ModelJson(model)}};
+            {"tool_version", kVersion}};
+  if (axes.size() == 1) {
+    j.update(AxisJson(axes[0]));
+  } else {
+    j["axes"] = json::array();
+    for (const LoadedModel& axis : axes) j["axes"].push_back(AxisJson(axis));
+  }
   return j;
 }
 
 }  // namespace
 
-std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info) {
-  json j = ModelFileJson(model, info);
+std::string RenderModelFile(const std::vector<LoadedModel>& axes) {
+  json j = ModelFileJson(axes);
   j["checksum"] = ChecksumText(j);
   return j.dump(1, ' ', false, json::error_handler_t::replace) + "\n";
+}
+
+std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info) {
+  return RenderModelFile({LoadedModel{model, info}});
+}
+
+void WriteModelFile(const std::string& path, const std::vector<LoadedModel>& axes) {
+  WriteFileAtomically(path, RenderModelFile(axes));
 }
 
 void WriteModelFile(const std::string& path, const drift::DriftModel& model,
@@ -713,7 +746,7 @@ std::string FirstUnknownField(const json& file, const json& known, const std::st
   return "";
 }
 
-LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
+std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source) {
   json j;
   try {
     j = json::parse(text);
@@ -745,28 +778,72 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
     throw DataError(source + ": checksum mismatch (file says " + stored + ", content gives " +
                     computed + "): the model file is damaged or was edited");
   }
-  LoadedModel out;
-  out.info.tool_version = root["tool_version"].String();
-  const Node training = root["training"];
-  out.info.target_column = training["target_column"].String();
-  out.info.temperature_column = training["temperature_column"].String();
-  out.info.source = training["source"].String();
-  out.model = ReadModel(root);
-  if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
-    training["samples"].Fail("differs from model.training_samples");
+  const std::string tool_version = root["tool_version"].String();
+  std::vector<LoadedModel> axes;
+  auto read_axis = [&](const Node& at) {
+    LoadedModel out;
+    out.info.tool_version = tool_version;
+    const Node training = at["training"];
+    out.info.target_column = training["target_column"].String();
+    out.info.temperature_column = training["temperature_column"].String();
+    out.info.source = training["source"].String();
+    out.model = ReadModel(at);
+    if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
+      training["samples"].Fail("differs from model.training_samples");
+    }
+    if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
+      training["temperature_column"].Fail("is empty but the model uses temperature");
+    }
+    for (const LoadedModel& earlier : axes) {
+      if (earlier.info.target_column == out.info.target_column) {
+        training["target_column"].Fail("= '" + out.info.target_column +
+                                       "' is the target of an earlier axis too");
+      }
+    }
+    axes.push_back(std::move(out));
+  };
+  if (j.contains("axes")) {
+    const std::vector<Node> items = root["axes"].Items();
+    if (items.size() < 2 || static_cast<int>(items.size()) > kMaxModelAxes) {
+      root["axes"].Fail("holds " + std::to_string(items.size()) + " axes (2 to " +
+                        std::to_string(kMaxModelAxes) +
+                        " expected; a one-axis file keeps its fields at the top level)");
+    }
+    for (const Node& item : items) read_axis(item);
+  } else {
+    read_axis(root);
   }
-  if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
-    training["temperature_column"].Fail("is empty but the model uses temperature");
-  }
-  json known = ModelFileJson(out.model, out.info);
+  json known = ModelFileJson(axes);
   known["checksum"] = stored;
-  known["options"]["learner"]["elm"]["threads"] = 0;  // older files' field, checked above
+  // Older files' field, checked on reading above.
+  if (known.contains("axes")) {
+    for (json& axis : known["axes"]) axis["options"]["learner"]["elm"]["threads"] = 0;
+  } else {
+    known["options"]["learner"]["elm"]["threads"] = 0;
+  }
   const std::string unknown = FirstUnknownField(j, known, "");
   if (!unknown.empty()) {
     throw DataError(source + ": field '" + unknown +
                     "' is not part of a gyrodrift model file (misspelt, or from another tool)");
   }
-  return out;
+  return axes;
+}
+
+LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
+  std::vector<LoadedModel> axes = ParseModelFileAxes(text, source);
+  if (axes.size() != 1) {
+    std::string names;
+    for (const LoadedModel& axis : axes) {
+      names += (names.empty() ? "" : ", ") + axis.info.target_column;
+    }
+    throw UsageError(source + " holds " + std::to_string(axes.size()) + " axes (" + names +
+                     "): this command reads one-axis models; fit each --target apart");
+  }
+  return std::move(axes[0]);
+}
+
+std::vector<LoadedModel> ReadModelFileAxes(const std::string& path) {
+  return ParseModelFileAxes(ReadTextFile(path), path);
 }
 
 LoadedModel ReadModelFile(const std::string& path) {

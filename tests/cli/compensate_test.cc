@@ -239,3 +239,84 @@ TEST(CompensateCliChannels, TwoTemperatureColumnsFitCompensateAndEvaluate) {
 
 }  // namespace
 }  // namespace gyrodrift
+
+namespace gyrodrift {
+namespace {
+
+// Three gyro axes in one log (issue 13): one model per axis in one file, each the model a fit of
+// that axis alone gives; compensate adds the columns of every axis.
+TEST(CompensateCliAxes, SeveralTargetsFitOneFileAndCompensateEveryAxis) {
+  const std::string dir = test::TempDir("cli_compensate_axes");
+  const io::CsvTable log = io::CsvTable::Parse(test::ThermalLogCsv(3000, 5), "log");
+  const Eigen::VectorXd x = log.Column("rate_dph");
+  const Eigen::VectorXd y = 0.5 * x.array() + 0.01;
+  const Eigen::VectorXd z = -2.0 * x.array();
+  io::WriteCsv(dir + "/imu.csv", {{"time_s", log.Column("time_s")},
+                                  {"gyro_x", x},
+                                  {"gyro_y", y},
+                                  {"gyro_z", z},
+                                  {"temperature_c", log.Column("temperature_c")}});
+  const std::string fit = "fit '" + dir + "/imu.csv' -T temperature_c --mode compensate -q ";
+  auto r = test::RunCli(fit + "-t gyro_x,gyro_y,gyro_z -o '" + dir + "/imu.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = test::RunCli(fit + "-t gyro_y -o '" + dir + "/y.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<io::LoadedModel> axes = io::ReadModelFileAxes(dir + "/imu.json");
+  ASSERT_EQ(axes.size(), 3u);
+  EXPECT_EQ(axes[0].info.target_column, "gyro_x");
+  EXPECT_EQ(axes[2].info.target_column, "gyro_z");
+  // The y axis of the three-axis file is the one-axis model of gyro_y, to the byte.
+  EXPECT_EQ(io::RenderModelFile(axes[1].model, axes[1].info),
+            io::RenderModelFile(io::ReadModelFile(dir + "/y.json").model,
+                                io::ReadModelFile(dir + "/y.json").info));
+
+  r = test::RunCli("compensate '" + dir + "/imu.json' '" + dir + "/imu.csv' -o '" + dir +
+                   "/out.csv'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::CsvTable out = io::CsvTable::Read(dir + "/out.csv");
+  for (const char* axis : {"gyro_x", "gyro_y", "gyro_z"}) {
+    for (const char* column : {"drift_est_", "drift_sd_", "compensated_"}) {
+      EXPECT_TRUE(out.HasColumn(std::string(column) + axis)) << column << axis;
+    }
+    EXPECT_NE(r.out.find(std::string(axis) + ": std"), std::string::npos) << r.out;
+  }
+  // The three-axis file estimates gyro_y as the one-axis model does.
+  r = test::RunCli("compensate '" + dir + "/y.json' '" + dir + "/imu.csv' -o '" + dir +
+                   "/y.csv'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(out.Column("drift_est_gyro_y"), io::CsvTable::Read(dir + "/y.csv").Column("drift_est"));
+  const auto sidecar = nlohmann::json::parse(io::ReadTextFile(dir + "/out.csv.json"));
+  ASSERT_EQ(sidecar["axes"].size(), 3u);
+  EXPECT_EQ(sidecar["axes"][2]["model"]["target_column"], "gyro_z");
+
+  // What a several-axis file cannot do says so, before any work.
+  r = test::RunCli("compensate '" + dir + "/imu.json' '" + dir + "/imu.csv' --truth gyro_x -o '" +
+                   dir + "/t.csv'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("3 axes"), std::string::npos) << r.err;
+  r = test::RunCli("predict '" + dir + "/imu.json' '" + dir + "/imu.csv' -o '" + dir + "/p.csv'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("gyro_x, gyro_y, gyro_z"), std::string::npos) << r.err;
+  r = test::RunCli(fit + "-t gyro_x,gyro_x -o '" + dir + "/rep.json'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--target"), std::string::npos) << r.err;
+  r = test::RunCli(fit + "-t gyro_x,temperature_c -o '" + dir + "/tt.json'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  r = test::RunCli("evaluate '" + dir + "/imu.csv' -t gyro_x,gyro_y -T temperature_c "
+                   "--mode compensate -o '" + dir + "/e.csv'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  for (const char* name : {"t.csv", "p.csv", "rep.json", "tt.json", "e.csv"}) {
+    EXPECT_FALSE(test::FileExists(dir + "/" + name)) << name;
+  }
+  // A log missing one axis is refused by name.
+  io::WriteCsv(dir + "/xy.csv", {{"gyro_x", x}, {"gyro_y", y},
+                                 {"temperature_c", log.Column("temperature_c")}});
+  r = test::RunCli("compensate '" + dir + "/imu.json' '" + dir + "/xy.csv' -o '" + dir +
+                   "/xy_out.csv'");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("gyro_z"), std::string::npos) << r.err;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace gyrodrift

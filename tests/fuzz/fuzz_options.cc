@@ -31,7 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     static const gyrodrift::io::CsvTable table = gyrodrift::io::CsvTable::Parse(
         "time_s,temperature_c,board_c\n0,20,21\n1,20.5,21.2\n", "log");
-    (void)cli::ReadTemperatureColumns(table, text);
+    (void)cli::ReadColumns(table, text, "--temperature");
   } catch (const gyrodrift::Error&) {
   }
   return 0;

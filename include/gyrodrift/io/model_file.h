@@ -1,8 +1,10 @@
 // Model files: a fitted drift::DriftModel saved as JSON and read back with predictions identical
 // to the bit.
 //
-// Layout (format "gyrodrift-model", format_version 1; every field required on reading):
+// Layout (format "gyrodrift-model"; every field required on reading):
 //   format, format_version, tool_version
+//   then one axis's fields at the top level, or, for a file of several gyro axes (fit --target
+//   gyro_x,gyro_y,gyro_z), an array "axes" of 2 to kMaxModelAxes objects each holding them:
 //   training   target_column, temperature_column ("" if none), samples, source (informative)
 //   options    every field of drift::DriftOptions (mode, method, decomposition with its sifting
 //              rule, selection with its KDE and Monte-Carlo settings, features with the thermal
@@ -29,6 +31,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gyrodrift/drift/drift_model.h"
 
@@ -40,7 +43,9 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // version-1 reader refuses version 2, which it would otherwise misread.
 // Version 3 adds identified thermal sub-models ("thermal" beside "learner") and the options of
 // their identification; older files read with the defaults.
-inline constexpr int kModelFormatVersion = 3;
+// Version 4 adds files of several axes ("axes"); a one-axis file keeps the version-3 layout.
+inline constexpr int kModelFormatVersion = 4;
+inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 
 // What the model was trained on, beside the model itself.
@@ -52,19 +57,27 @@ struct ModelFileInfo {
   std::string tool_version;        // ignored on writing (the running version is written)
 };
 
+// One axis of a model file: a gyro output column's model.
 struct LoadedModel {
   drift::DriftModel model;
   ModelFileInfo info;
 };
 
-// Renders / writes a model file. Throws UsageError when the model cannot be stored (options that
-// hold supplied decomposition noise, a predict-mode sub-model without a learner), IoError when the
+// Renders / writes a model file of one or several axes (distinct target columns, in order).
+// Throws UsageError when the model cannot be stored (options that hold supplied decomposition
+// noise, a predict-mode sub-model without a learner, no axis, repeated targets), IoError when the
 // file cannot be written (atomically: nothing partial is left).
+std::string RenderModelFile(const std::vector<LoadedModel>& axes);
 std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info);
+void WriteModelFile(const std::string& path, const std::vector<LoadedModel>& axes);
 void WriteModelFile(const std::string& path, const drift::DriftModel& model,
                     const ModelFileInfo& info);
 
-// Parses / reads a model file; `source` names it in messages. Throws DataError / IoError.
+// Parses / reads every axis of a model file; `source` names it in messages. Throws DataError /
+// IoError.
+std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source);
+std::vector<LoadedModel> ReadModelFileAxes(const std::string& path);
+// The same for commands that take one axis: a file of several throws UsageError naming them.
 LoadedModel ParseModelFile(const std::string& text, const std::string& source);
 LoadedModel ReadModelFile(const std::string& path);
 

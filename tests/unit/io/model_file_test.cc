@@ -338,9 +338,9 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 4;
+  j["format_version"] = 5;
   ExpectRefused(Reseal(j),
-                "format_version 4 is not supported (this gyrodrift reads versions 1 to 3)");
+                "format_version 5 is not supported (this gyrodrift reads versions 1 to 4)");
   j["format_version"] = 0;
   ExpectRefused(Reseal(j), "format_version 0 is not supported");
   // A version-1 file (before the feature set, the limit flag and the range were stored) loads,
@@ -417,6 +417,63 @@ TEST_F(Refusal, WrongTypesShapesAndValuesAreNamed) {
   j = Json();
   j["model"]["sub_models"] = json::array();
   ExpectRefused(Reseal(j), "at least one sub-model");
+}
+
+// Several gyro axes in one file (issue 13): every axis comes back exactly, in order; a one-axis
+// reader refuses the file by naming its axes; the axes' own shape is checked.
+TEST(ModelFile, SeveralAxesComeBackExactlyAndInOrder) {
+  const Log log = MakeLog(300, 9);
+  const drift::DriftModel a =
+      drift::FitDriftModel(log.rate, log.temperature, Small(Mode::kCompensate, Method::kThermal));
+  const drift::DriftModel b = drift::FitDriftModel(
+      (-2.0 * log.rate).eval(), log.temperature, Small(Mode::kCompensate, Method::kPoly));
+  const std::vector<LoadedModel> axes = {
+      {a, {"gyro_x", "temperature_c", "imu.csv", ""}},
+      {b, {"gyro_y", "temperature_c", "imu.csv", ""}}};
+  const std::string text = RenderModelFile(axes);
+  const std::vector<LoadedModel> loaded = ParseModelFileAxes(text, "m.json");
+  ASSERT_EQ(loaded.size(), 2u);
+  EXPECT_EQ(loaded[1].info.target_column, "gyro_y");
+  EXPECT_EQ(drift::EstimateDrift(loaded[0].model, log.temperature),
+            drift::EstimateDrift(a, log.temperature));
+  EXPECT_EQ(drift::EstimateDrift(loaded[1].model, log.temperature),
+            drift::EstimateDrift(b, log.temperature));
+  EXPECT_EQ(RenderModelFile(loaded), text);
+  // A one-axis file keeps its layout and is read by both readers.
+  EXPECT_EQ(ParseModelFileAxes(RenderModelFile({axes[0]}), "m.json").size(), 1u);
+  try {
+    ParseModelFile(text, "m.json");
+    ADD_FAILURE() << "a two-axis file read as one axis";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 axes (gyro_x, gyro_y)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(RenderModelFile(std::vector<LoadedModel>{}), UsageError);
+  EXPECT_THROW(RenderModelFile({axes[0], axes[0]}), UsageError);  // two axes of one target
+
+  auto refused = [](const json& j, const std::string& message) {
+    try {
+      ParseModelFileAxes(Reseal(j), "m.json");
+      ADD_FAILURE() << "accepted; expected: " << message;
+    } catch (const DataError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  json j = json::parse(text);
+  j["axes"][1]["training"]["target_column"] = "gyro_x";
+  refused(j, "field 'axes[1].training.target_column' = 'gyro_x' is the target of an earlier axis");
+  j = json::parse(text);
+  j["axes"].erase(1);
+  refused(j, "field 'axes' holds 1 axes");
+  j = json::parse(text);
+  j["axes"][0]["options"].erase("seed");
+  refused(j, "field 'axes[0].options.seed' is missing");
+  j = json::parse(text);
+  j["axes"][1]["note"] = 1;
+  refused(j, "field 'axes[1].note' is not part");
+  j = json::parse(text);
+  j["training"] = j["axes"][0]["training"];
+  refused(j, "field 'training' is not part");
 }
 
 TEST(ModelFile, RefusesToStoreWhatItCannotRebuild) {
