@@ -7,6 +7,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsvm-dev libfann-dev libjs-dygraphs
   clang libclang-rt-14-dev
+  libtomlplusplus-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -15,6 +15,8 @@ int ExitCode(ErrorKind kind) {
       return 3;
     case ErrorKind::kIo:
       return 4;
+    case ErrorKind::kUnitsFailed:
+      return 5;
   }
   return 1;
 }

@@ -185,6 +185,29 @@ th { background: #eee; } td.num { text-align: right; font-variant-numeric: tabul
 pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 0.85em; }
 )CSS";
 
+// A link to a file beside the report or below it (a fleet report's unit pages): no scheme, not
+// absolute, no "..". Such a link loads nothing when the report opens, so an <a href> may use it.
+bool LocalLink(const std::string& url) {
+  if (url.empty() || url[0] == '/' || url.find(':') != std::string::npos) return false;
+  return ("/" + url + "/").find("/../") == std::string::npos;
+}
+
+// Percent-encodes what a path may hold but a URL may not (spaces, #, ?, %, non-ASCII bytes).
+std::string PercentEncode(const std::string& path) {
+  std::string out;
+  for (const unsigned char ch : path) {
+    if (std::isalnum(ch) || ch == '/' || ch == '-' || ch == '_' || ch == '.' || ch == '~') {
+      out += static_cast<char>(ch);
+    } else {
+      static const char* kHex = "0123456789ABCDEF";
+      out += '%';
+      out += kHex[ch >> 4];
+      out += kHex[ch & 15];
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 DygraphsAssets LoadDygraphs(const std::string& dir) {
@@ -354,6 +377,22 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
 }
 
 void HtmlReport::AddTable(const ReportTable& t) {
+  if (!t.links.empty() && t.links.size() != t.rows.size()) {
+    throw DataError("table '" + t.title + "': links must be empty or one row per row");
+  }
+  for (size_t r = 0; r < t.links.size(); ++r) {
+    if (t.links[r].size() != t.header.size()) {
+      throw DataError("table '" + t.title + "': links row " + std::to_string(r + 1) + " has " +
+                      std::to_string(t.links[r].size()) + " cells for " +
+                      std::to_string(t.header.size()) + " columns");
+    }
+    for (const std::string& link : t.links[r]) {
+      if (!link.empty() && !LocalLink(link)) {
+        throw UsageError("table '" + t.title + "': link '" + link +
+                         "' must be a relative path to a file beside or below the report");
+      }
+    }
+  }
   for (size_t r = 0; r < t.rows.size(); ++r) {
     if (t.rows[r].size() != t.header.size()) {
       throw DataError("table '" + t.title + "': row " + std::to_string(r + 1) + " has " +
@@ -364,10 +403,15 @@ void HtmlReport::AddTable(const ReportTable& t) {
   body_ += "<div class=\"table\">\n<h3>" + Escape(t.title) + "</h3>\n<table>\n<tr>";
   for (const auto& h : t.header) body_ += "<th>" + Escape(h) + "</th>";
   body_ += "</tr>\n";
-  for (const auto& row : t.rows) {
+  for (size_t r = 0; r < t.rows.size(); ++r) {
     body_ += "<tr>";
-    for (const auto& cell : row) {
-      body_ += (LooksNumeric(cell) ? "<td class=\"num\">" : "<td>") + Escape(cell) + "</td>";
+    for (size_t c = 0; c < t.rows[r].size(); ++c) {
+      const std::string& cell = t.rows[r][c];
+      const std::string link = t.links.empty() ? std::string() : t.links[r][c];
+      body_ += (LooksNumeric(cell) ? "<td class=\"num\">" : "<td>");
+      body_ += link.empty() ? Escape(cell)
+                            : "<a href=\"" + Escape(PercentEncode(link)) + "\">" + Escape(cell) + "</a>";
+      body_ += "</td>";
     }
     body_ += "</tr>\n";
   }
@@ -546,7 +590,9 @@ ReportCheck CheckReportHtml(const std::string& html) {
       check.problems.push_back("line " + line_of(lt) + ": <" + name + "> has an unquoted attribute");
     }
     for (const auto& a : attributes) {
-      if ((a.name == "src" || a.name == "href" || a.name == "action") && External(a.value)) {
+      const bool local_anchor = name == "a" && a.name == "href" && LocalLink(a.value);
+      if ((a.name == "src" || a.name == "href" || a.name == "action") && External(a.value) &&
+          !local_anchor) {
         check.problems.push_back("line " + line_of(lt) + ": <" + name + " " + a.name + "=\"" +
                                  a.value + "\"> refers outside the file");
       }

@@ -17,6 +17,7 @@ enum class ErrorKind {
   kUsage,  // bad option or argument: exit code 2
   kData,   // the data cannot be processed (NaN, too short, missing column): exit code 3
   kIo,     // a file cannot be read or written: exit code 4
+  kUnitsFailed,  // a fleet calibration ran, but a unit failed its limits or its calibration: 5
 };
 
 class Error : public std::runtime_error {
@@ -59,6 +60,13 @@ class DataError : public Error {
 class IoError : public Error {
  public:
   explicit IoError(const std::string& message) : Error(ErrorKind::kIo, message) {}
+};
+
+// A fleet calibration that ran to the end with a unit that failed its limits or could not be
+// calibrated (its outputs, fleet.csv and fleet.html are written).
+class FleetFailure : public Error {
+ public:
+  explicit FleetFailure(const std::string& message) : Error(ErrorKind::kUnitsFailed, message) {}
 };
 
 // Exit code the CLI returns for an error of this kind.

@@ -14,7 +14,8 @@
 //   Values are printed with 7 significant digits (plotting precision; the CSV files beside the
 //   report keep full precision); NaN and infinities become null (a gap).
 // CheckReportHtml: a structural check of a report file (balanced tags outside <script>/<style>,
-//   figure data present and non-empty, dygraphs inlined, no external resource), used by the tests
+//   figure data present and non-empty, dygraphs inlined, no external resource; an <a href> may
+//   point to a relative path beside or below the report), used by the tests
 //   and available to anyone who post-processes a report.
 // Units: whatever the caller labels the axes with. Cost: O(total samples) to decimate and print.
 #pragma once
@@ -76,6 +77,9 @@ struct ReportTable {
   std::string caption;
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;  // each as long as header
+  // Empty, or one per row and cell: a non-empty entry makes the cell a link to that relative
+  // path (a file beside or below the report, such as a fleet's unit pages; percent-encoded).
+  std::vector<std::vector<std::string>> links;
 };
 
 // Builds the document in order. Text is escaped; nothing the caller passes is taken as HTML.

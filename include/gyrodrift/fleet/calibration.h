@@ -1,0 +1,121 @@
+// Thermal calibration of a fleet of gyros (gyrodrift calibrate, docs/calibration.md).
+//
+// Per unit and axis: fit the compensate-mode drift model on the calibration log (exactly what
+// `gyrodrift fit --target <every axis> --mode compensate` writes, seed and options alike),
+// compensate each verification log, and measure before and after compensation:
+//   - the residual drift: RMS, about their mean, of the output's means over drift_window_s
+//     blocks (the slow part the compensation is for; white noise averages out of it);
+//   - the Allan deviation (overlapping, octave taus) and its IEEE 952 terms N, B, K;
+//   - with a true-drift column: the share of its RMS removed, 1 - RMS(truth - estimate) /
+//     RMS(truth), as `compensate --truth` reports it;
+// then pass/fail against the manifest's limits (every verification log must pass).
+//
+// Units run in parallel (ParallelFor over units, each unit single-threaded inside, so results do
+// not depend on the thread count). Each unit's files are written together, atomically, into
+// OUT/<serial>/ with summary.json last in the set; a rerun skips a unit whose summary.json holds
+// the same fingerprint (manifest settings and the logs' bytes: UnitFingerprint) unless `force`.
+// A unit that fails (unreadable log, a fit that cannot run) is reported with its one-line error
+// and the others go on. OUT/fleet.csv (one row per unit, axis and verification log) and
+// OUT/fleet.html (distributions across the fleet, outliers flagged, links to each unit's page)
+// are written at the end.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/io/report.h"
+
+namespace gyrodrift::fleet {
+
+// One verification log of one axis.
+struct VerificationResult {
+  std::string log;  // path
+  Eigen::Index samples = 0;
+  double rate_hz = 0.0;
+  double std_before = 0.0, std_after = 0.0;                // rate unit
+  double drift_rms_before = 0.0, drift_rms_after = 0.0;    // rate unit (drift_window_s means)
+  double truth_removed = std::numeric_limits<double>::quiet_NaN();  // share, NaN: no truth
+  double outside_share = 0.0;  // samples beyond the calibration's temperature range
+  allan::NoiseTerms noise_before, noise_after;
+  Eigen::VectorXd tau_s, adev_before, adev_after;  // rate unit
+  // Series for the unit's report, drift_window_s block means (x in hours).
+  Eigen::VectorXd block_hours, output_means, compensated_means, estimate_means, truth_means;
+  std::vector<std::string> failures;  // limits this log breaks, one phrase each
+};
+
+struct AxisResult {
+  std::string target;
+  std::string temperature;  // columns, comma-separated
+  std::string model_summary;
+  std::vector<std::string> regressors;  // the identified model's regressor names (thermal)
+  double bias = std::numeric_limits<double>::quiet_NaN();  // intercept, rate unit (thermal)
+  double cv_rmse = std::numeric_limits<double>::quiet_NaN();
+  double skill = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::string> warnings;  // calibration-run warnings
+  std::vector<VerificationResult> verification;
+  bool pass() const;
+};
+
+struct UnitResult {
+  std::string serial;
+  std::string error;  // "" = calibrated; else the one-line error
+  std::vector<AxisResult> axes;
+  double seconds = 0.0;  // wall time of this unit
+  bool pass() const;
+};
+
+// The result of one unit and the files to write into its folder (names relative to it; the
+// model file, the compensated logs, the Allan table, report.html, summary.json).
+struct UnitOutputs {
+  UnitResult result;
+  std::vector<std::pair<std::string, std::string>> files;
+};
+
+// Calibrates one unit (never throws for the unit's own data: the error goes into result.error and
+// files is empty). `assets` inline dygraphs into the report.
+UnitOutputs CalibrateUnit(const Manifest& manifest, const UnitSpec& unit,
+                          const io::DygraphsAssets& assets);
+
+// One row of fleet.csv: unit, axis, verification log and every figure above, as text.
+struct FleetRow {
+  std::vector<std::string> cells;  // FleetColumns() order
+};
+const std::vector<std::string>& FleetColumns();
+std::vector<FleetRow> Rows(const UnitResult& unit);
+
+struct FleetOptions {
+  std::string output_dir;  // created if missing
+  bool force = false;      // redo units whose summary.json matches
+  int threads = 0;         // units at once; 0 = every core
+  // Called (serialised) after each unit: units done, total, serial, "calibrated" / "skipped" /
+  // "error".
+  std::function<void(int done, int total, const std::string& serial, const std::string& what)>
+      progress;
+};
+
+struct FleetResult {
+  std::vector<FleetRow> rows;  // every unit's rows, in manifest order
+  int units = 0, calibrated = 0, skipped = 0, errors = 0, failed_limits = 0;
+  double seconds = 0.0;
+  double unit_seconds_median = 0.0;  // of the units calibrated in this run
+  bool all_pass() const { return errors == 0 && failed_limits == 0; }
+  std::string Summary() const;  // one line
+};
+
+// Calibrates every unit of the manifest into options.output_dir (see the header comment).
+// Throws UsageError / IoError for the fleet as a whole (no output folder, no dygraphs); a unit's
+// own failure is a row, not an exception.
+FleetResult RunFleet(const Manifest& manifest, const FleetOptions& options);
+
+// The fleet report from fleet.csv's rows: a summary, the distributions of the residual drift, the
+// share removed, the bias and the noise terms across units, the rows with outliers flagged and a
+// link to each unit's report.
+std::string RenderFleetReport(const Manifest& manifest, const FleetResult& fleet,
+                              const io::DygraphsAssets& assets);
+
+}  // namespace gyrodrift::fleet

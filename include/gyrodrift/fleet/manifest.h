@@ -1,0 +1,98 @@
+// The calibration manifest of a fleet of gyros: which units, their calibration and verification
+// logs, the axes (gyro column, temperature column(s), optional true-drift column), the method and
+// the pass/fail limits. TOML (toml.io), parsed with toml++ (Debian libtomlplusplus-dev).
+//
+//   method = "thermal"            # fit --method of every axis (compensate mode); default thermal
+//   rate_unit = "dph"             # unit of the gyro columns: dph | dps | rads (allan --units)
+//   rate_hz = 1.0                 # optional; default: from each log's time_s, else 1 Hz
+//   seed = 1                      # optional
+//   nonlinear = false             # optional, fit --nonlinear
+//   reference_temperature_c = 20  # optional, fit --reference-temperature
+//   drift_window_s = 100          # optional: residual drift = RMS of block means this long
+//
+//   [limits]                      # optional; a limit left out is not checked
+//   residual_drift_rms = 0.02     # compensated verification output, rate unit
+//   bias_instability_dph = 0.05   # IEEE 952 B of the compensated output, deg/h
+//   removed_share_min = 0.8       # of the true drift (needs `truth`), in [0, 1]
+//
+//   [[axis]]                      # one per gyro axis, in the model file's order
+//   target = "gyro_x"
+//   temperature = ["temp_x"]      # one column or several
+//   truth = "drift_x"             # optional: column of the true drift in the verification logs
+//
+//   [[unit]]
+//   serial = "FOG-0001"
+//   calibration = "FOG-0001/cal.csv"          # relative paths are relative to the manifest
+//   verification = ["FOG-0001/ver.csv"]       # one or several
+//
+// Every key is checked: an unknown key (a misspelt limit would silently go unchecked), a wrong
+// type, a value out of range, a repeated serial or axis, a log that does not exist or lacks a
+// column, all throw UsageError "MANIFEST:LINE: ..." naming the line, before any unit is fitted.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/drift/drift_model.h"
+
+namespace gyrodrift::fleet {
+
+inline constexpr double kNoLimit = std::numeric_limits<double>::quiet_NaN();
+
+struct Limits {
+  double residual_drift_rms = kNoLimit;    // rate unit, >= 0
+  double bias_instability_dph = kNoLimit;  // deg/h, >= 0
+  double removed_share_min = kNoLimit;     // in [0, 1]
+  bool operator==(const Limits&) const = default;
+};
+
+struct AxisSpec {
+  std::string target;                    // gyro output column
+  std::vector<std::string> temperature;  // temperature column(s), degC
+  std::string truth;                     // "" = none
+  int line = 0;                          // in the manifest
+};
+
+struct UnitSpec {
+  std::string serial;
+  std::string calibration;                // resolved path
+  std::vector<std::string> verification;  // resolved paths
+  int line = 0;
+};
+
+struct Manifest {
+  std::string path;  // the manifest file
+  drift::Method method = drift::Method::kThermal;
+  allan::RateUnit rate_unit = allan::RateUnit::kDegPerHour;
+  double rate_hz = 0.0;  // 0 = from each log
+  std::uint64_t seed = 1;
+  bool nonlinear = false;
+  double reference_c = std::numeric_limits<double>::quiet_NaN();
+  double drift_window_s = 100.0;  // in [1, 1e5]
+  Limits limits;
+  std::vector<AxisSpec> axes;  // 1 to io::kMaxModelAxes
+  std::vector<UnitSpec> units;  // at least one
+
+  // The drift options every axis is fitted with (compensate mode); rate_hz is settled per log.
+  drift::DriftOptions FitOptions() const;
+};
+
+// Parses a manifest's text; `path` names it in messages and anchors relative log paths. Checks
+// the keys, types and ranges and that the logs exist (not their columns: CheckLogColumns).
+// Throws UsageError "PATH:LINE: ...".
+Manifest ParseManifest(const std::string& text, const std::string& path);
+// Reads and parses; IoError when the file cannot be read.
+Manifest ReadManifest(const std::string& path);
+
+// Reads the header of every log of every unit and throws UsageError "PATH:LINE: ..." (the unit's
+// line) naming the first missing axis, temperature or truth column.
+void CheckLogColumns(const Manifest& manifest);
+
+// A unit's fingerprint: FNV-1a 64 of the settings that shape its results and of the bytes of its
+// logs, so a rerun redoes a unit whose logs or settings changed and skips one that is done.
+std::string UnitFingerprint(const Manifest& manifest, const UnitSpec& unit);
+
+}  // namespace gyrodrift::fleet

@@ -1,0 +1,370 @@
+#include "gyrodrift/fleet/manifest.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <toml++/toml.h>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/io/model_file.h"
+
+namespace gyrodrift::fleet {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every message names the manifest and the line of the offending key or value.
+class Context {
+ public:
+  explicit Context(std::string path) : path_(std::move(path)) {}
+  [[noreturn]] void Fail(int line, const std::string& what) const {
+    throw UsageError(fmt::format("{}:{}: {}", path_, line, what));
+  }
+  [[noreturn]] void Fail(const toml::node& node, const std::string& what) const {
+    Fail(static_cast<int>(node.source().begin.line), what);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+const char* TypeName(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "true/false";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date or time";
+  }
+}
+
+// A table whose keys must come from `known`; lookups name the key's line.
+class Table {
+ public:
+  Table(const toml::table& t, const Context& c, std::string where, std::set<std::string> known)
+      : t_(t), c_(c), where_(std::move(where)) {
+    for (auto&& [key, value] : t_) {
+      if (known.count(std::string(key.str())) == 0) {
+        c_.Fail(value, fmt::format("unknown key '{}'{} (known: {})", key.str(), where_,
+                                   Join(known)));
+      }
+    }
+  }
+  const toml::node* Find(const std::string& key) const { return t_.get(key); }
+  int line() const { return static_cast<int>(t_.source().begin.line); }
+
+  std::string String(const std::string& key) const {
+    const toml::node* n = Require(key);
+    if (!n->is_string()) c_.Fail(*n, fmt::format("'{}' must be a string, not {}", key, TypeName(*n)));
+    const std::string s = *n->value<std::string>();
+    if (s.empty()) c_.Fail(*n, fmt::format("'{}' is empty", key));
+    return s;
+  }
+  std::string String(const std::string& key, const std::string& fallback) const {
+    return Find(key) ? String(key) : fallback;
+  }
+  double Number(const std::string& key, double fallback, double lo, double hi) const {
+    const toml::node* n = Find(key);
+    if (!n) return fallback;
+    if (!n->is_number()) c_.Fail(*n, fmt::format("'{}' must be a number, not {}", key, TypeName(*n)));
+    const double v = *n->value<double>();
+    if (!(v >= lo && v <= hi)) {
+      c_.Fail(*n, fmt::format("'{}' = {}: must be in [{}, {}]", key, v, lo, hi));
+    }
+    return v;
+  }
+  bool Bool(const std::string& key, bool fallback) const {
+    const toml::node* n = Find(key);
+    if (!n) return fallback;
+    if (!n->is_boolean()) c_.Fail(*n, fmt::format("'{}' must be true or false, not {}", key, TypeName(*n)));
+    return *n->value<bool>();
+  }
+  // A string or an array of non-empty strings, at least one.
+  std::vector<std::string> Strings(const std::string& key) const {
+    const toml::node* n = Require(key);
+    std::vector<std::string> out;
+    if (n->is_string()) {
+      out.push_back(*n->value<std::string>());
+    } else if (const toml::array* a = n->as_array()) {
+      for (const toml::node& item : *a) {
+        if (!item.is_string()) {
+          c_.Fail(item, fmt::format("'{}' must hold strings, not {}", key, TypeName(item)));
+        }
+        out.push_back(*item.value<std::string>());
+      }
+    } else {
+      c_.Fail(*n, fmt::format("'{}' must be a string or an array of strings, not {}", key,
+                              TypeName(*n)));
+    }
+    if (out.empty()) c_.Fail(*n, fmt::format("'{}' is empty", key));
+    for (size_t i = 0; i < out.size(); ++i) {
+      if (out[i].empty()) c_.Fail(*n, fmt::format("'{}' holds an empty name", key));
+      if (std::find(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(i), out[i]) !=
+          out.begin() + static_cast<std::ptrdiff_t>(i)) {
+        c_.Fail(*n, fmt::format("'{}' names '{}' twice", key, out[i]));
+      }
+    }
+    return out;
+  }
+  const toml::node* Require(const std::string& key) const {
+    const toml::node* n = Find(key);
+    if (!n) c_.Fail(line(), fmt::format("'{}' is missing{}", key, where_));
+    return n;
+  }
+
+ private:
+  static std::string Join(const std::set<std::string>& names) {
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+  }
+  const toml::table& t_;
+  const Context& c_;
+  std::string where_;
+};
+
+// An array of tables ([[axis]], [[unit]]).
+std::vector<const toml::table*> TableArray(const toml::table& root, const std::string& key,
+                                           const Context& c) {
+  const toml::node* n = root.get(key);
+  if (!n) c.Fail(1, fmt::format("no [[{}]] table: the manifest needs at least one", key));
+  const toml::array* a = n->as_array();
+  if (!a || !a->is_array_of_tables()) {
+    c.Fail(*n, fmt::format("'{}' must be an array of tables ([[{}]])", key, key));
+  }
+  std::vector<const toml::table*> out;
+  for (const toml::node& item : *a) out.push_back(item.as_table());
+  return out;
+}
+
+std::string Resolve(const std::string& manifest, const std::string& log) {
+  const fs::path p(log);
+  if (p.is_absolute()) return log;
+  return (fs::path(manifest).parent_path() / p).lexically_normal().string();
+}
+
+}  // namespace
+
+drift::DriftOptions Manifest::FitOptions() const {
+  drift::DriftOptions o;
+  o.mode = drift::Mode::kCompensate;
+  o.method = method;
+  o.seed = seed;
+  o.linear_compensation = !nonlinear;
+  o.reference_c = reference_c;
+  return o;
+}
+
+Manifest ParseManifest(const std::string& text, const std::string& path) {
+  const Context c(path);
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    c.Fail(static_cast<int>(e.source().begin.line),
+           fmt::format("not valid TOML: {}", e.description()));
+  }
+  Manifest m;
+  m.path = path;
+  const Table top(root, c, "",
+                  {"method", "rate_unit", "rate_hz", "seed", "nonlinear", "reference_temperature_c",
+                   "drift_window_s", "limits", "axis", "unit"});
+  if (top.Find("method")) {
+    const std::string name = top.String("method");
+    try {
+      m.method = drift::MethodFromString(name);
+    } catch (const UsageError& e) {
+      c.Fail(*top.Find("method"), fmt::format("method = '{}': {}", name, e.what()));
+    }
+    if (!drift::SupportsMode(m.method, drift::Mode::kCompensate)) {
+      c.Fail(*top.Find("method"), fmt::format("method = '{}' does not compensate", name));
+    }
+  }
+  if (top.Find("rate_unit")) {
+    const std::string unit = top.String("rate_unit");
+    try {
+      m.rate_unit = allan::RateUnitFromString(unit);
+    } catch (const UsageError&) {
+      c.Fail(*top.Find("rate_unit"),
+             fmt::format("rate_unit = '{}': must be dph, dps or rads (as allan --units)", unit));
+    }
+  }
+  m.rate_hz = top.Number("rate_hz", 0.0, 1e-9, 1e6);
+  if (const toml::node* n = top.Find("seed")) {
+    if (!n->is_integer() || *n->value<std::int64_t>() < 0) {
+      c.Fail(*n, "'seed' must be a non-negative integer");
+    }
+    m.seed = static_cast<std::uint64_t>(*n->value<std::int64_t>());
+  }
+  m.nonlinear = top.Bool("nonlinear", false);
+  m.reference_c = top.Number("reference_temperature_c", m.reference_c, -273.15, 1000.0);
+  m.drift_window_s = top.Number("drift_window_s", m.drift_window_s, 1.0, 1e5);
+
+  if (const toml::node* n = top.Find("limits")) {
+    if (!n->is_table()) c.Fail(*n, "'limits' must be a table ([limits])");
+    const Table limits(*n->as_table(), c, " in [limits]",
+                       {"residual_drift_rms", "bias_instability_dph", "removed_share_min"});
+    m.limits.residual_drift_rms = limits.Number("residual_drift_rms", kNoLimit, 0.0, 1e12);
+    m.limits.bias_instability_dph = limits.Number("bias_instability_dph", kNoLimit, 0.0, 1e12);
+    m.limits.removed_share_min = limits.Number("removed_share_min", kNoLimit, 0.0, 1.0);
+  }
+
+  for (const toml::table* t : TableArray(root, "axis", c)) {
+    const Table axis(*t, c, " in [[axis]]", {"target", "temperature", "truth"});
+    AxisSpec a;
+    a.line = axis.line();
+    a.target = axis.String("target");
+    a.temperature = axis.Strings("temperature");
+    a.truth = axis.Find("truth") ? axis.String("truth") : "";
+    for (const AxisSpec& earlier : m.axes) {
+      if (earlier.target == a.target) {
+        c.Fail(a.line, fmt::format("axis target '{}' repeats the axis of line {}", a.target,
+                                   earlier.line));
+      }
+    }
+    for (const std::string& t_col : a.temperature) {
+      if (t_col == a.target || t_col == a.truth) {
+        c.Fail(a.line, fmt::format("column '{}' is both the target or truth and a temperature", t_col));
+      }
+    }
+    if (!a.truth.empty() && a.truth == a.target) {
+      c.Fail(a.line, fmt::format("truth '{}' is the target column", a.truth));
+    }
+    m.axes.push_back(std::move(a));
+  }
+  if (static_cast<int>(m.axes.size()) > io::kMaxModelAxes) {
+    c.Fail(m.axes.back().line, fmt::format("{} axes: a model file holds at most {}",
+                                           m.axes.size(), io::kMaxModelAxes));
+  }
+  if (!std::isnan(m.limits.removed_share_min)) {
+    for (const AxisSpec& a : m.axes) {
+      if (a.truth.empty()) {
+        c.Fail(a.line, fmt::format("limits.removed_share_min needs the true drift: axis '{}' has "
+                                   "no 'truth' column", a.target));
+      }
+    }
+  }
+
+  for (const toml::table* t : TableArray(root, "unit", c)) {
+    const Table unit(*t, c, " in [[unit]]", {"serial", "calibration", "verification"});
+    UnitSpec u;
+    u.line = unit.line();
+    u.serial = unit.String("serial");
+    // The serial names the unit's output folder: no path separators, no "." or "..".
+    if (u.serial == "." || u.serial == ".." ||
+        u.serial.find_first_of("/\\:*?\"<>|") != std::string::npos ||
+        u.serial.find_first_of(std::string("\0\n\r\t", 4)) != std::string::npos) {
+      c.Fail(u.line, fmt::format("serial '{}' must be usable as a folder name (no / \\ : * ? \" "
+                                 "< > |)", u.serial));
+    }
+    for (const UnitSpec& earlier : m.units) {
+      if (earlier.serial == u.serial) {
+        c.Fail(u.line, fmt::format("serial '{}' repeats the unit of line {}", u.serial,
+                                   earlier.line));
+      }
+    }
+    const std::vector<std::string> calibration = unit.Strings("calibration");
+    if (calibration.size() != 1) {
+      c.Fail(*unit.Find("calibration"),
+             "'calibration' names one log (the thermal states of a model run through one record; "
+             "joined runs would put a step in them)");
+    }
+    u.calibration = Resolve(path, calibration[0]);
+    for (const std::string& v : unit.Strings("verification")) {
+      u.verification.push_back(Resolve(path, v));
+    }
+    for (const std::string& log : [&] {
+           std::vector<std::string> all = u.verification;
+           all.insert(all.begin(), u.calibration);
+           return all;
+         }()) {
+      std::error_code ec;
+      if (!fs::is_regular_file(log, ec)) {
+        c.Fail(u.line, fmt::format("unit '{}': log {} does not exist", u.serial, log));
+      }
+    }
+    m.units.push_back(std::move(u));
+  }
+  return m;
+}
+
+Manifest ReadManifest(const std::string& path) { return ParseManifest(io::ReadTextFile(path), path); }
+
+namespace {
+
+// The header row of a log, parsed by the CSV reader from the log's first lines up to its first
+// data row (comments and blank lines included), so the whole file need not be read.
+std::vector<std::string> Header(const std::string& log) {
+  std::ifstream in(log, std::ios::binary);
+  if (!in) throw IoError(log + ": cannot be read");
+  std::string text, line;
+  int rows = 0;
+  while (rows < 2 && std::getline(in, line)) {
+    text += line + "\n";
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string::npos && line[first] != '#') ++rows;
+  }
+  return io::CsvTable::Parse(text, log).header();
+}
+
+}  // namespace
+
+void CheckLogColumns(const Manifest& m) {
+  const Context c(m.path);
+  for (const UnitSpec& u : m.units) {
+    std::vector<std::string> logs = u.verification;
+    logs.insert(logs.begin(), u.calibration);
+    for (size_t k = 0; k < logs.size(); ++k) {
+      std::vector<std::string> header;
+      try {
+        header = Header(logs[k]);
+      } catch (const Error& e) {
+        c.Fail(u.line, fmt::format("unit '{}': {}", u.serial, e.what()));
+      }
+      auto has = [&](const std::string& name) {
+        return std::find(header.begin(), header.end(), name) != header.end();
+      };
+      for (const AxisSpec& a : m.axes) {
+        std::vector<std::string> needed = a.temperature;
+        needed.insert(needed.begin(), a.target);
+        if (k > 0 && !a.truth.empty()) needed.push_back(a.truth);
+        for (const std::string& col : needed) {
+          if (!has(col)) {
+            c.Fail(u.line, fmt::format("unit '{}': {} has no column '{}' (axis of line {})",
+                                       u.serial, logs[k], col, a.line));
+          }
+        }
+      }
+    }
+  }
+}
+
+std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
+  std::string text = fmt::format(
+      "method={};unit={};rate={};seed={};nonlinear={};ref={};window={};limits={},{},{};",
+      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, m.seed, m.nonlinear,
+      m.reference_c, m.drift_window_s, m.limits.residual_drift_rms, m.limits.bias_instability_dph,
+      m.limits.removed_share_min);
+  for (const AxisSpec& a : m.axes) {
+    text += "axis=" + a.target + "|" + a.truth + "|";
+    for (const std::string& t : a.temperature) text += t + ",";
+  }
+  text += "serial=" + u.serial + ";";
+  std::vector<std::string> logs = u.verification;
+  logs.insert(logs.begin(), u.calibration);
+  for (const std::string& log : logs) {
+    text += "log=" + log + ":" + fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log))) + ";";
+  }
+  return fmt::format("fnv1a64:{:016x}", io::Fnv1a64(text));
+}
+
+}  // namespace gyrodrift::fleet

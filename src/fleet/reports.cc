@@ -1,0 +1,236 @@
+// The unit pages and the fleet page of a calibration (calibration.h).
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "gyrodrift/fleet/calibration.h"
+#include "unit_report.h"
+
+namespace gyrodrift::fleet {
+namespace {
+
+std::string Num(double v, int digits = 4) {
+  return std::isnan(v) ? "-" : fmt::format("{:.{}g}", v, digits);
+}
+
+std::string Percent(double share) {
+  return std::isnan(share) ? "-" : fmt::format("{:.1f} %", 100.0 * share);
+}
+
+std::string LimitsText(const Limits& l) {
+  std::string out;
+  if (!std::isnan(l.residual_drift_rms)) out += fmt::format("residual drift <= {:.4g}; ", l.residual_drift_rms);
+  if (!std::isnan(l.bias_instability_dph)) out += fmt::format("bias instability <= {:.4g} deg/h; ", l.bias_instability_dph);
+  if (!std::isnan(l.removed_share_min)) out += fmt::format("true drift removed >= {:.1f} %; ", 100.0 * l.removed_share_min);
+  return out.empty() ? "no limits set" : out.substr(0, out.size() - 2);
+}
+
+io::ReportSeries Line(std::string name, Eigen::VectorXd v, const char* color, bool dashed = false) {
+  io::ReportSeries s;
+  s.name = std::move(name);
+  s.values = std::move(v);
+  s.color = color;
+  s.dashed = dashed;
+  return s;
+}
+
+// A fleet.csv cell as a number (NaN when empty).
+double Cell(const FleetRow& row, const std::string& column) {
+  const auto& c = FleetColumns();
+  const size_t i = static_cast<size_t>(std::find(c.begin(), c.end(), column) - c.begin());
+  const std::string& text = row.cells[i];
+  return text.empty() ? std::numeric_limits<double>::quiet_NaN() : std::strtod(text.c_str(), nullptr);
+}
+const std::string& Text(const FleetRow& row, const std::string& column) {
+  const auto& c = FleetColumns();
+  return row.cells[static_cast<size_t>(std::find(c.begin(), c.end(), column) - c.begin())];
+}
+
+}  // namespace
+
+std::string RenderUnitReport(const Manifest& m, const UnitResult& unit,
+                             const io::DygraphsAssets& assets) {
+  const std::string unit_name(allan::ToString(m.rate_unit));
+  io::HtmlReport report("gyrodrift calibration: " + unit.serial);
+  report.AddParagraph(fmt::format(
+      "Unit {}: {} (compensate mode), fitted on {} and verified on {} log(s). Limits: {}. "
+      "Result: {}.",
+      unit.serial, drift::ToString(m.method), m.units.empty() ? "" : "its calibration log",
+      unit.axes.empty() ? 0 : unit.axes[0].verification.size(), LimitsText(m.limits),
+      unit.pass() ? "PASS" : "FAIL"));
+  for (const AxisResult& a : unit.axes) {
+    report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));
+    std::string model = a.model_summary + "\nregressors: ";
+    for (size_t i = 0; i < a.regressors.size(); ++i) model += (i ? ", " : "") + a.regressors[i];
+    if (!std::isnan(a.bias)) model += fmt::format("\nintercept (repeatable bias): {:.6g} {}", a.bias, unit_name);
+    if (!std::isnan(a.cv_rmse)) model += fmt::format("\ncross-validated RMSE {:.4g} {}, skill {:.3f}", a.cv_rmse, unit_name, a.skill);
+    for (const std::string& w : a.warnings) model += "\nwarning: " + w;
+    report.AddPreformatted(model);
+    io::ReportTable table;
+    table.title = "Verification of " + a.target;
+    table.header = {"log", "samples", "std before", "std after", "residual drift before",
+                    "residual drift after", "true drift removed", "ARW after (deg/rt h)",
+                    "B before (deg/h)", "B after (deg/h)", "outside cal. range", "limits broken"};
+    for (const VerificationResult& v : a.verification) {
+      std::string failures;
+      for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
+      table.rows.push_back({std::filesystem::path(v.log).filename().string(),
+                            std::to_string(v.samples), Num(v.std_before), Num(v.std_after),
+                            Num(v.drift_rms_before), Num(v.drift_rms_after),
+                            Percent(v.truth_removed), Num(v.noise_after.n_dpsh.value),
+                            Num(v.noise_before.b_dph.value), Num(v.noise_after.b_dph.value),
+                            Percent(v.outside_share), failures.empty() ? "none" : failures});
+    }
+    table.caption = fmt::format(
+        "Residual drift: RMS of the output's {:g}-s means about their mean, {}. True drift "
+        "removed: 1 - RMS(truth - estimate) / RMS(truth). Noise terms: IEEE 952 fit to the "
+        "overlapping Allan deviation.",
+        m.drift_window_s, unit_name);
+    report.AddTable(table);
+    for (size_t k = 0; k < a.verification.size(); ++k) {
+      const VerificationResult& v = a.verification[k];
+      io::ReportFigure drift;
+      drift.title = fmt::format("{}: verification log {} ({:g}-s means)", a.target, k + 1,
+                                m.drift_window_s);
+      drift.caption = "The output before and after compensation, and the model's estimate"
+                      " (with the true drift when the log has it). After compensation the "
+                      "curve should be flat.";
+      drift.x_label = "time (h)";
+      drift.y_label = unit_name;
+      drift.x = v.block_hours;
+      drift.series.push_back(Line("output", v.output_means, "#999999"));
+      drift.series.push_back(Line("compensated", v.compensated_means, "#1f77b4"));
+      drift.series.push_back(Line("estimate", v.estimate_means, "#d62728", true));
+      if (v.truth_means.size() == v.block_hours.size()) {
+        drift.series.push_back(Line("true drift", v.truth_means, "#2ca02c"));
+      }
+      report.AddFigure(drift);
+      io::ReportFigure adev;
+      adev.title = fmt::format("{}: Allan deviation, verification log {}", a.target, k + 1);
+      adev.caption = "Overlapping Allan deviation before and after compensation: the thermal "
+                     "drift lifts the long-tau end; compensation should bring it down.";
+      adev.x_label = "tau (s)";
+      adev.y_label = unit_name;
+      adev.x = v.tau_s;
+      adev.log_x = adev.log_y = true;
+      adev.draw_points = true;
+      adev.series.push_back(Line("before", v.adev_before, "#999999"));
+      adev.series.push_back(Line("after", v.adev_after, "#1f77b4"));
+      report.AddFigure(adev);
+    }
+  }
+  return report.Render(assets);
+}
+
+std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
+                              const io::DygraphsAssets& assets) {
+  const std::string unit_name(allan::ToString(m.rate_unit));
+  io::HtmlReport report("gyrodrift fleet calibration");
+  report.AddParagraph(fleet.Summary() + ". Limits: " + LimitsText(m.limits) + ".");
+  std::vector<std::string> serials;
+  for (const FleetRow& row : fleet.rows) {
+    if (std::find(serials.begin(), serials.end(), row.cells[0]) == serials.end()) {
+      serials.push_back(row.cells[0]);
+    }
+  }
+  std::vector<std::string> outliers;
+  for (const FleetRow& row : fleet.rows) {
+    if (!Text(row, "outliers").empty()) {
+      outliers.push_back(fmt::format("{} {} ({})", row.cells[0], Text(row, "axis"), Text(row, "outliers")));
+    }
+  }
+  report.AddParagraph(outliers.empty()
+                          ? "No outliers: every unit's figures lie within 3.5 robust standard "
+                            "deviations of its axis's fleet median."
+                          : "Outliers (more than 3.5 robust standard deviations from the axis's "
+                            "fleet median): " + [&] {
+                              std::string s;
+                              for (const std::string& o : outliers) s += (s.empty() ? "" : "; ") + o;
+                              return s;
+                            }() + ".");
+
+  // Distributions: one point per unit (x = its row in the table below), one series per axis,
+  // the limit as a dashed line.
+  auto distribution = [&](const std::string& column, const std::string& title,
+                          const std::string& y_label, double limit, double scale) {
+    io::ReportFigure f;
+    f.title = title;
+    f.caption = "One point per unit (x: the unit's number in the table below), one colour per "
+                "axis; the dashed line is the limit.";
+    f.x_label = "unit";
+    f.y_label = y_label;
+    f.integer_x = true;
+    f.draw_points = true;
+    const auto n = static_cast<Eigen::Index>(serials.size());
+    f.x = Eigen::VectorXd::LinSpaced(n, 1.0, static_cast<double>(n));
+    bool any = false;
+    for (const AxisSpec& axis : m.axes) {
+      Eigen::VectorXd v = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+      for (const FleetRow& row : fleet.rows) {
+        if (Text(row, "axis") != axis.target || Text(row, "verification").empty()) continue;
+        const auto i = std::find(serials.begin(), serials.end(), row.cells[0]) - serials.begin();
+        // Several verification logs: the unit's worst is the one that decides pass/fail.
+        const double x = scale * Cell(row, column);
+        if (std::isnan(v[i]) || (column == "truth_removed" ? x < v[i] : x > v[i])) v[i] = x;
+        any |= !std::isnan(x);
+      }
+      io::ReportSeries s;
+      s.name = axis.target;
+      s.values = v;
+      f.series.push_back(s);
+    }
+    if (!any || n == 0) return;
+    if (!std::isnan(limit)) {
+      io::ReportSeries s;
+      s.name = "limit";
+      s.values = Eigen::VectorXd::Constant(n, scale * limit);
+      s.dashed = true;
+      s.color = "#d62728";
+      f.series.push_back(s);
+    }
+    report.AddFigure(f);
+  };
+  report.AddHeading("Distributions across the fleet");
+  distribution("drift_rms_after", "Residual drift after compensation", unit_name,
+               m.limits.residual_drift_rms, 1.0);
+  distribution("drift_rms_before", "Drift before compensation (same measure)", unit_name,
+               std::numeric_limits<double>::quiet_NaN(), 1.0);
+  distribution("truth_removed", "Share of the true drift removed", "%", m.limits.removed_share_min,
+               100.0);
+  distribution("bias_instability_after_dph", "Bias instability B after compensation", "deg/h",
+               m.limits.bias_instability_dph, 1.0);
+  distribution("arw_after_dpsh", "Angle random walk N after compensation", "deg/rt h",
+               std::numeric_limits<double>::quiet_NaN(), 1.0);
+  distribution("bias", "Repeatable bias (the thermal model's intercept)", unit_name,
+               std::numeric_limits<double>::quiet_NaN(), 1.0);
+
+  report.AddHeading("Units");
+  io::ReportTable table;
+  table.title = "Every unit, axis and verification log (fleet.csv)";
+  table.header = {"#", "serial", "axis", "log", "status", "residual drift before",
+                  "residual drift after", "true drift removed", "B after (deg/h)",
+                  "ARW after (deg/rt h)", "bias", "outliers", "limits broken / error"};
+  for (const FleetRow& row : fleet.rows) {
+    const auto i = std::find(serials.begin(), serials.end(), row.cells[0]) - serials.begin();
+    const bool error = Text(row, "status") == "error";
+    table.rows.push_back({std::to_string(i + 1), row.cells[0], Text(row, "axis"),
+                          Text(row, "verification"), Text(row, "status"),
+                          Num(Cell(row, "drift_rms_before")), Num(Cell(row, "drift_rms_after")),
+                          Percent(Cell(row, "truth_removed")),
+                          Num(Cell(row, "bias_instability_after_dph")),
+                          Num(Cell(row, "arw_after_dpsh")), Num(Cell(row, "bias")),
+                          Text(row, "outliers"), Text(row, "failures")});
+    std::vector<std::string> links(table.header.size());
+    if (!error) links[1] = row.cells[0] + "/report.html";
+    table.links.push_back(links);
+  }
+  table.caption = "Click a serial for the unit's page (its models, figures and files are in its "
+                  "folder). Residual drift in " + unit_name + ".";
+  report.AddTable(table);
+  return report.Render(assets);
+}
+
+}  // namespace gyrodrift::fleet

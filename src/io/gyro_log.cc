@@ -1,0 +1,104 @@
+#include "gyrodrift/io/gyro_log.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::io {
+namespace {
+
+double MedianStep(const Eigen::VectorXd& t) {
+  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
+  const size_t mid = steps.size() / 2;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
+  double median = steps[mid];
+  if (steps.size() % 2 == 0) {
+    const double below =
+        *std::max_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid));
+    median = 0.5 * (median + below);
+  }
+  return median;
+}
+
+}  // namespace
+
+CsvTable ReadLog(const std::string& path) {
+  CsvTable table = CsvTable::Read(path);
+  if (!table.HasColumn("time_s")) return table;
+  Eigen::VectorXd t;
+  try {
+    t = table.Column("time_s");
+  } catch (const Error&) {
+    return table;  // unreadable: refused where the rate is read from it (ResolveSampleRate)
+  }
+  for (Eigen::Index i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) continue;
+    throw DataError(fmt::format(
+        "{}: time_s {} at data row {} ({:g} s after {:g} s): time stamps must increase (sort "
+        "the log or split it where the clock jumped)",
+        path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
+  }
+  return table;
+}
+
+
+double ResolveSampleRate(const CsvTable& table, double given, std::string* how) {
+  if (given > 0.0) {
+    *how = "given";
+    return given;
+  }
+  if (!table.HasColumn("time_s") || table.rows() < 2) {
+    *how = "default";
+    return 1.0;
+  }
+  const double median = MedianStep(table.Column("time_s"));
+  if (!(median > 0.0)) {
+    throw DataError(table.source() + ": column 'time_s' has a median step of " +
+                    FormatValue(median) +
+                    " s: it must increase to give the sample rate (or pass --rate-hz)");
+  }
+  *how = "time_s";
+  const double rate = 1.0 / median;
+  if (!(rate >= 1e-9 && rate <= 1e6)) {
+    throw DataError(table.source() + ": column 'time_s' has a median step of " +
+                    FormatValue(median) + " s, a sample rate of " + FormatValue(rate) +
+                    " Hz outside [1e-09, 1e+06] Hz (seconds expected; or pass --rate-hz)");
+  }
+  return rate;
+}
+
+std::string NonUniformTimeNote(const CsvTable& table) {
+  if (!table.HasColumn("time_s") || table.rows() < 3) return "";
+  Eigen::VectorXd t;
+  try {
+    t = table.Column("time_s");
+  } catch (const Error&) {
+    return "";  // a note never fails a command; where time_s is needed it is read and refused
+  }
+  const double median = MedianStep(t);  // > 0: ReadLog refused a time_s that does not increase
+  long off = 0;
+  double largest = t[1] - t[0];
+  Eigen::Index largest_row = 2;  // 1-based data row of the sample after the step
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
+    const double step = t[i + 1] - t[i];
+    if (!(std::abs(step - median) <= 0.5 * median)) ++off;
+    if (std::abs(step - median) > std::abs(largest - median)) {
+      largest = step;
+      largest_row = i + 2;
+    }
+  }
+  if (off == 0) return "";
+  return fmt::format(
+      "note: time_s is not uniform: {} of {} steps differ from the median step {:g} s by more than "
+      "half (largest {:g} s, before data row {}); the models and the Allan analysis treat the "
+      "samples as equally spaced",
+      off, t.size() - 1, median, largest, largest_row);
+}
+
+}  // namespace gyrodrift::io
