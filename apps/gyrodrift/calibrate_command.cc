@@ -58,7 +58,13 @@ void Run(const CalibrateArgs& a) {
     }
     fmt::print("{}\nwrote {}/fleet.csv and {}/fleet.html\n", result.Summary(), a.output, a.output);
   }
-  if (!result.all_pass()) throw FleetFailure(result.Summary());
+  if (!result.all_pass()) {
+    throw FleetFailure(fmt::format(
+        "{} of {} units did not pass ({} failed their limits, {} could not be calibrated): see "
+        "{}/fleet.csv",
+        result.failed_limits + result.errors, result.units, result.failed_limits, result.errors,
+        a.output));
+  }
 }
 
 const RegisterCommand kRegister("calibrate", 75, [](CLI::App& app) {

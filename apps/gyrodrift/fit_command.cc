@@ -16,21 +16,14 @@
 namespace gyrodrift::cli {
 namespace {
 
-// The chosen regressors with their coefficients, the calibration report and its warnings; "T1"
-// in the names is the first temperature column, and so on.
+// The chosen regressors (named by the temperature columns) with their coefficients, the
+// calibration report and its warnings.
 void PrintThermalModel(const std::string& name, const drift::ThermalRegression& t,
                        const std::vector<std::string>& channels) {
   fmt::print("  {:<8} {}\n", name, t.Summary());
-  const std::vector<std::string> names = t.RegressorNames();
+  const std::vector<std::string> names = t.RegressorNames(channels);
   for (size_t i = 0; i < names.size(); ++i) {
-    std::string label = names[i];
-    for (size_t c = channels.size(); c-- > 0;) {
-      const std::string key = "T" + std::to_string(c + 1);
-      for (size_t at = label.find(key); at != std::string::npos; at = label.find(key, at)) {
-        label.replace(at, key.size(), channels[c]);
-        at += channels[c].size();
-      }
-    }
+    const std::string& label = names[i];
     const auto k = static_cast<Eigen::Index>(i);
     fmt::print("           {:<40} {:>12.6g} +- {:.2g}\n", label, t.coefficients[k],
                std::sqrt(t.covariance(k, k)));

@@ -560,13 +560,20 @@ Eigen::MatrixXd ThermalRegression::Regressors(
   return x;
 }
 
-std::vector<std::string> ThermalRegression::RegressorNames() const {
+std::vector<std::string> ThermalRegression::RegressorNames(
+    const std::vector<std::string>& channel_names) const {
+  auto channel = [&](int c) {
+    return static_cast<int>(channel_names.size()) == channels()
+               ? channel_names[static_cast<size_t>(c)]
+               : Format("T%d", c + 1);
+  };
   std::vector<std::string> names{"1"};
   for (int c = 0; c < channels(); ++c) {
-    if (linear[static_cast<size_t>(c)]) names.push_back(Format("T%d", c + 1));
+    if (linear[static_cast<size_t>(c)]) names.push_back(channel(c));
   }
   for (const ThermalState& s : states) {
-    const std::string state = Format("L%d(T%d; %.4g s)", order, s.channel + 1, s.tau_s);
+    const std::string state =
+        Format("L%d(%s; %.4g s)", order, channel(s.channel).c_str(), s.tau_s);
     names.push_back(state);
     for (int p = 2; p <= max_power; ++p) names.push_back(Format("%s^%d", state.c_str(), p));
     names.push_back("d/dt " + state);

@@ -131,7 +131,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
       if (!sub.thermal) continue;
       const drift::ThermalRegression& t = *sub.thermal;
       if (model.model.sub_models.size() == 1) {
-        a.regressors = t.RegressorNames();
+        a.regressors = t.RegressorNames(axis.temperature);
         a.bias = t.coefficients[0];
         a.cv_rmse = t.report.cv_rmse;
         a.skill = t.report.skill;
@@ -216,7 +216,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
     c.values.tail(longest - n).setConstant(std::numeric_limits<double>::quiet_NaN());
   }
   out.files.push_back({"allan.csv", io::RenderCsv(allan_columns)});
-  out.files.push_back({"report.html", RenderUnitReport(m, r, assets)});
+  out.files.push_back({"report.html", RenderUnitReport(m, unit, r, assets)});
   return out;
 }
 

@@ -2,6 +2,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +12,10 @@
 
 namespace gyrodrift::fleet {
 namespace {
+
+// One colour per axis in every figure of the fleet page.
+constexpr std::array<const char*, 6> kAxisColours = {"#1f77b4", "#ff7f0e", "#2ca02c",
+                                                     "#9467bd", "#8c564b", "#17becf"};
 
 std::string Num(double v, int digits = 4) {
   return std::isnan(v) ? "-" : fmt::format("{:.{}g}", v, digits);
@@ -51,16 +56,20 @@ const std::string& Text(const FleetRow& row, const std::string& column) {
 
 }  // namespace
 
-std::string RenderUnitReport(const Manifest& m, const UnitResult& unit,
+std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const UnitResult& unit,
                              const io::DygraphsAssets& assets) {
   const std::string unit_name(allan::ToString(m.rate_unit));
   io::HtmlReport report("gyrodrift calibration: " + unit.serial);
+  std::string verification;
+  for (const std::string& v : spec.verification) {
+    verification += (verification.empty() ? "" : ", ") + std::filesystem::path(v).filename().string();
+  }
   report.AddParagraph(fmt::format(
-      "Unit {}: {} (compensate mode), fitted on {} and verified on {} log(s). Limits: {}. "
+      "Unit {}: method {} (compensate mode), fitted on {} and verified on {}. Limits: {}. "
       "Result: {}.",
-      unit.serial, drift::ToString(m.method), m.units.empty() ? "" : "its calibration log",
-      unit.axes.empty() ? 0 : unit.axes[0].verification.size(), LimitsText(m.limits),
-      unit.pass() ? "PASS" : "FAIL"));
+      unit.serial, drift::ToString(m.method),
+      std::filesystem::path(spec.calibration).filename().string(), verification,
+      LimitsText(m.limits), unit.pass() ? "PASS" : "FAIL"));
   for (const AxisResult& a : unit.axes) {
     report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));
     std::string model = a.model_summary + "\nregressors: ";
@@ -158,8 +167,9 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
                           const std::string& y_label, double limit, double scale) {
     io::ReportFigure f;
     f.title = title;
-    f.caption = "One point per unit (x: the unit's number in the table below), one colour per "
-                "axis; the dashed line is the limit.";
+    f.caption = std::string("One point per unit (x: the unit's number in the table below), one "
+                            "colour per axis") +
+                (std::isnan(limit) ? "." : "; the dashed line is the limit.");
     f.x_label = "unit";
     f.y_label = y_label;
     f.integer_x = true;
@@ -180,6 +190,8 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
       io::ReportSeries s;
       s.name = axis.target;
       s.values = v;
+      s.markers_only = true;
+      s.color = kAxisColours[(&axis - m.axes.data()) % kAxisColours.size()];
       f.series.push_back(s);
     }
     if (!any || n == 0) return;

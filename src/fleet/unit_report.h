@@ -10,7 +10,7 @@ namespace gyrodrift::fleet {
 // Per axis: the model, the verification runs' block means before and after compensation (with
 // the true drift when there is one), the Allan deviation before and after, and the figures that
 // go into fleet.csv, with the limits each breaks.
-std::string RenderUnitReport(const Manifest& manifest, const UnitResult& unit,
-                             const io::DygraphsAssets& assets);
+std::string RenderUnitReport(const Manifest& manifest, const UnitSpec& spec,
+                             const UnitResult& unit, const io::DygraphsAssets& assets);
 
 }  // namespace gyrodrift::fleet

@@ -121,6 +121,7 @@ constexpr std::string_view kPlotScript = R"JS(
       if (s.dashed) o.strokePattern = [6, 4];
       if (s.color) o.color = s.color;
       if (s.bold) { o.strokeWidth = 2.2; o.color = s.color || '#000000'; }
+      if (s.markers) { o.strokeWidth = 0; o.drawPoints = true; o.pointSize = 4; }
       seriesOptions[s.name] = o;
     });
     var right = f.series.some(function (s) { return s.right; });
@@ -345,7 +346,8 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
     if (c) json += ',';
     json += "{\"name\":" + JsonString(s.name) + ",\"dashed\":" + (s.dashed ? "true" : "false") +
             ",\"bold\":" + (s.emphasis ? "true" : "false") +
-            (s.color.empty() ? std::string() : ",\"color\":" + JsonString(s.color)) + ",\"right\":" +
+            (s.color.empty() ? std::string() : ",\"color\":" + JsonString(s.color)) +
+            (s.markers_only ? ",\"markers\":true" : "") + ",\"right\":" +
             (s.right_axis ? "true" : "false") + ",\"y\":";
     AppendArray(json, d.values.col(c));
     if (s.lower.size()) {

@@ -143,7 +143,9 @@ struct ThermalRegression {
   int channels() const { return static_cast<int>(centre_c.size()); }
   // N x coefficients() design of temperatures (N x channels()).
   Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
-  std::vector<std::string> RegressorNames() const;  // "1", "T1", "L2(T1; 480 s)^2", "rate ..."
+  // "1", "T1", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)"; with one name per channel, the channels
+  // are named by them ("L2(coil_c; 480 s)").
+  std::vector<std::string> RegressorNames(const std::vector<std::string>& channel_names = {}) const;
   Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
   // Estimate and its standard deviation (columns 0 and 1).
   Eigen::MatrixXd EstimateWithSd(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;

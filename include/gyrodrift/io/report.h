@@ -46,6 +46,7 @@ struct ReportSeries {
   bool dashed = false;      // e.g. a fitted model curve
   bool emphasis = false;    // drawn thick and black (the reference the others are judged by)
   bool right_axis = false;  // plotted against the right-hand y axis (y2_label)
+  bool markers_only = false;  // a marker per point and no line (values of separate units)
   std::string color;        // CSS colour such as "#1f77b4"; empty = dygraphs' palette
 };
 
