@@ -7,61 +7,23 @@
 // tangent continuation). The measured errors are printed ("measured: ..."; docs/firmware.md).
 #include <gtest/gtest.h>
 
-#include <cctype>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/firmware_export.h"
 #include "gyrodrift/io/model_file.h"
+#include "support/firmware_driver.h"
 #include "support/test_support.h"
 
 namespace gyrodrift {
 namespace {
-
-// Steps the header named HEADER (prefix PFX, macros PFXU) through a file of temperatures, one
-// sample a line, and prints every axis' estimate with 17 digits.
-constexpr const char* kDriver = R"(#include <stdio.h>
-#include "HEADER"
-
-static int read_sample(FILE *in, PFX_real t[PFXU_N_CHANNELS]) {
-  double v;
-  int c;
-  for (c = 0; c < PFXU_N_CHANNELS; ++c) {
-    if (fscanf(in, "%lf", &v) != 1) return 0;
-    t[c] = (PFX_real)v;
-  }
-  return 1;
-}
-
-int main(int argc, char **argv) {
-  PFX_state s;
-  PFX_real t[PFXU_N_CHANNELS];
-  PFX_real drift[PFXU_N_AXES];
-  FILE *in;
-  int a;
-  if (argc != 2 || (in = fopen(argv[1], "r")) == NULL) return 2;
-  if (!read_sample(in, t)) return 3;
-  PFX_init(&s, t);
-  do {
-    PFX_step(&s, t, drift);
-    for (a = 0; a < PFXU_N_AXES; ++a) printf(a ? " %.17g" : "%.17g", (double)drift[a]);
-    printf("\n");
-  } while (read_sample(in, t));
-  fclose(in);
-  return 0;
-}
-)";
-
-constexpr const char* kCFlags =
-    "-std=c99 -O2 -Wall -Wextra -Werror -pedantic -Wconversion -Wdouble-promotion -Wshadow";
 
 std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
@@ -130,34 +92,21 @@ class ExportCli : public ::testing::Test {
     return io::CsvTable::Read(out).Column("drift_est");
   }
 
-  // Exports `model` (extra flags `flags`), compiles the driver against it and runs it over the
+  // Exports `model` (extra flags `flags`), compiles a driver against it and runs it over the
   // temperature columns of `log`; returns axis 0's estimates.
   static Eigen::VectorXd RunHeader(const std::string& model, const std::string& log,
                                    const std::string& prefix, const std::string& flags,
-                                   const std::string& compiler = GYRODRIFT_C_COMPILER,
-                                   const std::string& language_flags = kCFlags) {
-    const std::string stem = Dir() + "/" + prefix;
+                                   const std::string& compiler = test::kCCompiler,
+                                   const std::string& language_flags = test::kCFlags) {
+    const std::string header = Dir() + "/" + prefix + ".h";
     const auto exported =
         test::RunCli("export " + Quote(Dir() + "/" + model + ".json") + " --format c --prefix " +
-                     prefix + " " + flags + " -o " + Quote(stem + ".h"));
+                     prefix + " " + flags + " -o " + Quote(header));
     EXPECT_EQ(exported.exit_code, 0) << exported.err;
-    EXPECT_NE(exported.out.find("wrote " + stem + ".h"), std::string::npos) << exported.out;
-    std::string upper;
-    for (char ch : prefix) upper += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-    // PFXU before PFX: one is a prefix of the other.
-    io::WriteFileAtomically(
-        stem + "_driver.c",
-        test::Substitute(kDriver, {{"HEADER", stem + ".h"}, {"PFXU", upper}, {"PFX", prefix}}));
-    // No -lm: the header needs nothing from libm.
-    const auto compiled =
-        test::RunShell(Quote(compiler) + " " + language_flags + " " + Quote(stem + "_driver.c") +
-                       " -o " + Quote(stem + "_driver"));
-    EXPECT_EQ(compiled.exit_code, 0) << compiled.err;
-
+    EXPECT_NE(exported.out.find("wrote " + header), std::string::npos) << exported.out;
     const io::CsvTable table = io::CsvTable::Read(Dir() + "/" + log + ".csv");
-    const io::LoadedModel loaded = io::ReadModelFile(Dir() + "/" + model + ".json");
-    std::string temperatures;
-    const std::string columns = loaded.info.temperature_column;
+    const std::string columns =
+        io::ReadModelFile(Dir() + "/" + model + ".json").info.temperature_column;
     std::vector<Eigen::VectorXd> t;
     for (size_t start = 0;;) {
       const size_t comma = columns.find(',', start);
@@ -165,21 +114,11 @@ class ExportCli : public ::testing::Test {
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
-    char number[40];
-    for (Eigen::Index i = 0; i < table.rows(); ++i) {
-      for (size_t c = 0; c < t.size(); ++c) {
-        std::snprintf(number, sizeof number, "%s%.17g", c ? " " : "", t[c][i]);
-        temperatures += number;
-      }
-      temperatures += '\n';
-    }
-    io::WriteFileAtomically(stem + "_in.txt", temperatures);
-    const auto run = test::RunShell(Quote(stem + "_driver") + " " + Quote(stem + "_in.txt"));
-    EXPECT_EQ(run.exit_code, 0) << run.err;
-    std::istringstream lines(run.out);
-    std::vector<double> out;
-    for (double v; lines >> v;) out.push_back(v);
-    return Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+    Eigen::MatrixXd temperature(table.rows(), static_cast<Eigen::Index>(t.size()));
+    for (size_t c = 0; c < t.size(); ++c) temperature.col(static_cast<Eigen::Index>(c)) = t[c];
+    const Eigen::MatrixXd out =
+        test::RunFirmwareHeader(header, prefix, temperature, Dir(), compiler, language_flags);
+    return out.cols() > 0 ? Eigen::VectorXd(out.col(0)) : Eigen::VectorXd();
   }
 
   // Max |header - drift_est| / RMS(drift_est), printed for docs/firmware.md.
@@ -204,7 +143,7 @@ struct Case {
 };
 
 TEST_F(ExportCli, HeaderReproducesCompensateInDoubleAndFloat) {
-  ASSERT_TRUE(std::filesystem::exists(GYRODRIFT_C_COMPILER))
+  ASSERT_TRUE(std::filesystem::exists(test::kCCompiler))
       << "no C compiler (cc, gcc or clang) was found when the tests were configured";
   for (const Case& c : {Case{"thermal", "test"}, Case{"thermal", "warm"}, Case{"two", "test2"},
                         Case{"ms", "test"}, Case{"ref", "test"}}) {
@@ -221,7 +160,7 @@ TEST_F(ExportCli, HeaderReproducesCompensateInDoubleAndFloat) {
 
 TEST_F(ExportCli, TheHeaderIsAlsoValidCpp) {
   const Eigen::VectorXd est = DriftEst("two", "test2");
-  EXPECT_LE(Error(RunHeader("two", "test2", "cpp_two", "", GYRODRIFT_CXX_COMPILER,
+  EXPECT_LE(Error(RunHeader("two", "test2", "cpp_two", "", test::kCxxCompiler,
                             "-x c++ -std=c++17 -O2 -Wall -Wextra -Werror -pedantic"),
                   est, "two on test2, double, compiled as C++"),
             1e-9);

@@ -9,12 +9,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <numbers>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/features.h"
+#include "gyrodrift/io/files.h"
+#include "support/firmware_driver.h"
+#include "support/test_support.h"
 
 namespace gyrodrift::io {
 namespace {
@@ -222,6 +227,39 @@ TEST_F(FirmwareExport, AxesShareTheChannelsAndLagsTheyHaveInCommon) {
   EXPECT_GT(one.lag_stages, 0);
   EXPECT_EQ(three.rate_hz, 1.0);
   EXPECT_NE(three.Line().find("3 axes, 2 temperature channels"), std::string::npos) << three.Line();
+}
+
+// The header is C: the only test of its text is a compiler (the system's, as a user's would be).
+// Several axes with two channels, ms-elm, a reference and a model without states (no lag stage)
+// in one header, and that last model alone (a state struct without lags), double and float.
+TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
+  ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
+  drift::DriftOptions flat = Compensate(Method::kThermal);
+  flat.thermal.max_states = 0;
+  const LoadedModel stateless = Fit(MakeLog(3000, 3), flat, 2, "rate_z_dph");
+  ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
+  const std::vector<LoadedModel> axes{*thermal_, *two_, *ms_, *referenced_, stateless};
+  const Log test = MakeLog(2000, 4, 8.0);
+  const std::string dir = test::TempDir("firmware_header");
+  for (const bool single : {false, true}) {
+    const ExportOptions options{.single_precision = single, .prefix = single ? "imu_f" : "imu"};
+    for (const bool alone : {false, true}) {
+      const std::vector<LoadedModel> exported = alone ? std::vector<LoadedModel>{stateless} : axes;
+      const std::string header = dir + "/" + options.prefix + (alone ? "_alone" : "") + ".h";
+      WriteFileAtomically(header, RenderFirmwareC(exported, options));
+      const Eigen::MatrixXd got =
+          test::RunFirmwareHeader(header, options.prefix, test.temperature, dir);
+      ASSERT_EQ(got.cols(), static_cast<Eigen::Index>(exported.size()));
+      for (size_t a = 0; a < exported.size(); ++a) {
+        const Eigen::MatrixXd t =
+            test.temperature.leftCols(exported[a].model.temperature_channels());
+        EXPECT_LT(MaxRelativeError(got.col(static_cast<Eigen::Index>(a)),
+                                   drift::EstimateDrift(exported[a].model, t)),
+                  single ? 1e-5 : 1e-9)
+            << "axis " << a << (single ? ", float" : ", double");
+      }
+    }
+  }
 }
 
 TEST_F(FirmwareExport, RenderingIsDeterministicAndHasTheDocumentedShape) {
