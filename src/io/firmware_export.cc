@@ -241,7 +241,7 @@ class CWriter {
 
   std::string StateName(const State& s) const {
     const Chain& c = plan_.chains[static_cast<size_t>(s.chain)];
-    return fmt::format("L{}({}; {} s)", s.order, plan_.channels[static_cast<size_t>(c.channel)],
+    return fmt::format("L{}({}; {:.4g} s)", s.order, plan_.channels[static_cast<size_t>(c.channel)],
                        c.tau_s);
   }
 
@@ -376,7 +376,7 @@ class CWriter {
     // (u + d)(1 - g) and its output moves by g (u + d), the next stage's d.
     for (size_t c = 0; c < plan_.chains.size(); ++c) {
       const Chain& chain = plan_.chains[c];
-      out_ += fmt::format("  /* lags of {}, tau {} s, gain 1 - exp(-{} s / tau) */\n",
+      out_ += fmt::format("  /* lags of {}, tau {:.4g} s, gain 1 - exp(-{} s / tau) */\n",
                           CommentText(plan_.channels[static_cast<size_t>(chain.channel)]),
                           chain.tau_s, 1.0 / plan_.rate_hz);
       out_ += fmt::format("  d = temperature_c[{0}] - s->temperature_c[{0}];\n", chain.channel);
