@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
       "  gyrodrift allan fog.csv --column rate_dph --rate-hz 1 -o adev.csv\n"
       "  gyrodrift fit fog.csv --target rate_dph --temperature temperature_c --mode compensate \\\n"
       "      -o model.json && gyrodrift compensate model.json other_run.csv -o compensated.csv\n"
+      "  gyrodrift export model.json --format c -o gyro_comp.h  # the model as C99 for firmware\n"
       "  gyrodrift demo                                        # everything, with an HTML report\n"
       "Run 'gyrodrift SUBCOMMAND --help' for each subcommand. Exit codes: 0 ok, 2 usage,\n"
       "3 data, 4 file I/O, 1 internal error (see docs/errors.md).");

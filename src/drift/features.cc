@@ -26,9 +26,11 @@ constexpr double kQuadraticCentreC = 20.0;
 
 }  // namespace
 
+double FirstOrderLagGain(double tau_s, double dt_s) { return -std::expm1(-dt_s / tau_s); }
+
 void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
                    double dt_s, Eigen::Ref<Eigen::VectorXd> out) {
-  const double gain = -std::expm1(-dt_s / tau_s);
+  const double gain = FirstOrderLagGain(tau_s, dt_s);
   double state = temperature_c[0];
   for (Eigen::Index t = 0; t < temperature_c.size(); ++t) {
     state += gain * (temperature_c[t] - state);

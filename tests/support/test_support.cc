@@ -80,12 +80,15 @@ Eigen::VectorXd LehmerBoxMullerNormals(std::int64_t seed, Eigen::Index n) {
 }
 
 CommandResult RunCli(const std::string& args) {
+  return RunShell(std::string("'") + GYRODRIFT_CLI + "' " + args);
+}
+
+CommandResult RunShell(const std::string& command_line) {
   CommandResult result;
   const std::string dir = TempDir("cli-capture");
   const std::string out_path = dir + "/stdout";
   const std::string err_path = dir + "/stderr";
-  const std::string command =
-      std::string("'") + GYRODRIFT_CLI + "' " + args + " >'" + out_path + "' 2>'" + err_path + "' </dev/null";
+  const std::string command = command_line + " >'" + out_path + "' 2>'" + err_path + "' </dev/null";
   const int status = std::system(command.c_str());
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = io::ReadTextFile(out_path);

@@ -39,6 +39,8 @@ struct CommandResult {
 };
 // Runs the built gyrodrift binary with the given argument string (shell-quoted by the caller).
 CommandResult RunCli(const std::string& args);
+// Runs a shell command line (quoted by the caller), stdin from /dev/null.
+CommandResult RunShell(const std::string& command_line);
 
 // A small thermal log for the CLI tests, one row per `step_s` seconds: time_s, rate_dph = drift +
 // white noise (0.02), temperature_c (1.5 cycles of 20 +- 15 degC), drift_dph (the truth: a

@@ -69,6 +69,9 @@ FeatureOptions ForTrainingRecord(FeatureOptions options, Eigen::Index samples);
 // (the exact one-sample step response; stable for any dt / tau).
 void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
                    double dt_s, Eigen::Ref<Eigen::VectorXd> out);
+// Its gain 1 - exp(-dt/tau), the one formula every lag uses (firmware export prints it as a
+// literal so that generated C code runs the same recursion).
+double FirstOrderLagGain(double tau_s, double dt_s);
 
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,
