@@ -123,7 +123,8 @@ std::string DemoRecord(const DemoArgs& a, const study::StudyResult& s) {
 void Run(const DemoArgs& a) {
   RequireInputsOutsideFolder({a.input}, a.output);
   const auto wall_start = Clock::now();
-  // Options first: every mistake is reported before any work.
+  // Options first: every mistake is reported before any work (but the range of --rate-hz, which
+  // the study checks with the log's other data).
   const bool user = !a.input.empty();
   if (!user && (!a.target.empty() || !a.temperature.empty() || a.rate_option->count() > 0)) {
     throw UsageError("--target, --temperature and --rate-hz need --input FILE.csv");
