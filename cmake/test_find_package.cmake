@@ -1,5 +1,5 @@
 # Test driver: install gyrodrift from BUILD_DIR into a scratch prefix, build the find_package
-# example against it and run it.
+# examples against it and run them.
 set(prefix ${BUILD_DIR}/test-install/prefix)
 set(example_build ${BUILD_DIR}/test-install/example)
 file(REMOVE_RECURSE ${BUILD_DIR}/test-install)
@@ -19,8 +19,10 @@ execute_process(COMMAND ${CMAKE_COMMAND} --build ${example_build}
 if(rc)
   message(FATAL_ERROR "building the example failed:\n${out}\n${err}")
 endif()
-execute_process(COMMAND ${example_build}/decompose_example RESULT_VARIABLE rc OUTPUT_VARIABLE out)
-message(STATUS "${out}")
-if(rc)
-  message(FATAL_ERROR "the example failed: ${rc}\n${out}")
-endif()
+foreach(example decompose_example study_example)
+  execute_process(COMMAND ${example_build}/${example} RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+  message(STATUS "${out}")
+  if(rc)
+    message(FATAL_ERROR "${example} failed: ${rc}\n${out}")
+  endif()
+endforeach()

@@ -61,7 +61,7 @@ HtmlReport SmallReport() {
   s.values[3] = std::nan("");  // a gap
   allan.series.push_back(s);
   report.AddFigure(allan);
-  report.AddTable({"t", "cap", {"method", "rmse"}, {{"ms-elm", "0.1"}, {"elm<", "0.2"}}});
+  report.AddTable({"t", "cap", {"method", "rmse"}, {{"ms-elm", "0.1"}, {"elm<", "0.2"}}, {}});
   return report;
 }
 
@@ -139,7 +139,7 @@ TEST(Report, FigureErrorsAreDataErrors) {
   f.series[0].lower.resize(0);
   f.max_points = 4;
   EXPECT_THROW(report.AddFigure(f), UsageError);
-  EXPECT_THROW(report.AddTable({"t", "", {"a", "b"}, {{"1"}}}), DataError);
+  EXPECT_THROW(report.AddTable({"t", "", {"a", "b"}, {{"1"}}, {}}), DataError);
   EXPECT_EQ(report.figures(), 0);
 }
 
@@ -165,6 +165,35 @@ TEST(Report, DecimationKeepsTheEnvelopeAndOrder) {
   // Short input comes back unchanged.
   const Decimated same = DecimateMinMax(x.head(100), v.topRows(100), Eigen::MatrixXd(), Eigen::MatrixXd(), 4000);
   EXPECT_EQ(same.values, v.topRows(100));
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
+
+namespace gyrodrift::io {
+namespace {
+
+// A fleet page links its unit pages: relative paths beside or below the report become <a href>
+// (percent-encoded) and pass the check; anything that could leave the folder or load a resource
+// is refused.
+TEST(HtmlReport, TableCellsLinkLocalPagesOnly) {
+  HtmlReport report("fleet");
+  ReportTable t{"units", "", {"serial", "status"}, {{"SN 1", "pass"}, {"SN2", "fail"}},
+                {{"SN 1/report.html", ""}, {"", ""}}};
+  report.AddTable(t);
+  const std::string html = report.Render(LoadDygraphs());
+  EXPECT_NE(html.find("<a href=\"SN%201/report.html\">SN 1</a>"), std::string::npos) << html;
+  const ReportCheck check = CheckReportHtml(html);
+  EXPECT_TRUE(check.ok()) << check.Summary();
+  for (const char* bad : {"../x.html", "/etc/passwd", "http://example.com/a.html", "a/../../b"}) {
+    t.links[0][0] = bad;
+    EXPECT_THROW(report.AddTable(t), UsageError) << bad;
+  }
+  t.links = {{"a.html", ""}};  // one row of links for two rows
+  EXPECT_THROW(report.AddTable(t), DataError);
+  // The check still refuses a link that leaves the folder, and any src.
+  EXPECT_FALSE(CheckReportHtml("<!DOCTYPE html><html><body><a href=\"../x.html\">x</a></body></html>").ok());
+  EXPECT_FALSE(CheckReportHtml("<!DOCTYPE html><html><body><img src=\"x.png\"/></body></html>").ok());
 }
 
 }  // namespace

@@ -1,0 +1,417 @@
+// The study's steps: data, decomposition, predict mode, compensate mode, Allan deviation.
+#include "gyrodrift/study/study.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/model_file.h"
+#include "gyrodrift/simulation/temperature_programme.h"
+#include "study_internal.h"
+
+namespace gyrodrift::study {
+namespace {
+
+namespace sim = gyrodrift::simulation;
+namespace dec = gyrodrift::decomposition;
+namespace sel = gyrodrift::selection;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kMinDurationS = 2 * 3600.0;
+// A 70/30 split with 32 training and 16 test samples, and room for the decomposition.
+constexpr Eigen::Index kMinLogSamples = 64;
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+double Rms(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  return v.size() ? std::sqrt(v.squaredNorm() / static_cast<double>(v.size())) : 0.0;
+}
+
+std::string UnitText(allan::RateUnit unit) {
+  switch (unit) {
+    case allan::RateUnit::kDegPerHour:
+      return "deg/h";
+    case allan::RateUnit::kDegPerSecond:
+      return "deg/s";
+    case allan::RateUnit::kRadPerSecond:
+      return "rad/s";
+  }
+  return "deg/h";
+}
+
+// The observer's calls, each of which may be empty.
+struct Notifier {
+  const StudyObserver& observer;
+  void Progress(int stage, double fraction, const std::string& what) const {
+    if (observer.progress) observer.progress(stage, fraction, what);
+  }
+  void StageDone(int stage, const std::string& summary) const {
+    if (observer.stage_done) observer.stage_done(stage, summary);
+  }
+};
+
+// Evaluate reports the share of its trials done; the trials differ in cost by orders of magnitude
+// (a causal MS-ELM trial decomposes one window per test sample), so the trial index is mapped to
+// a share of the expected cost instead. Weights: measured shares of the default demo.
+std::function<void(double, const std::string&)> TrialProgress(
+    const Notifier& notify, int stage, const std::vector<drift::Method>& methods, drift::Mode mode,
+    const std::string& prefix) {
+  const std::vector<drift::Protocol> protocols{drift::Protocol::kPaper, drift::Protocol::kCausal};
+  std::vector<double> cumulative{0.0};
+  for (drift::Method m : methods) {
+    for (drift::Protocol p : protocols) {
+      double w = 0.0;
+      if (drift::UsesDecomposition(m)) {
+        w = p == drift::Protocol::kCausal && mode == drift::Mode::kPredict ? 10.0 : 1.5;
+      } else if (p == drift::Protocol::kPaper) {
+        w = 0.5;  // the causal row of a single model is a copy
+      }
+      cumulative.push_back(cumulative.back() + w);
+    }
+  }
+  return [notify, stage, cumulative, prefix](double fraction, const std::string& label) {
+    const double trials = static_cast<double>(cumulative.size() - 1);
+    const size_t i =
+        std::min(cumulative.size() - 1, static_cast<size_t>(std::lround(fraction * trials)));
+    notify.Progress(stage, cumulative[i] / cumulative.back(), prefix + label);
+  };
+}
+
+drift::EvaluationOptions EvaluationFor(const StudyOptions& a, std::vector<drift::Method> methods) {
+  drift::EvaluationOptions e;
+  e.methods = std::move(methods);
+  e.causal.window = a.causal_window;
+  e.causal.threads = a.threads;
+  e.causal.ensemble_size = a.ensemble_size;
+  return e;
+}
+
+void SimulateRuns(const StudyOptions& a, StudyResult& s) {
+  const sim::FogParameters fog = sim::PresetParameters(sim::Preset::kNavigation);
+  sim::SimulationOptions so;
+  so.duration_s = a.duration_s;
+  so.rate_hz = 1.0;
+  so.seed = a.seed;
+  s.run_a = sim::Simulate(sim::BuiltinProgramme("chamber"), fog, so);
+  so.seed = a.seed + 1;
+  s.run_b = sim::Simulate(sim::BuiltinProgramme("chamber-b"), fog, so);
+  s.source = "simulation";
+  s.target_name = "rate_dph";
+  s.unit = "deg/h";
+  s.temperature_name = "temperature_c";
+  s.rate_hz = so.rate_hz;
+  s.rate_source = "simulated";
+  s.output = s.run_a.rate_dph;
+  s.temperature = s.run_a.temperature_c;
+  s.truth = s.run_a.drift_dph;
+  s.time_h = s.run_a.time_s / 3600.0;
+}
+
+void TakeLog(const StudyOptions& a, const StudyLog& log, StudyResult& s) {
+  s.output = log.output;
+  s.temperature = log.temperature;
+  s.source = log.source;
+  s.target_name = log.target_name;
+  s.unit = UnitText(a.units);
+  s.temperature_name = log.temperature_name;
+  s.rate_hz = log.rate_hz;
+  s.rate_source = log.rate_source;
+  s.time_note = log.time_note;
+  s.time_h = Eigen::VectorXd::LinSpaced(s.output.size(), 0.0,
+                                        static_cast<double>(s.output.size() - 1)) /
+             (3600.0 * s.rate_hz);
+}
+
+void DecomposeStep(StudyResult& s) {
+  const StudyOptions& a = s.options;
+  dec::DecompositionOptions dopt = s.drift_options.decomposition;
+  dopt.seed = a.seed;
+  dopt.threads = a.threads;
+  sel::SelectionOptions sopt = s.drift_options.selection;
+  sopt.threads = a.threads;
+  sel::GroupedDecomposition grouped = sel::DecomposeAndSelect(s.output, dopt, sopt);
+  if (!grouped.selection) {
+    throw DataError(s.target_name +
+                    " has fewer than 3 extrema: there is nothing to decompose or to model");
+  }
+  s.decomposition = std::move(grouped.decomposition);
+  s.selection = std::move(*grouped.selection);
+}
+
+void PredictStep(StudyResult& s, const Notifier& notify) {
+  drift::DriftOptions o = s.drift_options;
+  o.mode = drift::Mode::kPredict;
+  std::vector<drift::Method> methods;
+  for (drift::Method m : s.options.methods) {
+    if (drift::SupportsMode(m, drift::Mode::kPredict)) methods.push_back(m);
+  }
+  drift::EvaluationOptions e = EvaluationFor(s.options, methods);
+  e.progress = TrialProgress(notify, 2, e.methods, drift::Mode::kPredict, "predict: ");
+  s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e);
+}
+
+void CompensateSimulated(StudyResult& s, const Notifier& notify) {
+  const std::vector<drift::Method>& methods = s.options.methods;
+  drift::DriftOptions base = s.drift_options;
+  base.mode = drift::Mode::kCompensate;
+  s.compensate_reference = s.run_b.drift_dph;
+  s.compensate_output = s.run_b.rate_dph;
+  s.compensate_time_h = s.run_b.time_s / 3600.0;
+  const double reference_rms = Rms(s.compensate_reference);
+  for (size_t i = 0; i < methods.size(); ++i) {
+    notify.Progress(3, static_cast<double>(i) / static_cast<double>(methods.size()),
+                    "compensate: " + std::string(drift::ToString(methods[i])));
+    drift::DriftOptions o = base;
+    o.method = methods[i];
+    StudyResult::CompensateRow row{methods[i], "train A test B", {}, 0.0, 0.0, 0.0, {}, {}};
+    auto start = Clock::now();
+    const drift::DriftModel model =
+        drift::FitDriftModel(s.run_a.rate_dph, s.run_a.temperature_c, o);
+    row.train_s = Seconds(start);
+    start = Clock::now();
+    row.estimate = drift::EstimateDrift(model, s.run_b.temperature_c);
+    row.estimate_s = Seconds(start);
+    row.metrics = drift::ComputeMetrics(s.compensate_reference - row.estimate);
+    row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
+    row.summary = model.Summary();
+    io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", ""};
+    s.model_files.push_back(
+        {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
+         io::RenderModelFile(model, info)});
+    s.compensate.push_back(std::move(row));
+  }
+}
+
+void CompensateSplit(StudyResult& s, const Notifier& notify) {
+  const std::vector<drift::Method>& methods = s.options.methods;
+  drift::DriftOptions base = s.drift_options;
+  base.mode = drift::Mode::kCompensate;
+  drift::EvaluationOptions e = EvaluationFor(s.options, methods);
+  e.progress = TrialProgress(notify, 3, methods, drift::Mode::kCompensate, "compensate: ");
+  s.compensate_split = drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e);
+  const Eigen::Index split = s.compensate_split.split_index;
+  s.compensate_reference = s.compensate_split.reference;
+  s.compensate_output = s.output.tail(s.output.size() - split);
+  s.compensate_time_h = s.time_h.tail(s.output.size() - split);
+  // The measured output carries the sensor's constant bias, which any model removes; the share is
+  // taken of the output's variation about its mean instead.
+  const double reference_rms =
+      Rms(s.compensate_reference.array() - s.compensate_reference.mean());
+  for (const auto& r : s.compensate_split.rows) {
+    StudyResult::CompensateRow row{r.method,   std::string(drift::ToString(r.protocol)),
+                                   {},         0.0,
+                                   r.train_s,  r.predict_s,
+                                   r.estimate, r.model_summary};
+    row.metrics = drift::ComputeMetrics(s.compensate_reference - r.estimate);
+    row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
+    s.compensate.push_back(std::move(row));
+  }
+  // Models for the files: fitted on the whole record (what a user would deploy).
+  for (drift::Method m : methods) {
+    drift::DriftOptions o = base;
+    o.method = m;
+    const drift::DriftModel model = drift::FitDriftModel(s.output, s.temperature, o);
+    // gyrodrift compensate reads the temperature from the column named here.
+    io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, ""};
+    s.model_files.push_back({"models/" + std::string(drift::ToString(m)) + "_compensate.json",
+                             io::RenderModelFile(model, info)});
+  }
+}
+
+void AllanStep(StudyResult& s) {
+  // The compensated output: MS-ELM if it ran (causal row for a split), else the first method.
+  const StudyResult::CompensateRow* best = nullptr;
+  for (const auto& r : s.compensate) {
+    if (r.method == drift::Method::kMsElm && (r.protocol != "paper")) best = &r;
+  }
+  if (!best && !s.compensate.empty()) best = &s.compensate.front();
+  s.compensated_by =
+      best ? std::string(drift::ToString(best->method)) + " (" + best->protocol + ")" : "";
+  const StudyResult::CompensateRow* lowest = nullptr;
+  for (const auto& r : s.compensate) {
+    if (r.protocol != "paper" && (!lowest || r.metrics.rmse < lowest->metrics.rmse)) lowest = &r;
+  }
+  // Another method only when it is clearly better (linear sub-models of MS-ELM and EMD-ELM can sum
+  // to the same estimate).
+  if (lowest == best || (best && lowest && lowest->metrics.rmse > 0.99 * best->metrics.rmse))
+    lowest = nullptr;
+  if (lowest)
+    s.best_by = std::string(drift::ToString(lowest->method)) + " (" + lowest->protocol + ")";
+  allan::AllanOptions o;
+  o.rate_hz = s.rate_hz;
+  o.units = s.options.units;
+  o.threads = s.options.threads;
+  s.allan_raw = allan::Compute(s.compensate_output, o);
+  if (best) {
+    s.allan_compensated =
+        allan::Compute(Eigen::VectorXd(s.compensate_output - best->estimate), o);
+  }
+  if (lowest)
+    s.allan_best = allan::Compute(Eigen::VectorXd(s.compensate_output - lowest->estimate), o);
+  if (s.simulated) s.allan_noise = allan::Compute(s.run_b.noise_dph, o);
+  // The noise terms are in deg/h; a curve too short to fit is reported, not fatal.
+  auto fit = [&](const allan::AllanResult& r, std::optional<allan::NoiseTerms>& out) {
+    if (r.points.empty()) return;
+    try {
+      allan::AllanResult converted = r;
+      const double to_dph = allan::ToDegPerHour(o.units);
+      for (auto& p : converted.points) {
+        p.dev *= to_dph;
+        p.dev_lo *= to_dph;
+        p.dev_hi *= to_dph;
+      }
+      converted.options.units = allan::RateUnit::kDegPerHour;
+      out = allan::IdentifyNoise(converted);
+    } catch (const Error& e) {
+      s.terms_note += std::string(e.what()) + "; ";
+    }
+  };
+  fit(s.allan_raw, s.terms_raw);
+  fit(s.allan_compensated, s.terms_compensated);
+  fit(s.allan_best, s.terms_best);
+  if (s.simulated) fit(s.allan_noise, s.terms_noise);
+}
+
+StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyObserver& observer) {
+  options.Validate();
+  const bool simulated = log == nullptr;
+  if (log) {
+    internal::StudyDriftOptions(options, log->rate_hz, false).Validate();
+    if (log->output.size() < kMinLogSamples) {
+      throw DataError(log->source + ": " + std::to_string(log->output.size()) +
+                      " samples; the study needs at least 64 (a 70/30 split with 32 training and "
+                      "16 test samples, and room for the decomposition)");
+    }
+    if (log->temperature.size() != log->output.size()) {
+      throw DataError(log->source + ": the temperature has " +
+                      std::to_string(log->temperature.size()) + " samples, the output " +
+                      std::to_string(log->output.size()) + ": one per output sample expected");
+    }
+  }
+  const auto start = Clock::now();
+  const double read_s = log ? log->read_s : 0.0;
+  const Notifier notify{observer};
+  StudyResult s;
+  s.options = options;
+  s.simulated = simulated;
+  auto time_stage = [&](const std::string& name, Clock::time_point t0, double extra_s = 0.0) {
+    s.stage_s.push_back({name, extra_s + Seconds(t0)});
+  };
+
+  notify.Progress(0, 0.0, simulated ? "simulating runs A and B" : "checking " + log->source);
+  auto t0 = Clock::now();
+  if (simulated) {
+    SimulateRuns(options, s);
+  } else {
+    TakeLog(options, *log, s);
+  }
+  s.drift_options = internal::StudyDriftOptions(options, s.rate_hz, simulated);
+  time_stage(simulated ? "simulate A and B" : "read", t0, read_s);
+  if (simulated) {
+    notify.StageDone(0, fmt::format("1. simulated run A: {}\n   simulated run B: {}\n",
+                                    s.run_a.Summary(), s.run_b.Summary()));
+  } else {
+    notify.StageDone(0, fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", s.source,
+                                    s.output.size(), s.target_name, RoundedText(s.rate_hz),
+                                    s.rate_source) +
+                            (s.time_note.empty() ? "" : "   " + s.time_note + "\n"));
+  }
+
+  notify.Progress(1, 0.0, "BEEMDAN decomposition and mode selection");
+  t0 = Clock::now();
+  DecomposeStep(s);
+  time_stage("decompose + select", t0);
+  notify.StageDone(1, fmt::format("2. {}\n   {}\n", s.decomposition.report.Summary(),
+                                  s.selection.Summary()));
+
+  notify.Progress(2, 0.0, "predict mode");
+  t0 = Clock::now();
+  PredictStep(s, notify);
+  time_stage("predict mode (both protocols)", t0);
+  internal::FillPredictTable(s);
+  notify.StageDone(2, "3. " + s.predict_table.Text());
+
+  notify.Progress(3, 0.0, "compensate mode");
+  t0 = Clock::now();
+  if (simulated) {
+    CompensateSimulated(s, notify);
+  } else {
+    CompensateSplit(s, notify);
+  }
+  time_stage("compensate mode", t0);
+  internal::FillCompensateTable(s);
+  notify.StageDone(3, "4. " + s.compensate_table.Text());
+
+  notify.Progress(4, 0.0, "Allan deviation");
+  t0 = Clock::now();
+  AllanStep(s);
+  time_stage("Allan deviation + noise fits", t0);
+  internal::FillNoiseTermsTable(s);
+  notify.StageDone(4, "5. " + s.terms_table.Text());
+
+  internal::FillSettingsTable(s);
+  internal::FillTimingTable(s, read_s + Seconds(start));
+  return s;
+}
+
+}  // namespace
+
+namespace internal {
+
+drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz,
+                                      bool simulated) {
+  drift::DriftOptions o;
+  o.decomposition.ensemble_size = options.ensemble_size;
+  o.selection.monte_carlo.realisations = options.realisations;
+  o.features.rate_hz = rate_hz;
+  o.seed = options.seed;
+  o.threads = options.threads;
+  if (simulated) o.reference_c = 20.0;
+  return o;
+}
+
+std::string GroupOf(const sel::SelectionResult& selection, int k) {
+  for (const auto& g : selection.groups) {
+    if (std::find(g.imfs.begin(), g.imfs.end(), k) != g.imfs.end())
+      return std::string(sel::ToString(g.kind));
+  }
+  return "drift";
+}
+
+}  // namespace internal
+
+void StudyOptions::Validate() const {
+  if (ensemble_size < 1 || ensemble_size > 10000)
+    ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 10000]");
+  EvaluationFor(*this, methods).causal.Validate();
+  if (!(duration_s >= kMinDurationS)) {
+    ThrowOption("duration_s", FormatValue(duration_s),
+                "at least 2h (run A needs a ramp and a dwell)");
+  }
+  if (methods.empty()) ThrowOption("methods", "(empty)", "at least one method");
+  for (auto m = methods.begin(); m != methods.end(); ++m) {
+    if (std::find(methods.begin(), m, *m) != m) {
+      ThrowOption("methods", std::string(drift::ToString(*m)) + " twice",
+                  "a list without repeats (each method saves one model file)");
+    }
+  }
+  internal::StudyDriftOptions(*this, 1.0, true).Validate();
+}
+
+StudyResult RunStudy(const StudyOptions& options, const StudyObserver& observer) {
+  return Run(options, nullptr, observer);
+}
+
+StudyResult RunStudy(const StudyOptions& options, const StudyLog& log,
+                     const StudyObserver& observer) {
+  return Run(options, &log, observer);
+}
+
+}  // namespace gyrodrift::study

@@ -1,0 +1,265 @@
+// The study module: tables render the same numbers three ways; StudyOptions and StudyLog
+// refuse bad values naming the field; small studies (a log, a short simulation) produce the
+// expected tables, observer calls, files and report sections; the files are written as a set.
+#include "gyrodrift/study/study.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
+#include "gyrodrift/simulation/fog_simulator.h"
+#include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/table.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::study {
+namespace {
+
+namespace sim = gyrodrift::simulation;
+
+// Stand-in for dygraphs: the report's composition, not the package, is under test here.
+io::DygraphsAssets FakeAssets() {
+  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
+}
+
+// The option a call refused, or "" when it did not throw an OptionError.
+template <typename F>
+std::string RefusedOption(F&& call) {
+  try {
+    call();
+  } catch (const OptionError& e) {
+    return e.option();
+  }
+  return "";
+}
+
+// The cheapest settings that still run every step.
+StudyOptions Quick(std::vector<drift::Method> methods) {
+  StudyOptions o;
+  o.ensemble_size = 4;
+  o.realisations = 20;
+  o.causal_window = 32;
+  o.duration_s = 2 * 3600.0;
+  o.methods = std::move(methods);
+  o.threads = 2;
+  return o;
+}
+
+// A 40-minute chamber log (the simulator's rate_dph and case sensor) as a user's log.
+StudyLog ChamberLog() {
+  sim::SimulationOptions so;
+  so.duration_s = 2400.0;
+  so.seed = 5;
+  const sim::SimulationResult run = sim::Simulate(
+      sim::BuiltinProgramme("chamber"), sim::PresetParameters(sim::Preset::kNavigation), so);
+  StudyLog log;
+  log.source = "chamber.csv";
+  log.target_name = "rate_dph";
+  log.temperature_name = "temperature_c";
+  log.output = run.rate_dph;
+  log.temperature = run.temperature_c;
+  log.rate_hz = 1.0;
+  log.rate_source = "given";
+  return log;
+}
+
+std::set<std::string> Pairs(const Table& t) {
+  std::set<std::string> pairs;
+  for (const auto& row : t.csv) pairs.insert(row[0] + "/" + row[1]);
+  return pairs;
+}
+
+std::set<std::string> Names(const std::vector<StudyFile>& files) {
+  std::set<std::string> names;
+  for (const auto& f : files) names.insert(f.name);
+  return names;
+}
+
+TEST(StudyTable, KeepsFullPrecisionForCsvAndRoundsForDisplay) {
+  Table t;
+  t.title = "Scores";
+  t.header = {"method", "protocol", "rmse", "train_s"};
+  t.Add({"ms-elm", "paper", 0.123456789, {1.5, 3}});
+  t.Add({"poly", "causal", std::numeric_limits<double>::quiet_NaN(), {12.345, 3}});
+  EXPECT_EQ(t.Csv(),
+            "method,protocol,rmse,train_s\n"
+            "ms-elm,paper," + io::FormatDouble(0.123456789) + ",1.5\n"
+            "poly,causal," + io::FormatDouble(std::nan("")) + ",12.345\n");
+  // Names left-aligned, numbers right-aligned, each column as wide as its widest cell.
+  EXPECT_EQ(t.Text(),
+            "Scores\n"
+            "  method protocol   rmse train_s\n"
+            "  ms-elm paper    0.1235     1.5\n"
+            "  poly   causal        -    12.3\n");
+  const io::ReportTable r = t.Report();
+  EXPECT_EQ(r.title, "Scores");
+  EXPECT_EQ(r.header, t.header);
+  EXPECT_EQ(r.rows, t.shown);
+  EXPECT_EQ(RoundedText(std::nan("")), "-");
+  EXPECT_EQ(RoundedText(2.0 / 3.0, 3), "0.667");
+}
+
+TEST(StudyOptions, DefaultsAreValid) { EXPECT_NO_THROW(StudyOptions().Validate()); }
+
+TEST(StudyOptions, ValidateNamesTheField) {
+  auto refused = [](auto change) {
+    StudyOptions o;
+    change(o);
+    return RefusedOption([&] { o.Validate(); });
+  };
+  EXPECT_EQ(refused([](StudyOptions& o) { o.ensemble_size = 0; }), "ensemble_size");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.ensemble_size = 10001; }), "ensemble_size");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.duration_s = 5400.0; }), "duration_s");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.duration_s = std::nan(""); }), "duration_s");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.methods.clear(); }), "methods");
+  EXPECT_EQ(refused([](StudyOptions& o) {
+              o.methods = {drift::Method::kElm, drift::Method::kPoly, drift::Method::kElm};
+            }),
+            "methods");
+  // Ranges the library owns keep the library's names (OptionErrorMessage maps them to flags).
+  EXPECT_EQ(refused([](StudyOptions& o) { o.causal_window = 4; }), "causal window");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.realisations = 3; }), "realisations");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.threads = -1; }), "threads");
+}
+
+TEST(StudyLog, RefusesWhatTheStudyCannotUse) {
+  const StudyOptions options = Quick({drift::Method::kPoly});
+  StudyLog log = ChamberLog();
+  log.output.conservativeResize(63);
+  log.temperature.conservativeResize(63);
+  EXPECT_THROW(RunStudy(options, log), DataError);
+  log = ChamberLog();
+  log.temperature.conservativeResize(log.output.size() - 1);
+  EXPECT_THROW(RunStudy(options, log), DataError);
+  log = ChamberLog();
+  log.rate_hz = 0.0;
+  EXPECT_EQ(RefusedOption([&] { RunStudy(options, log); }), "rate_hz");
+  // Options are checked before the data.
+  StudyOptions bad = options;
+  bad.ensemble_size = 0;
+  EXPECT_EQ(RefusedOption([&] { RunStudy(bad, log); }), "ensemble_size");
+}
+
+TEST(Study, LogStudyGivesTablesFilesAndReport) {
+  const StudyOptions options = Quick({drift::Method::kMsElm, drift::Method::kPoly});
+  const StudyLog log = ChamberLog();
+  std::vector<int> begun, done;
+  int last_stage = -1;
+  bool fractions_in_range = true;
+  StudyObserver observer;
+  observer.progress = [&](int stage, double fraction, const std::string&) {
+    if (stage != last_stage) begun.push_back(stage);
+    last_stage = stage;
+    fractions_in_range = fractions_in_range && fraction >= 0.0 && fraction <= 1.0;
+  };
+  std::string summaries;
+  observer.stage_done = [&](int stage, const std::string& summary) {
+    done.push_back(stage);
+    summaries += summary;
+  };
+  const StudyResult s = RunStudy(options, log, observer);
+
+  EXPECT_EQ(begun, (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(done, (std::vector<int>{0, 1, 2, 3, 4}));
+  EXPECT_TRUE(fractions_in_range);
+  EXPECT_EQ(summaries.rfind("1. read chamber.csv: 2400 samples of rate_dph at 1 Hz (given)\n", 0),
+            0u)
+      << summaries;
+  for (const char* part : {"\n2. ", "\n3. Predict mode", "\n4. Compensate mode", "\n5. IEEE 952"})
+    EXPECT_NE(summaries.find(part), std::string::npos) << part;
+
+  EXPECT_FALSE(s.simulated);
+  EXPECT_EQ(s.unit, "deg/h");
+  EXPECT_TRUE(std::isnan(s.drift_options.reference_c));  // a log keeps the fitted intercept
+  EXPECT_GE(s.decomposition.num_imfs(), 3);
+  const std::set<std::string> both{"ms-elm/paper", "ms-elm/causal", "poly/paper", "poly/causal"};
+  EXPECT_EQ(Pairs(s.predict_table), both);
+  EXPECT_EQ(Pairs(s.compensate_table), both);
+  for (const auto& row : s.compensate) {
+    EXPECT_EQ(row.estimate.size(), s.compensate_reference.size());
+    EXPECT_TRUE(std::isfinite(row.metrics.rmse));
+  }
+  EXPECT_EQ(s.compensated_by, "ms-elm (causal)");
+  EXPECT_EQ(s.terms_table.csv.size(), 6u);  // five IEEE 952 terms and the minimum ADEV
+  EXPECT_EQ(s.terms_table.header.size(), s.best_by.empty() ? 4u : 5u);
+  ASSERT_EQ(s.stage_s.size(), 5u);
+  EXPECT_EQ(s.stage_s[0].first, "read");
+  EXPECT_EQ(s.timing_table.csv.size(), 6u);
+
+  const std::vector<StudyFile> files = RenderStudyFiles(s, FakeAssets());
+  EXPECT_EQ(Names(files),
+            (std::set<std::string>{"imfs.csv", "selection.csv", "predict_table.csv",
+                                   "compensate_table.csv", "noise_terms.csv",
+                                   "predict_estimates.csv", "compensate_estimates.csv",
+                                   "allan.csv", "models/ms-elm_compensate.json",
+                                   "models/poly_compensate.json", "report.html"}));
+  for (const auto& f : files) {
+    if (f.name == "predict_table.csv") {
+      EXPECT_EQ(f.contents, s.predict_table.Csv());
+    }
+  }
+  const std::string& html = files.back().contents;
+  EXPECT_EQ(files.back().name, kStudyReportFile);
+  for (const char* section :
+       {"gyrodrift demo: chamber.csv", "1. The record", "2. BEEMDAN decomposition and mode selection",
+        "3. Predict mode (the paper&#39;s task)", "4. Compensate mode: chronological split",
+        "5. Allan deviation", "6. Settings and timing", "Selection curves", "IMF 1 ("}) {
+    EXPECT_NE(html.find(section), std::string::npos) << section;
+  }
+  const io::ReportCheck check = io::CheckReportHtml(html);
+  EXPECT_TRUE(check.ok()) << check.Summary();
+  EXPECT_EQ(check.tables, 5);  // predict, compensate, noise terms, settings, timing
+
+  const nlohmann::json record = StudyRecord(s);
+  for (const char* key : {"drift_options", "decomposition", "selection", "stages_s",
+                          "compensated_by"}) {
+    EXPECT_TRUE(record.contains(key)) << key;
+  }
+  EXPECT_EQ(record["stages_s"].size(), 5u);
+}
+
+TEST(Study, ShortSimulationComparesRunsAAndB) {
+  // thermal is compensate-only: predict mode runs poly alone.
+  const StudyResult s = RunStudy(Quick({drift::Method::kPoly, drift::Method::kThermal}));
+  EXPECT_TRUE(s.simulated);
+  EXPECT_EQ(s.output.size(), 7200);
+  EXPECT_EQ(s.run_b.samples, 7200);
+  EXPECT_EQ(s.drift_options.reference_c, 20.0);  // the simulator's equilibrium
+  EXPECT_EQ(Pairs(s.predict_table), (std::set<std::string>{"poly/paper", "poly/causal"}));
+  EXPECT_EQ(Pairs(s.compensate_table),
+            (std::set<std::string>{"poly/train A test B", "thermal/train A test B"}));
+  // Scored against run B's true drift: the identified thermal model removes most of it.
+  for (const auto& row : s.compensate) {
+    if (row.method == drift::Method::kThermal) {
+      EXPECT_GT(row.share_removed, 0.5);
+    }
+  }
+  EXPECT_EQ(s.compensated_by, "poly (train A test B)");  // the first method: no ms-elm
+  EXPECT_EQ(s.terms_table.header.back(), "simulator setting");
+  const std::set<std::string> names = Names(RenderStudyFiles(s, FakeAssets()));
+  EXPECT_TRUE(names.count("run_a.csv") && names.count("run_b.csv"));
+  EXPECT_TRUE(names.count("models/thermal_compensate.json"));
+}
+
+TEST(StudyFiles, WritesTheSetWithItsSubfolders) {
+  const std::string dir = test::TempDir("study_files") + "/out/deeper";
+  EXPECT_NO_THROW(RequireUsableOutputFolder(dir));
+  WriteStudyFiles(dir, {{"a.csv", "x\n1\n"}, {"models/m.json", "{}\n"}});
+  EXPECT_EQ(io::ReadTextFile(dir + "/a.csv"), "x\n1\n");
+  EXPECT_EQ(io::ReadTextFile(dir + "/models/m.json"), "{}\n");
+  // A file where a folder should be: refused up front, and by the writer.
+  EXPECT_THROW(RequireUsableOutputFolder(dir + "/a.csv/sub"), IoError);
+  EXPECT_THROW(WriteStudyFiles(dir + "/a.csv/sub", {{"b.csv", "y\n"}}), IoError);
+}
+
+}  // namespace
+}  // namespace gyrodrift::study
