@@ -32,6 +32,7 @@ struct AllanArgs {
   int threads = 0;
   double fit_tau_min_s = 0.0;
   double fit_tau_max_s = INFINITY;
+  std::string gaps = "error";  // io::GapPolicy
   bool quiet = false;
 };
 
@@ -109,7 +110,8 @@ void Run(const AllanArgs& a) {
   const al::NoiseFitOptions fit_options{.tau_min_s = a.fit_tau_min_s, .tau_max_s = a.fit_tau_max_s};
   fit_options.Validate();  // every option error before any file is read
 
-  const io::CsvTable table = ReadLog(a.input);
+  std::string notes;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
   const Eigen::VectorXd data = table.Column(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
                        "its Allan deviation is zero at every tau (a logging fault?)");
@@ -223,7 +225,8 @@ void Run(const AllanArgs& a) {
     fmt::print("noise terms not fitted: {}\n", fit_error);
   }
   const std::string time_note = NonUniformTimeNote(table);
-  if (!time_note.empty()) fmt::print("{}\n", time_note);
+  if (!time_note.empty()) notes += time_note + "\n";
+  fmt::print("{}", notes);
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));
 }
 
@@ -266,6 +269,7 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
   cmd->add_option("--fit-tau-min", args->fit_tau_min_s, "noise fit: smallest tau in s")
       ->capture_default_str();
   cmd->add_option("--fit-tau-max", args->fit_tau_max_s, "noise fit: largest tau in s");
+  AddGapsOption(cmd, &args->gaps);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

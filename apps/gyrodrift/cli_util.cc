@@ -169,6 +169,22 @@ double ParseDuration(const std::string& text) {
   ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
 }
 
+void AddGapsOption(CLI::App* cmd, std::string* gaps) {
+  cmd->add_option("--gaps", *gaps,
+                  "a time_s step of 1.5 median steps or more (missing samples): error (refuse, "
+                  "naming the row) | interpolate (fill every column linearly; the rows are kept "
+                  "in the outputs)")
+      ->check(CLI::IsMember({"error", "interpolate"}))
+      ->capture_default_str();
+}
+
+io::CsvTable ReadLog(const std::string& path, const std::string& gaps, std::string* notes) {
+  std::string note;
+  io::CsvTable table = io::ReadLog(path, io::GapPolicyFromString(gaps), &note);
+  if (!note.empty()) *notes += note + "\n";
+  return table;
+}
+
 // "all" | "octave" | "decade" | "1,10,100" (seconds).
 void ParseTaus(const std::string& text, allan::AllanOptions* o) {
   if (text == "all" || text == "octave" || text == "decade") {

@@ -54,6 +54,12 @@ using io::NonUniformTimeNote;
 using io::ReadLog;
 using io::ResolveSampleRate;
 
+// --gaps error|interpolate (io::GapPolicy), default error.
+void AddGapsOption(CLI::App* cmd, std::string* gaps);
+// ReadLog under the --gaps choice; the note on filled gaps, if any, is appended (with a newline)
+// to *notes.
+io::CsvTable ReadLog(const std::string& path, const std::string& gaps, std::string* notes);
+
 // The one-line message for an option error: the library names its field (`ensemble_size = 0:
 // must be ...`); when the user gave the subcommand's flag that sets that field, the message
 // names the flag instead (`--ensemble = 0: must be ...`).

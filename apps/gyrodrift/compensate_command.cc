@@ -22,6 +22,7 @@ struct CompensateArgs {
   std::string input;
   std::string output;
   std::string truth;  // "" = none
+  std::string gaps = "error";  // io::GapPolicy
   bool quiet = false;
 };
 
@@ -116,7 +117,8 @@ void Run(const CompensateArgs& a) {
                        "needs a model fitted with --mode compensate)");
     }
   }
-  const io::CsvTable table = ReadLog(a.input);
+  std::string text;  // the console report, notes first
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &text);
   for (const io::LoadedModel& axis : axes) RequireModelColumns(axis, table);
   std::vector<std::string> suffixes;
   for (const io::LoadedModel& axis : axes) {
@@ -145,8 +147,7 @@ void Run(const CompensateArgs& a) {
     columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
   }
   nlohmann::json sidecar = SidecarHeader("compensate");
-  sidecar["options"] = {{"model", a.model}, {"input", a.input}};
-  std::string text;
+  sidecar["options"] = {{"model", a.model}, {"input", a.input}, {"gaps", a.gaps}};
   for (size_t i = 0; i < axes.size(); ++i) {
     AxisResult r = CompensateAxis(axes[i], table, truth, truth_column, suffixes[i]);
     for (io::CsvColumn& column : r.columns) columns.push_back(std::move(column));
@@ -193,6 +194,7 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
   cmd->add_option("--truth", args->truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "
                   "share of its RMS the estimate removes");
+  AddGapsOption(cmd, &args->gaps);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -39,6 +39,7 @@ struct DecomposeArgs {
   double band = 0.99;
   int noise_stages = 3;
   std::string noise_file;
+  std::string gaps = "error";  // io::GapPolicy
   bool quiet = false;
 };
 
@@ -87,7 +88,8 @@ void Run(const DecomposeArgs& a) {
   o.noise_stages = a.noise_stages;
   o.Validate();  // option errors before any file is read
 
-  const io::CsvTable table = ReadLog(a.input);
+  std::string notes;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
   const Eigen::VectorXd x = table.Column(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", x,
                        "it has no oscillation to decompose");
@@ -135,7 +137,7 @@ void Run(const DecomposeArgs& a) {
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet)
-    fmt::print("{}\nwrote {} and {}\n", d.report.Summary(), a.output, SidecarPath(a.output));
+    fmt::print("{}{}\nwrote {} and {}\n", notes, d.report.Summary(), a.output, SidecarPath(a.output));
 }
 
 const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
@@ -191,6 +193,7 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--noise-file", args->noise_file,
                   "CSV of white-noise realisations (one per column) to use instead of drawing")
       ->check(kInputFile);
+  AddGapsOption(cmd, &args->gaps);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -46,6 +46,7 @@ struct DemoArgs {
   std::string methods = "all";
   std::uint64_t seed = 1;
   int threads = 0;
+  std::string gaps = "error";  // io::GapPolicy, for --input
   bool quiet = false;
 };
 
@@ -81,7 +82,8 @@ study::StudyOptions MakeStudyOptions(const DemoArgs& a) {
 
 study::StudyLog ReadStudyLog(const DemoArgs& a) {
   const auto start = Clock::now();
-  const io::CsvTable table = ReadLog(a.input);
+  std::string notes;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
   study::StudyLog log;
   log.source = a.input;
   log.output = table.Column(a.target);
@@ -94,7 +96,8 @@ study::StudyLog ReadStudyLog(const DemoArgs& a) {
   log.rate_source = how == "given"    ? "given by --rate-hz"
                     : how == "time_s" ? "from the median step of time_s"
                                       : "assumed 1 Hz (no --rate-hz, no time_s column)";
-  log.time_note = NonUniformTimeNote(table);
+  log.time_note = notes + NonUniformTimeNote(table);
+  if (!log.time_note.empty() && log.time_note.back() == '\n') log.time_note.pop_back();
   log.read_s = Seconds(start);
   return log;
 }
@@ -218,6 +221,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       ->check(kSeed);
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
+  AddGapsOption(cmd, &args->gaps);
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
   cmd->add_option("--duration", args->duration,
                   "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")

@@ -93,6 +93,7 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
                   "worker threads (0 = all cores); results do not "
                   "depend on it")
       ->capture_default_str();
+  AddGapsOption(cmd, &a->gaps);
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 

@@ -38,6 +38,7 @@ struct DriftArgs {
   std::vector<double> time_constants_s;   // empty = the library default
   std::uint64_t seed = 1;
   int threads = 0;
+  std::string gaps = "error";  // io::GapPolicy
   bool quiet = false;
 };
 

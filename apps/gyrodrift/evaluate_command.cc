@@ -67,7 +67,8 @@ void Run(const EvaluateArgs& a) {
                      ": evaluate scores one axis at a time (fit takes several targets)");
   }
 
-  const io::CsvTable table = ReadLog(a.input);
+  std::string gap_note;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &gap_note);
   std::string rate_how;
   base.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   const std::string target = ColumnName(table, a.target);
@@ -127,8 +128,8 @@ void Run(const EvaluateArgs& a) {
                     {"notes", r.notes}});
   }
   // Test temperatures beyond the training block's make every thermal model extrapolate.
-  std::string notes = NonUniformTimeNote(table);
-  if (!notes.empty()) notes += "\n";
+  std::string notes = gap_note + NonUniformTimeNote(table);
+  if (!notes.empty() && notes.back() != '\n') notes += "\n";
   for (const auto& r : result.rows) {
     for (const std::string& note : r.notes) {
       notes += std::string(drift::ToString(r.method)) + ", " + note + "\n";

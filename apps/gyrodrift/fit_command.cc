@@ -95,7 +95,8 @@ void Run(const FitArgs& a) {
                      "mode and to --method elm");
   }
 
-  const io::CsvTable table = ReadLog(a.input);
+  std::string notes;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
   std::string rate_how;
   o.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   // Every axis is fitted as if alone (same options, same seed): a file of several axes holds the
@@ -141,9 +142,9 @@ void Run(const FitArgs& a) {
     PrintModel(axis, o);
   }
   const std::string time_note = NonUniformTimeNote(table);
+  if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", o.features.rate_hz,
-             rate_how == "time_s" ? "from the median step of time_s" : rate_how,
-             time_note.empty() ? "" : time_note + "\n", a.output);
+             rate_how == "time_s" ? "from the median step of time_s" : rate_how, notes, a.output);
 }
 
 const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {

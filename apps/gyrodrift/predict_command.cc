@@ -28,6 +28,7 @@ struct PredictArgs {
   int window = 512;
   int horizon = 1;
   int threads = 0;
+  std::string gaps = "error";  // io::GapPolicy
   bool quiet = false;
 };
 
@@ -49,7 +50,8 @@ void Run(const PredictArgs& a) {
   }
   model.options.threads = a.threads;  // the thread count never changes the result
 
-  const io::CsvTable table = ReadLog(a.input);
+  std::string notes;
+  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;
@@ -101,6 +103,7 @@ void Run(const PredictArgs& a) {
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (!a.quiet) {
+    fmt::print("{}", notes);
     const std::string ahead = a.horizon > 1 ? std::to_string(a.horizon) + "-step-ahead, " : "";
     fmt::print("{}\npredicted samples {}..{} ({}{} protocol)\n{}wrote {} and {}\n", model.Summary(),
                first + 1, y.size(), ahead, a.protocol,
@@ -144,6 +147,7 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
+  AddGapsOption(cmd, &args->gaps);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -86,7 +86,7 @@ struct Log {
 };
 
 Log ReadUnitLog(const Manifest& m, const std::string& path) {
-  Log log{io::ReadLog(path), 1.0};
+  Log log{io::ReadLog(path, m.gaps), 1.0};
   std::string how;
   log.rate_hz = io::ResolveSampleRate(log.table, m.rate_hz, &how);
   return log;

@@ -176,7 +176,7 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
   Manifest m;
   m.path = path;
   const Table top(root, c, "",
-                  {"method", "rate_unit", "rate_hz", "seed", "nonlinear", "reference_temperature_c",
+                  {"method", "rate_unit", "rate_hz", "gaps", "seed", "nonlinear", "reference_temperature_c",
                    "drift_window_s", "limits", "axis", "unit"});
   if (top.Find("method")) {
     const std::string name = top.String("method");
@@ -199,6 +199,14 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     }
   }
   m.rate_hz = top.Number("rate_hz", 0.0, 1e-9, 1e6);
+  if (top.Find("gaps")) {
+    const std::string gaps = top.String("gaps");
+    try {
+      m.gaps = io::GapPolicyFromString(gaps);
+    } catch (const UsageError& e) {
+      c.Fail(*top.Find("gaps"), e.what());
+    }
+  }
   if (const toml::node* n = top.Find("seed")) {
     if (!n->is_integer() || *n->value<std::int64_t>() < 0) {
       c.Fail(*n, "'seed' must be a non-negative integer");
@@ -350,8 +358,8 @@ void CheckLogColumns(const Manifest& m) {
 
 std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
   std::string text = fmt::format(
-      "method={};unit={};rate={};seed={};nonlinear={};ref={};window={};limits={},{},{};",
-      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, m.seed, m.nonlinear,
+      "method={};unit={};rate={};gaps={};seed={};nonlinear={};ref={};window={};limits={},{},{};",
+      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, io::ToString(m.gaps), m.seed, m.nonlinear,
       m.reference_c, m.drift_window_s, m.limits.residual_drift_rms, m.limits.bias_instability_dph,
       m.limits.removed_share_min);
   for (const AxisSpec& a : m.axes) {

@@ -159,6 +159,33 @@ Eigen::VectorXd CsvTable::Column(int index) const {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 
+CsvTable CsvTable::WithInterpolatedRows(
+    const std::vector<std::pair<Eigen::Index, int>>& insert) const {
+  CsvTable out = *this;
+  size_t added = 0;
+  for (const auto& [row, count] : insert) added += static_cast<size_t>(count);
+  for (size_t c = 0; c < columns_.size(); ++c) {
+    const std::vector<double>& in = columns_[c];
+    std::vector<double>& v = out.columns_[c];
+    v.clear();
+    v.reserve(in.size() + added);
+    size_t next = 0;
+    for (size_t r = 0; r < in.size(); ++r) {
+      v.push_back(in[r]);
+      if (next < insert.size() && static_cast<size_t>(insert[next].first) == r && r + 1 < in.size()) {
+        const int m = insert[next].second;
+        for (int k = 1; k <= m; ++k) {
+          const double f = static_cast<double>(k) / static_cast<double>(m + 1);
+          v.push_back(in[r] + f * (in[r + 1] - in[r]));
+        }
+        ++next;
+      }
+    }
+  }
+  out.rows_ = static_cast<Eigen::Index>(out.columns_.empty() ? 0 : out.columns_[0].size());
+  return out;
+}
+
 std::string FormatDouble(double value) {
   char buffer[64];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);

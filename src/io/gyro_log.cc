@@ -28,7 +28,18 @@ double MedianStep(const Eigen::VectorXd& t) {
 
 }  // namespace
 
-CsvTable ReadLog(const std::string& path) {
+std::string_view ToString(GapPolicy policy) {
+  return policy == GapPolicy::kError ? "error" : "interpolate";
+}
+
+GapPolicy GapPolicyFromString(std::string_view text) {
+  if (text == "error") return GapPolicy::kError;
+  if (text == "interpolate") return GapPolicy::kInterpolate;
+  throw OptionError("gaps", "'" + std::string(text) + "'", "error or interpolate");
+}
+
+CsvTable ReadLog(const std::string& path, GapPolicy gaps, std::string* gap_note) {
+  if (gap_note) gap_note->clear();
   CsvTable table = CsvTable::Read(path);
   if (!table.HasColumn("time_s")) return table;
   Eigen::VectorXd t;
@@ -44,7 +55,38 @@ CsvTable ReadLog(const std::string& path) {
         "the log or split it where the clock jumped)",
         path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
   }
-  return table;
+  if (t.size() < 3) return table;
+  // A gap: a step of 1.5 median steps or more, so at least one sample is missing.
+  const double median = MedianStep(t);
+  std::vector<std::pair<Eigen::Index, int>> insert;
+  long missing = 0;
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
+    const double step = t[i + 1] - t[i];
+    if (!(step >= 1.5 * median)) continue;
+    const double samples = std::round(step / median) - 1.0;
+    // A gap of more than 1e7 samples or 10 times the log is a clock jump, not lost samples.
+    if (gaps == GapPolicy::kError || samples > 1e7 ||
+        samples > 10.0 * static_cast<double>(t.size())) {
+      throw DataError(fmt::format(
+          "{}: time_s jumps by {:g} s before data row {} ({:g} missing samples at the median step "
+          "{:g} s): {}",
+          path, step, i + 2, samples, median,
+          gaps == GapPolicy::kError
+              ? "fill gaps by linear interpolation (--gaps interpolate; in a manifest gaps = "
+                "\"interpolate\") or split the log where it stops"
+              : "too long to fill by interpolation: split the log where it stops"));
+    }
+    insert.push_back({i, static_cast<int>(samples)});
+    missing += static_cast<long>(samples);
+  }
+  if (insert.empty()) return table;
+  if (gap_note) {
+    *gap_note = fmt::format(
+        "note: time_s has {} gap{} (median step {:g} s): {} samples filled by linear "
+        "interpolation (--gaps interpolate)",
+        insert.size(), insert.size() == 1 ? "" : "s", median, missing);
+  }
+  return table.WithInterpolatedRows(insert);
 }
 
 

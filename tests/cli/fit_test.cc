@@ -130,28 +130,38 @@ TEST_F(FitCli, ThermalFeatureSetAndTimeConstantsAreStoredAndUsed) {
 }
 
 TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
-  // Rows 101.. shifted by 300 s: a logging gap the models cannot see.
+  // Rows 101.. shifted by 300 s: a logging gap the models cannot see. Refused by default, naming
+  // the row; filled by linear interpolation when asked, and said so.
   std::string csv = test::ThermalLogCsv(300, 4);
   const auto table = io::CsvTable::Parse(csv, "log");
   Eigen::VectorXd t = table.Column("time_s");
   t.tail(200).array() += 300.0;
   io::WriteCsv(dir_ + "/gap.csv", {{"time_s", t}, {"rate_dph", table.Column("rate_dph")}});
-  auto r = test::RunCli("fit '" + dir_ + "/gap.csv' -t rate_dph --mode predict -m poly -o '" +
-                        dir_ + "/g.json'");
+  const std::string fit = "fit '" + dir_ + "/gap.csv' -t rate_dph --mode predict -m poly ";
+  auto r = test::RunCli(fit + "-o '" + dir_ + "/g.json'");
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("time_s jumps by 301 s before data row 101 (300 missing samples at the "
+                       "median step 1 s): fill gaps by linear interpolation (--gaps interpolate"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(test::FileExists(dir_ + "/g.json"));
+  r = test::RunCli(fit + "--gaps interpolate -o '" + dir_ + "/g.json'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("note: time_s is not uniform: 1 of 299 steps differ from the median step "
-                       "1 s by more than half (largest 301 s, before data row 101)"),
+  EXPECT_NE(r.out.find("note: time_s has 1 gap (median step 1 s): 300 samples filled by linear "
+                       "interpolation"),
             std::string::npos)
       << r.out;
-  // A step only 0.8 s too long is still the largest; an unreadable time_s is no reason to fail
-  // a fit that was given --rate-hz.
+  EXPECT_EQ(io::ReadModelFile(dir_ + "/g.json").model.training_samples, 600);
+  r = test::RunCli(fit + "--gaps split -o '" + dir_ + "/s.json'");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  // Steps shorter than the median are not missing samples: a note names the most irregular.
   t = table.Column("time_s");
-  t.tail(150).array() += 0.8;
+  t.tail(150).array() -= 0.6;
   io::WriteCsv(dir_ + "/jitter.csv", {{"time_s", t}, {"rate_dph", table.Column("rate_dph")}});
   r = test::RunCli("fit '" + dir_ + "/jitter.csv' -t rate_dph --mode predict -m poly -o '" + dir_ +
                    "/j.json'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("(largest 1.8 s, before data row 151)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(largest 0.4 s, before data row 151)"), std::string::npos) << r.out;
   std::string broken = "time_s,rate_dph\n";
   for (int i = 0; i < 100; ++i) {
     broken += (i == 50 ? std::string("x") : std::to_string(i)) + "," + std::to_string(i % 7) + "\n";

@@ -5,6 +5,7 @@
 //   method = "thermal"            # fit --method of every axis (compensate mode); default thermal
 //   rate_unit = "dph"             # unit of the gyro columns: dph | dps | rads (allan --units)
 //   rate_hz = 1.0                 # optional; default: from each log's time_s, else 1 Hz
+//   gaps = "error"                # optional: error | interpolate (io::GapPolicy)
 //   seed = 1                      # optional
 //   nonlinear = false             # optional, fit --nonlinear
 //   reference_temperature_c = 20  # optional, fit --reference-temperature
@@ -37,6 +38,7 @@
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/io/gyro_log.h"
 
 namespace gyrodrift::fleet {
 
@@ -68,6 +70,7 @@ struct Manifest {
   drift::Method method = drift::Method::kThermal;
   allan::RateUnit rate_unit = allan::RateUnit::kDegPerHour;
   double rate_hz = 0.0;  // 0 = from each log
+  io::GapPolicy gaps = io::GapPolicy::kError;
   std::uint64_t seed = 1;
   bool nonlinear = false;
   double reference_c = std::numeric_limits<double>::quiet_NaN();

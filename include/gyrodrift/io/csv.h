@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace gyrodrift::io {
@@ -36,6 +37,11 @@ class CsvTable {
   // infinite cell.
   Eigen::VectorXd Column(const std::string& spec) const;
   Eigen::VectorXd Column(int index) const;
+
+  // A copy with rows inserted by linear interpolation: for each (row, count), `count` rows evenly
+  // spaced between data rows `row` and `row + 1` (0-based), in every column. Messages about a bad
+  // cell keep naming its row in the file.
+  CsvTable WithInterpolatedRows(const std::vector<std::pair<Eigen::Index, int>>& insert) const;
 
  private:
   struct BadCell {

@@ -4,17 +4,29 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "gyrodrift/io/csv.h"
 
 namespace gyrodrift::io {
 
+// What to do with gaps in time_s: a step longer than 1.5 median steps (samples missing).
+//   error:       refuse the log, naming the first gap's row, its length and the choices;
+//   interpolate: insert round(step / median) - 1 rows across each gap, every column linear
+//                between its neighbours (the models and the Allan analysis then see a uniform
+//                record; the note says how many samples were made up).
+enum class GapPolicy { kError, kInterpolate };
+std::string_view ToString(GapPolicy policy);
+GapPolicy GapPolicyFromString(std::string_view text);  // UsageError naming the choices
+
 // Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
 // increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row
 // (the log was merged, sorted wrongly or its clock jumped; every model and the Allan analysis
-// would otherwise take the samples as equally spaced, silently). Gaps and jitter stay a note
-// (NonUniformTimeNote).
-CsvTable ReadLog(const std::string& path);
+// would otherwise take the samples as equally spaced, silently). Gaps are handled by `gaps`;
+// when rows were interpolated, *gap_note (if given) says how many, else it is cleared. Shorter
+// irregular steps stay a note (NonUniformTimeNote).
+CsvTable ReadLog(const std::string& path, GapPolicy gaps = GapPolicy::kError,
+                 std::string* gap_note = nullptr);
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
 // column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when

@@ -1,0 +1,66 @@
+// The log rules every command shares: time stamps that must increase, and gaps refused or filled
+// by linear interpolation under an explicit policy.
+#include "gyrodrift/io/gyro_log.h"
+
+#include <gtest/gtest.h>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::io {
+namespace {
+
+std::string Write(const std::string& name, const std::string& text) {
+  const std::string path = test::TempDir("gyro_log") + "/" + name;
+  WriteFileAtomically(path, text);
+  return path;
+}
+
+TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
+  // 1-s steps, a 3-s step after row 3 (two samples missing) and a 2-s step after row 5.
+  const std::string path =
+      Write("gaps.csv", "time_s,rate,status\n0,1,0\n1,2,0\n2,3,x\n5,6,0\n6,8,0\n8,10,0\n9,11,0\n");
+  try {
+    ReadLog(path);
+    ADD_FAILURE() << "a gap was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("time_s jumps by 3 s before data row 4 (2 missing"),
+              std::string::npos)
+        << e.what();
+  }
+  std::string note;
+  const CsvTable t = ReadLog(path, GapPolicy::kInterpolate, &note);
+  EXPECT_EQ(t.rows(), 10);
+  const Eigen::VectorXd time = t.Column("time_s");
+  for (Eigen::Index i = 0; i < time.size(); ++i) EXPECT_DOUBLE_EQ(time[i], static_cast<double>(i));
+  EXPECT_DOUBLE_EQ(t.Column("rate")[3], 4.0);
+  EXPECT_DOUBLE_EQ(t.Column("rate")[4], 5.0);
+  EXPECT_DOUBLE_EQ(t.Column("rate")[7], 9.0);
+  EXPECT_EQ(note, "note: time_s has 2 gaps (median step 1 s): 3 samples filled by linear "
+                  "interpolation (--gaps interpolate)");
+  // A bad cell is still named by its row in the file.
+  try {
+    t.Column("status");
+    ADD_FAILURE() << "a text cell was read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("data row 3 is 'x'"), std::string::npos) << e.what();
+  }
+  // A uniform log is untouched and gets no note.
+  note = "stale";
+  EXPECT_EQ(ReadLog(Write("u.csv", "time_s,r\n0,1\n1,2\n2,3\n"), GapPolicy::kInterpolate, &note)
+                .rows(),
+            3);
+  EXPECT_TRUE(note.empty());
+}
+
+TEST(GyroLog, AClockJumpIsNotFilled) {
+  // A jump of 1e6 steps in a 4-row log: not lost samples, a clock that jumped.
+  const std::string path = Write("jump.csv", "time_s,r\n0,1\n1,2\n1000001,3\n1000002,4\n");
+  EXPECT_THROW(ReadLog(path, GapPolicy::kInterpolate), DataError);
+  EXPECT_EQ(GapPolicyFromString("interpolate"), GapPolicy::kInterpolate);
+  EXPECT_THROW(GapPolicyFromString("split"), UsageError);
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
