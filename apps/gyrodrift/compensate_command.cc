@@ -60,15 +60,18 @@ AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& tab
   j["model"] = {{"summary", model.Summary()},
                 {"method", drift::ToString(model.options.method)},
                 {"target_column", loaded.info.target_column},
+                {"rate_unit", loaded.info.rate_unit},
                 {"temperature_column", loaded.info.temperature_column},
                 {"seed", model.options.seed},
                 {"tool_version", loaded.info.tool_version}};
   j["samples"] = y.size();
   j["std_before"] = Rms(y);
   j["std_after"] = Rms(compensated);
-  r.text = fmt::format("{}\n{}: std {:.6g} before, {:.6g} after compensation ({} samples)\n",
-                       model.Summary(), loaded.info.target_column, Rms(y), Rms(compensated),
-                       y.size());
+  // Files before format 4 did not record the unit.
+  const std::string unit = loaded.info.rate_unit.empty() ? "" : " " + loaded.info.rate_unit;
+  r.text = fmt::format("{}\n{}: std {:.6g}{} before, {:.6g}{} after compensation ({} samples)\n",
+                       model.Summary(), loaded.info.target_column, Rms(y), unit, Rms(compensated),
+                       unit, y.size());
   // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
   // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
   if (truth.size() > 0) {

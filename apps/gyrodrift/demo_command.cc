@@ -47,6 +47,7 @@ struct DemoArgs {
   std::uint64_t seed = 1;
   int threads = 0;
   std::string gaps = "error";  // io::GapPolicy, for --input
+  CLI::Option* units_option = nullptr;  // "--units given"
   bool quiet = false;
 };
 
@@ -129,8 +130,10 @@ void Run(const DemoArgs& a) {
   // Options first: every mistake is reported before any work (but the range of --rate-hz, which
   // the study checks with the log's other data).
   const bool user = !a.input.empty();
-  if (!user && (!a.target.empty() || !a.temperature.empty() || a.rate_option->count() > 0)) {
-    throw UsageError("--target, --temperature and --rate-hz need --input FILE.csv");
+  // The simulated output is in deg/h: --units describes a user's log only.
+  if (!user && (!a.target.empty() || !a.temperature.empty() || a.rate_option->count() > 0 ||
+                a.units_option->count() > 0 || a.gaps != "error")) {
+    throw UsageError("--target, --temperature, --rate-hz, --units and --gaps need --input FILE.csv");
   }
   if (user && a.target.empty())
     throw UsageError("--input needs --target COL (the gyro output column)");
@@ -212,7 +215,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   args->rate_option =
       cmd->add_option("--rate-hz", args->rate_hz,
                       "with --input: sample rate, Hz (default: from a time_s column, else 1)");
-  cmd->add_option("--units", args->units,
+  args->units_option = cmd->add_option("--units", args->units,
                   "unit of the --input target for the Allan noise terms: dph|dps|rads")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed,

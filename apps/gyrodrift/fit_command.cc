@@ -64,6 +64,7 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
 
 struct FitArgs : DriftArgs {
   std::string method = "auto";
+  std::string units = "dph";  // of the target column(s), recorded in the model file
   std::string output;
 };
 
@@ -123,6 +124,7 @@ void Run(const FitArgs& a) {
       axis.info.source = a.input;
       axis.info.target_column = targets.names[static_cast<size_t>(i)];
       axis.info.temperature_column = temperature.joined;
+      axis.info.rate_unit = a.units;
       const std::string label = axes > 1 ? axis.info.target_column + ": " + std::string(drift::ToString(method))
                                          : std::string(drift::ToString(method));
       progress.BeginStage(i, label);
@@ -172,6 +174,11 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
   cmd->add_option("--method,-m", args->method,
                   "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in predict mode, "
                   "thermal in compensate mode)")
+      ->capture_default_str();
+  cmd->add_option("--units", args->units,
+                  "unit of the target column(s), recorded in the model file and used in reports: "
+                  "dph (deg/h) | dps (deg/s) | rads (rad/s)")
+      ->check(CLI::IsMember({"dph", "dps", "rads"}))
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output,
                   "model file to write (JSON; one model per --target column)")

@@ -121,6 +121,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
     model.info.target_column = axis.target;
     model.info.temperature_column = Joined(axis.temperature);
     model.info.source = unit.calibration;
+    model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
     model.model =
         drift::FitDriftModel(cal.table.Column(axis.target), Temperatures(cal.table, axis), options);
     AxisResult a;

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/io/files.h"
@@ -669,6 +670,7 @@ json AxisJson(const LoadedModel& axis) {
   return {{"training",
            {{"target_column", axis.info.target_column},
             {"temperature_column", axis.info.temperature_column},
+            {"rate_unit", axis.info.rate_unit},
             {"samples", model.training_samples},
             {"source", axis.info.source}}},
           {"options", DriftOptionsToJson(model.options)},
@@ -787,6 +789,17 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     out.info.target_column = training["target_column"].String();
     out.info.temperature_column = training["temperature_column"].String();
     out.info.source = training["source"].String();
+    out.info.rate_unit = "";
+    if (version >= 4) {
+      out.info.rate_unit = training["rate_unit"].String();
+      if (!out.info.rate_unit.empty()) {
+        try {
+          (void)allan::RateUnitFromString(out.info.rate_unit);
+        } catch (const UsageError&) {
+          training["rate_unit"].Fail("= '" + out.info.rate_unit + "': must be dph, dps or rads");
+        }
+      }
+    }
     out.model = ReadModel(at);
     if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
       training["samples"].Fail("differs from model.training_samples");

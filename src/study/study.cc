@@ -181,7 +181,7 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
     row.metrics = drift::ComputeMetrics(s.compensate_reference - row.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
     row.summary = model.Summary();
-    io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", ""};
+    io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"};
     s.model_files.push_back(
         {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
          io::RenderModelFile(model, info)});
@@ -219,7 +219,8 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
     o.method = m;
     const drift::DriftModel model = drift::FitDriftModel(s.output, s.temperature, o);
     // gyrodrift compensate reads the temperature from the column named here.
-    io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, ""};
+    io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, "",
+                           std::string(allan::ToString(s.options.units))};
     s.model_files.push_back({"models/" + std::string(drift::ToString(m)) + "_compensate.json",
                              io::RenderModelFile(model, info)});
   }

@@ -178,3 +178,19 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
 
 }  // namespace
 }  // namespace gyrodrift
+
+namespace gyrodrift {
+namespace {
+
+// The simulated output is in deg/h: a unit or gap policy without --input would be applied to it.
+TEST(DemoCliOptions, LogOnlyOptionsNeedInput) {
+  const std::string dir = test::TempDir("cli_demo_log_only");
+  for (const char* flags : {"--units dps", "--gaps interpolate"}) {
+    const auto r = test::RunCli(std::string("demo ") + flags + " -o '" + dir + "/out'");
+    EXPECT_EQ(r.exit_code, 2) << flags << ": " << r.err;
+    EXPECT_NE(r.err.find("need --input"), std::string::npos) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace gyrodrift

@@ -5,7 +5,8 @@
 //   format, format_version, tool_version
 //   then one axis's fields at the top level, or, for a file of several gyro axes (fit --target
 //   gyro_x,gyro_y,gyro_z), an array "axes" of 2 to kMaxModelAxes objects each holding them:
-//   training   target_column, temperature_column ("" if none), samples, source (informative)
+//   training   target_column, temperature_column ("" if none), rate_unit (format 4), samples,
+//              source (informative)
 //   options    every field of drift::DriftOptions (mode, method, decomposition with its sifting
 //              rule, selection with its KDE and Monte-Carlo settings, features with the thermal
 //              time constants and rate_hz, learner, lag candidates, seed, threads); enums as the
@@ -43,7 +44,8 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // version-1 reader refuses version 2, which it would otherwise misread.
 // Version 3 adds identified thermal sub-models ("thermal" beside "learner") and the options of
 // their identification; older files read with the defaults.
-// Version 4 adds files of several axes ("axes"); a one-axis file keeps the version-3 layout.
+// Version 4 adds files of several axes ("axes"; a one-axis file keeps the version-3 layout) and
+// the target's rate unit (training.rate_unit).
 inline constexpr int kModelFormatVersion = 4;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
@@ -55,6 +57,9 @@ struct ModelFileInfo {
   std::string temperature_column;
   std::string source;              // training file, informative only
   std::string tool_version;        // ignored on writing (the running version is written)
+  // Unit of the target column and of every estimate: "dph", "dps" or "rads" (allan::RateUnit
+  // names); "" in files written before format 4, which did not record it.
+  std::string rate_unit = "dph";
 };
 
 // One axis of a model file: a gyro output column's model.

@@ -354,6 +354,16 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   EXPECT_EQ(old.model.options.features.thermal_set, drift::ThermalSet::kAuto);
   EXPECT_FALSE(old.model.options.features.limit_time_constants);
   EXPECT_TRUE(std::isnan(old.model.temperature_min_c));
+  // The rate unit is recorded from format 4 on: older files read as "not recorded", a bad one is
+  // named.
+  EXPECT_EQ(ParseModelFile(*text_, "m.json").info.rate_unit, "dph");
+  j = Json();
+  j["format_version"] = 3;
+  j["training"].erase("rate_unit");
+  EXPECT_EQ(ParseModelFile(Reseal(j), "v3.json").info.rate_unit, "");
+  j = Json();
+  j["training"]["rate_unit"] = "mph";
+  ExpectRefused(Reseal(j), "field 'training.rate_unit' = 'mph': must be dph, dps or rads");
   // A range must be ordered and finite.
   j = Json();
   j["model"]["temperature_range_c"] = json::array({30.0, 20.0});
