@@ -20,7 +20,8 @@ demo: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# libFuzzer on the CSV reader, the model-file loader and the option parsers, FUZZ_SECONDS each,
+# libFuzzer on the CSV reader, the model-file loader, the option parsers and the calibration
+# manifest, FUZZ_SECONDS each,
 # with AddressSanitizer and UndefinedBehaviorSanitizer; the corpora grow in build-fuzz/ (issue 14).
 FUZZ_SECONDS ?= 30
 FUZZ_SEED ?= 1
@@ -29,8 +30,8 @@ fuzz: deps
 	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE= \
 		-DGYRODRIFT_BUILD_TESTS=OFF -DGYRODRIFT_BUILD_APPS=OFF -DGYRODRIFT_BUILD_FUZZ=ON \
 		"-DCMAKE_CXX_FLAGS=$(FUZZ_FLAGS)" >/dev/null
-	@cmake --build build-fuzz -j $(JOBS) --target fuzz_csv fuzz_model_file fuzz_options
-	@for h in csv model_file options; do \
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_csv fuzz_model_file fuzz_options fuzz_manifest
+	@for h in csv model_file options manifest; do \
 		mkdir -p build-fuzz/corpus/$$h && cp tests/fuzz/corpus/$$h/* build-fuzz/corpus/$$h/ && \
 		./build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -seed=$(FUZZ_SEED) -artifact_prefix=build-fuzz/ \
 			-print_final_stats=1 build-fuzz/corpus/$$h > build-fuzz/fuzz_$$h.log 2>&1 \
