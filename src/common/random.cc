@@ -62,13 +62,15 @@ void Rng::FillNormal(Eigen::Ref<Eigen::VectorXd> out) {
   for (Eigen::Index i = 0; i < out.size(); ++i) out[i] = Normal();
 }
 
-std::uint64_t StreamId(std::string_view name) {
+std::uint64_t Fnv1a64(std::string_view text) {
   std::uint64_t hash = 0xCBF29CE484222325ULL;
-  for (unsigned char c : name) {
+  for (unsigned char c : text) {
     hash ^= c;
     hash *= 0x100000001B3ULL;
   }
   return hash;
 }
+
+std::uint64_t StreamId(std::string_view name) { return Fnv1a64(name); }
 
 }  // namespace gyrodrift

@@ -11,6 +11,7 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
+#include "gyrodrift/common/statistics.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -247,13 +248,6 @@ bool ReadFinished(const std::string& path, const std::string& fingerprint,
     rows->clear();
     return false;
   }
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 int ColumnIndex(const std::string& name) {

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/statistics.h"
 
 namespace gyrodrift::io {
 namespace {
@@ -15,15 +17,7 @@ namespace {
 double MedianStep(const Eigen::VectorXd& t) {
   std::vector<double> steps(static_cast<size_t>(t.size() - 1));
   for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
-  const size_t mid = steps.size() / 2;
-  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid), steps.end());
-  double median = steps[mid];
-  if (steps.size() % 2 == 0) {
-    const double below =
-        *std::max_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(mid));
-    median = 0.5 * (median + below);
-  }
-  return median;
+  return Median(std::move(steps));
 }
 
 }  // namespace

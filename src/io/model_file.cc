@@ -620,15 +620,6 @@ drift::DriftModel ReadModel(const Node& root) {
 
 }  // namespace
 
-std::uint64_t Fnv1a64(std::string_view text) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
 nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
   const drift::FeatureOptions& f = o.features;
   return {{"mode", drift::ToString(o.mode)},

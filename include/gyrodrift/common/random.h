@@ -34,6 +34,10 @@ class Rng {
   bool has_spare_ = false;
 };
 
+// FNV-1a 64 (Fowler, Noll & Vo) of the bytes of text: the project's one non-cryptographic hash
+// (stream ids, model-file checksums, calibration fingerprints).
+std::uint64_t Fnv1a64(std::string_view text);
+
 // Stable 64-bit id of a named stream (FNV-1a of the name), for sources such as "arw" or "bias".
 std::uint64_t StreamId(std::string_view name);
 

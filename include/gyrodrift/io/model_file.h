@@ -34,6 +34,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
 
 namespace gyrodrift::io {
@@ -91,7 +92,7 @@ LoadedModel ReadModelFile(const std::string& path);
 nlohmann::json DriftOptionsToJson(const drift::DriftOptions& options);
 drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::string& source);
 
-// FNV-1a 64 of the bytes of text.
-std::uint64_t Fnv1a64(std::string_view text);
+// FNV-1a 64 of the bytes of text (common/random.h), as the checksum uses it.
+using gyrodrift::Fnv1a64;
 
 }  // namespace gyrodrift::io
