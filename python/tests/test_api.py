@@ -38,7 +38,7 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
     with pytest.raises(gd.FileError) as e:
         gd.DriftModel.load(tmp_path / "missing.json")
     assert isinstance(e.value, OSError) and "missing.json" in str(e.value)
-    with pytest.raises(gd.UsageError, match="2-D"):
+    with pytest.raises(gd.UsageError, match="1-D array"):
         gd.allan(np.zeros((3, 3, 3)), rate_hz=1.0)
     with pytest.raises(gd.UsageError, match="rate_hz"):
         gd.allan(np.ones(100), rate_hz=-1.0)

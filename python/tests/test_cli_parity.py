@@ -87,7 +87,7 @@ def test_noise_terms_of_a_bare_curve_match_the_result_fit(sim_csv):
 
 def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     cli("fit", sim_csv, "--target", "rate_dph", "--temperature", "temperature_c",
-        "--mode", "compensate", "--seed", "3", "-q", "-o", tmp_path / "cli_model.json")
+        "--mode", "compensate", "--seed", "3", "-j", "2", "-q", "-o", tmp_path / "cli_model.json")
     cli("compensate", tmp_path / "cli_model.json", sim_csv, "-q", "-o", tmp_path / "comp.csv")
     comp = read_csv(tmp_path / "comp.csv")
 
@@ -97,7 +97,8 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
                                 target="rate_dph", temperature_columns=["temperature_c"],
                                 source=str(sim_csv))
     assert model.method == "thermal" and model.mode == "compensate"
-    # The model file is the CLI's, byte for byte (same options, same source, same doubles).
+    # The model file is the CLI's, byte for byte (same options, threads included as the file
+    # records them, same source, same doubles).
     model.save(tmp_path / "py_model.json")
     assert (tmp_path / "py_model.json").read_bytes() == (tmp_path / "cli_model.json").read_bytes()
 
