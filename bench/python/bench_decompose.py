@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Binding overhead of gyrodrift.decompose: the same decomposition of 1e5 samples timed from Python
-and from C++ (decompose_timing, built by the Python package's CMake), median of 5 each.
+and from C++ (decompose_timing, built by the Python package's CMake), median of 3 rounds of 5
+each.
 
     cmake --build build --target _gyrodrift decompose_timing
     PYTHONPATH=build/python /usr/bin/python3 bench/python/bench_decompose.py \
@@ -8,7 +9,9 @@ and from C++ (decompose_timing, built by the Python package's CMake), median of 
 
 Prints one line per configuration: C++ median, Python median, their difference (the overhead:
 converting the input, the (N, K) result and the report, and releasing the GIL), and the IMF count
-(the same in both, as a check that the same work was timed).
+(the same in both, as a check that the same work was timed). The C++ and Python runs alternate, so
+a machine shared with other jobs loads both alike. The first configuration (one fixed sift per
+IMF) computes little, so the conversion shows; the others are the defaults.
 """
 
 import argparse
@@ -36,32 +39,46 @@ def main():
     p.add_argument("--timing", default="build/bench/python/decompose_timing")
     p.add_argument("--samples", type=int, default=100_000)
     p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--quick", action="store_true", help="leave out BEEMDAN (about 12 s a run)")
     a = p.parse_args()
     x = signal(a.samples)
     print(f"{platform.node()} {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, N = {a.samples}, "
-          f"threads = {a.threads}, median of {a.repeats}")
-    configs = [("emd", 1), ("beemdan", 10)]
+          f"threads = {a.threads}, median of {a.rounds} x {a.repeats}, "
+          f"load average {os.getloadavg()[0]:.1f}")
+    # (method, ensemble, stop rule, fixed sifts)
+    configs = [("emd", 1, "fixed", 1), ("emd", 1, "rilling", 10), ("beemdan", 10, "rilling", 10)]
+    if a.quick:
+        configs = configs[:2]
     with tempfile.TemporaryDirectory() as d:
         path = os.path.join(d, "x.f64")
         x.astype("<f8").tofile(path)
-        for method, ensemble in configs:
-            out = subprocess.run([a.timing, path, method, str(ensemble), "1", str(a.threads),
-                                  str(a.repeats)], capture_output=True, text=True, check=True)
-            cpp = json.loads(out.stdout)
-            py = []
-            for _ in range(a.repeats):
-                start = time.perf_counter()
-                imfs, _, _ = gd.decompose(x, method=method, ensemble=ensemble, seed=1,
-                                          threads=a.threads)
-                py.append(time.perf_counter() - start)
-            c, q = statistics.median(cpp["seconds"]), statistics.median(py)
-            assert imfs.shape[1] == cpp["imfs"], (imfs.shape, cpp["imfs"])
-            print(f"{method:8s} I={ensemble:<3d} C++ {c * 1e3:9.2f} ms   Python {q * 1e3:9.2f} ms   "
-                  f"overhead {(q - c) * 1e3:+8.2f} ms ({100 * (q - c) / c:+.2f} %)   "
-                  f"K = {cpp['imfs']}")
-
+        for method, ensemble, stop, sifts in configs:
+            cpp, py, k = [], [], None
+            # Rounds alternate between the C++ program and Python so a machine shared with other
+            # jobs loads both alike; each round drops its first call (a fresh process's first
+            # allocations fault pages in) and times `repeats` more.
+            for _ in range(a.rounds):
+                out = subprocess.run([a.timing, path, method, str(ensemble), "1", str(a.threads),
+                                      str(a.repeats + 1), stop, str(sifts)],
+                                     capture_output=True, text=True, check=True)
+                c = json.loads(out.stdout)
+                cpp += c["seconds"][1:]
+                k = c["imfs"]
+                for i in range(a.repeats + 1):
+                    start = time.perf_counter()
+                    imfs, _, _ = gd.decompose(x, method=method, ensemble=ensemble, seed=1,
+                                              threads=a.threads, stop=stop, fixed_sifts=sifts)
+                    if i:
+                        py.append(time.perf_counter() - start)
+                assert imfs.shape[1] == k, (imfs.shape, k)
+            c, q = statistics.median(cpp), statistics.median(py)
+            label = f"{method} {stop}" + (f" {sifts}" if stop == "fixed" else "") + \
+                (f" I={ensemble}" if method != "emd" else "")
+            print(f"{label:20s} C++ {c * 1e3:9.2f} ms   Python {q * 1e3:9.2f} ms   "
+                  f"overhead {(q - c) * 1e3:+8.2f} ms ({100 * (q - c) / c:+.2f} %)   K = {k}")
 
 if __name__ == "__main__":
     main()

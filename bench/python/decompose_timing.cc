@@ -3,7 +3,7 @@
 // {"seconds": [...], "imfs": K}. The script times gyrodrift.decompose on the same signal and
 // options; the difference of the medians is the binding's overhead (conversion in and out, the
 // GIL release).
-//   decompose_timing SIGNAL.f64 METHOD ENSEMBLE SEED THREADS REPEATS
+//   decompose_timing SIGNAL.f64 METHOD ENSEMBLE SEED THREADS REPEATS [STOP FIXED_SIFTS]
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdio>
@@ -15,8 +15,9 @@
 #include "gyrodrift/decomposition/decomposition.h"
 
 int main(int argc, char** argv) {
-  if (argc != 7) {
-    std::fprintf(stderr, "usage: %s SIGNAL.f64 METHOD ENSEMBLE SEED THREADS REPEATS\n", argv[0]);
+  if (argc != 7 && argc != 9) {
+    std::fprintf(stderr, "usage: %s SIGNAL.f64 METHOD ENSEMBLE SEED THREADS REPEATS [STOP FIXED_SIFTS]\n",
+                 argv[0]);
     return 2;
   }
   std::ifstream in(argv[1], std::ios::binary | std::ios::ate);
@@ -35,6 +36,10 @@ int main(int argc, char** argv) {
   o.seed = std::strtoull(argv[4], nullptr, 10);
   o.threads = std::atoi(argv[5]);
   const int repeats = std::atoi(argv[6]);
+  if (argc == 9) {
+    o.sifting.stop_rule = dec::StopRuleFromString(argv[7]);
+    o.sifting.fixed_sifts = std::atoi(argv[8]);
+  }
   std::vector<double> seconds;
   int imfs = 0;
   for (int i = 0; i < repeats; ++i) {
