@@ -27,9 +27,14 @@ for label, x in (("before", test["rate_dph"]), ("after", compensated)):
     a = gd.allan(x, rate_hz=1.0, taus="octave")
     ax.errorbar(a["tau_s"], a["dev"], yerr=[a["dev"] - a["dev_lo"], a["dev_hi"] - a["dev"]],
                 marker=".", capsize=2, label=f"{label} compensation")
-    b = a["noise_terms"].get("B", {})
-    print(f"{label:6s}: curve minimum {a['noise_terms'].get('min_dev_dph', float('nan')):.4g} deg/h,"
-          f" B {b.get('value', float('nan')):.4g} deg/h")
+    terms = a["noise_terms"]
+    if "error" in terms:
+        print(f"{label:6s}: noise terms not fitted: {terms['error']}")
+        continue
+    b = terms["B"]
+    b_text = f"{b['value']:.4g} +- {b['sigma']:.2g} deg/h" if b["identified"] else "not identified"
+    print(f"{label:6s}: curve minimum {terms['min_dev_dph']:.4g} deg/h at {terms['min_dev_tau_s']:.4g} s,"
+          f" bias instability B {b_text}")
 ax.set(xscale="log", yscale="log", xlabel="tau [s]", ylabel="overlapping ADEV [deg/h]",
        title="Allan deviation of a test run")
 ax.grid(True, which="both", alpha=0.3)

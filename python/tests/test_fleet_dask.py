@@ -87,9 +87,16 @@ def test_dask_fleet_matches_calibrate(cli, fleet):
                    (fleet / "dask" / sn / name).read_bytes(), f"{sn}/{name}"
     assert (fleet / "dask/fleet.html").stat().st_size > 0
 
-    # A rerun skips both units (their summary.json matches), as calibrate's rerun does.
-    again = gyrodrift.fleet.calibrate(fleet / "fleet.toml", fleet / "dask", workers=2)
-    assert again["skipped"] == 2 and again["calibrated"] == 0
+    # A rerun, through a running scheduler's address (--scheduler), skips both units (their
+    # summary.json matches), as calibrate's rerun does.
+    from dask.distributed import LocalCluster
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", str(fleet / "fleet.toml"),
+                            "-o", str(fleet / "dask"), "--scheduler", cluster.scheduler_address],
+                           capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert "2 units: 0 calibrated, 2 skipped" in p.stdout, p.stdout
     assert without_unit_seconds(dask_csv) == without_unit_seconds(cli_csv)
 
     # The in-process binding of RunFleet agrees too.
