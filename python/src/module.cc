@@ -77,12 +77,11 @@ py::array_t<double> ToArray(const Eigen::VectorXd& v) {
   return a;
 }
 
-// N x K as a C-ordered (N, K) array.
-py::array_t<double> ToArray(const Eigen::MatrixXd& m) {
-  py::array_t<double> a({m.rows(), m.cols()});
-  auto w = a.mutable_unchecked<2>();
-  for (Eigen::Index i = 0; i < m.rows(); ++i)
-    for (Eigen::Index j = 0; j < m.cols(); ++j) w(i, j) = m(i, j);
+// N x K as an (N, K) array in Eigen's column-major order (one memcpy; each IMF imfs[:, k] is
+// then contiguous).
+py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
+  py::array_t<double, py::array::f_style> a({m.rows(), m.cols()});
+  std::copy(m.data(), m.data() + m.size(), a.mutable_data());
   return a;
 }
 
