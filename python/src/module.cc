@@ -305,7 +305,13 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   if (py::isinstance<py::str>(profile)) {
     programme = sim::BuiltinProgramme(profile.cast<std::string>());
   } else {
-    const auto pair = profile.cast<std::pair<Array, Array>>();
+    std::pair<Array, Array> pair;
+    try {
+      pair = profile.cast<std::pair<Array, Array>>();
+    } catch (const py::cast_error&) {
+      throw UsageError("profile: must be chamber, chamber-b, sine or a pair of arrays "
+                       "(time_s, temperature_c)");
+    }
     programme = sim::TemperatureProgramme::FromSamples(
         ToVector(pair.first, "profile time_s"), ToVector(pair.second, "profile temperature_c"),
         "profile");
@@ -355,6 +361,10 @@ int AutoOrInteger(const char* option, const py::object& value, int lo, int hi) {
     const std::string text = value.cast<std::string>();
     if (text == "auto") return -1;
     throw OptionError(option, "'" + text + "'",
+                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  if (!py::isinstance<py::int_>(value)) {
+    throw OptionError(option, py::str(value).cast<std::string>(),
                       "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
   }
   const long long v = value.cast<long long>();

@@ -44,6 +44,12 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.allan(np.ones(100), rate_hz=-1.0)
     with pytest.raises(gd.UsageError, match="temperature"):
         gd.DriftModel().fit(np.ones(100), mode="compensate")
+    with pytest.raises(gd.UsageError, match="pair of arrays"):
+        gd.simulate(profile=3)
+    with pytest.raises(gd.UsageError, match=r"hidden = 2.5: must be auto or an integer"):
+        gd.DriftModel().fit(np.ones(100), mode="predict", hidden=2.5)
+    with pytest.raises(gd.FileError, match="nonexistent.toml"):
+        gd.calibrate(tmp_path / "nonexistent.toml", tmp_path / "out")
     with pytest.raises(gd.UsageError, match="not fitted"):
         gd.DriftModel().summary
 
