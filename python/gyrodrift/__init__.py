@@ -186,6 +186,12 @@ class DriftModel:
                 return a
         raise UsageError(f"axis = {axis}: must be one of {', '.join(a.target for a in axes)}")
 
+    @staticmethod
+    def save_axes(path, models):
+        """Writes several fitted models (one per axis, each with its own ``target``) into one
+        model file, as ``gyrodrift fit --target gyro_x,gyro_y,...`` does."""
+        _gyrodrift.DriftModel.save_axes(str(path), [m._core for m in models])
+
     @classmethod
     def load_axes(cls, path):
         """Every axis of a model file, in file order."""

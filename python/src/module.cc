@@ -575,6 +575,14 @@ class PyDriftModel {
 
   void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
 
+  // One model file of several axes, as `gyrodrift fit --target a,b,c` writes it.
+  static void SaveAxes(const std::string& path, const std::vector<const PyDriftModel*>& models) {
+    if (models.empty()) throw UsageError("models: must hold at least one fitted model");
+    std::vector<io::LoadedModel> axes;
+    for (const PyDriftModel* m : models) axes.push_back(m->Loaded());
+    io::WriteModelFile(path, axes);
+  }
+
   static std::vector<PyDriftModel> LoadAxes(const std::string& path) {
     std::vector<PyDriftModel> out;
     for (io::LoadedModel& axis : io::ReadModelFileAxes(path)) out.emplace_back(std::move(axis));
@@ -776,6 +784,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("threads") = 0)
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
+      .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
       .def_property_readonly("fitted", [](const gp::PyDriftModel& d) { return d.fitted_; })
       .def_property_readonly("summary", &gp::PyDriftModel::Summary)
       .def_property_readonly("sub_models", &gp::PyDriftModel::SubModels)

@@ -115,3 +115,25 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     assert len(thermal["regressors"]) == len(thermal["coefficients"]) == len(thermal["sd"])
     assert any("temperature_c" in name for name in thermal["regressors"])
     assert np.all(np.isfinite(thermal["sd"]))
+
+
+def test_two_axis_model_file_matches_cli(cli, tmp_path):
+    # Two axes of one IMU: the simulator's output and a second unit's, each with its own sensor.
+    a, b = gd.simulate(duration=3600, seed=1), gd.simulate(duration=3600, seed=2, preset="tactical")
+    write_csv(tmp_path / "imu.csv", {"time_s": a["time_s"], "gyro_x": a["rate_dph"],
+                                     "gyro_y": b["rate_dph"], "temp_x": a["temperature_c"],
+                                     "temp_y": b["temperature_c"]})
+    cli("fit", tmp_path / "imu.csv", "--target", "gyro_x,gyro_y", "--temperature", "temp_x,temp_y",
+        "--mode", "compensate", "-j", "1", "-q", "-o", tmp_path / "cli.json")
+    both = np.column_stack([a["temperature_c"], b["temperature_c"]])
+    models = [gd.DriftModel().fit(y, both, target=name, temperature_columns=["temp_x", "temp_y"],
+                                  threads=1, source=str(tmp_path / "imu.csv"))
+              for name, y in (("gyro_x", a["rate_dph"]), ("gyro_y", b["rate_dph"]))]
+    gd.DriftModel.save_axes(tmp_path / "py.json", models)
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    axes = gd.DriftModel.load_axes(tmp_path / "cli.json")
+    assert [m.target for m in axes] == ["gyro_x", "gyro_y"]
+    assert axes[1].temperature_columns == ["temp_x", "temp_y"]
+    with pytest.raises(gd.UsageError, match="2 axes"):
+        gd.DriftModel.load(tmp_path / "cli.json")
+    assert gd.DriftModel.load(tmp_path / "cli.json", axis="gyro_y").summary == models[1].summary
