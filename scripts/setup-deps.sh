@@ -8,6 +8,9 @@ packages=(
   libsvm-dev libfann-dev libjs-dygraphs
   clang libclang-rt-14-dev
   libtomlplusplus-dev
+  # The Python package (python/, docs/python.md): bindings, tests, the Dask fleet runner, examples.
+  pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
+  python3-dask python3-distributed python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do

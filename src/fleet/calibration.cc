@@ -401,88 +401,77 @@ std::string FleetResult::Summary() const {
       units, calibrated, skipped, failed_limits, errors, seconds, unit_seconds_median);
 }
 
-FleetResult RunFleet(const Manifest& m, const FleetOptions& o) {
-  const auto start = std::chrono::steady_clock::now();
-  std::error_code ec;
-  fs::create_directories(o.output_dir, ec);
-  if (!fs::is_directory(o.output_dir, ec)) {
-    throw IoError(o.output_dir + ": cannot create the output folder");
+UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& output_dir,
+                bool force, const io::DygraphsAssets& assets) {
+  const std::string folder = (fs::path(output_dir) / unit.serial).string();
+  const std::string summary = (fs::path(folder) / kSummaryFile).string();
+  UnitRun run;
+  std::string fingerprint;
+  try {
+    fingerprint = UnitFingerprint(m, unit);
+  } catch (const Error& e) {
+    UnitResult failed;
+    failed.serial = unit.serial;
+    failed.error = e.what();
+    run.rows = Rows(failed);
+    run.what = "error";
+    return run;
   }
-  const io::DygraphsAssets assets = io::LoadDygraphs();
-  const int n = static_cast<int>(m.units.size());
-  std::vector<std::vector<FleetRow>> unit_rows(static_cast<size_t>(n));
-  std::vector<std::string> outcome(static_cast<size_t>(n));
-  std::vector<double> seconds(static_cast<size_t>(n), -1.0);
-  std::mutex mutex;
-  int done = 0;
-  ParallelFor(n, ResolveThreads(o.threads), [&](int task, int /*worker*/) {
-    const UnitSpec& unit = m.units[static_cast<size_t>(task)];
-    const std::string folder = (fs::path(o.output_dir) / unit.serial).string();
-    const std::string summary = (fs::path(folder) / kSummaryFile).string();
-    std::string what;
-    std::vector<FleetRow> rows;
-    std::string fingerprint;
-    try {
-      fingerprint = UnitFingerprint(m, unit);
-    } catch (const Error& e) {
-      UnitResult failed;
-      failed.serial = unit.serial;
-      failed.error = e.what();
-      rows = Rows(failed);
-      what = "error";
-    }
-    if (what.empty() && !o.force && ReadFinished(summary, fingerprint, &rows)) {
-      what = "skipped";
-    } else if (what.empty()) {
-      UnitOutputs outputs = CalibrateUnit(m, unit, assets);
-      rows = Rows(outputs.result);
-      if (outputs.result.error.empty()) {
-        json s = {{"fingerprint", fingerprint},
-                  {"serial", unit.serial},
-                  {"columns", FleetColumns()},
-                  {"rows", RowsJson(rows)}};
-        std::vector<std::pair<std::string, std::string>> files;
-        fs::create_directories(folder, ec);
-        for (auto& [name, text] : outputs.files) {
-          files.push_back({(fs::path(folder) / name).string(), std::move(text)});
-        }
-        files.push_back({summary, s.dump(1) + "\n"});
-        try {
-          io::WriteFilesAtomically(files);
-          what = "calibrated";
-          seconds[static_cast<size_t>(task)] = outputs.result.seconds;
-        } catch (const Error& e) {
-          outputs.result.error = e.what();
-          rows = Rows(outputs.result);
-          what = "error";
-        }
-      } else {
-        what = "error";
-      }
-    }
-    std::lock_guard<std::mutex> lock(mutex);
-    unit_rows[static_cast<size_t>(task)] = std::move(rows);
-    outcome[static_cast<size_t>(task)] = what;
-    ++done;
-    if (o.progress) o.progress(done, n, unit.serial, what);
-  });
+  if (!force && ReadFinished(summary, fingerprint, &run.rows)) {
+    run.what = "skipped";
+    return run;
+  }
+  UnitOutputs outputs = CalibrateUnit(m, unit, assets);
+  run.rows = Rows(outputs.result);
+  if (!outputs.result.error.empty()) {
+    run.what = "error";
+    return run;
+  }
+  json s = {{"fingerprint", fingerprint},
+            {"serial", unit.serial},
+            {"columns", FleetColumns()},
+            {"rows", RowsJson(run.rows)}};
+  std::vector<std::pair<std::string, std::string>> files;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  for (auto& [name, text] : outputs.files) {
+    files.push_back({(fs::path(folder) / name).string(), std::move(text)});
+  }
+  files.push_back({summary, s.dump(1) + "\n"});
+  try {
+    io::WriteFilesAtomically(files);
+    run.what = "calibrated";
+    run.seconds = outputs.result.seconds;
+  } catch (const Error& e) {
+    outputs.result.error = e.what();
+    run.rows = Rows(outputs.result);
+    run.what = "error";
+  }
+  return run;
+}
 
+FleetResult FinishFleet(const Manifest& m, const std::string& output_dir,
+                        const std::vector<UnitRun>& units, double seconds,
+                        const io::DygraphsAssets& assets) {
+  if (units.size() != m.units.size()) {
+    throw UsageError("FinishFleet: " + std::to_string(units.size()) + " unit runs for a manifest of " +
+                     std::to_string(m.units.size()) + " units");
+  }
   FleetResult fleet;
-  fleet.units = n;
+  fleet.units = static_cast<int>(units.size());
   std::vector<double> calibrated_seconds;
-  for (int i = 0; i < n; ++i) {
-    const std::string& what = outcome[static_cast<size_t>(i)];
-    fleet.calibrated += what == "calibrated";
-    fleet.skipped += what == "skipped";
+  for (const UnitRun& run : units) {
+    fleet.calibrated += run.what == "calibrated";
+    fleet.skipped += run.what == "skipped";
     bool error = false, fail = false;
-    for (const FleetRow& row : unit_rows[static_cast<size_t>(i)]) {
+    for (const FleetRow& row : run.rows) {
       error |= row.cells[3] == "error";
       fail |= row.cells[3] == "fail";
       fleet.rows.push_back(row);
     }
     fleet.errors += error;
     fleet.failed_limits += fail && !error;
-    if (seconds[static_cast<size_t>(i)] >= 0.0) calibrated_seconds.push_back(seconds[static_cast<size_t>(i)]);
+    if (run.seconds >= 0.0) calibrated_seconds.push_back(run.seconds);
   }
   FlagOutliers(fleet.rows);
   fleet.unit_seconds_median = Median(calibrated_seconds);
@@ -500,11 +489,36 @@ FleetResult RunFleet(const Manifest& m, const FleetOptions& o) {
     for (size_t c = 0; c < row.cells.size(); ++c) csv += (c ? "," : "") + quote(row.cells[c]);
     csv += "\n";
   }
-  fleet.seconds = Seconds(start);
-  io::WriteFilesAtomically({{(fs::path(o.output_dir) / "fleet.csv").string(), csv},
-                            {(fs::path(o.output_dir) / "fleet.html").string(),
+  fleet.seconds = seconds;
+  io::WriteFilesAtomically({{(fs::path(output_dir) / "fleet.csv").string(), csv},
+                            {(fs::path(output_dir) / "fleet.html").string(),
                              RenderFleetReport(m, fleet, assets)}});
   return fleet;
+}
+
+FleetResult RunFleet(const Manifest& m, const FleetOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  fs::create_directories(o.output_dir, ec);
+  if (!fs::is_directory(o.output_dir, ec)) {
+    throw IoError(o.output_dir + ": cannot create the output folder");
+  }
+  const io::DygraphsAssets assets = io::LoadDygraphs();
+  const int n = static_cast<int>(m.units.size());
+  std::vector<UnitRun> runs(static_cast<size_t>(n));
+  std::mutex mutex;
+  int done = 0;
+  ParallelFor(n, ResolveThreads(o.threads), [&](int task, int /*worker*/) {
+    const UnitSpec& unit = m.units[static_cast<size_t>(task)];
+    UnitRun run = RunUnit(m, unit, o.output_dir, o.force, assets);
+    std::lock_guard<std::mutex> lock(mutex);
+    const std::string what = run.what;
+    runs[static_cast<size_t>(task)] = std::move(run);
+    ++done;
+    if (o.progress) o.progress(done, n, unit.serial, what);
+  });
+  // The time of the whole run, fleet.csv and fleet.html being the last bit of it.
+  return FinishFleet(m, o.output_dir, runs, Seconds(start), assets);
 }
 
 }  // namespace gyrodrift::fleet

@@ -107,6 +107,25 @@ struct FleetResult {
   std::string Summary() const;  // one line
 };
 
+// One unit's part of RunFleet, shared with callers that spread units over other workers (the
+// Python package's Dask runner): calibrates `unit` into output_dir/<serial>/ (its files written
+// together, atomically, summary.json last) unless that summary.json holds the unit's fingerprint
+// and !force. Never throws for the unit's own data: errors become rows.
+struct UnitRun {
+  std::vector<FleetRow> rows;
+  std::string what;      // "calibrated", "skipped" or "error"
+  double seconds = -1.0;  // wall time when calibrated in this run, else -1
+};
+UnitRun RunUnit(const Manifest& manifest, const UnitSpec& unit, const std::string& output_dir,
+                bool force, const io::DygraphsAssets& assets);
+
+// The end of RunFleet: the totals of every unit's run (manifest order, one per unit; UsageError
+// otherwise), outliers flagged, and output_dir/fleet.csv and fleet.html written. `seconds` is the
+// fleet's wall time as the caller measured it.
+FleetResult FinishFleet(const Manifest& manifest, const std::string& output_dir,
+                        const std::vector<UnitRun>& units, double seconds,
+                        const io::DygraphsAssets& assets);
+
 // Calibrates every unit of the manifest into options.output_dir (see the header comment).
 // Throws UsageError / IoError for the fleet as a whole (no output folder, no dygraphs); a unit's
 // own failure is a row, not an exception.

@@ -1,0 +1,224 @@
+"""gyrodrift: gyroscope thermal-drift modelling and compensation, from Python.
+
+The compiled module ``_gyrodrift`` calls the same C++ library as the ``gyrodrift`` command line
+tool, so the same inputs and options give the same numbers, to the bit. Arrays go in and come
+out as numpy float64 arrays; keyword arguments are named as the CLI's flags (``-`` as ``_``).
+
+Example::
+
+    import gyrodrift as gd
+    sim = gd.simulate(duration=7200, seed=7)
+    imfs, residue, report = gd.decompose(sim["rate_dph"], method="beemdan", seed=7)
+    a = gd.allan(sim["rate_dph"], rate_hz=1.0)
+    model = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"], mode="compensate")
+    compensated = model.compensate(sim["temperature_c"], sim["rate_dph"])
+
+Errors are ``UsageError`` (a bad option, a ValueError), ``DataError`` (data that cannot be
+processed, a ValueError) and ``FileError`` (an OSError), with the library's one-line messages.
+See docs/python.md.
+"""
+
+from . import _gyrodrift
+from ._gyrodrift import DataError, FileError, UsageError, __version__
+
+__all__ = [
+    "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
+    "decompose", "noise_terms", "simulate",
+]
+
+
+def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, seed=1, threads=0,
+              max_imfs=0, max_sifts=0, s_number=4, fixed_sifts=10, sd=0.2,
+              noise_scaling="colominas2014", bound="energy", band=0.99, noise_stages=3,
+              noise_realisations=None):
+    """Splits a signal into IMFs and a residue (EMD, EEMD, CEEMDAN, ICEEMDAN, BEEMDAN).
+
+    As ``gyrodrift decompose``; ``noise_realisations`` (an (N, I) array, one white-noise
+    realisation per column) replaces ``--noise-file``. Results do not depend on ``threads``.
+
+    Returns ``(imfs, residue, report)``: imfs an (N, K) array, one IMF per column, so that
+    ``imfs.sum(axis=1) + residue == x`` up to rounding; report a dict (summary, sifts_per_imf,
+    noise_assisted_stages, stop_reason, ...) as in the CLI's sidecar.
+
+    >>> import numpy as np, gyrodrift as gd
+    >>> t = np.arange(2000.0)
+    >>> imfs, residue, report = gd.decompose(np.sin(t / 5) + 0.01 * t, method="emd")
+    >>> imfs.shape[0]
+    2000
+    """
+    return _gyrodrift.decompose(
+        x, method=method, stop=stop, ensemble=ensemble, noise=noise, seed=seed, threads=threads,
+        max_imfs=max_imfs, max_sifts=max_sifts, s_number=s_number, fixed_sifts=fixed_sifts,
+        sd=sd, noise_scaling=noise_scaling, bound=bound, band=band, noise_stages=noise_stages,
+        noise_realisations=noise_realisations)
+
+
+def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", confidence=0.683,
+          threads=0, fit_tau_min=0.0, fit_tau_max=float("inf")):
+    """Allan-family deviation with confidence intervals and the IEEE 952 noise terms.
+
+    As ``gyrodrift allan``. ``taus`` is "all", "octave", "decade" or a sequence of averaging
+    times in s (each rounded to a whole number of samples by the library).
+
+    Returns a dict: ``tau_s``, ``m``, ``dev``, ``dev_lo``, ``dev_hi``, ``n_terms``, ``edf``,
+    ``alpha``, ``alpha_identified`` (arrays, one entry per tau), ``dev_unit``, ``summary`` and
+    ``noise_terms`` (Q, N, B, K, R each a dict with value, sigma, identified, ...; or
+    ``{"error": ...}`` when the curve has too few points to fit).
+
+    >>> import numpy as np, gyrodrift as gd
+    >>> r = gd.allan(np.random.default_rng(1).normal(size=4096), rate_hz=1.0)
+    >>> round(float(r["tau_s"][0]), 1)
+    1.0
+    """
+    return _gyrodrift.allan(x, rate_hz=rate_hz, type=type, dev=dev, taus=taus, units=units,
+                            confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
+                            fit_tau_max=fit_tau_max)
+
+
+def noise_terms(tau_s, adev_dph, edf, *, fit_tau_min=0.0, fit_tau_max=float("inf"),
+                min_share=0.1, significance=0.05, sample_period_s=0.0):
+    """IEEE 952 noise terms fitted to a bare Allan-deviation curve (deg/h) with its EDF.
+
+    Returns the dict ``allan(...)["noise_terms"]`` has (without ``source_dev``).
+
+    >>> import numpy as np, gyrodrift as gd
+    >>> r = gd.allan(np.random.default_rng(1).normal(size=4096), rate_hz=1.0)
+    >>> gd.noise_terms(r["tau_s"], r["dev"], r["edf"])["N"]["identified"]
+    True
+    """
+    return _gyrodrift.noise_terms(tau_s, adev_dph, edf, fit_tau_min=fit_tau_min,
+                                  fit_tau_max=fit_tau_max, min_share=min_share,
+                                  significance=significance, sample_period_s=sample_period_s)
+
+
+def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1.0, seed=1,
+             winding="", asymmetry=None, input_rate_dph=0.0, noise=True):
+    """Simulates a fibre optic gyro's thermal drift in a temperature chamber.
+
+    As ``gyrodrift simulate``: ``duration`` in seconds (None: the programme's own length),
+    ``profile`` a built-in programme name ("chamber", "chamber-b", "sine") or a pair of arrays
+    ``(time_s, temperature_c)``; ``noise=False`` is ``--no-noise``.
+
+    Returns a dict with what a user would log, ``time_s``, ``rate_dph`` and ``temperature_c``,
+    apart from ``truth`` (a dict: drift_dph, shupe_dph, stress_dph, bias_dph, noise_dph and the
+    true temperatures), plus ``summary``.
+
+    >>> import gyrodrift as gd
+    >>> sim = gd.simulate(duration=600, seed=7)
+    >>> len(sim["rate_dph"]), sorted(sim["truth"])[0]
+    (600, 'bias_dph')
+    """
+    return _gyrodrift.simulate(duration=duration, profile=profile, preset=preset, rate_hz=rate_hz,
+                               seed=seed, winding=winding, asymmetry=asymmetry,
+                               input_rate_dph=input_rate_dph, noise=noise)
+
+
+class DriftModel:
+    """A drift model (MS-ELM, the thermal model or a baseline), as ``gyrodrift fit`` makes it.
+
+    >>> import gyrodrift as gd
+    >>> sim = gd.simulate(duration=3600, seed=7)
+    >>> m = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"], mode="compensate")
+    >>> m.method
+    'thermal'
+    >>> est, sd = m.estimate(sim["temperature_c"])
+    >>> out = m.compensate(sim["temperature_c"], sim["rate_dph"])   # rate_dph - est
+    """
+
+    def __init__(self, _core=None):
+        self._core = _core if _core is not None else _gyrodrift.DriftModel()
+
+    def fit(self, y, temperature=None, *, mode="compensate", method="auto",
+            decomposition="beemdan", lags=None, hidden="auto", rate_hz=1.0,
+            thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
+            threads=0, nonlinear=False, reference_temperature=None, target="rate_dph",
+            temperature_columns=None, source="python"):
+        """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
+
+        Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
+        ``hidden`` "auto" or an int, ``time_constants`` seconds. ``method="auto"`` is ms-elm in
+        predict mode and thermal in compensate mode. ``rate_hz`` is the sample rate (the CLI
+        reads it from a time_s column). ``target`` and ``temperature_columns`` are the column
+        names written into the model file (the CLI's compensate reads those columns).
+        Returns self.
+        """
+        self._core.fit(y, temperature, mode=mode, method=method, decomposition=decomposition,
+                       lags=lags, hidden=hidden, rate_hz=rate_hz,
+                       thermal_features=thermal_features, time_constants=list(time_constants),
+                       ensemble=ensemble, realisations=realisations, seed=seed, threads=threads,
+                       nonlinear=nonlinear, reference_temperature=reference_temperature,
+                       target=target, temperature_columns=temperature_columns, source=source)
+        return self
+
+    def estimate(self, temperature):
+        """Compensate mode: ``(estimate, sd)`` of the drift at every temperature sample (sd NaN
+        for models without an uncertainty band)."""
+        return self._core.estimate(temperature)
+
+    def compensate(self, temperature, y):
+        """Compensate mode: ``y - estimate(temperature)``, the ``compensated`` column of
+        ``gyrodrift compensate``."""
+        return self._core.compensate(temperature, y)
+
+    def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=512,
+                threads=0):
+        """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
+        horizon-step-ahead predictions of y[first:], first being the model's history."""
+        return self._core.predict(y, temperature, horizon=horizon, protocol=protocol,
+                                  window=window, threads=threads)
+
+    def save(self, path):
+        """Writes the model file ``gyrodrift fit`` writes (JSON, exact doubles, checksummed)."""
+        self._core.save(str(path))
+
+    @classmethod
+    def load(cls, path, axis=None):
+        """Reads a model file (written by ``gyrodrift fit`` or ``save``). A file of several axes
+        needs ``axis``, the target column name; ``load_axes`` returns them all."""
+        axes = cls.load_axes(path)
+        if axis is None:
+            if len(axes) != 1:
+                raise UsageError(f"{path} holds {len(axes)} axes "
+                                 f"({', '.join(a.target for a in axes)}): pass axis=")
+            return axes[0]
+        for a in axes:
+            if a.target == axis:
+                return a
+        raise UsageError(f"axis = {axis}: must be one of {', '.join(a.target for a in axes)}")
+
+    @staticmethod
+    def save_axes(path, models):
+        """Writes several fitted models (one per axis, each with its own ``target``) into one
+        model file, as ``gyrodrift fit --target gyro_x,gyro_y,...`` does."""
+        _gyrodrift.DriftModel.save_axes(str(path), [m._core for m in models])
+
+    @classmethod
+    def load_axes(cls, path):
+        """Every axis of a model file, in file order."""
+        return [cls(core) for core in _gyrodrift.DriftModel.load_axes(str(path))]
+
+    summary = property(lambda self: self._core.summary, doc="One-line summary of the model.")
+    sub_models = property(
+        lambda self: self._core.sub_models,
+        doc="Sub-models: name, imfs, learner summary, and for identified thermal models "
+            "``thermal`` (regressors named by the temperature columns, coefficients, sd).")
+    mode = property(lambda self: self._core.mode)
+    method = property(lambda self: self._core.method)
+    target = property(lambda self: self._core.target)
+    temperature_columns = property(lambda self: self._core.temperature_columns)
+    temperature_range_c = property(lambda self: self._core.temperature_range_c,
+                                   doc="Training temperature range (min, max), degC.")
+    fitted = property(lambda self: self._core.fitted)
+
+    def __repr__(self):
+        return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"
+
+
+def calibrate(manifest_path, output_dir, *, force=False, threads=0):
+    """Calibrates a fleet from a TOML manifest, as ``gyrodrift calibrate`` (docs/calibration.md).
+
+    Returns a dict: ``rows`` (fleet.csv's rows, each a dict of its columns, as text), the counts
+    (units, calibrated, skipped, errors, failed_limits), ``all_pass`` and ``summary``. Units
+    that fail their limits are rows, not exceptions. ``gyrodrift.fleet`` runs the same on Dask.
+    """
+    return _gyrodrift.calibrate(str(manifest_path), str(output_dir), force=force, threads=threads)

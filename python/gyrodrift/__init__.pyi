@@ -1,0 +1,98 @@
+# Type stub of the gyrodrift package (python/gyrodrift/__init__.py; docs/python.md).
+from os import PathLike
+from typing import Any, Literal, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+Array = npt.NDArray[np.float64]
+
+class UsageError(ValueError): ...
+class DataError(ValueError): ...
+class FileError(OSError): ...
+
+def decompose(
+    x: ArrayLike, *,
+    method: Literal["emd", "eemd", "ceemdan", "iceemdan", "beemdan"] = ...,
+    stop: Literal["rilling", "snumber", "fixed", "sd"] = ...,
+    ensemble: int = ..., noise: float = ..., seed: int = ..., threads: int = ...,
+    max_imfs: int = ..., max_sifts: int = ..., s_number: int = ..., fixed_sifts: int = ...,
+    sd: float = ..., noise_scaling: Literal["colominas2014", "constant-snr"] = ...,
+    bound: Literal["energy", "stages", "full"] = ..., band: float = ..., noise_stages: int = ...,
+    noise_realisations: ArrayLike | None = ...,
+) -> tuple[Array, Array, dict[str, Any]]: ...
+
+def allan(
+    x: ArrayLike, *, rate_hz: float,
+    type: Literal["rate", "angle"] = ...,
+    dev: Literal["adev", "oadev", "mdev", "hdev", "ohdev", "tdev", "totdev"] = ...,
+    taus: Literal["all", "octave", "decade"] | Sequence[float] = ...,
+    units: Literal["dph", "dps", "rads"] = ..., confidence: float = ..., threads: int = ...,
+    fit_tau_min: float = ..., fit_tau_max: float = ...,
+) -> dict[str, Any]: ...
+
+def noise_terms(
+    tau_s: ArrayLike, adev_dph: ArrayLike, edf: ArrayLike, *, fit_tau_min: float = ...,
+    fit_tau_max: float = ..., min_share: float = ..., significance: float = ...,
+    sample_period_s: float = ...,
+) -> dict[str, Any]: ...
+
+def simulate(
+    *, duration: float | None = ...,
+    profile: str | tuple[ArrayLike, ArrayLike] = ...,
+    preset: Literal["navigation", "tactical"] = ..., rate_hz: float = ..., seed: int = ...,
+    winding: str = ..., asymmetry: float | None = ..., input_rate_dph: float = ...,
+    noise: bool = ...,
+) -> dict[str, Any]: ...
+
+class DriftModel:
+    def __init__(self) -> None: ...
+    def fit(
+        self, y: ArrayLike, temperature: ArrayLike | None = ..., *,
+        mode: Literal["compensate", "predict"] = ...,
+        method: Literal["auto", "ms-elm", "thermal", "elm", "emd-elm", "poly", "svr", "bp"] = ...,
+        decomposition: str = ..., lags: int | Literal["auto"] | None = ...,
+        hidden: int | Literal["auto"] = ..., rate_hz: float = ...,
+        thermal_features: Literal["auto", "ladder", "classic", "lag-bank"] = ...,
+        time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
+        seed: int = ..., threads: int = ..., nonlinear: bool = ...,
+        reference_temperature: float | None = ..., target: str = ...,
+        temperature_columns: Sequence[str] | None = ..., source: str = ...,
+    ) -> DriftModel: ...
+    def estimate(self, temperature: ArrayLike) -> tuple[Array, Array]: ...
+    def compensate(self, temperature: ArrayLike, y: ArrayLike) -> Array: ...
+    def predict(
+        self, y: ArrayLike, temperature: ArrayLike | None = ..., *, horizon: int = ...,
+        protocol: Literal["causal", "paper"] = ..., window: int = ..., threads: int = ...,
+    ) -> tuple[int, Array]: ...
+    def save(self, path: str | PathLike[str]) -> None: ...
+    @classmethod
+    def load(cls, path: str | PathLike[str], axis: str | None = ...) -> DriftModel: ...
+    @classmethod
+    def load_axes(cls, path: str | PathLike[str]) -> list[DriftModel]: ...
+    @staticmethod
+    def save_axes(path: str | PathLike[str], models: Sequence[DriftModel]) -> None: ...
+    @property
+    def summary(self) -> str: ...
+    @property
+    def sub_models(self) -> list[dict[str, Any]]: ...
+    @property
+    def mode(self) -> str: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def target(self) -> str: ...
+    @property
+    def temperature_columns(self) -> list[str]: ...
+    @property
+    def temperature_range_c(self) -> tuple[float, float]: ...
+    @property
+    def fitted(self) -> bool: ...
+
+def calibrate(
+    manifest_path: str | PathLike[str], output_dir: str | PathLike[str], *, force: bool = ...,
+    threads: int = ...,
+) -> dict[str, Any]: ...

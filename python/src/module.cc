@@ -1,0 +1,820 @@
+// _gyrodrift: the compiled half of the Python package `gyrodrift` (python/gyrodrift/__init__.py
+// re-exports it with docstrings and examples; docs/python.md).
+//
+// The bindings only convert: numpy arrays to Eigen and back, keyword arguments to the library's
+// option structs (named as the CLI flags name them, `-` as `_`), results to dicts. Every number
+// comes from the same library calls the CLI makes, so the same inputs and options give the same
+// bits (python/tests/test_cli_parity.py). Long calls run without the GIL. Library errors become
+// gyrodrift.UsageError (ValueError), DataError (ValueError) and FileError (OSError) with the
+// library's one-line message.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <Eigen/Core>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/version.h"
+#include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/fleet/calibration.h"
+#include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/io/model_file.h"
+#include "gyrodrift/io/report.h"
+#include "gyrodrift/simulation/fog_simulator.h"
+#include "gyrodrift/simulation/temperature_programme.h"
+
+namespace py = pybind11;
+
+namespace gyrodrift::python {
+namespace {
+
+namespace al = gyrodrift::allan;
+namespace dec = gyrodrift::decomposition;
+namespace sim = gyrodrift::simulation;
+
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A 1-D float64 copy of any array-like (lists, float32, strided views), checked under the GIL so
+// the computation can run without it.
+Eigen::VectorXd ToVector(const Array& a, const char* name) {
+  if (a.ndim() != 1) {
+    throw UsageError(std::string(name) + ": must be a 1-D array (got " + std::to_string(a.ndim()) +
+                     " dimensions)");
+  }
+  Eigen::VectorXd v(a.shape(0));
+  std::copy(a.data(), a.data() + a.shape(0), v.data());
+  return v;
+}
+
+// N x C from a 1-D array (one column) or an (N, C) array.
+Eigen::MatrixXd ToMatrix(const Array& a, const char* name) {
+  if (a.ndim() == 1) return ToVector(a, name);
+  if (a.ndim() != 2) {
+    throw UsageError(std::string(name) + ": must be a 1-D or 2-D array (got " +
+                     std::to_string(a.ndim()) + " dimensions)");
+  }
+  Eigen::MatrixXd m(a.shape(0), a.shape(1));
+  auto r = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    for (py::ssize_t j = 0; j < a.shape(1); ++j) m(i, j) = r(i, j);
+  return m;
+}
+
+py::array_t<double> ToArray(const Eigen::VectorXd& v) {
+  py::array_t<double> a(v.size());
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
+// N x K as an (N, K) array in Eigen's column-major order (one memcpy; each IMF imfs[:, k] is
+// then contiguous).
+py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
+  py::array_t<double, py::array::f_style> a({m.rows(), m.cols()});
+  std::copy(m.data(), m.data() + m.size(), a.mutable_data());
+  return a;
+}
+
+// ---- decompose ------------------------------------------------------------------------------
+
+py::tuple Decompose(const Array& x_in, const std::string& method, const std::string& stop,
+                    int ensemble, double noise, std::uint64_t seed, int threads, int max_imfs,
+                    int max_sifts, int s_number, int fixed_sifts, double sd,
+                    const std::string& noise_scaling, const std::string& bound, double band,
+                    int noise_stages, std::optional<Array> noise_realisations) {
+  // The same option mapping as `gyrodrift decompose` (apps/gyrodrift/decompose_command.cc).
+  dec::DecompositionOptions o;
+  o.method = dec::MethodFromString(method);
+  o.sifting.stop_rule = dec::StopRuleFromString(stop);
+  o.sifting.max_sifts = max_sifts;
+  o.sifting.s_number = s_number;
+  o.sifting.fixed_sifts = fixed_sifts;
+  o.sifting.sd_threshold = sd;
+  o.max_imfs = max_imfs;
+  o.ensemble_size = ensemble;
+  o.noise_strength = noise;
+  o.seed = seed;
+  o.threads = threads;
+  o.noise_scaling = dec::NoiseScalingFromString(noise_scaling);
+  o.beemdan_bound = dec::BeemdanBoundFromString(bound);
+  o.band_confidence = band;
+  o.noise_stages = noise_stages;
+  o.Validate();
+  const Eigen::VectorXd x = ToVector(x_in, "x");
+  if (noise_realisations) {
+    if (o.method == dec::Method::kEmd) {
+      throw UsageError("noise_realisations: must not be given with method='emd'");
+    }
+    auto w = std::make_shared<Eigen::MatrixXd>(ToMatrix(*noise_realisations, "noise_realisations"));
+    o.supplied_noise = w;
+    o.ensemble_size = static_cast<int>(w->cols());
+  }
+  dec::Decomposition d;
+  {
+    py::gil_scoped_release release;
+    d = dec::Decompose(x, o);
+  }
+  const dec::DecompositionReport& r = d.report;
+  py::dict report;
+  report["summary"] = r.Summary();
+  report["method"] = std::string(dec::ToString(r.method));
+  report["imfs"] = d.num_imfs();
+  report["sifts_per_imf"] = r.sifts_per_imf;
+  report["sift_cap_hit"] = r.sift_cap_hit;
+  report["sift_cap_hits"] = r.sift_cap_hits;
+  report["ensemble_size"] = r.ensemble_size;
+  report["seed"] = r.seed;
+  report["supplied_noise"] = r.supplied_noise;
+  report["noise_assisted_stages"] = r.noise_assisted_stages;
+  report["stop_reason"] = r.stop_reason;
+  report["mode_log2_energy"] = r.mode_log2_energy;
+  report["noise_band_log2_upper"] = r.noise_band_log2_upper;
+  return py::make_tuple(ToArray(d.imfs), ToArray(d.residue), report);
+}
+
+// ---- allan ----------------------------------------------------------------------------------
+
+py::dict TermDict(const al::NoiseTerm& t, const char* unit) {
+  py::dict d;
+  d["unit"] = unit;
+  d["identified"] = t.identified;
+  d["value"] = t.value;
+  d["sigma"] = t.sigma;
+  d["tau_lo_s"] = t.tau_lo_s;
+  d["tau_hi_s"] = t.tau_hi_s;
+  d["slope_reading"] = t.slope_reading;
+  d["slope_tau_s"] = t.slope_tau_s;
+  d["evidence_chi2"] = t.evidence_chi2;
+  return d;
+}
+
+// The keys of the `noise_terms` object of `gyrodrift allan`'s sidecar.
+py::dict TermsDict(const al::NoiseTerms& t) {
+  py::dict d;
+  d["critical_chi2"] = t.critical_chi2;
+  d["points_used"] = t.points_used;
+  d["tau_min_s"] = t.tau_min_s;
+  d["tau_max_s"] = t.tau_max_s;
+  d["chi2_per_dof"] = t.chi2_per_dof;
+  d["min_dev_dph"] = t.min_dev_dph;
+  d["min_dev_tau_s"] = t.min_dev_tau_s;
+  d["Q"] = TermDict(t.q_urad, "urad");
+  d["Q_arcsec"] = t.q_urad.value * 0.206264806247;
+  d["N"] = TermDict(t.n_dpsh, "deg/sqrt(h)");
+  d["B"] = TermDict(t.b_dph, "deg/h");
+  d["K"] = TermDict(t.k_dphpsh, "deg/h/sqrt(h)");
+  d["R"] = TermDict(t.r_dphph, "deg/h/h");
+  d["summary"] = t.Summary();
+  return d;
+}
+
+// `taus`: "all", "octave", "decade", or a sequence of averaging times in s.
+void SetTaus(const std::variant<std::string, std::vector<double>>& taus, al::AllanOptions* o) {
+  if (const auto* grid = std::get_if<std::string>(&taus)) {
+    o->grid = al::TauGridFromString(*grid);
+    if (o->grid == al::TauGrid::kList) {
+      throw OptionError("taus", "'" + *grid + "'", "all, octave, decade or a sequence of taus in s");
+    }
+  } else {
+    o->grid = al::TauGrid::kList;
+    o->tau_list_s = std::get<std::vector<double>>(taus);
+  }
+}
+
+py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const std::string& dev,
+               const std::variant<std::string, std::vector<double>>& taus,
+               const std::string& units, double confidence, int threads, double fit_tau_min,
+               double fit_tau_max) {
+  al::AllanOptions o;
+  o.rate_hz = rate_hz;
+  o.data_type = al::DataTypeFromString(type);
+  o.deviation = al::DeviationFromString(dev);
+  o.units = al::RateUnitFromString(units);
+  o.confidence = confidence;
+  o.threads = threads;
+  SetTaus(taus, &o);
+  o.Validate();
+  const al::NoiseFitOptions fit_options{.tau_min_s = fit_tau_min, .tau_max_s = fit_tau_max};
+  fit_options.Validate();
+  const Eigen::VectorXd data = ToVector(x_in, "x");
+
+  al::AllanResult r;
+  std::optional<al::NoiseTerms> terms;
+  std::string fit_error, fit_source = al::ToString(o.deviation);
+  {
+    py::gil_scoped_release release;
+    r = al::Compute(data, o);
+    // As `gyrodrift allan`: the noise terms need an Allan-variance curve; for the other
+    // estimators an OADEV on the same grid is fitted.
+    const bool allan_curve = o.deviation == al::Deviation::kAdev ||
+                             o.deviation == al::Deviation::kOadev ||
+                             o.deviation == al::Deviation::kTotdev;
+    try {
+      if (allan_curve) {
+        terms = al::IdentifyNoise(r, fit_options);
+      } else {
+        al::AllanOptions oa = o;
+        oa.deviation = al::Deviation::kOadev;
+        fit_source = "oadev";
+        terms = al::IdentifyNoise(al::Compute(data, oa), fit_options);
+      }
+    } catch (const DataError& e) {
+      fit_error = e.what();  // too few points to fit: the deviations are still the result
+    }
+  }
+  const auto n = static_cast<Eigen::Index>(r.points.size());
+  Eigen::VectorXd tau(n), devs(n), lo(n), hi(n), edf(n);
+  py::array_t<std::int64_t> m(n), n_terms(n), alpha(n);
+  py::array_t<bool> identified(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const al::AllanPoint& p = r.points[static_cast<size_t>(i)];
+    tau[i] = p.tau_s;
+    devs[i] = p.dev;
+    lo[i] = p.dev_lo;
+    hi[i] = p.dev_hi;
+    edf[i] = p.edf;
+    m.mutable_at(i) = p.m;
+    n_terms.mutable_at(i) = p.n_terms;
+    alpha.mutable_at(i) = p.alpha;
+    identified.mutable_at(i) = p.alpha_identified;
+  }
+  py::dict d;
+  d["tau_s"] = ToArray(tau);
+  d["m"] = m;
+  d["dev"] = ToArray(devs);
+  d["dev_lo"] = ToArray(lo);
+  d["dev_hi"] = ToArray(hi);
+  d["n_terms"] = n_terms;
+  d["edf"] = ToArray(edf);
+  d["alpha"] = alpha;
+  d["alpha_identified"] = identified;
+  d["dev_unit"] = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
+  d["samples"] = r.n_samples;
+  d["summary"] = r.Summary();
+  if (terms) {
+    py::dict t = TermsDict(*terms);
+    t["source_dev"] = fit_source;
+    d["noise_terms"] = t;
+  } else {
+    d["noise_terms"] = py::dict(py::arg("error") = fit_error);
+  }
+  return d;
+}
+
+py::dict NoiseTerms(const Array& tau_s, const Array& adev_dph, const Array& edf,
+                    double fit_tau_min, double fit_tau_max, double min_share, double significance,
+                    double sample_period_s) {
+  const al::NoiseFitOptions o{.tau_min_s = fit_tau_min,
+                              .tau_max_s = fit_tau_max,
+                              .min_share = min_share,
+                              .sample_period_s = sample_period_s,
+                              .significance = significance};
+  o.Validate();
+  const Eigen::VectorXd t = ToVector(tau_s, "tau_s"), a = ToVector(adev_dph, "adev_dph"),
+                        e = ToVector(edf, "edf");
+  al::NoiseTerms terms;
+  {
+    py::gil_scoped_release release;
+    terms = al::IdentifyNoise(t, a, e, o);
+  }
+  return TermsDict(terms);
+}
+
+// ---- simulate -------------------------------------------------------------------------------
+
+py::dict Simulate(std::optional<double> duration, const py::object& profile,
+                  const std::string& preset, double rate_hz, std::uint64_t seed,
+                  const std::string& winding, std::optional<double> asymmetry,
+                  double input_rate_dph, bool noise) {
+  sim::FogParameters params = sim::PresetParameters(sim::PresetFromString(preset));
+  if (!winding.empty()) params.coil.winding = sim::WindingPatternFromString(winding);
+  if (asymmetry) params.coil.winding_asymmetry = *asymmetry;
+  params.Validate();
+  // A built-in programme by name, or (time_s, temperature_c) samples of a chamber programme.
+  std::optional<sim::TemperatureProgramme> programme;
+  if (py::isinstance<py::str>(profile)) {
+    programme = sim::BuiltinProgramme(profile.cast<std::string>());
+  } else {
+    std::pair<Array, Array> pair;
+    try {
+      pair = profile.cast<std::pair<Array, Array>>();
+    } catch (const py::cast_error&) {
+      throw UsageError("profile: must be chamber, chamber-b, sine or a pair of arrays "
+                       "(time_s, temperature_c)");
+    }
+    programme = sim::TemperatureProgramme::FromSamples(
+        ToVector(pair.first, "profile time_s"), ToVector(pair.second, "profile temperature_c"),
+        "profile");
+  }
+  sim::SimulationOptions o;
+  o.rate_hz = rate_hz;
+  o.seed = seed;
+  o.input_rate_dph = input_rate_dph;
+  o.include_noise = noise;
+  // As `gyrodrift simulate`: without a duration, the programme's own length (8 h for a sine).
+  o.duration_s = duration ? *duration
+                          : programme->kind() == sim::TemperatureProgramme::Kind::kSine
+                                ? 8 * 3600.0
+                                : programme->NominalDuration();
+  sim::SimulationResult r;
+  {
+    py::gil_scoped_release release;
+    r = sim::Simulate(*programme, params, o);
+  }
+  py::dict truth;
+  truth["drift_dph"] = ToArray(r.drift_dph);
+  truth["shupe_dph"] = ToArray(r.shupe_dph);
+  truth["stress_dph"] = ToArray(r.stress_dph);
+  truth["bias_dph"] = ToArray(r.bias_dph);
+  truth["noise_dph"] = ToArray(r.noise_dph);
+  truth["chamber_c"] = ToArray(r.chamber_c);
+  truth["case_c"] = ToArray(r.case_c);
+  truth["coil_mean_c"] = ToArray(r.coil_mean_c);
+  truth["coil_inner_c"] = ToArray(r.coil_inner_c);
+  truth["coil_outer_c"] = ToArray(r.coil_outer_c);
+  py::dict d;
+  d["time_s"] = ToArray(r.time_s);
+  d["rate_dph"] = ToArray(r.rate_dph);
+  d["temperature_c"] = ToArray(r.temperature_c);
+  d["truth"] = truth;
+  d["duration_s"] = o.duration_s;
+  d["seed"] = r.seed;
+  d["summary"] = r.Summary();
+  return d;
+}
+
+// ---- DriftModel -----------------------------------------------------------------------------
+
+// "auto" or an integer in [lo, hi]; -1 for auto. Ints pass as they are.
+int AutoOrInteger(const char* option, const py::object& value, int lo, int hi) {
+  if (py::isinstance<py::str>(value)) {
+    const std::string text = value.cast<std::string>();
+    if (text == "auto") return -1;
+    throw OptionError(option, "'" + text + "'",
+                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  if (!py::isinstance<py::int_>(value)) {
+    throw OptionError(option, py::str(value).cast<std::string>(),
+                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  const long long v = value.cast<long long>();
+  if (v < lo || v > hi) {
+    throw OptionError(option, std::to_string(v),
+                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return static_cast<int>(v);
+}
+
+std::vector<std::string> SplitColumns(const std::string& names) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = names.find(',', start);
+    out.push_back(names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
+// One axis of a model file: the fitted model and the column names it was fitted on.
+class PyDriftModel {
+ public:
+  PyDriftModel() = default;
+  explicit PyDriftModel(io::LoadedModel loaded) : loaded_(std::move(loaded)), fitted_(true) {}
+
+  // The option mapping of `gyrodrift fit` (apps/gyrodrift/drift_cli.cc MakeDriftOptions and
+  // fit_command.cc), with lags/hidden taking ints or "auto" and a given rate instead of time_s.
+  void Fit(const Array& y_in, const std::optional<Array>& temperature_in, const std::string& mode,
+           const std::string& method, const std::string& decomposition, const py::object& lags,
+           const py::object& hidden, double rate_hz, const std::string& thermal_features,
+           const std::vector<double>& time_constants, int ensemble, int realisations,
+           std::uint64_t seed, int threads, bool nonlinear,
+           std::optional<double> reference_temperature, const std::string& target,
+           const std::optional<std::vector<std::string>>& temperature_columns,
+           const std::string& source) {
+    drift::DriftOptions o;
+    o.mode = drift::ModeFromString(mode);
+    o.method = method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
+                                                                        : drift::Method::kMsElm)
+                                : drift::MethodFromString(method);
+    o.decomposition.method = dec::MethodFromString(decomposition);
+    o.decomposition.ensemble_size = ensemble;
+    o.selection.monte_carlo.realisations = realisations;
+    o.seed = seed;
+    o.threads = threads;
+    const bool lags_given = !lags.is_none();
+    const int p = lags_given ? AutoOrInteger("lags", lags, 1, 256) : 4;
+    o.auto_lags = p < 0;
+    if (p > 0) o.features.lags = p;
+    const int h = AutoOrInteger("hidden", hidden, 1, 100000);
+    if (h > 0) {
+      const bool elm_based = o.method == drift::Method::kMsElm ||
+                             o.method == drift::Method::kEmdElm || o.method == drift::Method::kElm;
+      if (!elm_based) {
+        throw UsageError("hidden = " + std::to_string(h) +
+                         ": applies to the ELM methods (ms-elm, emd-elm, elm), not method " +
+                         std::string(drift::ToString(o.method)));
+      }
+      if (o.mode == drift::Mode::kCompensate && o.method != drift::Method::kElm && !nonlinear) {
+        throw UsageError("hidden = " + std::to_string(h) + ": compensate-mode " +
+                         std::string(drift::ToString(o.method)) +
+                         " fits linear sub-models; hidden applies to predict mode and to "
+                         "method 'elm'");
+      }
+      o.learner.elm.selection = elm::Selection::kFixed;
+      o.learner.elm.hidden_units = h;
+    }
+    if (o.mode == drift::Mode::kCompensate && lags_given) {
+      throw UsageError("lags: applies to mode 'predict' (a compensate-mode model sees "
+                       "temperature only)");
+    }
+    if (o.mode == drift::Mode::kCompensate && !temperature_in) {
+      throw UsageError("mode 'compensate' needs temperature (the compensation model runs on "
+                       "temperature alone)");
+    }
+    o.features.use_temperature = o.mode == drift::Mode::kPredict && temperature_in.has_value();
+    if (nonlinear) {
+      if (!drift::IdentifiesThermalModel(o)) {
+        throw UsageError("nonlinear applies to mode 'compensate' with method thermal, ms-elm or "
+                         "emd-elm");
+      }
+      o.linear_compensation = false;
+    }
+    if (reference_temperature) {
+      if (o.mode != drift::Mode::kCompensate) {
+        throw UsageError("reference_temperature applies to mode 'compensate'");
+      }
+      if (!(*reference_temperature >= -100.0 && *reference_temperature <= 200.0)) {
+        throw OptionError("reference_temperature", std::to_string(*reference_temperature),
+                          "in [-100, 200]");
+      }
+      o.reference_c = *reference_temperature;
+    }
+    o.features.rate_hz = rate_hz;
+    o.features.thermal_set = drift::ThermalSetFromString(thermal_features);
+    if (!time_constants.empty()) {
+      o.features.time_constants_s = time_constants;
+      o.features.limit_time_constants = false;  // the user's constants, all of them
+    }
+    o.Validate();
+
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    Eigen::MatrixXd temperature;
+    if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
+    std::vector<std::string> names;
+    if (temperature_columns) {
+      names = *temperature_columns;
+    } else if (temperature.cols() == 1) {
+      names = {"temperature_c"};
+    } else {
+      for (Eigen::Index c = 0; c < temperature.cols(); ++c)
+        names.push_back("temperature_c" + std::to_string(c + 1));
+    }
+    if (temperature_in && static_cast<Eigen::Index>(names.size()) != temperature.cols()) {
+      throw UsageError("temperature_columns: " + std::to_string(names.size()) + " names for " +
+                       std::to_string(temperature.cols()) + " temperature columns");
+    }
+    io::LoadedModel loaded;
+    loaded.info.source = source;
+    loaded.info.target_column = target;
+    if (temperature_in) {
+      for (size_t c = 0; c < names.size(); ++c)
+        loaded.info.temperature_column += (c ? "," : "") + names[c];
+    }
+    {
+      py::gil_scoped_release release;
+      loaded.model = drift::FitDriftModel(y, temperature, o);
+    }
+    loaded_ = std::move(loaded);
+    fitted_ = true;
+  }
+
+  const io::LoadedModel& Loaded() const {
+    if (!fitted_) throw UsageError("DriftModel: not fitted (call fit() or DriftModel.load())");
+    return loaded_;
+  }
+
+  void RequireMode(drift::Mode mode, const char* what) const {
+    if (Loaded().model.options.mode != mode) {
+      throw UsageError(std::string(what) + ": needs a model fitted with mode '" +
+                       std::string(drift::ToString(mode)) + "', this one is '" +
+                       std::string(drift::ToString(Loaded().model.options.mode)) + "'");
+    }
+  }
+
+  py::tuple Estimate(const Array& temperature_in) const {
+    RequireMode(drift::Mode::kCompensate, "estimate");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    Eigen::MatrixXd e;
+    {
+      py::gil_scoped_release release;
+      e = drift::EstimateDriftWithSd(Loaded().model, t);
+    }
+    return py::make_tuple(ToArray(Eigen::VectorXd(e.col(0))), ToArray(Eigen::VectorXd(e.col(1))));
+  }
+
+  // y - estimate, as `gyrodrift compensate` writes it.
+  py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in) const {
+    RequireMode(drift::Mode::kCompensate, "compensate");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    if (y.size() != t.rows()) {
+      throw DataError("compensate: y has " + std::to_string(y.size()) + " samples, temperature " +
+                      std::to_string(t.rows()));
+    }
+    Eigen::VectorXd compensated;
+    {
+      py::gil_scoped_release release;
+      const Eigen::MatrixXd e = drift::EstimateDriftWithSd(Loaded().model, t);
+      compensated = y - e.col(0);
+    }
+    return ToArray(compensated);
+  }
+
+  // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
+  py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
+                    const std::string& protocol_name, int window, int threads) const {
+    RequireMode(drift::Mode::kPredict, "predict");
+    const drift::Protocol protocol = drift::ProtocolFromString(protocol_name);
+    if (window < 16 || window > 1000000) {
+      throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
+    }
+    drift::DriftModel model = Loaded().model;
+    model.options.threads = threads;  // the thread count never changes the result
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    Eigen::VectorXd temperature;
+    if (model.uses_temperature()) {
+      if (!temperature_in) throw UsageError("predict: this model needs temperature");
+      temperature = ToVector(*temperature_in, "temperature");
+    }
+    const Eigen::Index first = drift::FirstPredictable(model, protocol, horizon);
+    if (y.size() <= first) {
+      throw DataError("y has " + std::to_string(y.size()) + " samples: the model needs more than " +
+                      std::to_string(first) + " (its history) to predict any");
+    }
+    drift::CausalOptions causal;
+    causal.window = window;
+    causal.threads = threads;
+    Eigen::VectorXd prediction;
+    {
+      py::gil_scoped_release release;
+      prediction = drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal);
+    }
+    return py::make_tuple(first, ToArray(prediction));
+  }
+
+  void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
+
+  // One model file of several axes, as `gyrodrift fit --target a,b,c` writes it.
+  static void SaveAxes(const std::string& path, const std::vector<const PyDriftModel*>& models) {
+    if (models.empty()) throw UsageError("models: must hold at least one fitted model");
+    std::vector<io::LoadedModel> axes;
+    for (const PyDriftModel* m : models) axes.push_back(m->Loaded());
+    io::WriteModelFile(path, axes);
+  }
+
+  static std::vector<PyDriftModel> LoadAxes(const std::string& path) {
+    std::vector<PyDriftModel> out;
+    for (io::LoadedModel& axis : io::ReadModelFileAxes(path)) out.emplace_back(std::move(axis));
+    return out;
+  }
+
+  std::string Summary() const { return Loaded().model.Summary(); }
+
+  py::list SubModels() const {
+    const io::LoadedModel& l = Loaded();
+    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    py::list out;
+    for (const drift::SubModel& sub : l.model.sub_models) {
+      py::dict d;
+      d["name"] = sub.name;
+      d["imfs"] = sub.imfs;
+      d["has_residue"] = sub.has_residue;
+      d["learner"] = sub.learner ? py::cast(sub.learner->Summary()) : py::none();
+      if (sub.thermal) {
+        const drift::ThermalRegression& t = *sub.thermal;
+        Eigen::VectorXd sd(t.coefficients.size());
+        for (Eigen::Index k = 0; k < sd.size(); ++k) sd[k] = std::sqrt(t.covariance(k, k));
+        py::dict th;
+        th["summary"] = t.Summary();
+        th["regressors"] = t.RegressorNames(channels);
+        th["coefficients"] = ToArray(t.coefficients);
+        th["sd"] = ToArray(sd);
+        th["calibration"] = t.report.Summary();
+        th["warnings"] = t.report.warnings;
+        d["thermal"] = th;
+      } else {
+        d["thermal"] = py::none();
+      }
+      out.append(d);
+    }
+    return out;
+  }
+
+  io::LoadedModel loaded_;
+  bool fitted_ = false;
+};
+
+// ---- fleet ----------------------------------------------------------------------------------
+
+py::list RowsList(const std::vector<fleet::FleetRow>& rows) {
+  py::list out;
+  for (const fleet::FleetRow& row : rows) {
+    py::dict d;
+    for (size_t c = 0; c < row.cells.size(); ++c) d[py::str(fleet::FleetColumns()[c])] = row.cells[c];
+    out.append(d);
+  }
+  return out;
+}
+
+py::dict FleetDict(const fleet::FleetResult& r) {
+  py::dict d;
+  d["rows"] = RowsList(r.rows);
+  d["units"] = r.units;
+  d["calibrated"] = r.calibrated;
+  d["skipped"] = r.skipped;
+  d["errors"] = r.errors;
+  d["failed_limits"] = r.failed_limits;
+  d["seconds"] = r.seconds;
+  d["unit_seconds_median"] = r.unit_seconds_median;
+  d["all_pass"] = r.all_pass();
+  d["summary"] = r.Summary();
+  return d;
+}
+
+fleet::Manifest LoadManifest(const std::string& path) {
+  fleet::Manifest m = fleet::ReadManifest(path);
+  fleet::CheckLogColumns(m);  // every column of every log, before any unit is fitted
+  return m;
+}
+
+py::dict Calibrate(const std::string& manifest_path, const std::string& output_dir, bool force,
+                   int threads) {
+  if (threads < 0 || threads > 1024) {
+    throw OptionError("threads", std::to_string(threads), "in [0, 1024] (0: every core)");
+  }
+  fleet::FleetResult r;
+  {
+    py::gil_scoped_release release;
+    const fleet::Manifest m = LoadManifest(manifest_path);
+    fleet::FleetOptions o;
+    o.output_dir = output_dir;
+    o.force = force;
+    o.threads = threads;
+    r = fleet::RunFleet(m, o);
+  }
+  return FleetDict(r);
+}
+
+// One unit (0-based index in the manifest) for gyrodrift.fleet's Dask tasks: plain lists and
+// strings, so the result pickles back to the client.
+py::dict CalibrateUnit(const std::string& manifest_path, int index, const std::string& output_dir,
+                       bool force) {
+  fleet::UnitRun run;
+  {
+    py::gil_scoped_release release;
+    const fleet::Manifest m = LoadManifest(manifest_path);
+    if (index < 0 || index >= static_cast<int>(m.units.size())) {
+      throw OptionError("index", std::to_string(index),
+                        "in [0, " + std::to_string(m.units.size()) + ")");
+    }
+    run = fleet::RunUnit(m, m.units[static_cast<size_t>(index)], output_dir, force,
+                         io::LoadDygraphs());
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& row : run.rows) rows.push_back(row.cells);
+  py::dict d;
+  d["rows"] = rows;
+  d["what"] = run.what;
+  d["seconds"] = run.seconds;
+  d["serial"] = run.rows.empty() ? std::string() : run.rows.front().cells[0];
+  return d;
+}
+
+py::dict FinishFleet(const std::string& manifest_path, const std::string& output_dir,
+                     const py::list& units, double seconds) {
+  std::vector<fleet::UnitRun> runs;
+  for (const py::handle& u : units) {
+    fleet::UnitRun run;
+    for (auto& cells : u["rows"].cast<std::vector<std::vector<std::string>>>())
+      run.rows.push_back({std::move(cells)});
+    run.what = u["what"].cast<std::string>();
+    run.seconds = u["seconds"].cast<double>();
+    runs.push_back(std::move(run));
+  }
+  fleet::FleetResult r;
+  {
+    py::gil_scoped_release release;
+    const fleet::Manifest m = fleet::ReadManifest(manifest_path);
+    r = fleet::FinishFleet(m, output_dir, runs, seconds, io::LoadDygraphs());
+  }
+  return FleetDict(r);
+}
+
+}  // namespace
+}  // namespace gyrodrift::python
+
+PYBIND11_MODULE(_gyrodrift, m) {
+  namespace gp = gyrodrift::python;
+  using py::arg;
+  m.doc() = "Compiled core of the gyrodrift package; import gyrodrift instead.";
+  m.attr("__version__") = gyrodrift::kVersion;
+
+  // Python exception types, created here so the translator can raise them; __init__ re-exports.
+  static py::exception<gyrodrift::UsageError> usage_error(m, "UsageError", PyExc_ValueError);
+  static py::exception<gyrodrift::DataError> data_error(m, "DataError", PyExc_ValueError);
+  static py::exception<gyrodrift::IoError> file_error(m, "FileError", PyExc_OSError);
+  static py::exception<gyrodrift::Error> other_error(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const gyrodrift::UsageError& e) {  // OptionError included
+      usage_error(e.what());
+    } catch (const gyrodrift::DataError& e) {
+      data_error(e.what());
+    } catch (const gyrodrift::IoError& e) {
+      file_error(e.what());
+    } catch (const gyrodrift::Error& e) {
+      other_error(e.what());
+    }
+  });
+
+  m.def("decompose", &gp::Decompose, arg("x"), py::kw_only(), arg("method") = "beemdan",
+        arg("stop") = "rilling", arg("ensemble") = 100, arg("noise") = 0.2, arg("seed") = 1,
+        arg("threads") = 0, arg("max_imfs") = 0, arg("max_sifts") = 0, arg("s_number") = 4,
+        arg("fixed_sifts") = 10, arg("sd") = 0.2, arg("noise_scaling") = "colominas2014",
+        arg("bound") = "energy", arg("band") = 0.99, arg("noise_stages") = 3,
+        arg("noise_realisations") = py::none());
+  m.def("allan", &gp::Allan, arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = "rate",
+        arg("dev") = "oadev", arg("taus") = "octave", arg("units") = "dph",
+        arg("confidence") = 0.683, arg("threads") = 0, arg("fit_tau_min") = 0.0,
+        arg("fit_tau_max") = std::numeric_limits<double>::infinity());
+  m.def("noise_terms", &gp::NoiseTerms, arg("tau_s"), arg("adev_dph"), arg("edf"), py::kw_only(),
+        arg("fit_tau_min") = 0.0, arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
+        arg("min_share") = 0.1, arg("significance") = 0.05, arg("sample_period_s") = 0.0);
+  m.def("simulate", &gp::Simulate, py::kw_only(), arg("duration") = py::none(),
+        arg("profile") = "chamber", arg("preset") = "navigation", arg("rate_hz") = 1.0,
+        arg("seed") = 1, arg("winding") = "", arg("asymmetry") = py::none(),
+        arg("input_rate_dph") = 0.0, arg("noise") = true);
+
+  py::class_<gp::PyDriftModel>(m, "DriftModel")
+      .def(py::init<>())
+      .def("fit", &gp::PyDriftModel::Fit, arg("y"), arg("temperature") = py::none(), py::kw_only(),
+           arg("mode") = "compensate", arg("method") = "auto", arg("decomposition") = "beemdan",
+           arg("lags") = py::none(), arg("hidden") = "auto", arg("rate_hz") = 1.0,
+           arg("thermal_features") = "auto", arg("time_constants") = std::vector<double>{},
+           arg("ensemble") = 100, arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
+           arg("nonlinear") = false, arg("reference_temperature") = py::none(),
+           arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
+           arg("source") = "python")
+      .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"))
+      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"))
+      .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
+           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal", arg("window") = 512,
+           arg("threads") = 0)
+      .def("save", &gp::PyDriftModel::Save, arg("path"))
+      .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
+      .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
+      .def_property_readonly("fitted", [](const gp::PyDriftModel& d) { return d.fitted_; })
+      .def_property_readonly("summary", &gp::PyDriftModel::Summary)
+      .def_property_readonly("sub_models", &gp::PyDriftModel::SubModels)
+      .def_property_readonly("mode", [](const gp::PyDriftModel& d) {
+        return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.mode));
+      })
+      .def_property_readonly("method", [](const gp::PyDriftModel& d) {
+        return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.method));
+      })
+      .def_property_readonly("target", [](const gp::PyDriftModel& d) {
+        return d.Loaded().info.target_column;
+      })
+      .def_property_readonly("temperature_columns", [](const gp::PyDriftModel& d) {
+        const std::string& t = d.Loaded().info.temperature_column;
+        return t.empty() ? std::vector<std::string>{} : gp::SplitColumns(t);
+      })
+      .def_property_readonly("temperature_range_c", [](const gp::PyDriftModel& d) {
+        return py::make_tuple(d.Loaded().model.temperature_min_c,
+                              d.Loaded().model.temperature_max_c);
+      });
+
+  m.def("calibrate", &gp::Calibrate, arg("manifest_path"), arg("output_dir"), py::kw_only(),
+        arg("force") = false, arg("threads") = 0);
+  m.def("_calibrate_unit", &gp::CalibrateUnit, arg("manifest_path"), arg("index"),
+        arg("output_dir"), arg("force") = false);
+  m.def("_finish_fleet", &gp::FinishFleet, arg("manifest_path"), arg("output_dir"), arg("units"),
+        arg("seconds"));
+  m.def("_manifest_serials", [](const std::string& path) {
+    std::vector<std::string> serials;
+    for (const auto& u : gp::LoadManifest(path).units) serials.push_back(u.serial);
+    return serials;
+  }, arg("path"));
+}

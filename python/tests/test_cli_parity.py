@@ -1,0 +1,139 @@
+"""The Python API and the CLI give the same numbers, to the bit, for the same inputs and options:
+simulate, decompose, allan, fit + compensate (and the model file itself)."""
+
+import numpy as np
+import pytest
+
+import gyrodrift as gd
+from conftest import read_csv, read_json, same_bits, write_csv
+
+
+@pytest.fixture(scope="module")
+def sim_csv(cli, tmp_path_factory):
+    """A 2-hour simulated log written by the CLI (the same seed is simulated in Python below)."""
+    path = tmp_path_factory.mktemp("parity") / "sim.csv"
+    cli("simulate", "--duration", "2h", "--seed", "7", "-q", "-o", path)
+    return path
+
+
+def test_simulate_matches_cli(sim_csv):
+    logged = read_csv(sim_csv)
+    sim = gd.simulate(duration=7200, seed=7)
+    for name in ("time_s", "rate_dph", "temperature_c"):
+        assert np.array_equal(sim[name], logged[name]), name
+    for name in ("drift_dph", "shupe_dph", "stress_dph", "bias_dph", "noise_dph"):
+        assert np.array_equal(sim["truth"][name], logged[name]), name
+
+
+@pytest.mark.parametrize("method,extra", [("beemdan", ["--ensemble", "20"]),
+                                          ("emd", []),
+                                          ("ceemdan", ["--ensemble", "10", "--stop", "snumber"])])
+def test_decompose_matches_cli(cli, tmp_path, method, extra):
+    rng = np.random.default_rng(11)
+    t = np.arange(3000.0)
+    x = np.sin(t / 17.0) + 0.3 * np.sin(t / 3.1) + 0.2 * rng.standard_normal(t.size) + 1e-3 * t
+    write_csv(tmp_path / "x.csv", {"x": x})
+    cli("decompose", tmp_path / "x.csv", "-c", "x", "--method", method, "--seed", "5",
+        "-j", "2", "-q", *extra, "-o", tmp_path / "imfs.csv")
+    out = read_csv(tmp_path / "imfs.csv")
+    side = read_json(tmp_path / "imfs.csv.json")["report"]
+
+    kw = dict(ensemble=int(extra[1])) if extra else {}
+    if "--stop" in extra:
+        kw["stop"] = "snumber"
+    imfs, residue, report = gd.decompose(x, method=method, seed=5, threads=1, **kw)
+    assert imfs.shape == (x.size, side["imfs"])
+    for k in range(imfs.shape[1]):
+        assert np.array_equal(imfs[:, k], out[f"imf{k + 1}"]), f"imf{k + 1}"
+    assert np.array_equal(residue, out["residue"])
+    for key in ("summary", "sifts_per_imf", "sift_cap_hits", "noise_assisted_stages",
+                "stop_reason", "seed", "ensemble_size"):
+        assert report[key] == side[key], key
+    assert same_bits(report["mode_log2_energy"], side["mode_log2_energy"])
+
+
+@pytest.mark.parametrize("dev,taus", [("oadev", "octave"), ("mdev", "decade"),
+                                      ("totdev", "1,4,16,64")])
+def test_allan_matches_cli(cli, sim_csv, tmp_path, dev, taus):
+    cli("allan", sim_csv, "-c", "rate_dph", "--rate-hz", "1", "--dev", dev, "--taus", taus,
+        "-q", "-o", tmp_path / "a.csv")
+    out = read_csv(tmp_path / "a.csv")
+    side = read_json(tmp_path / "a.csv.json")
+
+    x = read_csv(sim_csv)["rate_dph"]
+    grid = taus if not taus[0].isdigit() else [float(v) for v in taus.split(",")]
+    r = gd.allan(x, rate_hz=1.0, dev=dev, taus=grid, threads=2)
+    for key in ("tau_s", "dev", "dev_lo", "dev_hi", "n_terms"):
+        assert np.array_equal(np.asarray(r[key], dtype=float), out[key]), key
+    assert same_bits(r["edf"], [p["edf"] for p in side["points"]])
+    assert list(r["alpha"]) == [p["alpha"] for p in side["points"]]
+    assert r["summary"] == side["summary"] and r["dev_unit"] == side["dev_unit"]
+    terms, side_terms = r["noise_terms"], side["noise_terms"]
+    assert terms["source_dev"] == side_terms["source_dev"]
+    assert terms["summary"] == side_terms["summary"]
+    for name in "QNBKR":
+        for field in ("value", "sigma", "identified", "evidence_chi2", "slope_reading"):
+            assert same_bits(terms[name][field], side_terms[name][field]), (name, field)
+
+
+def test_noise_terms_of_a_bare_curve_match_the_result_fit(sim_csv):
+    x = read_csv(sim_csv)["rate_dph"]
+    r = gd.allan(x, rate_hz=1.0)
+    bare = gd.noise_terms(r["tau_s"], r["dev"], r["edf"], sample_period_s=1.0)
+    assert bare["N"]["identified"]
+    for name in "QNBKR":
+        assert same_bits(bare[name]["value"], r["noise_terms"][name]["value"]), name
+
+
+def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
+    cli("fit", sim_csv, "--target", "rate_dph", "--temperature", "temperature_c",
+        "--mode", "compensate", "--seed", "3", "-j", "2", "-q", "-o", tmp_path / "cli_model.json")
+    cli("compensate", tmp_path / "cli_model.json", sim_csv, "-q", "-o", tmp_path / "comp.csv")
+    comp = read_csv(tmp_path / "comp.csv")
+
+    log = read_csv(sim_csv)
+    y, temperature = log["rate_dph"], log["temperature_c"]
+    model = gd.DriftModel().fit(y, temperature, mode="compensate", seed=3, threads=2,
+                                target="rate_dph", temperature_columns=["temperature_c"],
+                                source=str(sim_csv))
+    assert model.method == "thermal" and model.mode == "compensate"
+    # The model file is the CLI's, byte for byte (same options, threads included as the file
+    # records them, same source, same doubles).
+    model.save(tmp_path / "py_model.json")
+    assert (tmp_path / "py_model.json").read_bytes() == (tmp_path / "cli_model.json").read_bytes()
+
+    estimate, sd = model.estimate(temperature)
+    assert np.array_equal(estimate, comp["drift_est"])
+    assert np.array_equal(sd, comp["drift_sd"])
+    assert np.array_equal(model.compensate(temperature, y), comp["compensated"])
+    # And the CLI's file, loaded in Python, compensates the same.
+    loaded = gd.DriftModel.load(tmp_path / "cli_model.json")
+    assert loaded.summary == model.summary
+    assert np.array_equal(loaded.compensate(temperature, y), comp["compensated"])
+    thermal = loaded.sub_models[0]["thermal"]
+    assert thermal is not None
+    assert len(thermal["regressors"]) == len(thermal["coefficients"]) == len(thermal["sd"])
+    assert any("temperature_c" in name for name in thermal["regressors"])
+    assert np.all(np.isfinite(thermal["sd"]))
+
+
+def test_two_axis_model_file_matches_cli(cli, tmp_path):
+    # Two axes of one IMU: the simulator's output and a second unit's, each with its own sensor.
+    a, b = gd.simulate(duration=3600, seed=1), gd.simulate(duration=3600, seed=2, preset="tactical")
+    write_csv(tmp_path / "imu.csv", {"time_s": a["time_s"], "gyro_x": a["rate_dph"],
+                                     "gyro_y": b["rate_dph"], "temp_x": a["temperature_c"],
+                                     "temp_y": b["temperature_c"]})
+    cli("fit", tmp_path / "imu.csv", "--target", "gyro_x,gyro_y", "--temperature", "temp_x,temp_y",
+        "--mode", "compensate", "-j", "1", "-q", "-o", tmp_path / "cli.json")
+    both = np.column_stack([a["temperature_c"], b["temperature_c"]])
+    models = [gd.DriftModel().fit(y, both, target=name, temperature_columns=["temp_x", "temp_y"],
+                                  threads=1, source=str(tmp_path / "imu.csv"))
+              for name, y in (("gyro_x", a["rate_dph"]), ("gyro_y", b["rate_dph"]))]
+    gd.DriftModel.save_axes(tmp_path / "py.json", models)
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    axes = gd.DriftModel.load_axes(tmp_path / "cli.json")
+    assert [m.target for m in axes] == ["gyro_x", "gyro_y"]
+    assert axes[1].temperature_columns == ["temp_x", "temp_y"]
+    with pytest.raises(gd.UsageError, match="2 axes"):
+        gd.DriftModel.load(tmp_path / "cli.json")
+    assert gd.DriftModel.load(tmp_path / "cli.json", axis="gyro_y").summary == models[1].summary
