@@ -2,6 +2,7 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -68,6 +69,20 @@ nlohmann::json OptionsJson(const DecomposeArgs& a, const dec::DecompositionOptio
   };
 }
 
+// Beyond this many samples a decomposition does not fit in the memory of a workstation: the
+// IMFs alone are 8 bytes x samples x (about log2(samples) modes), and sifting keeps a dozen
+// working vectors of the signal's length per thread (measured peaks in docs/errors.md).
+constexpr Eigen::Index kMaxDecomposeSamples = 20'000'000;
+
+void RequireDecomposableSize(const std::string& name, Eigen::Index samples) {
+  if (samples > kMaxDecomposeSamples) {
+    throw DataError(fmt::format(
+        "{} has {} samples: decompose takes at most {} (memory grows with samples x modes; "
+        "decimate or split the log)",
+        name, samples, kMaxDecomposeSamples));
+  }
+}
+
 void Run(const DecomposeArgs& a) {
   RequireOutputsAreNotInputs({a.input, a.noise_file}, {a.output, SidecarPath(a.output)});
   dec::DecompositionOptions o;
@@ -88,11 +103,16 @@ void Run(const DecomposeArgs& a) {
   o.noise_stages = a.noise_stages;
   o.Validate();  // option errors before any file is read
 
+  // The table (every column of the log) is dropped once the one column is out.
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
-  const Eigen::VectorXd x = table.Column(a.column);
-  RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", x,
-                       "it has no oscillation to decompose");
+  const Eigen::VectorXd x = [&] {
+    const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
+    Eigen::VectorXd column = table.Column(a.column);
+    const std::string name = "column '" + ColumnName(table, a.column) + "'";
+    RequireVaryingSignal(name, column, "it has no oscillation to decompose");
+    RequireDecomposableSize(name, column.size());
+    return column;
+  }();
   if (!a.noise_file.empty()) {
     if (o.method == dec::Method::kEmd) {
       throw UsageError("--noise-file = " + a.noise_file + ": must not be given with --method emd");
@@ -112,11 +132,12 @@ void Run(const DecomposeArgs& a) {
     d = dec::Decompose(x, o);
   }
 
-  std::vector<io::CsvColumn> columns;
+  // Streamed from the decomposition itself: the text of 1e7 samples is gigabytes.
+  std::vector<io::CsvColumnView> columns;
   for (int k = 0; k < d.num_imfs(); ++k) {
-    columns.push_back({"imf" + std::to_string(k + 1), d.imfs.col(k)});
+    columns.push_back({"imf" + std::to_string(k + 1), d.imfs.col(k).data(), d.imfs.rows()});
   }
-  columns.push_back({"residue", d.residue});
+  columns.push_back({"residue", d.residue.data(), d.residue.size()});
   nlohmann::json sidecar = SidecarHeader("decompose");
   sidecar["options"] = OptionsJson(a, o);
   sidecar["samples"] = x.size();
@@ -134,8 +155,12 @@ void Run(const DecomposeArgs& a) {
       {"mode_log2_energy", d.report.mode_log2_energy},
       {"noise_band_log2_upper", d.report.noise_band_log2_upper},
   };
-  io::WriteFilesAtomically(
-      {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
+  const std::string sidecar_text = sidecar.dump(2) + "\n";
+  io::WriteStreamedFilesAtomically({
+      {a.output, [&](std::FILE* out) { io::WriteCsvTo(out, columns); }},
+      {SidecarPath(a.output), [&](std::FILE* out) {
+         std::fwrite(sidecar_text.data(), 1, sidecar_text.size(), out);
+       }}});
   if (!a.quiet)
     fmt::print("{}{}\nwrote {} and {}\n", notes, d.report.Summary(), a.output, SidecarPath(a.output));
 }

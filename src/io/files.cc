@@ -1,5 +1,6 @@
 #include "gyrodrift/io/files.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -7,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -25,11 +27,69 @@ std::string ReadTextFile(const std::string& path) {
   return buffer.str();
 }
 
+namespace {
+
+// "<name>.tmp.<pid>" or "<name>.bak.<pid>" -> pid; 0 for anything else.
+pid_t TemporaryOwner(const std::string& entry, const std::string& name) {
+  for (const char* kind : {".tmp.", ".bak."}) {
+    const std::string prefix = name + kind;
+    if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = entry.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return 0;
+    return static_cast<pid_t>(std::stol(digits));
+  }
+  return 0;
+}
+
+// Removes the temporaries and backups of these targets left by writers that were killed (their
+// process is gone), so that stale copies do not pile up beside the outputs. A temporary of a
+// writer that still runs is left alone; so is anything not of our own naming pattern.
+void RemoveStaleTemporaries(const std::vector<std::string>& targets) {
+  namespace fs = std::filesystem;
+  std::map<fs::path, std::set<std::string>> names_by_folder;
+  for (const std::string& target : targets) {
+    const fs::path p(target);
+    names_by_folder[p.parent_path()].insert(p.filename().string());
+  }
+  std::vector<fs::path> stale;
+  for (const auto& [folder, names] : names_by_folder) {
+    std::error_code ec;
+    fs::directory_iterator it(folder.empty() ? fs::path(".") : folder, ec), end;
+    for (; !ec && it != end; it.increment(ec)) {
+      const std::string entry = it->path().filename().string();
+      pid_t owner = 0;
+      for (const std::string& name : names) {
+        if ((owner = TemporaryOwner(entry, name)) > 0) break;
+      }
+      if (owner <= 0 || owner == ::getpid()) continue;
+      if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+      stale.push_back(it->path());
+    }
+  }
+  for (const fs::path& path : stale) {
+    std::error_code ignored;
+    fs::remove(path, ignored);
+  }
+}
+
+}  // namespace
+
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<StreamedFile> streamed;
+  streamed.reserve(files.size());
+  for (const auto& [path, contents] : files) {
+    streamed.push_back({path, [&contents = contents](std::FILE* out) {
+                          std::fwrite(contents.data(), 1, contents.size(), out);
+                        }});
+  }
+  WriteStreamedFilesAtomically(streamed);
+}
+
+void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files) {
   namespace fs = std::filesystem;
   // Refuse what would fail half-way through the renames: a target named twice, or a directory.
   std::set<fs::path> targets;
-  for (const auto& [path, contents] : files) {
+  for (const auto& [path, write] : files) {
     std::error_code ec;
     const fs::path key = fs::weakly_canonical(fs::path(path), ec);
     if (!targets.insert(ec ? fs::path(path) : key).second) {
@@ -44,7 +104,12 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
   auto remove_temps = [&] {
     for (const auto& t : temps) std::remove(t.c_str());
   };
-  for (const auto& [path, contents] : files) {
+  {
+    std::vector<std::string> targets;
+    for (const auto& file : files) targets.push_back(file.path);
+    RemoveStaleTemporaries(targets);
+  }
+  for (const auto& [path, write] : files) {
     const std::string temp = path + ".tmp" + suffix;
     std::FILE* f = std::fopen(temp.c_str(), "wb");
     if (!f) {
@@ -53,7 +118,14 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
       throw IoError(path + ": cannot open for writing (" + reason + ")");
     }
     temps.push_back(temp);
-    const bool ok = std::fwrite(contents.data(), 1, contents.size(), f) == contents.size();
+    try {
+      write(f);
+    } catch (...) {
+      std::fclose(f);
+      remove_temps();
+      throw;
+    }
+    const bool ok = std::ferror(f) == 0;
     if (std::fclose(f) != 0 || !ok) {
       remove_temps();
       throw IoError(path + ": write failed (disk full?)");
@@ -71,7 +143,7 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
   };
   if (set) {
     for (size_t i = 0; i < files.size(); ++i) {
-      const std::string& target = files[i].first;
+      const std::string& target = files[i].path;
       std::error_code ec;
       if (!fs::exists(fs::symlink_status(target, ec))) continue;
       const std::string backup = target + ".bak" + suffix;
@@ -88,12 +160,12 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
     }
   }
   for (size_t i = 0; i < files.size(); ++i) {
-    const std::string& target = files[i].first;
+    const std::string& target = files[i].path;
     if (std::rename(temps[i].c_str(), target.c_str()) == 0) continue;
     const std::string reason = std::strerror(errno);
     std::string restore_failed;
     for (size_t j = 0; j < i; ++j) {
-      const std::string& placed = files[j].first;
+      const std::string& placed = files[j].path;
       const bool ok = backups[j].empty() ? std::remove(placed.c_str()) == 0
                                          : std::rename(backups[j].c_str(), placed.c_str()) == 0;
       if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + placed;

@@ -1,6 +1,7 @@
 // gyrodrift decompose, run as a user would: outputs, the sidecar, and every bad-input case.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "gyrodrift/io/csv.h"
@@ -124,6 +125,24 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
         test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
+}
+
+TEST_F(DecomposeCli, RefusesMoreSamplesThanFitInMemory) {
+  // One sample over the limit (docs/errors.md): a data error before any sifting, with the count.
+  std::string csv = "x\n";
+  const int n = 20'000'001;
+  csv.reserve(static_cast<size_t>(2 * n + 2));
+  for (int i = 0; i < n; ++i) csv += (i % 2 ? "1\n" : "2\n");
+  const std::string big = dir_ + "/big.csv";
+  io::WriteFileAtomically(big, csv);
+  csv.clear();
+  csv.shrink_to_fit();
+  const std::string out = dir_ + "/big_imfs.csv";
+  const test::CommandResult r =
+      test::RunCli("decompose '" + big + "' -c x --method emd -o '" + out + "'");
+  test::ExpectCleanFailure(r, 3, "has 20000001 samples: decompose takes at most 20000000", out,
+                           "20000001 samples");
+  std::filesystem::remove(big);
 }
 
 TEST(Cli, HelpShowsWorkedExamples) {

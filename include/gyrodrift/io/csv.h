@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,5 +69,17 @@ std::string FormatDouble(double value);
 void WriteCsv(const std::string& path, const std::vector<CsvColumn>& columns);
 // Renders the same text as WriteCsv without touching the file system.
 std::string RenderCsv(const std::vector<CsvColumn>& columns);
+
+// A named column of `rows` contiguous doubles owned by the caller: a large table (a
+// decomposition's N x K matrix, one column each) is streamed to a file without a copy.
+struct CsvColumnView {
+  std::string name;
+  const double* values = nullptr;
+  Eigen::Index rows = 0;
+};
+// Writes the text RenderCsv gives for the same columns to `out`, a block at a time (memory is
+// independent of the table's size). Throws DataError for columns of different lengths; a write
+// error is left on `out` (see io::StreamedFile).
+void WriteCsvTo(std::FILE* out, const std::vector<CsvColumnView>& columns);
 
 }  // namespace gyrodrift::io

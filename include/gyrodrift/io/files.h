@@ -3,8 +3,15 @@
 // An output set (a CSV and its JSON sidecar, say) is committed with one AtomicWriteSet: every file
 // is written to a temporary beside its target first, and only when all are written are they
 // renamed into place, so a failure leaves no partial output.
+//
+// Temporaries are named <target>.tmp.<pid> (and, while a set is renamed, backups
+// <target>.bak.<pid>), beside their targets. A process killed by SIGKILL (or a power cut) cannot
+// remove them; they never carry a target's name, and the next write of the same target removes
+// those whose process no longer runs.
 #pragma once
 
+#include <cstdio>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,5 +29,15 @@ std::string ReadTextFile(const std::string& path);
 // says so if a restore itself failed).
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
+
+// One file of an output set whose contents are streamed into the temporary file by `write`
+// rather than held in memory (a decomposition of 1e7 samples renders to gigabytes of text).
+// `write` may throw; a write error on the stream is caught after it returns.
+struct StreamedFile {
+  std::string path;
+  std::function<void(std::FILE* out)> write;
+};
+// As above, with the same guarantees.
+void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files);
 
 }  // namespace gyrodrift::io

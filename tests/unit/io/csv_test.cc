@@ -1,9 +1,14 @@
 #include "gyrodrift/io/csv.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
@@ -25,7 +30,10 @@ TEST(CsvTable, TabAndSemicolonFilesAreReadWhenTheHeaderHasNoComma) {
   const CsvTable tab = CsvTable::Parse("time_s\trate_dph\n0\t1.5\n1\t-2\n", "tab");
   EXPECT_EQ(tab.header(), (std::vector<std::string>{"time_s", "rate_dph"}));
   EXPECT_EQ(tab.Column("rate_dph"), (Eigen::VectorXd(2) << 1.5, -2.0).finished());
-  const CsvTable semi = CsvTable::Parse("\xEF\xBB\xBFa;b\r\n1;2\r\n3;4\r\n", "semi");
+  // The BOM literal ends before "a": "\xBFa" would be one (out of range) hex escape, and the
+  // file would start with a garbled byte instead of a byte-order mark.
+  const CsvTable semi = CsvTable::Parse("\xEF\xBB\xBF" "a;b\r\n1;2\r\n3;4\r\n", "semi");
+  EXPECT_EQ(semi.header(), (std::vector<std::string>{"a", "b"}));
   EXPECT_EQ(semi.Column("b"), (Eigen::VectorXd(2) << 2.0, 4.0).finished());
   // Decimal commas are not read: the cell is named, not silently split.
   const CsvTable decimal = CsvTable::Parse("a;b\n1,5;2\n", "decimal");
@@ -111,6 +119,60 @@ TEST(Files, FailedSetLeavesNothingBehind) {
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 3);  // old.txt, other.txt, sub
+}
+
+TEST(Csv, StreamedTextEqualsRenderedText) {
+  const std::string dir = test::TempDir("csv_streamed");
+  // Enough rows for several 1-MiB blocks.
+  const Eigen::Index n = 120000;
+  Eigen::MatrixXd m(n, 3);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    m(r, 0) = r * 0.1;
+    m(r, 1) = std::sin(r * 1e-3) / 3.0;
+    m(r, 2) = -1e-300 * r;
+  }
+  const std::string path = dir + "/s.csv";
+  WriteStreamedFilesAtomically({{path, [&](std::FILE* out) {
+                                   WriteCsvTo(out, {{"a", m.col(0).data(), n},
+                                                    {"b", m.col(1).data(), n},
+                                                    {"c", m.col(2).data(), n}});
+                                 }}});
+  const std::string text = ReadTextFile(path);
+  EXPECT_GT(text.size(), size_t{3} << 20);
+  EXPECT_TRUE(text == RenderCsv({{"a", m.col(0)}, {"b", m.col(1)}, {"c", m.col(2)}}));
+  // Columns of different lengths: a DataError, and the previous file stays as it was.
+  EXPECT_THROW(WriteStreamedFilesAtomically({{path, [&](std::FILE* out) {
+                                                WriteCsvTo(out, {{"a", m.col(0).data(), n},
+                                                                 {"b", m.col(1).data(), n - 1}});
+                                              }}}),
+               DataError);
+  EXPECT_TRUE(ReadTextFile(path) == text);
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 1);
+}
+
+TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
+  const std::string dir = test::TempDir("atomic_stale");
+  // A pid that no longer runs: a child that has exited and been reaped.
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = std::to_string(child);
+  const std::string alive = std::to_string(::getppid());
+  const std::vector<std::string> stale = {"x.csv.tmp." + dead, "x.csv.bak." + dead};
+  const std::vector<std::string> kept = {
+      "x.csv.tmp." + alive,  // a writer that still runs
+      "y.csv.tmp." + dead,   // another target's: that write cleans it
+      "x.csv.tmp.12ab",      // not our naming pattern
+      "x.csv.old"};
+  for (const auto& name : stale) WriteFileAtomically(dir + "/" + name, "partial");
+  for (const auto& name : kept) WriteFileAtomically(dir + "/" + name, "other");
+  WriteFileAtomically(dir + "/x.csv", "complete");
+  EXPECT_EQ(ReadTextFile(dir + "/x.csv"), "complete");
+  for (const auto& name : stale) EXPECT_FALSE(test::FileExists(dir + "/" + name)) << name;
+  for (const auto& name : kept) EXPECT_EQ(ReadTextFile(dir + "/" + name), "other") << name;
 }
 
 }  // namespace
