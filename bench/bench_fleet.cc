@@ -53,7 +53,7 @@ void BM_CalibrateUnit(benchmark::State& state) {
     m.axes.push_back({std::string("gyro_") + a, {std::string("temp_") + a},
                       std::string("drift_") + a, 0});
   }
-  m.units.push_back({"SN-1", dir + "/cal.csv", {dir + "/ver.csv"}, 0});
+  m.units.push_back({"SN-1", {dir + "/cal.csv"}, {dir + "/ver.csv"}, 0});
   const io::DygraphsAssets assets = io::LoadDygraphs();
   for (auto _ : state) {
     const fleet::UnitOutputs out = fleet::CalibrateUnit(m, m.units[0], assets);

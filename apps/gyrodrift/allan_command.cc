@@ -32,7 +32,7 @@ struct AllanArgs {
   int threads = 0;
   double fit_tau_min_s = 0.0;
   double fit_tau_max_s = INFINITY;
-  std::string gaps = "error";  // io::GapPolicy
+  LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
 
@@ -111,7 +111,7 @@ void Run(const AllanArgs& a) {
   fit_options.Validate();  // every option error before any file is read
 
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
+  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
   const Eigen::VectorXd data = table.Column(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
                        "its Allan deviation is zero at every tau (a logging fault?)");
@@ -269,7 +269,7 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
   cmd->add_option("--fit-tau-min", args->fit_tau_min_s, "noise fit: smallest tau in s")
       ->capture_default_str();
   cmd->add_option("--fit-tau-max", args->fit_tau_max_s, "noise fit: largest tau in s");
-  AddGapsOption(cmd, &args->gaps);
+  AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

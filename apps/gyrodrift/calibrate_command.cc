@@ -30,8 +30,7 @@ void Run(const CalibrateArgs& a) {
   const fleet::Manifest manifest = fleet::ReadManifest(a.manifest);
   std::vector<std::string> inputs = {a.manifest};
   for (const fleet::UnitSpec& u : manifest.units) {
-    inputs.push_back(u.calibration);
-    inputs.insert(inputs.end(), u.verification.begin(), u.verification.end());
+    for (const std::string& log : u.Logs()) inputs.push_back(log);
   }
   RequireInputsOutsideFolder(inputs, a.output);
   fleet::CheckLogColumns(manifest);  // every column of every log, before any unit is fitted

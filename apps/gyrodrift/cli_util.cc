@@ -169,18 +169,31 @@ double ParseDuration(const std::string& text) {
   ThrowOption("--duration", text, "a positive duration such as 30s, 10min, 8h or plain seconds");
 }
 
-void AddGapsOption(CLI::App* cmd, std::string* gaps) {
-  cmd->add_option("--gaps", *gaps,
-                  "a time_s step of 1.5 median steps or more (missing samples): error (refuse, "
-                  "naming the row) | interpolate (fill every column linearly; the rows are kept "
-                  "in the outputs)")
-      ->check(CLI::IsMember({"error", "interpolate"}))
+io::LogOptions LogArgs::Options() const {
+  return {io::GapPolicyFromString(gaps), io::DelimiterFromString(delimiter)};
+}
+
+void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split) {
+  std::string help =
+      "a time_s step of 1.5 median steps or more (missing samples): error (refuse, naming the "
+      "row) | interpolate (fill every column linearly; the rows are kept in the outputs)";
+  std::vector<std::string> choices{"error", "interpolate"};
+  if (split) {
+    help += " | split (keep the rows; the thermal model's lag states restart after each gap)";
+    choices.push_back("split");
+  }
+  cmd->add_option("--gaps", log->gaps, help)->check(CLI::IsMember(choices))->capture_default_str();
+  cmd->add_option("--delimiter", log->delimiter,
+                  "cell delimiter: auto (a comma where the header has one, else a tab, else a "
+                  "semicolon) | comma | tab | semicolon")
+      ->check(CLI::IsMember({"auto", "comma", "tab", "semicolon"}))
       ->capture_default_str();
 }
 
-io::CsvTable ReadLog(const std::string& path, const std::string& gaps, std::string* notes) {
+io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
+                     std::vector<Eigen::Index>* record_starts) {
   std::string note;
-  io::CsvTable table = io::ReadLog(path, io::GapPolicyFromString(gaps), &note);
+  io::CsvTable table = io::ReadLog(path, log.Options(), &note, record_starts);
   if (!note.empty()) *notes += note + "\n";
   return table;
 }

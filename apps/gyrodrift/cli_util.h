@@ -54,11 +54,20 @@ using io::NonUniformTimeNote;
 using io::ReadLog;
 using io::ResolveSampleRate;
 
-// --gaps error|interpolate (io::GapPolicy), default error.
-void AddGapsOption(CLI::App* cmd, std::string* gaps);
-// ReadLog under the --gaps choice; the note on filled gaps, if any, is appended (with a newline)
-// to *notes.
-io::CsvTable ReadLog(const std::string& path, const std::string& gaps, std::string* notes);
+// How a command reads its log: --gaps (io::GapPolicy) and --delimiter (io::Delimiter).
+struct LogArgs {
+  std::string gaps = "error";
+  std::string delimiter = "auto";
+  io::LogOptions Options() const;
+  bool Given() const { return gaps != "error" || delimiter != "auto"; }
+};
+// --gaps error|interpolate, and split where the command takes several records (`split`), and
+// --delimiter auto|comma|tab|semicolon.
+void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split);
+// ReadLog under those choices; the note on filled or split gaps, if any, is appended (with a
+// newline) to *notes; record_starts as io::ReadLog's.
+io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
+                     std::vector<Eigen::Index>* record_starts = nullptr);
 
 // The one-line message for an option error: the library names its field (`ensemble_size = 0:
 // must be ...`); when the user gave the subcommand's flag that sets that field, the message

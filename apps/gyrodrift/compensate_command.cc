@@ -22,7 +22,7 @@ struct CompensateArgs {
   std::string input;
   std::string output;
   std::string truth;  // "" = none
-  std::string gaps = "error";  // io::GapPolicy
+  LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
 
@@ -40,13 +40,14 @@ struct AxisResult {
 
 // `suffix` is "" for a one-axis model (drift_est, drift_sd, compensated), "_<target>" otherwise.
 AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& table,
+                          const std::vector<Eigen::Index>& record_starts,
                           const Eigen::VectorXd& truth, const std::string& truth_column,
                           const std::string& suffix) {
   const drift::DriftModel& model = loaded.model;
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   const Eigen::MatrixXd temperature =
       ReadColumns(table, loaded.info.temperature_column, "--temperature").values;
-  const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature);
+  const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature, record_starts);
   const Eigen::VectorXd estimate = estimate_sd.col(0);
   const Eigen::VectorXd compensated = y - estimate;
 
@@ -121,7 +122,8 @@ void Run(const CompensateArgs& a) {
     }
   }
   std::string text;  // the console report, notes first
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &text);
+  std::vector<Eigen::Index> record_starts;  // --gaps split: the estimate restarts after each gap
+  const io::CsvTable table = ReadLog(a.input, a.log, &text, &record_starts);
   for (const io::LoadedModel& axis : axes) RequireModelColumns(axis, table);
   std::vector<std::string> suffixes;
   for (const io::LoadedModel& axis : axes) {
@@ -150,9 +152,9 @@ void Run(const CompensateArgs& a) {
     columns.push_back({table.header()[static_cast<size_t>(c)], table.Column(c)});
   }
   nlohmann::json sidecar = SidecarHeader("compensate");
-  sidecar["options"] = {{"model", a.model}, {"input", a.input}, {"gaps", a.gaps}};
+  sidecar["options"] = {{"model", a.model}, {"input", a.input}, {"gaps", a.log.gaps}, {"records", record_starts.size() + 1}};
   for (size_t i = 0; i < axes.size(); ++i) {
-    AxisResult r = CompensateAxis(axes[i], table, truth, truth_column, suffixes[i]);
+    AxisResult r = CompensateAxis(axes[i], table, record_starts, truth, truth_column, suffixes[i]);
     for (io::CsvColumn& column : r.columns) columns.push_back(std::move(column));
     // One axis: its fields at the top level (the layout of one-axis models); several: "axes".
     if (axes.size() == 1) {
@@ -197,7 +199,7 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
   cmd->add_option("--truth", args->truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "
                   "share of its RMS the estimate removes");
-  AddGapsOption(cmd, &args->gaps);
+  AddLogOptions(cmd, &args->log, /*split=*/true);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -40,7 +40,7 @@ struct DecomposeArgs {
   double band = 0.99;
   int noise_stages = 3;
   std::string noise_file;
-  std::string gaps = "error";  // io::GapPolicy
+  LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
 
@@ -106,7 +106,7 @@ void Run(const DecomposeArgs& a) {
   // The table (every column of the log) is dropped once the one column is out.
   std::string notes;
   const Eigen::VectorXd x = [&] {
-    const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
+    const io::CsvTable table = ReadLog(a.input, a.log, &notes);
     Eigen::VectorXd column = table.Column(a.column);
     const std::string name = "column '" + ColumnName(table, a.column) + "'";
     RequireVaryingSignal(name, column, "it has no oscillation to decompose");
@@ -218,7 +218,7 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--noise-file", args->noise_file,
                   "CSV of white-noise realisations (one per column) to use instead of drawing")
       ->check(kInputFile);
-  AddGapsOption(cmd, &args->gaps);
+  AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -46,7 +46,7 @@ struct DemoArgs {
   std::string methods = "all";
   std::uint64_t seed = 1;
   int threads = 0;
-  std::string gaps = "error";  // io::GapPolicy, for --input
+  LogArgs log;  // --gaps, --delimiter
   CLI::Option* units_option = nullptr;  // "--units given"
   bool quiet = false;
 };
@@ -84,7 +84,7 @@ study::StudyOptions MakeStudyOptions(const DemoArgs& a) {
 study::StudyLog ReadStudyLog(const DemoArgs& a) {
   const auto start = Clock::now();
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
+  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
   study::StudyLog log;
   log.source = a.input;
   log.output = table.Column(a.target);
@@ -132,8 +132,9 @@ void Run(const DemoArgs& a) {
   const bool user = !a.input.empty();
   // The simulated output is in deg/h: --units describes a user's log only.
   if (!user && (!a.target.empty() || !a.temperature.empty() || a.rate_option->count() > 0 ||
-                a.units_option->count() > 0 || a.gaps != "error")) {
-    throw UsageError("--target, --temperature, --rate-hz, --units and --gaps need --input FILE.csv");
+                a.units_option->count() > 0 || a.log.Given())) {
+    throw UsageError(
+        "--target, --temperature, --rate-hz, --units, --gaps and --delimiter need --input FILE.csv");
   }
   if (user && a.target.empty())
     throw UsageError("--input needs --target COL (the gyro output column)");
@@ -224,7 +225,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       ->check(kSeed);
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
-  AddGapsOption(cmd, &args->gaps);
+  AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
   cmd->add_option("--duration", args->duration,
                   "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")

@@ -36,8 +36,20 @@ std::string Columns(const io::CsvTable& table) {
 
 }  // namespace
 
-void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
-  cmd->add_option("input", a->input, "CSV file with a header row")->required()->check(kInputFile);
+void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
+  if (split_records) {
+    cmd->add_option("input", a->inputs,
+                    "CSV file(s) with a header row; several calibration logs (same columns and "
+                    "sample rate) are fitted as one run, the thermal model's lag states "
+                    "restarting at the start of each")
+        ->required()
+        ->check(kInputFile);
+  } else {
+    cmd->add_option("input", a->inputs, "CSV file with a header row")
+        ->required()
+        ->expected(1)
+        ->check(kInputFile);
+  }
   cmd->add_option("--target,-t", a->target,
                   "column of the gyro output (name or 1-based index); fit takes several, "
                   "comma-separated: one model per axis in one file")
@@ -93,7 +105,7 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a) {
                   "worker threads (0 = all cores); results do not "
                   "depend on it")
       ->capture_default_str();
-  AddGapsOption(cmd, &a->gaps);
+  AddLogOptions(cmd, &a->log, split_records);
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 

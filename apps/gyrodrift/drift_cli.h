@@ -13,12 +13,13 @@
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
+#include "cli_util.h"
 
 namespace gyrodrift::cli {
 
 // Options fit and evaluate share. Defaults are those of drift::DriftOptions.
 struct DriftArgs {
-  std::string input;
+  std::vector<std::string> inputs;  // fit takes several calibration logs, evaluate one
   std::string target;
   std::string temperature;  // "" = none; several columns comma-separated
   double reference_c = 0.0;
@@ -38,14 +39,15 @@ struct DriftArgs {
   std::vector<double> time_constants_s;   // empty = the library default
   std::uint64_t seed = 1;
   int threads = 0;
-  std::string gaps = "error";  // io::GapPolicy
+  LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
 
-// Adds input, --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
+// Adds the input(s) (several with `split_records`: fit's calibration logs, and --gaps split),
+// --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
 // --thermal-features, --time-constants, --ensemble, --realisations, --seed, --threads and
 // --quiet to cmd.
-void AddDriftOptions(CLI::App* cmd, DriftArgs* args);
+void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
 // DriftOptions from the arguments (method = `method`), before any file is read; the sample rate
 // is settled later by ResolveRateHz. Throws UsageError naming the option.

@@ -51,7 +51,7 @@ std::string TableCsv(const drift::EvaluationResult& result) {
 }
 
 void Run(const EvaluateArgs& a) {
-  RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
+  RequireOutputsAreNotInputs(a.inputs, {a.output, SidecarPath(a.output)});
   drift::DriftOptions base = MakeDriftOptions(a, drift::Method::kMsElm);
   drift::EvaluationOptions e;
   e.split = a.split;
@@ -68,7 +68,7 @@ void Run(const EvaluateArgs& a) {
   }
 
   std::string gap_note;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &gap_note);
+  const io::CsvTable table = ReadLog(a.inputs.front(), a.log, &gap_note);
   std::string rate_how;
   base.features.rate_hz = ResolveRateHz(a, table, &rate_how);
   const std::string target = ColumnName(table, a.target);
@@ -102,7 +102,7 @@ void Run(const EvaluateArgs& a) {
   for (auto m : e.methods) methods.push_back(drift::ToString(m));
   for (auto p : e.protocols) protocols.push_back(drift::ToString(p));
   nlohmann::json sidecar = SidecarHeader("evaluate");
-  sidecar["options"] = {{"input", a.input},
+  sidecar["options"] = {{"input", a.inputs.front()},
                         {"target_column", target},
                         {"temperature_column", temperature_column},
                         {"truth_column", truth_column},
@@ -182,7 +182,7 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       "Single models (elm, poly, svr, bp) never decompose, so their two rows are the same run.\n"
       "Writes table.csv\n"
       "(method,protocol,rmse,rmse_std,mae,max_abs,train_s,predict_s) and table.csv.json.");
-  AddDriftOptions(cmd, args.get());
+  AddDriftOptions(cmd, args.get(), /*split_records=*/false);
   cmd->add_option("--truth", args->truth, "column to score against (e.g. drift_dph)");
   cmd->add_option("--protocol", args->protocol, "paper|causal|both")->capture_default_str();
   cmd->add_option("--split", args->split, "training share of the record, in [0.1, 0.95]")

@@ -62,6 +62,9 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
   }
 }
 
+// Calibration logs fitted together agree on their sample rate to this share.
+constexpr double kSameRate = 0.01;
+
 struct FitArgs : DriftArgs {
   std::string method = "auto";
   std::string units = "dph";  // of the target column(s), recorded in the model file
@@ -78,7 +81,7 @@ drift::Method ResolveMethod(const FitArgs& a) {
 }
 
 void Run(const FitArgs& a) {
-  RequireOutputsAreNotInputs({a.input}, {a.output});
+  RequireOutputsAreNotInputs(a.inputs, {a.output});
   const drift::Method method = ResolveMethod(a);
   drift::DriftOptions o = MakeDriftOptions(a, method);
   const bool elm_based = method == drift::Method::kMsElm || method == drift::Method::kEmdElm ||
@@ -96,23 +99,58 @@ void Run(const FitArgs& a) {
                      "mode and to --method elm");
   }
 
-  std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
-  std::string rate_how;
-  o.features.rate_hz = ResolveRateHz(a, table, &rate_how);
-  // Every axis is fitted as if alone (same options, same seed): a file of several axes holds the
-  // models one-axis fits of each target would give.
-  const SelectedColumns targets = ReadColumns(table, a.target, "--target");
-  SelectedColumns temperature;
-  if (!a.temperature.empty()) {
-    temperature = ReadColumns(table, a.temperature, "--temperature");
-    for (const std::string& name : temperature.names) {
-      for (const std::string& target : targets.names) {
-        if (name == target) {
-          throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
-        }
+  // Several calibration logs (or one split at its gaps) become one run of several records.
+  std::string notes, rate_how, sources;
+  SelectedColumns targets, temperature;
+  std::vector<Eigen::Index> record_starts;
+  for (const std::string& input : a.inputs) {
+    std::vector<Eigen::Index> starts;
+    const io::CsvTable table = ReadLog(input, a.log, &notes, &starts);
+    std::string how;
+    const double rate_hz = ResolveRateHz(a, table, &how);
+    const std::string time_note = NonUniformTimeNote(table);
+    if (!time_note.empty()) notes += (a.inputs.size() > 1 ? input + ": " : "") + time_note + "\n";
+    SelectedColumns t = ReadColumns(table, a.target, "--target");
+    SelectedColumns c;
+    if (!a.temperature.empty()) c = ReadColumns(table, a.temperature, "--temperature");
+    if (sources.empty()) {
+      o.features.rate_hz = rate_hz;
+      rate_how = how;
+      targets = std::move(t);
+      temperature = std::move(c);
+    } else {
+      if (std::abs(rate_hz / o.features.rate_hz - 1.0) > kSameRate) {
+        throw DataError(fmt::format(
+            "{} is sampled at {:g} Hz, {} at {:g} Hz: calibration logs fitted together need one "
+            "sample rate (resample one, or pass --rate-hz if the time stamps are wrong)",
+            a.inputs.front(), o.features.rate_hz, input, rate_hz));
+      }
+      const Eigen::Index offset = targets.values.rows();
+      record_starts.push_back(offset);
+      for (const Eigen::Index start : starts) record_starts.push_back(offset + start);
+      starts.clear();
+      targets.values.conservativeResize(offset + t.values.rows(), Eigen::NoChange);
+      targets.values.bottomRows(t.values.rows()) = t.values;
+      if (c.values.size() > 0) {
+        temperature.values.conservativeResize(offset + c.values.rows(), Eigen::NoChange);
+        temperature.values.bottomRows(c.values.rows()) = c.values;
       }
     }
+    record_starts.insert(record_starts.end(), starts.begin(), starts.end());
+    sources += (sources.empty() ? "" : ",") + input;
+  }
+  for (const std::string& name : temperature.names) {
+    for (const std::string& target : targets.names) {
+      if (name == target) {
+        throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+      }
+    }
+  }
+  if (!record_starts.empty() && method != drift::Method::kThermal) {
+    throw UsageError(fmt::format(
+        "--method {}: several records ({}) are fitted by --method thermal only (a decomposition "
+        "or lags would run across the breaks)",
+        drift::ToString(method), a.inputs.size() > 1 ? "several input logs" : "--gaps split"));
   }
   const auto axes = static_cast<int>(targets.names.size());
   std::vector<io::LoadedModel> fitted;
@@ -121,7 +159,7 @@ void Run(const FitArgs& a) {
                          IsTerminal() && !a.quiet);
     for (int i = 0; i < axes; ++i) {
       io::LoadedModel axis;
-      axis.info.source = a.input;
+      axis.info.source = sources;
       axis.info.target_column = targets.names[static_cast<size_t>(i)];
       axis.info.temperature_column = temperature.joined;
       axis.info.rate_unit = a.units;
@@ -132,7 +170,8 @@ void Run(const FitArgs& a) {
       axis_options.progress = [&progress, &label](double fraction, const std::string& step) {
         progress.Update(fraction, label + ": " + step);
       };
-      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, axis_options);
+      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, axis_options,
+                                        record_starts);
       axis.model.options.progress = nullptr;
       fitted.push_back(std::move(axis));
     }
@@ -143,8 +182,6 @@ void Run(const FitArgs& a) {
     if (axes > 1) fmt::print("axis {}:\n", axis.info.target_column);
     PrintModel(axis, o);
   }
-  const std::string time_note = NonUniformTimeNote(table);
-  if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", o.features.rate_hz,
              rate_how == "time_s" ? "from the median step of time_s" : rate_how, notes, a.output);
 }
@@ -170,7 +207,7 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "(exact doubles, checksummed). Several targets (--target gyro_x,gyro_y,gyro_z) are fitted\n"
       "one by one with the same options into one model file, one model per axis.\n"
       "See docs/cli.md and docs/drift.md.");
-  AddDriftOptions(cmd, args.get());
+  AddDriftOptions(cmd, args.get(), /*split_records=*/true);
   cmd->add_option("--method,-m", args->method,
                   "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in predict mode, "
                   "thermal in compensate mode)")

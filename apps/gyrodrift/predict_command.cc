@@ -28,7 +28,7 @@ struct PredictArgs {
   int window = 512;
   int horizon = 1;
   int threads = 0;
-  std::string gaps = "error";  // io::GapPolicy
+  LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
 
@@ -51,7 +51,7 @@ void Run(const PredictArgs& a) {
   model.options.threads = a.threads;  // the thread count never changes the result
 
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.gaps, &notes);
+  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;
@@ -147,7 +147,7 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
       ->capture_default_str();
-  AddGapsOption(cmd, &args->gaps);
+  AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

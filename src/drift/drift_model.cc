@@ -302,7 +302,8 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
-                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                 const std::vector<Eigen::Index>& record_starts) {
   const DriftOptions& o = model.options;
   model.training_samples = fit_end;
   const size_t groups = model.sub_models.size();
@@ -313,7 +314,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-                               o.features.rate_hz, o.thermal, !o.linear_compensation, o.seed));
+                               o.features.rate_hz, o.thermal, !o.linear_compensation, o.seed,
+                               record_starts));
     }
     return;
   }
@@ -364,9 +366,19 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
 
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                         const DriftOptions& options) {
+                         const DriftOptions& options,
+                         const std::vector<Eigen::Index>& record_starts) {
   options.Validate();
+  if (!record_starts.empty() &&
+      !(options.mode == Mode::kCompensate && options.method == Method::kThermal)) {
+    throw UsageError(
+        "several records (calibration logs, or a log split at its gaps) are fitted by method "
+        "thermal in compensate mode only: method " + std::string(ToString(options.method)) +
+        " in " + std::string(ToString(options.mode)) +
+        " mode needs one uniform record (decompositions and lags run across a break)");
+  }
   RequireFiniteSignal("target", y, 32);
+  CheckRecordStarts(record_starts, y.size());
   RequireVaryingSignal("target", y, "there is nothing to model");
   if (options.uses_temperature()) {
     // Checked before the decomposition, which is the slow part.
@@ -384,7 +396,8 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decomposed = UsesDecomposition(options.method);
   if (options.progress)
     options.progress(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
-  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c);
+  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c,
+                        record_starts);
   if (prepared.model.uses_temperature()) {
     prepared.model.temperature_min_c = temperature_c.col(0).minCoeff();
     prepared.model.temperature_max_c = temperature_c.col(0).maxCoeff();
@@ -401,10 +414,21 @@ double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
 }
 
 Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
-                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
+                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                                    const std::vector<Eigen::Index>& record_starts) {
   if (model.options.mode != Mode::kCompensate) {
     throw UsageError(
         "model mode = predict: drift estimation needs a model fitted with --mode compensate");
+  }
+  if (!record_starts.empty()) {
+    // Every record on its own: each starts in equilibrium at its first temperature.
+    CheckRecordStarts(record_starts, temperature_c.rows());
+    Eigen::MatrixXd out(temperature_c.rows(), 2);
+    ForEachRecord(temperature_c.rows(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+      out.middleRows(begin, length) =
+          EstimateDriftWithSd(model, temperature_c.middleRows(begin, length));
+    });
+    return out;
   }
   const Eigen::Index n = temperature_c.rows();
   if (temperature_c.cols() != model.temperature_channels()) {
@@ -447,8 +471,9 @@ Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
 }
 
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
-                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c) {
-  return EstimateDriftWithSd(model, temperature_c).col(0);
+                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                              const std::vector<Eigen::Index>& record_starts) {
+  return EstimateDriftWithSd(model, temperature_c, record_starts).col(0);
 }
 
 namespace {

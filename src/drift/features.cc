@@ -28,6 +28,17 @@ constexpr double kQuadraticCentreC = 20.0;
 
 double FirstOrderLagGain(double tau_s, double dt_s) { return -std::expm1(-dt_s / tau_s); }
 
+void CheckRecordStarts(const std::vector<Eigen::Index>& record_starts, Eigen::Index n) {
+  Eigen::Index previous = 0;
+  for (const Eigen::Index start : record_starts) {
+    if (!(start > previous && start < n)) {
+      throw DataError("record starts must increase strictly within (0, " + std::to_string(n) +
+                      "): got " + std::to_string(start) + " after " + std::to_string(previous));
+    }
+    previous = start;
+  }
+}
+
 void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
                    double dt_s, Eigen::Ref<Eigen::VectorXd> out) {
   const double gain = FirstOrderLagGain(tau_s, dt_s);

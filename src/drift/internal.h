@@ -33,10 +33,11 @@ Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels);
 
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
-// identified sub-models read the temperature channels, N x C, instead).
+// identified sub-models read the temperature channels, N x C, instead, as records: features.h).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
-                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                 const std::vector<Eigen::Index>& record_starts = {});
 
 }  // namespace gyrodrift::drift::internal

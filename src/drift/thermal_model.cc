@@ -42,13 +42,17 @@ double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
   return std::sqrt((x.array() - x.mean()).square().mean());
 }
 
-// The state of `order` cascaded lags of t (and the lag before the last, for its rate).
+// The state of `order` cascaded lags of t (and the lag before the last, for its rate), every
+// lag restarting at each record's first sample.
 void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order, double dt_s,
-             Eigen::VectorXd& previous, Eigen::VectorXd& state) {
+             const std::vector<Eigen::Index>& record_starts, Eigen::VectorXd& previous,
+             Eigen::VectorXd& state) {
   state = t;
   for (int o = 0; o < order; ++o) {
     previous = state;
-    FirstOrderLag(previous, tau_s, dt_s, state);
+    ForEachRecord(t.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+      FirstOrderLag(previous.segment(begin, length), tau_s, dt_s, state.segment(begin, length));
+    });
   }
 }
 
@@ -57,9 +61,9 @@ void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order
 // `learn_range` the range is first set to the level's own (the calibration run).
 void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
                   int max_power, double dt_s, double centre, double scale, bool learn_range,
-                  Eigen::Ref<Eigen::MatrixXd> out) {
+                  const std::vector<Eigen::Index>& record_starts, Eigen::Ref<Eigen::MatrixXd> out) {
   Eigen::VectorXd previous, state;
-  StateOf(t, s.tau_s, order, dt_s, previous, state);
+  StateOf(t, s.tau_s, order, dt_s, record_starts, previous, state);
   const Eigen::ArrayXd z = (state.array() - centre) / scale;
   if (learn_range) {
     s.level_min = z.minCoeff();
@@ -155,7 +159,8 @@ std::string Format(const char* format, ...) {
 
 // Span of every channel, heating and cooling rates, ramps and dwells (channel 0 for the latter).
 void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
-                 const std::vector<ThermalSegment>& segments, CalibrationReport& report) {
+                 const std::vector<ThermalSegment>& segments,
+                 const std::vector<Eigen::Index>& record_starts, CalibrationReport& report) {
   const double dt = 1.0 / rate_hz;
   for (Eigen::Index c = 0; c < temperatures_c.cols(); ++c) {
     report.span_k.push_back(temperatures_c.col(c).maxCoeff() - temperatures_c.col(c).minCoeff());
@@ -167,17 +172,37 @@ void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double
       ++report.dwells;
     }
   }
-  Eigen::VectorXd smooth(temperatures_c.rows());
-  FirstOrderLag(temperatures_c.col(0), kRateSmoothingS, dt, smooth);
-  const Eigen::VectorXd rate = (temperatures_c.col(0) - smooth) * (60.0 / kRateSmoothingS);
-  report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
-  report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
+  ForEachRecord(temperatures_c.rows(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    const auto t = temperatures_c.col(0).segment(begin, length);
+    Eigen::VectorXd smooth(length);
+    FirstOrderLag(t, kRateSmoothingS, dt, smooth);
+    const Eigen::VectorXd rate = (t - smooth) * (60.0 / kRateSmoothingS);
+    report.max_heating_k_per_min = std::max(report.max_heating_k_per_min, rate.maxCoeff());
+    report.max_cooling_k_per_min = std::max(report.max_cooling_k_per_min, -rate.minCoeff());
+  });
+}
+
+// Ramps and dwells of every record, one after the other (a regime never spans two records).
+std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                           double rate_hz, double ramp_rate_k_per_min,
+                                           const std::vector<Eigen::Index>& record_starts) {
+  std::vector<ThermalSegment> all;
+  ForEachRecord(temperature_c.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    for (ThermalSegment s : Segments(temperature_c.segment(begin, length), rate_hz,
+                                     ramp_rate_k_per_min)) {
+      s.begin += begin;
+      s.end += begin;
+      all.push_back(s);
+    }
+  });
+  return all;
 }
 
 // Every candidate column: the intercept, the channels' standardised linear terms, then per
 // candidate state its powers and rate (each candidate learning its level's range).
 Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
-                                double rate_hz, const ThermalRegression& model,
+                                double rate_hz, const std::vector<Eigen::Index>& record_starts,
+                                const ThermalRegression& model,
                                 std::vector<ThermalState>& candidates) {
   const int channels = static_cast<int>(temperatures_c.cols());
   const int per_state = model.max_power + 1;
@@ -193,7 +218,7 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
     const auto c = static_cast<size_t>(candidates[j].channel);
     StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
                  model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
-                 /*learn_range=*/true,
+                 /*learn_range=*/true, record_starts,
                  x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
   }
   return x;
@@ -519,9 +544,10 @@ std::string CalibrationReport::Summary() const {
   std::string span;
   for (size_t c = 0; c < span_k.size(); ++c) span += Format("%s%.3g", c ? "/" : "", span_k[c]);
   return Format(
-      "%.3g h, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d folds; "
+      "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d folds; "
       "cross-validated RMSE %.4g (constant %.4g), skill %.1f %% of the slow drift, condition %.2g",
-      duration_s / 3600.0, span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps,
+      duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
+      span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps,
       dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition) +
          (std::isnan(cv_rmse_nonlinear)
               ? std::string()
@@ -533,7 +559,8 @@ std::string CalibrationReport::Summary() const {
 }
 
 Eigen::MatrixXd ThermalRegression::Regressors(
-    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+    const std::vector<Eigen::Index>& record_starts) const {
   if (temperatures_c.cols() != channels()) {
     throw DataError("the thermal model takes " + std::to_string(channels()) +
                     " temperature channel(s), " + std::to_string(temperatures_c.cols()) +
@@ -543,6 +570,7 @@ Eigen::MatrixXd ThermalRegression::Regressors(
   for (int c = 0; c < channels(); ++c) {
     RequireFiniteSignal("temperature", temperatures_c.col(c), 1);
   }
+  CheckRecordStarts(record_starts, n);
   Eigen::MatrixXd x(n, coefficients.size());
   Eigen::Index col = 0;
   x.col(col++).setOnes();
@@ -554,7 +582,7 @@ Eigen::MatrixXd ThermalRegression::Regressors(
   for (ThermalState s : states) {
     const auto c = static_cast<size_t>(s.channel);
     StateColumns(temperatures_c.col(s.channel), s, order, max_power, 1.0 / rate_hz, centre_c[c],
-                 scale_k[c], /*learn_range=*/false, x.middleCols(col, max_power + 1));
+                 scale_k[c], /*learn_range=*/false, record_starts, x.middleCols(col, max_power + 1));
     col += max_power + 1;
   }
   return x;
@@ -582,8 +610,9 @@ std::vector<std::string> ThermalRegression::RegressorNames(
 }
 
 Eigen::VectorXd ThermalRegression::Estimate(
-    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
-  const Eigen::MatrixXd x = Regressors(temperatures_c);
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+    const std::vector<Eigen::Index>& record_starts) const {
+  const Eigen::MatrixXd x = Regressors(temperatures_c, record_starts);
   return EstimateOf(x);
 }
 
@@ -594,8 +623,9 @@ Eigen::VectorXd ThermalRegression::EstimateOf(const Eigen::Ref<const Eigen::Matr
 }
 
 Eigen::MatrixXd ThermalRegression::EstimateWithSd(
-    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const {
-  const Eigen::MatrixXd x = Regressors(temperatures_c);
+    const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+    const std::vector<Eigen::Index>& record_starts) const {
+  const Eigen::MatrixXd x = Regressors(temperatures_c, record_starts);
   Eigen::MatrixXd out(x.rows(), 2);
   out.col(0) = EstimateOf(x);
   const Eigen::MatrixXd xv = x * covariance;
@@ -658,7 +688,8 @@ void ThermalRegression::Validate() const {
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
                                        const ThermalModelOptions& options, bool nonlinear,
-                                       std::uint64_t seed) {
+                                       std::uint64_t seed,
+                                       const std::vector<Eigen::Index>& record_starts) {
   options.Validate();
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
   const Eigen::Index n = y.size();
@@ -669,6 +700,7 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
                     " x " + std::to_string(channels));
   }
   RequireFiniteSignal("target", y, 2 * kShortestFold);
+  CheckRecordStarts(record_starts, n);
   ThermalRegression model;
   model.rate_hz = rate_hz;
   model.order = options.state_order;
@@ -683,9 +715,10 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   }
   CalibrationReport& report = model.report;
   report.duration_s = static_cast<double>(n) / rate_hz;
-  const std::vector<ThermalSegment> segments =
-      Segments(temperatures_c.col(0), rate_hz, options.ramp_rate_k_per_min);
-  DescribeRun(temperatures_c, rate_hz, segments, report);
+  report.records = static_cast<int>(record_starts.size()) + 1;
+  const std::vector<ThermalSegment> segments = RecordSegments(
+      temperatures_c.col(0), rate_hz, options.ramp_rate_k_per_min, record_starts);
+  DescribeRun(temperatures_c, rate_hz, segments, record_starts, report);
 
   // Folds: contiguous blocks of equal duration, or groups of whole regimes.
   std::vector<ThermalSegment> units = TimeBlocks(n, options.folds);
@@ -706,7 +739,8 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   for (int c = 0; c < channels; ++c) {
     for (double tau : options.Grid(report.duration_s)) candidates.push_back({c, tau});
   }
-  const Eigen::MatrixXd x = CandidateDesign(temperatures_c, rate_hz, model, candidates);
+  const Eigen::MatrixXd x =
+      CandidateDesign(temperatures_c, rate_hz, record_starts, model, candidates);
   const Eigen::VectorXd yc = y.array() - y.mean();
   const CrossValidation cv(x, yc, units, folds);
   const Subset best = BestSubset(cv, channels, static_cast<int>(candidates.size()),

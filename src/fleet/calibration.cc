@@ -8,11 +8,13 @@
 #include <filesystem>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/statistics.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/features.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/gyro_log.h"
@@ -46,7 +48,17 @@ Eigen::VectorXd BlockMeans(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::In
   return out;
 }
 
-allan::NoiseTerms NoiseOf(const Eigen::VectorXd& rate, double rate_hz, allan::RateUnit unit,
+// The first sample and length of the longest record.
+std::pair<Eigen::Index, Eigen::Index> LongestRecord(Eigen::Index n,
+                                                    const std::vector<Eigen::Index>& starts) {
+  std::pair<Eigen::Index, Eigen::Index> longest{0, 0};
+  drift::ForEachRecord(n, starts, [&](Eigen::Index begin, Eigen::Index length) {
+    if (length > longest.second) longest = {begin, length};
+  });
+  return longest;
+}
+
+allan::NoiseTerms NoiseOf(const Eigen::Ref<const Eigen::VectorXd>& rate, double rate_hz, allan::RateUnit unit,
                           Eigen::VectorXd* tau, Eigen::VectorXd* adev) {
   allan::AllanOptions o;
   o.rate_hz = rate_hz;
@@ -84,14 +96,28 @@ std::vector<std::string> Failures(const Limits& limits, const VerificationResult
 struct Log {
   io::CsvTable table;
   double rate_hz = 1.0;
+  std::vector<Eigen::Index> record_starts;  // gaps = split: where the log's records start
 };
 
 Log ReadUnitLog(const Manifest& m, const std::string& path) {
-  Log log{io::ReadLog(path, m.gaps), 1.0};
+  Log log;
+  log.table = io::ReadLog(path, m.log, nullptr,
+                          m.log.gaps == io::GapPolicy::kSplit ? &log.record_starts : nullptr);
   std::string how;
   log.rate_hz = io::ResolveSampleRate(log.table, m.rate_hz, &how);
   return log;
 }
+
+// The calibration logs of an axis as one run of records: its target and temperatures, each log
+// after the other, and where every record after the first starts.
+struct Run {
+  Eigen::VectorXd y;
+  Eigen::MatrixXd temperature;
+  std::vector<Eigen::Index> record_starts;
+};
+
+// Calibration logs fitted together agree on their sample rate to this share.
+constexpr double kSameRate = 0.01;
 
 Eigen::MatrixXd Temperatures(const io::CsvTable& table, const AxisSpec& axis) {
   Eigen::MatrixXd t(table.rows(), static_cast<Eigen::Index>(axis.temperature.size()));
@@ -113,18 +139,36 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   UnitResult& r = out.result;
   r.serial = unit.serial;
 
-  const Log cal = ReadUnitLog(m, unit.calibration);
+  std::vector<Log> cal;
+  for (const std::string& path : unit.calibration) {
+    cal.push_back(ReadUnitLog(m, path));
+    if (std::abs(cal.back().rate_hz / cal.front().rate_hz - 1.0) > kSameRate) {
+      throw DataError(fmt::format(
+          "{} is sampled at {:g} Hz, {} at {:g} Hz: calibration logs fitted together need one "
+          "sample rate", unit.calibration.front(), cal.front().rate_hz, path, cal.back().rate_hz));
+    }
+  }
   drift::DriftOptions options = m.FitOptions();
-  options.features.rate_hz = cal.rate_hz;
+  options.features.rate_hz = cal.front().rate_hz;
   std::vector<io::LoadedModel> models;
   for (const AxisSpec& axis : m.axes) {
+    Run run;
+    for (const Log& log : cal) {
+      const Eigen::Index offset = run.y.size();
+      if (offset > 0) run.record_starts.push_back(offset);
+      for (const Eigen::Index start : log.record_starts) run.record_starts.push_back(offset + start);
+      const Eigen::MatrixXd t = Temperatures(log.table, axis);
+      run.y.conservativeResize(offset + t.rows());
+      run.y.tail(t.rows()) = log.table.Column(axis.target);
+      run.temperature.conservativeResize(offset + t.rows(), t.cols());
+      run.temperature.bottomRows(t.rows()) = t;
+    }
     io::LoadedModel model;
     model.info.target_column = axis.target;
     model.info.temperature_column = Joined(axis.temperature);
-    model.info.source = unit.calibration;
+    model.info.source = Joined(unit.calibration);
     model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
-    model.model =
-        drift::FitDriftModel(cal.table.Column(axis.target), Temperatures(cal.table, axis), options);
+    model.model = drift::FitDriftModel(run.y, run.temperature, options, run.record_starts);
     AxisResult a;
     a.target = axis.target;
     a.temperature = model.info.temperature_column;
@@ -159,7 +203,8 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
       const drift::DriftModel& model = models[i].model;
       const Eigen::VectorXd y = ver.table.Column(axis.target);
       const Eigen::MatrixXd temperature = Temperatures(ver.table, axis);
-      const Eigen::MatrixXd est_sd = drift::EstimateDriftWithSd(model, temperature);
+      const Eigen::MatrixXd est_sd =
+          drift::EstimateDriftWithSd(model, temperature, ver.record_starts);
       const Eigen::VectorXd estimate = est_sd.col(0);
       const Eigen::VectorXd compensated = y - estimate;
       const std::string suffix = m.axes.size() == 1 ? "" : "_" + axis.target;
@@ -194,9 +239,13 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
       }
       v.outside_share = drift::ShareOutsideRange(temperature.col(0), model.temperature_min_c,
                                                  model.temperature_max_c);
-      v.noise_before = NoiseOf(y, ver.rate_hz, m.rate_unit, &v.tau_s, &v.adev_before);
+      // The Allan analysis needs uniform samples: of a log split at its gaps, its longest record.
+      const auto [first, length] = LongestRecord(y.size(), ver.record_starts);
+      v.noise_before =
+          NoiseOf(y.segment(first, length), ver.rate_hz, m.rate_unit, &v.tau_s, &v.adev_before);
       Eigen::VectorXd tau_after;
-      v.noise_after = NoiseOf(compensated, ver.rate_hz, m.rate_unit, &tau_after, &v.adev_after);
+      v.noise_after = NoiseOf(compensated.segment(first, length), ver.rate_hz, m.rate_unit,
+                              &tau_after, &v.adev_after);
       v.failures = Failures(m.limits, v);
       // Every axis of one log has the same length, so the same taus.
       if (i == 0) allan_columns.push_back({fmt::format("tau_s_v{}", k + 1), v.tau_s});

@@ -154,6 +154,12 @@ std::string Resolve(const std::string& manifest, const std::string& log) {
 
 }  // namespace
 
+std::vector<std::string> UnitSpec::Logs() const {
+  std::vector<std::string> logs = calibration;
+  logs.insert(logs.end(), verification.begin(), verification.end());
+  return logs;
+}
+
 drift::DriftOptions Manifest::FitOptions() const {
   drift::DriftOptions o;
   o.mode = drift::Mode::kCompensate;
@@ -176,7 +182,7 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
   Manifest m;
   m.path = path;
   const Table top(root, c, "",
-                  {"method", "rate_unit", "rate_hz", "gaps", "seed", "nonlinear", "reference_temperature_c",
+                  {"method", "rate_unit", "rate_hz", "gaps", "delimiter", "seed", "nonlinear", "reference_temperature_c",
                    "drift_window_s", "limits", "axis", "unit"});
   if (top.Find("method")) {
     const std::string name = top.String("method");
@@ -202,9 +208,22 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
   if (top.Find("gaps")) {
     const std::string gaps = top.String("gaps");
     try {
-      m.gaps = io::GapPolicyFromString(gaps);
+      m.log.gaps = io::GapPolicyFromString(gaps);
     } catch (const UsageError& e) {
       c.Fail(*top.Find("gaps"), e.what());
+    }
+    if (m.log.gaps == io::GapPolicy::kSplit && m.method != drift::Method::kThermal) {
+      c.Fail(*top.Find("gaps"), fmt::format("gaps = 'split' needs method = 'thermal', not '{}' (a "
+                                            "decomposition would run across the gaps)",
+                                            drift::ToString(m.method)));
+    }
+  }
+  if (top.Find("delimiter")) {
+    const std::string delimiter = top.String("delimiter");
+    try {
+      m.log.delimiter = io::DelimiterFromString(delimiter);
+    } catch (const UsageError& e) {
+      c.Fail(*top.Find("delimiter"), e.what());
     }
   }
   if (const toml::node* n = top.Find("seed")) {
@@ -280,21 +299,19 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
                                    earlier.line));
       }
     }
-    const std::vector<std::string> calibration = unit.Strings("calibration");
-    if (calibration.size() != 1) {
-      c.Fail(*unit.Find("calibration"),
-             "'calibration' names one log (the thermal states of a model run through one record; "
-             "joined runs would put a step in them)");
+    for (const std::string& log : unit.Strings("calibration")) {
+      u.calibration.push_back(Resolve(path, log));
     }
-    u.calibration = Resolve(path, calibration[0]);
+    if (u.calibration.size() > 1 && m.method != drift::Method::kThermal) {
+      c.Fail(*unit.Find("calibration"),
+             fmt::format("several calibration logs need method = 'thermal', not '{}' (its thermal "
+                         "states restart with each log; a decomposition would run across them)",
+                         drift::ToString(m.method)));
+    }
     for (const std::string& v : unit.Strings("verification")) {
       u.verification.push_back(Resolve(path, v));
     }
-    for (const std::string& log : [&] {
-           std::vector<std::string> all = u.verification;
-           all.insert(all.begin(), u.calibration);
-           return all;
-         }()) {
+    for (const std::string& log : u.Logs()) {
       std::error_code ec;
       if (!fs::is_regular_file(log, ec)) {
         c.Fail(u.line, fmt::format("unit '{}': log {} does not exist", u.serial, log));
@@ -311,7 +328,7 @@ namespace {
 
 // The header row of a log, parsed by the CSV reader from the log's first lines up to its first
 // data row (comments and blank lines included), so the whole file need not be read.
-std::vector<std::string> Header(const std::string& log) {
+std::vector<std::string> Header(const std::string& log, io::Delimiter delimiter) {
   std::ifstream in(log, std::ios::binary);
   if (!in) throw IoError(log + ": cannot be read");
   std::string text, line;
@@ -321,7 +338,7 @@ std::vector<std::string> Header(const std::string& log) {
     const size_t first = line.find_first_not_of(" \t\r");
     if (first != std::string::npos && line[first] != '#') ++rows;
   }
-  return io::CsvTable::Parse(text, log).header();
+  return io::CsvTable::Parse(text, log, delimiter).header();
 }
 
 }  // namespace
@@ -329,12 +346,11 @@ std::vector<std::string> Header(const std::string& log) {
 void CheckLogColumns(const Manifest& m) {
   const Context c(m.path);
   for (const UnitSpec& u : m.units) {
-    std::vector<std::string> logs = u.verification;
-    logs.insert(logs.begin(), u.calibration);
+    const std::vector<std::string> logs = u.Logs();
     for (size_t k = 0; k < logs.size(); ++k) {
       std::vector<std::string> header;
       try {
-        header = Header(logs[k]);
+        header = Header(logs[k], m.log.delimiter);
       } catch (const Error& e) {
         c.Fail(u.line, fmt::format("unit '{}': {}", u.serial, e.what()));
       }
@@ -344,7 +360,7 @@ void CheckLogColumns(const Manifest& m) {
       for (const AxisSpec& a : m.axes) {
         std::vector<std::string> needed = a.temperature;
         needed.insert(needed.begin(), a.target);
-        if (k > 0 && !a.truth.empty()) needed.push_back(a.truth);
+        if (k >= u.calibration.size() && !a.truth.empty()) needed.push_back(a.truth);
         for (const std::string& col : needed) {
           if (!has(col)) {
             c.Fail(u.line, fmt::format("unit '{}': {} has no column '{}' (axis of line {})",
@@ -359,17 +375,20 @@ void CheckLogColumns(const Manifest& m) {
 std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
   std::string text = fmt::format(
       "method={};unit={};rate={};gaps={};seed={};nonlinear={};ref={};window={};limits={},{},{};",
-      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, io::ToString(m.gaps), m.seed, m.nonlinear,
+      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, io::ToString(m.log.gaps), m.seed, m.nonlinear,
       m.reference_c, m.drift_window_s, m.limits.residual_drift_rms, m.limits.bias_instability_dph,
       m.limits.removed_share_min);
   for (const AxisSpec& a : m.axes) {
     text += "axis=" + a.target + "|" + a.truth + "|";
     for (const std::string& t : a.temperature) text += t + ",";
   }
+  // Added only when not the default, so the fingerprints of earlier runs stay valid.
+  if (m.log.delimiter != io::Delimiter::kAuto) {
+    text += fmt::format("delimiter={};", io::ToString(m.log.delimiter));
+  }
   text += "serial=" + u.serial + ";";
-  std::vector<std::string> logs = u.verification;
-  logs.insert(logs.begin(), u.calibration);
-  for (const std::string& log : logs) {
+  if (u.calibration.size() > 1) text += fmt::format("calibration_logs={};", u.calibration.size());
+  for (const std::string& log : u.Logs()) {
     text += "log=" + log + ":" + fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log))) + ";";
   }
   return fmt::format("fnv1a64:{:016x}", io::Fnv1a64(text));

@@ -60,15 +60,19 @@ std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const Unit
                              const io::DygraphsAssets& assets) {
   const std::string unit_name(allan::ToString(m.rate_unit));
   io::HtmlReport report("gyrodrift calibration: " + unit.serial);
-  std::string verification;
-  for (const std::string& v : spec.verification) {
-    verification += (verification.empty() ? "" : ", ") + std::filesystem::path(v).filename().string();
-  }
+  auto names = [](const std::vector<std::string>& logs) {
+    std::string out;
+    for (const std::string& log : logs) {
+      out += (out.empty() ? "" : ", ") + std::filesystem::path(log).filename().string();
+    }
+    return out;
+  };
+  const std::string calibration = names(spec.calibration), verification = names(spec.verification);
   report.AddParagraph(fmt::format(
       "Unit {}: method {} (compensate mode), fitted on {} and verified on {}. Limits: {}. "
       "Result: {}.",
       unit.serial, drift::ToString(m.method),
-      std::filesystem::path(spec.calibration).filename().string(), verification,
+      calibration, verification,
       LimitsText(m.limits), unit.pass() ? "PASS" : "FAIL"));
   for (const AxisResult& a : unit.axes) {
     report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));

@@ -61,9 +61,29 @@ bool IsSkippable(std::string_view line) {
 
 }  // namespace
 
-CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadTextFile(path), path); }
+std::string_view ToString(Delimiter delimiter) {
+  switch (delimiter) {
+    case Delimiter::kComma: return "comma";
+    case Delimiter::kTab: return "tab";
+    case Delimiter::kSemicolon: return "semicolon";
+    case Delimiter::kAuto: break;
+  }
+  return "auto";
+}
 
-CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
+Delimiter DelimiterFromString(std::string_view text) {
+  for (Delimiter d : {Delimiter::kAuto, Delimiter::kComma, Delimiter::kTab, Delimiter::kSemicolon}) {
+    if (text == ToString(d)) return d;
+  }
+  throw OptionError("delimiter", "'" + std::string(text) + "'", "auto, comma, tab or semicolon");
+}
+
+CsvTable CsvTable::Read(const std::string& path, Delimiter delimiter) {
+  return Parse(ReadTextFile(path), path, delimiter);
+}
+
+CsvTable CsvTable::Parse(const std::string& text, const std::string& source,
+                         Delimiter given) {
   CsvTable table;
   table.source_ = source;
   std::string_view rest(text);
@@ -78,7 +98,12 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& source) {
     rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 1);
     ++line_number;
     if (IsSkippable(line)) continue;
-    if (!have_header) delimiter = DetectDelimiter(line);
+    if (!have_header) {
+      delimiter = given == Delimiter::kComma       ? ','
+                  : given == Delimiter::kTab       ? '\t'
+                  : given == Delimiter::kSemicolon ? ';'
+                                                   : DetectDelimiter(line);
+    }
     SplitLine(line, delimiter, cells);
     if (!have_header) {
       for (auto cell : cells) table.header_.emplace_back(Unquote(cell));

@@ -23,18 +23,32 @@ double MedianStep(const Eigen::VectorXd& t) {
 }  // namespace
 
 std::string_view ToString(GapPolicy policy) {
-  return policy == GapPolicy::kError ? "error" : "interpolate";
+  switch (policy) {
+    case GapPolicy::kInterpolate: return "interpolate";
+    case GapPolicy::kSplit: return "split";
+    case GapPolicy::kError: break;
+  }
+  return "error";
 }
 
 GapPolicy GapPolicyFromString(std::string_view text) {
-  if (text == "error") return GapPolicy::kError;
-  if (text == "interpolate") return GapPolicy::kInterpolate;
-  throw OptionError("gaps", "'" + std::string(text) + "'", "error or interpolate");
+  for (GapPolicy p : {GapPolicy::kError, GapPolicy::kInterpolate, GapPolicy::kSplit}) {
+    if (text == ToString(p)) return p;
+  }
+  throw OptionError("gaps", "'" + std::string(text) + "'", "error, interpolate or split");
 }
 
-CsvTable ReadLog(const std::string& path, GapPolicy gaps, std::string* gap_note) {
+CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,
+                 std::vector<Eigen::Index>* record_starts) {
+  const GapPolicy gaps = options.gaps;
   if (gap_note) gap_note->clear();
-  CsvTable table = CsvTable::Read(path);
+  if (record_starts) record_starts->clear();
+  if (gaps == GapPolicy::kSplit && record_starts == nullptr) {
+    throw UsageError(path + ": gaps = split needs a caller that takes several records (a thermal "
+                     "model's fit or compensation); a decomposition or an Allan analysis needs "
+                     "one uniform record: fill the gaps by interpolation or split the file");
+  }
+  CsvTable table = CsvTable::Read(path, options.delimiter);
   if (!table.HasColumn("time_s")) return table;
   Eigen::VectorXd t;
   try {
@@ -58,6 +72,11 @@ CsvTable ReadLog(const std::string& path, GapPolicy gaps, std::string* gap_note)
     const double step = t[i + 1] - t[i];
     if (!(step >= 1.5 * median)) continue;
     const double samples = std::round(step / median) - 1.0;
+    if (gaps == GapPolicy::kSplit) {
+      record_starts->push_back(i + 1);
+      missing += static_cast<long>(samples);
+      continue;
+    }
     // A gap of more than 1e7 samples or 10 times the log is a clock jump, not lost samples.
     if (gaps == GapPolicy::kError || samples > 1e7 ||
         samples > 10.0 * static_cast<double>(t.size())) {
@@ -66,12 +85,23 @@ CsvTable ReadLog(const std::string& path, GapPolicy gaps, std::string* gap_note)
           "{:g} s): {}",
           path, step, i + 2, samples, median,
           gaps == GapPolicy::kError
-              ? "fill gaps by linear interpolation (--gaps interpolate; in a manifest gaps = "
-                "\"interpolate\") or split the log where it stops"
-              : "too long to fill by interpolation: split the log where it stops"));
+              ? "fill gaps by linear interpolation or split the log into records at its gaps "
+                "(--gaps interpolate|split; in a manifest gaps = \"interpolate\" or \"split\")"
+              : "too long to fill by interpolation: split the log at its gaps (--gaps split)"));
     }
     insert.push_back({i, static_cast<int>(samples)});
     missing += static_cast<long>(samples);
+  }
+  if (gaps == GapPolicy::kSplit) {
+    if (gap_note && !record_starts->empty()) {
+      *gap_note = fmt::format(
+          "note: time_s has {} gap{} (median step {:g} s, {} samples missing): the log is split "
+          "into {} records, and the thermal model's lag states restart after each gap (--gaps "
+          "split)",
+          record_starts->size(), record_starts->size() == 1 ? "" : "s", median, missing,
+          record_starts->size() + 1);
+    }
+    return table;
   }
   if (insert.empty()) return table;
   if (gap_note) {
@@ -119,22 +149,22 @@ std::string NonUniformTimeNote(const CsvTable& table) {
   }
   const double median = MedianStep(t);  // > 0: ReadLog refused a time_s that does not increase
   long off = 0;
-  double largest = t[1] - t[0];
-  Eigen::Index largest_row = 2;  // 1-based data row of the sample after the step
+  double shortest = t[1] - t[0];
+  Eigen::Index shortest_row = 2;  // 1-based data row of the sample after the step
   for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
     const double step = t[i + 1] - t[i];
-    if (!(std::abs(step - median) <= 0.5 * median)) ++off;
-    if (std::abs(step - median) > std::abs(largest - median)) {
-      largest = step;
-      largest_row = i + 2;
+    if (step < 0.5 * median) ++off;  // a gap (>= 1.5 median) was refused, filled or split
+    if (step < shortest) {
+      shortest = step;
+      shortest_row = i + 2;
     }
   }
   if (off == 0) return "";
   return fmt::format(
-      "note: time_s is not uniform: {} of {} steps differ from the median step {:g} s by more than "
-      "half (largest {:g} s, before data row {}); the models and the Allan analysis treat the "
+      "note: time_s is not uniform: {} of {} steps are shorter than half the median step {:g} s "
+      "(shortest {:g} s, before data row {}); the models and the Allan analysis treat the "
       "samples as equally spaced",
-      off, t.size() - 1, median, largest, largest_row);
+      off, t.size() - 1, median, shortest, shortest_row);
 }
 
 }  // namespace gyrodrift::io

@@ -155,7 +155,7 @@ json ThermalJson(const drift::ThermalRegression& t) {
   json linear = json::array();
   for (bool b : t.linear) linear.push_back(b);
   const drift::CalibrationReport& r = t.report;
-  return {{"rate_hz", Number(t.rate_hz)},
+  json j = {{"rate_hz", Number(t.rate_hz)},
           {"order", t.order},
           {"max_power", t.max_power},
           {"centre_c", Numbers(t.centre_c)},
@@ -183,6 +183,9 @@ json ThermalJson(const drift::ThermalRegression& t) {
             {"nonlinear_ridge_c", Number(r.nonlinear_ridge_c)},
             {"cv_rmse_nonlinear", Number(r.cv_rmse_nonlinear)},
             {"warnings", r.warnings}}}};
+  // Written only for a fit on several records, so a one-record model's file is unchanged.
+  if (r.records > 1) j["report"]["records"] = r.records;
+  return j;
 }
 
 json ModelJson(const drift::DriftModel& model) {
@@ -492,6 +495,7 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   const Node r = n["report"];
   drift::CalibrationReport& report = t->report;
   report.duration_s = r["duration_s"].Double();
+  report.records = r.raw().contains("records") ? r["records"].Int(2, 1000000000) : 1;
   report.span_k = r["span_k"].Doubles();
   report.max_heating_k_per_min = r["max_heating_k_per_min"].Double();
   report.max_cooling_k_per_min = r["max_cooling_k_per_min"].Double();

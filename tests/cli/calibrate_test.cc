@@ -147,6 +147,56 @@ TEST_F(CalibrateCli, CalibratesEveryUnitAndAxisAndMatchesFit) {
   EXPECT_NE(r.out.find("0 calibrated, 3 skipped"), std::string::npos) << r.out;
 }
 
+// Calibration in two chamber runs, and a verification log whose logger stopped for an hour: the
+// runs are fitted as records of one run (the model `fit` gives for the two logs), the
+// verification is compensated with the states restarting after the gap (gaps = "split").
+TEST_F(CalibrateCli, SeveralCalibrationLogsAndASplitVerification) {
+  const io::CsvTable cal = io::CsvTable::Read(Dir() + "/logs/SN1_cal.csv");
+  const io::CsvTable ver = io::CsvTable::Read(Dir() + "/logs/SN1_ver.csv");
+  const Eigen::Index half = cal.rows() / 2, hour = 3600;
+  auto rows = [](const io::CsvTable& t, Eigen::Index first, Eigen::Index count) {
+    std::vector<io::CsvColumn> out;
+    for (const std::string& name : t.header()) out.push_back({name, t.Column(name).segment(first, count)});
+    return out;
+  };
+  io::WriteCsv(Dir() + "/logs/R_cal_a.csv", rows(cal, 0, half));
+  io::WriteCsv(Dir() + "/logs/R_cal_b.csv", rows(cal, half, cal.rows() - half));
+  // The verification without its third hour.
+  std::vector<io::CsvColumn> gap = rows(ver, 0, 2 * hour);
+  const std::vector<io::CsvColumn> rest = rows(ver, 3 * hour, ver.rows() - 3 * hour);
+  for (size_t c = 0; c < gap.size(); ++c) {
+    gap[c].values.conservativeResize(2 * hour + rest[c].values.size());
+    gap[c].values.tail(rest[c].values.size()) = rest[c].values;
+  }
+  io::WriteCsv(Dir() + "/logs/R_ver_gap.csv", gap);
+  const std::string manifest = Dir() + "/records.toml";
+  io::WriteFileAtomically(manifest, std::string("gaps = \"split\"\n") + kAxes +
+                                        "\n[[unit]]\nserial = \"R1\"\ncalibration = "
+                                        "[\"logs/R_cal_a.csv\", \"logs/R_cal_b.csv\"]\n"
+                                        "verification = \"logs/R_ver_gap.csv\"\n");
+  const std::string out = Dir() + "/out_records";
+  auto r = test::RunCli("calibrate '" + manifest + "' -o '" + out + "' -q");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = test::RunCli("fit '" + Dir() + "/logs/R_cal_a.csv' '" + Dir() + "/logs/R_cal_b.csv' " +
+                   "-t gyro_x -T temp_x --mode compensate -q -o '" + Dir() + "/r.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto axes = io::ReadModelFileAxes(out + "/R1/model.json");
+  const io::LoadedModel fitted = io::ReadModelFile(Dir() + "/r.json");
+  ASSERT_TRUE(axes[0].model.sub_models.front().thermal);
+  EXPECT_EQ(axes[0].model.sub_models.front().thermal->report.records, 2);
+  EXPECT_EQ(axes[0].model.sub_models.front().thermal->coefficients,
+            fitted.model.sub_models.front().thermal->coefficients);
+  // The verification's estimate restarts after the gap: that of its two pieces.
+  const io::CsvTable compensated = io::CsvTable::Read(out + "/R1/verification_1_compensated.csv");
+  const Eigen::VectorXd t = ver.Column("temp_x");
+  Eigen::VectorXd expected(compensated.rows());
+  expected << drift::EstimateDrift(fitted.model, t.head(2 * hour)),
+      drift::EstimateDrift(fitted.model, t.tail(ver.rows() - 3 * hour));
+  EXPECT_EQ(compensated.Column("drift_est_gyro_x"), expected);
+  EXPECT_NE(io::ReadTextFile(out + "/R1/report.html").find("R_cal_a.csv, R_cal_b.csv"),
+            std::string::npos);
+}
+
 TEST_F(CalibrateCli, AFailingUnitIsReportedAndTheOthersGoOn) {
   // SN1's verification log loses a value; the limit is one no unit meets.
   fs::create_directories(Dir() + "/bad");
@@ -193,6 +243,15 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
       {"no axis", unit, "no [[axis]] table"},
       {"bad limit", "[limits]\nresidual_drift_rms = -1\n" + std::string(kAxes) + unit,
        "bad.toml:2: 'residual_drift_rms' = -1"},
+      {"several calibration logs, not thermal",
+       "method = \"ms-elm\"\n" + std::string(kAxes) + "\n[[unit]]\nserial = \"SN1\"\n"
+       "calibration = [\"logs/SN1_cal.csv\", \"logs/SN2_cal.csv\"]\nverification = "
+       "\"logs/SN1_ver.csv\"\n",
+       "bad.toml:15: several calibration logs need method = 'thermal', not 'ms-elm'"},
+      {"split, not thermal", "method = \"ms-elm\"\ngaps = \"split\"\n" + std::string(kAxes) + unit,
+       "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
+      {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
+       "bad.toml:1: delimiter = 'pipe': must be auto, comma, tab or semicolon"},
       {"serial with a slash", std::string(kAxes) + "\n[[unit]]\nserial = \"a/b\"\ncalibration = "
        "\"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n", "must be usable as a folder"},
   };

@@ -141,7 +141,8 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   auto r = test::RunCli(fit + "-o '" + dir_ + "/g.json'");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("time_s jumps by 301 s before data row 101 (300 missing samples at the "
-                       "median step 1 s): fill gaps by linear interpolation (--gaps interpolate"),
+                       "median step 1 s): fill gaps by linear interpolation or split the log into "
+                       "records at its gaps (--gaps interpolate|split"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(test::FileExists(dir_ + "/g.json"));
@@ -152,8 +153,14 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
             std::string::npos)
       << r.out;
   EXPECT_EQ(io::ReadModelFile(dir_ + "/g.json").model.training_samples, 600);
+  // A split needs a model whose states can restart: the thermal method.
   r = test::RunCli(fit + "--gaps split -o '" + dir_ + "/s.json'");
   EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--method poly: several records (--gaps split) are fitted by --method "
+                       "thermal only"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(test::FileExists(dir_ + "/s.json"));
   // Steps shorter than the median are not missing samples: a note names the most irregular.
   t = table.Column("time_s");
   t.tail(150).array() -= 0.6;
@@ -161,7 +168,7 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   r = test::RunCli("fit '" + dir_ + "/jitter.csv' -t rate_dph --mode predict -m poly -o '" + dir_ +
                    "/j.json'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("(largest 0.4 s, before data row 151)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(shortest 0.4 s, before data row 151)"), std::string::npos) << r.out;
   std::string broken = "time_s,rate_dph\n";
   for (int i = 0; i < 100; ++i) {
     broken += (i == 50 ? std::string("x") : std::to_string(i)) + "," + std::to_string(i % 7) + "\n";

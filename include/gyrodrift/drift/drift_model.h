@@ -132,11 +132,15 @@ Eigen::MatrixXd GroupSeries(const DriftModel& model, const decomposition::Decomp
 bool IdentifiesThermalModel(const DriftOptions& options);
 
 // Fits a model on target y (N samples) and, where the mode or options need it, temperature
-// (N x C, degC; C > 1 only for identified models; empty otherwise). Throws UsageError /
-// DataError.
+// (N x C, degC; C > 1 only for identified models; empty otherwise). Several records (calibration
+// runs, or a log split at its gaps; features.h CheckRecordStarts) are given one after the other
+// with the first sample of each after the first in record_starts: compensate mode with
+// Method::kThermal only (IdentifyThermalModel restarts its lag states there), UsageError
+// otherwise. Throws UsageError / DataError.
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                         const DriftOptions& options);
+                         const DriftOptions& options,
+                         const std::vector<Eigen::Index>& record_starts = {});
 
 // Share of temperature samples outside [min_c, max_c] (0 when the range is NaN: no temperature),
 // e.g. a model's training range: where a thermal model extrapolates.
@@ -144,13 +148,16 @@ double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                          double max_c);
 
 // Compensate mode: the drift estimate at every sample of a temperature record (N x channels;
-// relative to equilibrium at options.reference_c unless that is NaN).
+// relative to equilibrium at options.reference_c unless that is NaN). With record_starts, every
+// record is estimated on its own, its lags starting in equilibrium at its first temperature.
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
-                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
+                              const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                              const std::vector<Eigen::Index>& record_starts = {});
 // The estimate (column 0) and its standard deviation (column 1): identified sub-models' bands
 // added in quadrature; NaN for models without one (learners on features).
 Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
-                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c);
+                                    const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                                    const std::vector<Eigen::Index>& record_starts = {});
 
 // Predict mode from given sub-series (N x G, GroupSeries of some decomposition) and thermal
 // features (N x F, or empty): horizon-step-ahead predictions of y[t] for t = first .. first +

@@ -73,6 +73,21 @@ void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, doubl
 // literal so that generated C code runs the same recursion).
 double FirstOrderLagGain(double tau_s, double dt_s);
 
+// Several records (calibration runs, or a log split at its gaps) given one after the other, as
+// one N-sample series: record_starts holds the first sample of every record after the first, and
+// every lag restarts there. CheckRecordStarts throws DataError unless they increase strictly
+// within (0, n); ForEachRecord calls f(begin, length) for each record in order.
+void CheckRecordStarts(const std::vector<Eigen::Index>& record_starts, Eigen::Index n);
+template <class F>
+void ForEachRecord(Eigen::Index n, const std::vector<Eigen::Index>& record_starts, F&& f) {
+  Eigen::Index begin = 0;
+  for (const Eigen::Index start : record_starts) {
+    f(begin, start - begin);
+    begin = start;
+  }
+  f(begin, n - begin);
+}
+
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,
                         Eigen::Index count);

@@ -104,7 +104,8 @@ std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& te
 
 // What the calibration run offers for identification, and what the fit found.
 struct CalibrationReport {
-  double duration_s = 0.0;
+  double duration_s = 0.0;                     // of all records
+  int records = 1;                             // stretches whose lag states start afresh
   std::vector<double> span_k;                  // max - min per channel
   double max_heating_k_per_min = 0.0;          // of channel 0, 60-s smoothed
   double max_cooling_k_per_min = 0.0;          // positive number
@@ -141,14 +142,18 @@ struct ThermalRegression {
   CalibrationReport report;
 
   int channels() const { return static_cast<int>(centre_c.size()); }
-  // N x coefficients() design of temperatures (N x channels()).
-  Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  // N x coefficients() design of temperatures (N x channels()), the lag states restarting at
+  // every record start (see IdentifyThermalModel).
+  Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                             const std::vector<Eigen::Index>& record_starts = {}) const;
   // "1", "T1", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)"; with one name per channel, the channels
   // are named by them ("L2(coil_c; 480 s)").
   std::vector<std::string> RegressorNames(const std::vector<std::string>& channel_names = {}) const;
-  Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                           const std::vector<Eigen::Index>& record_starts = {}) const;
   // Estimate and its standard deviation (columns 0 and 1).
-  Eigen::MatrixXd EstimateWithSd(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c) const;
+  Eigen::MatrixXd EstimateWithSd(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                 const std::vector<Eigen::Index>& record_starts = {}) const;
   std::string Summary() const;  // the chosen states and the cross-validated error
   void Validate() const;        // throws DataError when the stored fields do not fit together
 
@@ -159,11 +164,17 @@ struct ThermalRegression {
 // Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz; with
 // `nonlinear`, also tries the correction above (its hidden weights drawn from a seed derived from
 // `seed` through the named stream "thermal-correction").
+// Several records (calibration runs, or one log split at its gaps) are given one after the other,
+// with record_starts the first sample of every record after the first (CheckRecordStarts): the
+// lag states restart at each (from the record's first temperature, as at the start of a run), so
+// no state runs across the break, and no ramp or dwell spans two records; the regressors of all
+// records are fitted together.
 // Throws DataError for a record the cross-validation cannot split (fewer than 2 folds of at least
 // 16 samples) or non-finite samples; UsageError for bad options.
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
                                        const ThermalModelOptions& options, bool nonlinear = false,
-                                       std::uint64_t seed = 1);
+                                       std::uint64_t seed = 1,
+                                       const std::vector<Eigen::Index>& record_starts = {});
 
 }  // namespace gyrodrift::drift

@@ -5,7 +5,9 @@
 //   method = "thermal"            # fit --method of every axis (compensate mode); default thermal
 //   rate_unit = "dph"             # unit of the gyro columns: dph | dps | rads (allan --units)
 //   rate_hz = 1.0                 # optional; default: from each log's time_s, else 1 Hz
-//   gaps = "error"                # optional: error | interpolate (io::GapPolicy)
+//   gaps = "error"                # optional: error | interpolate | split (io::GapPolicy; split:
+//                                 # the thermal method only)
+//   delimiter = "auto"            # optional: auto | comma | tab | semicolon (io::Delimiter)
 //   seed = 1                      # optional
 //   nonlinear = false             # optional, fit --nonlinear
 //   reference_temperature_c = 20  # optional, fit --reference-temperature
@@ -23,7 +25,8 @@
 //
 //   [[unit]]
 //   serial = "FOG-0001"
-//   calibration = "FOG-0001/cal.csv"          # relative paths are relative to the manifest
+//   calibration = "FOG-0001/cal.csv"          # relative paths are relative to the manifest;
+//                                             # several runs fitted together: the thermal method
 //   verification = ["FOG-0001/ver.csv"]       # one or several
 //
 // Every key is checked: an unknown key (a misspelt limit would silently go unchecked), a wrong
@@ -59,8 +62,9 @@ struct AxisSpec {
 };
 
 struct UnitSpec {
+  std::vector<std::string> Logs() const;  // calibration, then verification
   std::string serial;
-  std::string calibration;                // resolved path
+  std::vector<std::string> calibration;   // resolved paths, fitted as records of one run
   std::vector<std::string> verification;  // resolved paths
   int line = 0;
 };
@@ -70,7 +74,7 @@ struct Manifest {
   drift::Method method = drift::Method::kThermal;
   allan::RateUnit rate_unit = allan::RateUnit::kDegPerHour;
   double rate_hz = 0.0;  // 0 = from each log
-  io::GapPolicy gaps = io::GapPolicy::kError;
+  io::LogOptions log;  // gaps and delimiter of every log
   std::uint64_t seed = 1;
   bool nonlinear = false;
   double reference_c = std::numeric_limits<double>::quiet_NaN();

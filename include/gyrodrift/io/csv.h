@@ -1,7 +1,8 @@
 // CSV input and output.
 //
 // Input: a header row, then one row per sample, separated by commas, or by tabs or semicolons
-// when the header has no comma (instrument and spreadsheet exports; decimal commas are not read).
+// when the header has no comma (instrument and spreadsheet exports; decimal commas are not read),
+// or by the delimiter the caller names.
 // Lines starting with '#' and blank lines are skipped; CRLF endings, a UTF-8 byte-order mark and
 // quoted header names are accepted. Every cell is parsed
 // as a number up front; a column with a non-numeric cell can still be loaded as long as nobody
@@ -13,18 +14,25 @@
 #include <Eigen/Core>
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 namespace gyrodrift::io {
 
+// The cell delimiter: auto = a comma where the header has one, else a tab, else a semicolon.
+enum class Delimiter { kAuto, kComma, kTab, kSemicolon };
+std::string_view ToString(Delimiter delimiter);  // "auto", "comma", "tab", "semicolon"
+Delimiter DelimiterFromString(std::string_view text);  // OptionError naming the choices
+
 class CsvTable {
  public:
   // Reads the whole file. Throws IoError (missing/unreadable file) or DataError (no header,
   // ragged rows, no data rows).
-  static CsvTable Read(const std::string& path);
+  static CsvTable Read(const std::string& path, Delimiter delimiter = Delimiter::kAuto);
   // Parses CSV text; `source` names it in messages.
-  static CsvTable Parse(const std::string& text, const std::string& source);
+  static CsvTable Parse(const std::string& text, const std::string& source,
+                        Delimiter delimiter = Delimiter::kAuto);
 
   const std::vector<std::string>& header() const { return header_; }
   Eigen::Index rows() const { return rows_; }

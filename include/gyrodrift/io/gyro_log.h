@@ -5,6 +5,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "gyrodrift/io/csv.h"
 
@@ -14,19 +15,34 @@ namespace gyrodrift::io {
 //   error:       refuse the log, naming the first gap's row, its length and the choices;
 //   interpolate: insert round(step / median) - 1 rows across each gap, every column linear
 //                between its neighbours (the models and the Allan analysis then see a uniform
-//                record; the note says how many samples were made up).
-enum class GapPolicy { kError, kInterpolate };
+//                record; the note says how many samples were made up);
+//   split:       keep the rows as they are and cut the log into records at its gaps (the caller
+//                gets where each record starts): a thermal model's lag states restart after a
+//                gap instead of running across it, for a logger that stopped for a while. Only
+//                where the caller can use records (record_starts given); a decomposition or an
+//                Allan analysis needs one uniform record.
+enum class GapPolicy { kError, kInterpolate, kSplit };
 std::string_view ToString(GapPolicy policy);
 GapPolicy GapPolicyFromString(std::string_view text);  // UsageError naming the choices
+
+// How a log is read.
+struct LogOptions {
+  GapPolicy gaps = GapPolicy::kError;
+  Delimiter delimiter = Delimiter::kAuto;
+  bool operator==(const LogOptions&) const = default;
+};
 
 // Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
 // increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row
 // (the log was merged, sorted wrongly or its clock jumped; every model and the Allan analysis
-// would otherwise take the samples as equally spaced, silently). Gaps are handled by `gaps`;
-// when rows were interpolated, *gap_note (if given) says how many, else it is cleared. Shorter
+// would otherwise take the samples as equally spaced, silently). Gaps are handled by
+// options.gaps; when rows were interpolated or the log was split, *gap_note (if given) says so,
+// else it is cleared. With kSplit, *record_starts receives the first row (0-based) of every
+// record after the first (empty: no gap); kSplit without record_starts is a UsageError. Shorter
 // irregular steps stay a note (NonUniformTimeNote).
-CsvTable ReadLog(const std::string& path, GapPolicy gaps = GapPolicy::kError,
-                 std::string* gap_note = nullptr);
+CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
+                 std::string* gap_note = nullptr,
+                 std::vector<Eigen::Index>* record_starts = nullptr);
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
 // column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
@@ -34,9 +50,10 @@ CsvTable ReadLog(const std::string& path, GapPolicy gaps = GapPolicy::kError,
 double ResolveSampleRate(const CsvTable& table, double given, std::string* how);
 
 // "" for a log without time_s or with a uniform one (read by ReadLog, so time_s increases);
-// otherwise a one-line note that the time axis has gaps or jitter (steps more than half the
-// median step away from it: how many, the largest and its row), since every model and the Allan
-// analysis assume uniform sampling.
+// otherwise a one-line note that the time axis has jitter (steps shorter than half the median
+// step: how many, the shortest and its row), since every model and the Allan analysis assume
+// uniform sampling. Gaps (steps of 1.5 median steps or more) are not counted: ReadLog refused,
+// filled or split them.
 std::string NonUniformTimeNote(const CsvTable& table);
 
 }  // namespace gyrodrift::io

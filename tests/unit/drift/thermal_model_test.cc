@@ -70,6 +70,51 @@ TEST(ThermalModel, FindsTheStateADriftWasBuiltFrom) {
   EXPECT_EQ(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}).coefficients, m.coefficients);
 }
 
+// Two calibration runs (the second starting hot, away from where the first ended), fitted as two
+// records: each state restarts with its run, as the gyro's did, so the model is the one a single
+// long run gives; run across the break, the lags would carry a step that no gyro saw.
+TEST(ThermalModel, SeveralRecordsRestartTheirStates) {
+  const Eigen::VectorXd a = Programme(8.0);
+  const Eigen::VectorXd b = 40.0 - 0.5 * (Programme(8.0).array() - 20.0);
+  auto drift_of = [](const Eigen::VectorXd& t) {
+    const Eigen::VectorXd s = State(t, 480.0);
+    Eigen::VectorXd lag(t.size());
+    FirstOrderLag(t, 480.0, 1.0, lag);
+    const Eigen::VectorXd rate = (lag - s) / 480.0;
+    return Eigen::VectorXd(0.1 + 2e-3 * (s.array() - 20.0) + 4e-5 * (s.array() - 20.0).square() +
+                           30.0 * rate.array());
+  };
+  const Eigen::Index n = a.size();
+  Eigen::VectorXd t(2 * n), drift(2 * n), y(2 * n);
+  t << a, b;
+  drift << drift_of(a), drift_of(b);
+  Rng rng(5, 0);
+  for (Eigen::Index i = 0; i < y.size(); ++i) y[i] = drift[i] + 0.2 * rng.Normal();
+  const std::vector<Eigen::Index> starts{n};
+
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, starts);
+  EXPECT_EQ(m.report.records, 2);
+  EXPECT_NE(m.report.Summary().find("in 2 records"), std::string::npos) << m.report.Summary();
+  auto rms = [&](const Eigen::VectorXd& e) {
+    return std::sqrt((e - drift).squaredNorm() / static_cast<double>(drift.size()));
+  };
+  const double with_records = rms(m.Estimate(t, starts));
+  EXPECT_LT(with_records, 0.01) << m.Summary();
+  // Each record estimated on its own is the records' estimate, to the bit.
+  const Eigen::VectorXd whole = m.Estimate(t, starts);
+  EXPECT_EQ(m.Estimate(b), whole.tail(n));
+  EXPECT_EQ(m.Estimate(a), whole.head(n));
+  // Fitted as one run, the states carry the 20-K step across the break: a worse model.
+  const ThermalRegression joined = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  EXPECT_EQ(joined.report.records, 1);
+  EXPECT_GT(rms(joined.Estimate(t)), 2.0 * with_records) << joined.Summary();
+  // Record starts out of order or out of range are refused.
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {n, n}),
+               DataError);
+  EXPECT_THROW(m.Estimate(t, {0}), DataError);
+  EXPECT_THROW(m.Estimate(t, {2 * n}), DataError);
+}
+
 TEST(ThermalModel, SegmentsTellRampsFromDwells) {
   Eigen::VectorXd t(7200);
   for (Eigen::Index i = 0; i < 7200; ++i) {

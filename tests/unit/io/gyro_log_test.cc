@@ -30,7 +30,7 @@ TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
         << e.what();
   }
   std::string note;
-  const CsvTable t = ReadLog(path, GapPolicy::kInterpolate, &note);
+  const CsvTable t = ReadLog(path, {GapPolicy::kInterpolate}, &note);
   EXPECT_EQ(t.rows(), 10);
   const Eigen::VectorXd time = t.Column("time_s");
   for (Eigen::Index i = 0; i < time.size(); ++i) EXPECT_DOUBLE_EQ(time[i], static_cast<double>(i));
@@ -48,7 +48,7 @@ TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
   }
   // A uniform log is untouched and gets no note.
   note = "stale";
-  EXPECT_EQ(ReadLog(Write("u.csv", "time_s,r\n0,1\n1,2\n2,3\n"), GapPolicy::kInterpolate, &note)
+  EXPECT_EQ(ReadLog(Write("u.csv", "time_s,r\n0,1\n1,2\n2,3\n"), {GapPolicy::kInterpolate}, &note)
                 .rows(),
             3);
   EXPECT_TRUE(note.empty());
@@ -57,9 +57,48 @@ TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
 TEST(GyroLog, AClockJumpIsNotFilled) {
   // A jump of 1e6 steps in a 4-row log: not lost samples, a clock that jumped.
   const std::string path = Write("jump.csv", "time_s,r\n0,1\n1,2\n1000001,3\n1000002,4\n");
-  EXPECT_THROW(ReadLog(path, GapPolicy::kInterpolate), DataError);
+  EXPECT_THROW(ReadLog(path, {GapPolicy::kInterpolate}), DataError);
   EXPECT_EQ(GapPolicyFromString("interpolate"), GapPolicy::kInterpolate);
-  EXPECT_THROW(GapPolicyFromString("split"), UsageError);
+  EXPECT_EQ(GapPolicyFromString("split"), GapPolicy::kSplit);
+  EXPECT_THROW(GapPolicyFromString("drop"), UsageError);
+}
+
+TEST(GyroLog, SplitKeepsTheRowsAndSaysWhereRecordsStart) {
+  // Gaps after data rows 3 and 5 (0-based rows 3 and 5 start new records); a clock jump is a
+  // record break too (nothing is made up).
+  const std::string path =
+      Write("split.csv", "time_s,r\n0,1\n1,2\n2,3\n5,6\n6,8\n8,10\n9,11\n1000009,12\n");
+  std::string note;
+  std::vector<Eigen::Index> starts{99};
+  const CsvTable t = ReadLog(path, {GapPolicy::kSplit}, &note, &starts);
+  EXPECT_EQ(t.rows(), 8);
+  EXPECT_EQ(starts, (std::vector<Eigen::Index>{3, 5, 7}));
+  EXPECT_NE(note.find("3 gaps"), std::string::npos) << note;
+  EXPECT_NE(note.find("split into 4 records"), std::string::npos) << note;
+  // The jitter note does not count the gaps a policy handled.
+  EXPECT_EQ(NonUniformTimeNote(t), "");
+  // A uniform log: one record, no note.
+  EXPECT_EQ(ReadLog(Write("u2.csv", "time_s,r\n0,1\n1,2\n2,3\n"), {GapPolicy::kSplit}, &note,
+                    &starts)
+                .rows(),
+            3);
+  EXPECT_TRUE(starts.empty());
+  EXPECT_TRUE(note.empty());
+  // A caller that cannot take records cannot ask for a split.
+  EXPECT_THROW(ReadLog(path, {GapPolicy::kSplit}), UsageError);
+}
+
+TEST(GyroLog, TheDelimiterCanBeNamed) {
+  // A semicolon file whose header holds a comma inside a name: auto-detection takes the comma,
+  // naming the delimiter reads it right.
+  const std::string path = Write("semi.csv", "time_s;rate,dph\n0;1\n1;2\n2;3\n");
+  EXPECT_THROW(ReadLog(path), DataError);  // two header cells, one per row: ragged
+  const CsvTable t = ReadLog(path, {GapPolicy::kError, Delimiter::kSemicolon});
+  EXPECT_EQ(t.header(), (std::vector<std::string>{"time_s", "rate,dph"}));
+  EXPECT_DOUBLE_EQ(t.Column("rate,dph")[2], 3.0);
+  EXPECT_EQ(DelimiterFromString("tab"), Delimiter::kTab);
+  EXPECT_EQ(ToString(Delimiter::kComma), "comma");
+  EXPECT_THROW(DelimiterFromString("pipe"), UsageError);
 }
 
 }  // namespace
