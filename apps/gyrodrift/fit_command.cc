@@ -206,6 +206,9 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "model.json holds every option, the training column names and the fitted parameters\n"
       "(exact doubles, checksummed). Several targets (--target gyro_x,gyro_y,gyro_z) are fitted\n"
       "one by one with the same options into one model file, one model per axis.\n"
+      "Several calibration logs (fit day1.csv day2.csv ...), or one split at its gaps\n"
+      "(--gaps split), are fitted by the thermal method as records of one calibration: its\n"
+      "lag states restart at the start of each.\n"
       "See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/true);
   cmd->add_option("--method,-m", args->method,

@@ -132,7 +132,7 @@ class DriftModel:
             decomposition="beemdan", lags=None, hidden="auto", rate_hz=1.0,
             thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
             threads=0, nonlinear=False, reference_temperature=None, target="rate_dph",
-            temperature_columns=None, source="python"):
+            temperature_columns=None, source="python", record_starts=()):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
         Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
@@ -140,25 +140,30 @@ class DriftModel:
         predict mode and thermal in compensate mode. ``rate_hz`` is the sample rate (the CLI
         reads it from a time_s column). ``target`` and ``temperature_columns`` are the column
         names written into the model file (the CLI's compensate reads those columns).
-        Returns self.
+        Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
+        one after the other with ``record_starts`` the first sample of each run after the first:
+        the thermal model's lag states restart there (``fit A.csv B.csv``; method thermal in
+        compensate mode only). Returns self.
         """
         self._core.fit(y, temperature, mode=mode, method=method, decomposition=decomposition,
                        lags=lags, hidden=hidden, rate_hz=rate_hz,
                        thermal_features=thermal_features, time_constants=list(time_constants),
                        ensemble=ensemble, realisations=realisations, seed=seed, threads=threads,
                        nonlinear=nonlinear, reference_temperature=reference_temperature,
-                       target=target, temperature_columns=temperature_columns, source=source)
+                       target=target, temperature_columns=temperature_columns, source=source,
+                       record_starts=list(record_starts))
         return self
 
-    def estimate(self, temperature):
+    def estimate(self, temperature, *, record_starts=()):
         """Compensate mode: ``(estimate, sd)`` of the drift at every temperature sample (sd NaN
-        for models without an uncertainty band)."""
-        return self._core.estimate(temperature)
+        for models without an uncertainty band); with ``record_starts`` every record is estimated
+        on its own, as ``gyrodrift compensate --gaps split`` does after each gap."""
+        return self._core.estimate(temperature, record_starts=list(record_starts))
 
-    def compensate(self, temperature, y):
+    def compensate(self, temperature, y, *, record_starts=()):
         """Compensate mode: ``y - estimate(temperature)``, the ``compensated`` column of
         ``gyrodrift compensate``."""
-        return self._core.compensate(temperature, y)
+        return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
     def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=512,
                 threads=0):

@@ -401,7 +401,7 @@ class PyDriftModel {
            std::uint64_t seed, int threads, bool nonlinear,
            std::optional<double> reference_temperature, const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
-           const std::string& source) {
+           const std::string& source, const std::vector<Eigen::Index>& record_starts) {
     drift::DriftOptions o;
     o.mode = drift::ModeFromString(mode);
     o.method = method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
@@ -493,7 +493,7 @@ class PyDriftModel {
     }
     {
       py::gil_scoped_release release;
-      loaded.model = drift::FitDriftModel(y, temperature, o);
+      loaded.model = drift::FitDriftModel(y, temperature, o, record_starts);
     }
     loaded_ = std::move(loaded);
     fitted_ = true;
@@ -512,19 +512,21 @@ class PyDriftModel {
     }
   }
 
-  py::tuple Estimate(const Array& temperature_in) const {
+  py::tuple Estimate(const Array& temperature_in,
+                     const std::vector<Eigen::Index>& record_starts) const {
     RequireMode(drift::Mode::kCompensate, "estimate");
     const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
     Eigen::MatrixXd e;
     {
       py::gil_scoped_release release;
-      e = drift::EstimateDriftWithSd(Loaded().model, t);
+      e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
     }
     return py::make_tuple(ToArray(Eigen::VectorXd(e.col(0))), ToArray(Eigen::VectorXd(e.col(1))));
   }
 
   // y - estimate, as `gyrodrift compensate` writes it.
-  py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in) const {
+  py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in,
+                                 const std::vector<Eigen::Index>& record_starts) const {
     RequireMode(drift::Mode::kCompensate, "compensate");
     const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
     const Eigen::VectorXd y = ToVector(y_in, "y");
@@ -535,7 +537,7 @@ class PyDriftModel {
     Eigen::VectorXd compensated;
     {
       py::gil_scoped_release release;
-      const Eigen::MatrixXd e = drift::EstimateDriftWithSd(Loaded().model, t);
+      const Eigen::MatrixXd e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
       compensated = y - e.col(0);
     }
     return ToArray(compensated);
@@ -776,9 +778,11 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("ensemble") = 100, arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
            arg("nonlinear") = false, arg("reference_temperature") = py::none(),
            arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
-           arg("source") = "python")
-      .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"))
-      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"))
+           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
+           arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"),
+           py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal", arg("window") = 512,
            arg("threads") = 0)

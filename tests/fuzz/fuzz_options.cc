@@ -1,5 +1,5 @@
 // libFuzzer harness: the CLI's option parsers on any text: durations, tau lists, method lists,
-// temperature column lists. Each accepts or throws a gyrodrift::Error (a usage error naming the
+// temperature column lists, gap policies and delimiters. Each accepts or throws a gyrodrift::Error (a usage error naming the
 // option); nothing else may happen.
 #include <cstddef>
 #include <cstdint>
@@ -9,6 +9,7 @@
 #include "drift_cli.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/gyro_log.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace cli = gyrodrift::cli;
@@ -32,6 +33,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     static const gyrodrift::io::CsvTable table = gyrodrift::io::CsvTable::Parse(
         "time_s,temperature_c,board_c\n0,20,21\n1,20.5,21.2\n", "log");
     (void)cli::ReadColumns(table, text, "--temperature");
+  } catch (const gyrodrift::Error&) {
+  }
+  try {
+    (void)gyrodrift::io::GapPolicyFromString(text);
+  } catch (const gyrodrift::Error&) {
+  }
+  try {
+    (void)gyrodrift::io::DelimiterFromString(text);
   } catch (const gyrodrift::Error&) {
   }
   return 0;
