@@ -62,9 +62,6 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
   }
 }
 
-// Calibration logs fitted together agree on their sample rate to this share.
-constexpr double kSameRate = 0.01;
-
 struct FitArgs : DriftArgs {
   std::string method = "auto";
   std::string units = "dph";  // of the target column(s), recorded in the model file
@@ -99,10 +96,11 @@ void Run(const FitArgs& a) {
                      "mode and to --method elm");
   }
 
-  // Several calibration logs (or one split at its gaps) become one run of several records.
+  // Several calibration logs (or one split at its gaps) become one run of several records: the
+  // targets' columns, then the temperatures', of every log one after the other.
   std::string notes, rate_how, sources;
   SelectedColumns targets, temperature;
-  std::vector<Eigen::Index> record_starts;
+  drift::RecordRows run;
   for (const std::string& input : a.inputs) {
     std::vector<Eigen::Index> starts;
     const io::CsvTable table = ReadLog(input, a.log, &notes, &starts);
@@ -110,35 +108,23 @@ void Run(const FitArgs& a) {
     const double rate_hz = ResolveRateHz(a, table, &how);
     const std::string time_note = NonUniformTimeNote(table);
     if (!time_note.empty()) notes += (a.inputs.size() > 1 ? input + ": " : "") + time_note + "\n";
-    SelectedColumns t = ReadColumns(table, a.target, "--target");
-    SelectedColumns c;
-    if (!a.temperature.empty()) c = ReadColumns(table, a.temperature, "--temperature");
+    targets = ReadColumns(table, a.target, "--target");
+    if (!a.temperature.empty()) temperature = ReadColumns(table, a.temperature, "--temperature");
     if (sources.empty()) {
       o.features.rate_hz = rate_hz;
       rate_how = how;
-      targets = std::move(t);
-      temperature = std::move(c);
     } else {
-      if (std::abs(rate_hz / o.features.rate_hz - 1.0) > kSameRate) {
-        throw DataError(fmt::format(
-            "{} is sampled at {:g} Hz, {} at {:g} Hz: calibration logs fitted together need one "
-            "sample rate (resample one, or pass --rate-hz if the time stamps are wrong)",
-            a.inputs.front(), o.features.rate_hz, input, rate_hz));
-      }
-      const Eigen::Index offset = targets.values.rows();
-      record_starts.push_back(offset);
-      for (const Eigen::Index start : starts) record_starts.push_back(offset + start);
-      starts.clear();
-      targets.values.conservativeResize(offset + t.values.rows(), Eigen::NoChange);
-      targets.values.bottomRows(t.values.rows()) = t.values;
-      if (c.values.size() > 0) {
-        temperature.values.conservativeResize(offset + c.values.rows(), Eigen::NoChange);
-        temperature.values.bottomRows(c.values.rows()) = c.values;
-      }
+      io::RequireSameSampleRate(a.inputs.front(), o.features.rate_hz, input, rate_hz);
     }
-    record_starts.insert(record_starts.end(), starts.begin(), starts.end());
+    Eigen::MatrixXd block(table.rows(), targets.values.cols() + temperature.values.cols());
+    block.leftCols(targets.values.cols()) = targets.values;
+    if (temperature.values.cols() > 0) block.rightCols(temperature.values.cols()) = temperature.values;
+    run.Append(block, starts);
     sources += (sources.empty() ? "" : ",") + input;
   }
+  targets.values = run.rows.leftCols(targets.values.cols());
+  temperature.values = run.rows.rightCols(temperature.values.cols());
+  const std::vector<Eigen::Index>& record_starts = run.record_starts;
   for (const std::string& name : temperature.names) {
     for (const std::string& target : targets.names) {
       if (name == target) {

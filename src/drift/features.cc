@@ -28,6 +28,19 @@ constexpr double kQuadraticCentreC = 20.0;
 
 double FirstOrderLagGain(double tau_s, double dt_s) { return -std::expm1(-dt_s / tau_s); }
 
+void RecordRows::Append(const Eigen::Ref<const Eigen::MatrixXd>& block,
+                        const std::vector<Eigen::Index>& block_starts) {
+  const Eigen::Index offset = rows.rows();
+  if (offset > 0 && block.cols() != rows.cols()) {
+    throw DataError("records of " + std::to_string(rows.cols()) + " and " +
+                    std::to_string(block.cols()) + " columns cannot be joined");
+  }
+  if (offset > 0) record_starts.push_back(offset);
+  for (const Eigen::Index start : block_starts) record_starts.push_back(offset + start);
+  rows.conservativeResize(offset + block.rows(), block.cols());
+  rows.bottomRows(block.rows()) = block;
+}
+
 void CheckRecordStarts(const std::vector<Eigen::Index>& record_starts, Eigen::Index n) {
   Eigen::Index previous = 0;
   for (const Eigen::Index start : record_starts) {

@@ -108,16 +108,6 @@ Log ReadUnitLog(const Manifest& m, const std::string& path) {
   return log;
 }
 
-// The calibration logs of an axis as one run of records: its target and temperatures, each log
-// after the other, and where every record after the first starts.
-struct Run {
-  Eigen::VectorXd y;
-  Eigen::MatrixXd temperature;
-  std::vector<Eigen::Index> record_starts;
-};
-
-// Calibration logs fitted together agree on their sample rate to this share.
-constexpr double kSameRate = 0.01;
 
 Eigen::MatrixXd Temperatures(const io::CsvTable& table, const AxisSpec& axis) {
   Eigen::MatrixXd t(table.rows(), static_cast<Eigen::Index>(axis.temperature.size()));
@@ -142,33 +132,27 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   std::vector<Log> cal;
   for (const std::string& path : unit.calibration) {
     cal.push_back(ReadUnitLog(m, path));
-    if (std::abs(cal.back().rate_hz / cal.front().rate_hz - 1.0) > kSameRate) {
-      throw DataError(fmt::format(
-          "{} is sampled at {:g} Hz, {} at {:g} Hz: calibration logs fitted together need one "
-          "sample rate", unit.calibration.front(), cal.front().rate_hz, path, cal.back().rate_hz));
-    }
+    io::RequireSameSampleRate(unit.calibration.front(), cal.front().rate_hz, path,
+                              cal.back().rate_hz);
   }
   drift::DriftOptions options = m.FitOptions();
   options.features.rate_hz = cal.front().rate_hz;
   std::vector<io::LoadedModel> models;
   for (const AxisSpec& axis : m.axes) {
-    Run run;
+    // The calibration logs one after the other: the target, then the temperatures.
+    drift::RecordRows run;
     for (const Log& log : cal) {
-      const Eigen::Index offset = run.y.size();
-      if (offset > 0) run.record_starts.push_back(offset);
-      for (const Eigen::Index start : log.record_starts) run.record_starts.push_back(offset + start);
-      const Eigen::MatrixXd t = Temperatures(log.table, axis);
-      run.y.conservativeResize(offset + t.rows());
-      run.y.tail(t.rows()) = log.table.Column(axis.target);
-      run.temperature.conservativeResize(offset + t.rows(), t.cols());
-      run.temperature.bottomRows(t.rows()) = t;
+      Eigen::MatrixXd block(log.table.rows(), 1 + static_cast<Eigen::Index>(axis.temperature.size()));
+      block << log.table.Column(axis.target), Temperatures(log.table, axis);
+      run.Append(block, log.record_starts);
     }
     io::LoadedModel model;
     model.info.target_column = axis.target;
     model.info.temperature_column = Joined(axis.temperature);
     model.info.source = Joined(unit.calibration);
     model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
-    model.model = drift::FitDriftModel(run.y, run.temperature, options, run.record_starts);
+    model.model = drift::FitDriftModel(run.rows.col(0), run.rows.rightCols(run.rows.cols() - 1),
+                                       options, run.record_starts);
     AxisResult a;
     a.target = axis.target;
     a.temperature = model.info.temperature_column;

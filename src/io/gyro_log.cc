@@ -139,6 +139,15 @@ double ResolveSampleRate(const CsvTable& table, double given, std::string* how) 
   return rate;
 }
 
+void RequireSameSampleRate(const std::string& first, double first_hz, const std::string& log,
+                           double rate_hz) {
+  if (std::abs(rate_hz / first_hz - 1.0) <= 0.01) return;
+  throw DataError(fmt::format(
+      "{} is sampled at {:g} Hz, {} at {:g} Hz: calibration logs fitted together need one sample "
+      "rate (resample one, or pass the rate if the time stamps are wrong)",
+      first, first_hz, log, rate_hz));
+}
+
 std::string NonUniformTimeNote(const CsvTable& table) {
   if (!table.HasColumn("time_s") || table.rows() < 3) return "";
   Eigen::VectorXd t;

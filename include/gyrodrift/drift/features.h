@@ -88,6 +88,16 @@ void ForEachRecord(Eigen::Index n, const std::vector<Eigen::Index>& record_start
   f(begin, n - begin);
 }
 
+// Records appended one after another: each block of rows (N_i x C, the same C) below the earlier
+// ones, record_starts gaining the block's first row (after the first block) and its own record
+// starts shifted into place (the gaps of a log split at them).
+struct RecordRows {
+  Eigen::MatrixXd rows;
+  std::vector<Eigen::Index> record_starts;
+  void Append(const Eigen::Ref<const Eigen::MatrixXd>& block,
+              const std::vector<Eigen::Index>& block_starts = {});
+};
+
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,
                         Eigen::Index count);

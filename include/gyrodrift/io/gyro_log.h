@@ -49,6 +49,11 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
 // its median step is not positive or gives a rate outside [1e-9, 1e6] Hz.
 double ResolveSampleRate(const CsvTable& table, double given, std::string* how);
 
+// Logs fitted together as records of one calibration need one sample rate: throws DataError
+// naming both logs when `rate_hz` (of `log`) differs from `first_hz` (of `first`) by more than 1 %.
+void RequireSameSampleRate(const std::string& first, double first_hz, const std::string& log,
+                           double rate_hz);
+
 // "" for a log without time_s or with a uniform one (read by ReadLog, so time_s increases);
 // otherwise a one-line note that the time axis has jitter (steps shorter than half the median
 // step: how many, the shortest and its row), since every model and the Allan analysis assume
