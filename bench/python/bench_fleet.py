@@ -176,12 +176,18 @@ def main():
                 client.close()
                 cluster.close()
 
-        print("median wall time (CPU time of the run's processes):")
-        base = statistics.median(times[configurations[0][0]])
+        # Speed-up against the first configuration of the same runner (the CLI's, Dask's): the
+        # ratio of the medians, and the median of the ratios within each repetition (the runs
+        # of one repetition follow each other, so they share the machine's load more closely).
+        print("median wall time (CPU time of the run's processes), speed-up:")
+        firsts = {}
         for name, *_ in configurations:
+            first = firsts.setdefault(name.split(",")[0].split(" --")[0], name)
             m = statistics.median(times[name])
+            paired = statistics.median(f / t for f, t in zip(times[first], times[name]))
             print(f"  {name:36s} {m:7.2f} s  ({statistics.median(cpus[name]):7.2f} s)  "
-                  f"{base / m:4.2f}x of {configurations[0][0]}")
+                  f"{statistics.median(times[first]) / m:4.2f}x (paired {paired:4.2f}x) "
+                  f"of {first}")
         reference, differ = configurations[0][3], False
         for name, _, _, out in configurations[1:]:
             diff = differences(reference, out, serials)
