@@ -9,7 +9,13 @@ fleet.csv rows; the client then writes fleet.csv and fleet.html (fleet::FinishFl
 are those ``gyrodrift calibrate`` writes, apart from the timings. The workers must see the
 manifest, the logs and the output folder at the same paths (one machine, or a shared file
 system). Without ``--scheduler`` a LocalCluster of ``--workers`` processes (default: every core),
-one thread each, runs the units.
+one thread each, runs the units (each unit on one thread).
+
+A worker that dies while it holds a unit (the out-of-memory killer, a lost machine) costs a
+retry: the scheduler gives the unit to another worker, up to Dask's
+``distributed.scheduler.allowed-failures`` times (3 by default), then fails the run with Dask's
+KilledWorker. A unit's files reach their names only by one atomic rename of the set, so a killed
+unit leaves no partial file; the retry's write removes the dead process's temporaries.
 """
 
 import argparse

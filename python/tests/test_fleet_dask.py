@@ -1,19 +1,24 @@
 """gyrodrift.fleet on a LocalCluster of 2 workers writes what `gyrodrift calibrate` writes: fleet.csv
-byte for byte apart from the unit_seconds column, and each unit's model.json identical. The fleet
-is built as tests/cli/calibrate_test.cc builds its own, from the independent family's units."""
+byte for byte apart from the unit_seconds column, and each unit's model.json identical; a worker
+killed in the middle of a unit costs a retry, not the run. The fleet is built as
+tests/cli/calibrate_test.cc builds its own, from the independent family's units."""
 
 import csv
 import gzip
 import io
+import json
+import os
+import re
+import signal
 import subprocess
 import sys
-import os
 
 import numpy as np
 import pytest
 
 import gyrodrift as gd
 import gyrodrift.fleet
+from distributed.diagnostics.plugin import WorkerPlugin
 from conftest import write_csv
 
 AXES = """
@@ -35,7 +40,9 @@ def unit_file(testdata, name):
     return {h: np.array([float(r[i]) for r in rows[1:]]) for i, h in enumerate(rows[0])}
 
 
-def write_imu_log(testdata, path, ux, uy, mission):
+def write_imu_log(testdata, path, ux, uy, mission, hours=None):
+    """A two-axis log (family units ux, uy): the 16-h calibration run, or the 8-h mission run with
+    the true drift; `hours` keeps only the first hours (bench/python/bench_fleet.py)."""
     def file(u):
         return f"unit{u}_test8h_mission.csv.gz" if mission else f"unit{u}_train16h.csv.gz"
     x, y = unit_file(testdata, file(ux)), unit_file(testdata, file(uy))
@@ -45,6 +52,9 @@ def write_imu_log(testdata, path, ux, uy, mission):
         for axis, u in (("x", ux), ("y", uy)):
             columns[f"drift_{axis}"] = unit_file(
                 testdata, f"unit{u}_test8h_mission_truth.csv.gz")["drift_dph"]
+    if hours is not None:
+        keep = x["time_s"] < hours * 3600.0
+        columns = {name: v[keep] for name, v in columns.items()}
     write_csv(path, columns)
 
 
@@ -113,3 +123,120 @@ def test_command_line_entry_point(fleet):
     p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", str(fleet / "fleet.toml"),
                         "-o", str(fleet / "x"), "--workers", "0"], capture_output=True, text=True)
     assert p.returncode == 2 and "--workers" in p.stderr
+
+
+class KillWorkerInUnit(WorkerPlugin):
+    """Kills the first worker process that starts a unit with SIGKILL, as the out-of-memory killer
+    would, while the unit's C++ calibration runs on it: once the task is executing and its thread
+    is inside the `_unit` call (polled every 10 ms on the worker's event loop, which is also what
+    would report the task's end, so the task cannot be reported done between the check and the
+    kill). Just before, it leaves in the unit's folder the half-written temporaries a kill in the
+    unit's write phase leaves (`<file>.tmp.<pid>`), for the retry to clean up.
+
+    Files in `log_dir`: `start.<pid>.<key>` for every unit a worker starts (the retry shows as a
+    second start of the same key by another process), `claim` (one kill in all: the first worker
+    to start a unit claims it; restarted workers get the plugin too) and `killed` (JSON: pid, key,
+    serial and the temporaries left)."""
+
+    def __init__(self, log_dir):
+        self.log_dir = str(log_dir)
+
+    def setup(self, worker):
+        self.worker = worker
+
+    def transition(self, key, start, finish, **kwargs):
+        if finish != "executing" or not str(key).startswith("_unit-"):
+            return
+        open(os.path.join(self.log_dir, f"start.{os.getpid()}.{key}"), "w").close()
+        try:
+            os.close(os.open(os.path.join(self.log_dir, "claim"), os.O_CREAT | os.O_EXCL))
+        except FileExistsError:
+            return
+        self.worker.loop.call_later(0.01, self._kill_in_unit, key)
+
+    def _kill_in_unit(self, key):
+        ts = self.worker.state.tasks.get(key)
+        if ts is None or ts.state != "executing":
+            # Done before it was caught (not with these logs): the next unit to start is the one.
+            os.remove(os.path.join(self.log_dir, "claim"))
+            return
+        frames = [f for f in sys._current_frames().values()
+                  if f.f_code is gyrodrift.fleet._unit.__code__]
+        if not frames:
+            self.worker.loop.call_later(0.01, self._kill_in_unit, key)
+            return
+        args = frames[0].f_locals
+        serial = gd._gyrodrift._manifest_serials(args["manifest_path"])[args["index"]]
+        folder = os.path.join(args["output_dir"], serial)
+        os.makedirs(folder, exist_ok=True)  # RunUnit creates it just before its writes
+        left = []
+        for name in ("model.json", "allan.csv", "summary.json"):
+            left.append(os.path.join(folder, f"{name}.tmp.{os.getpid()}"))
+            with open(left[-1], "w") as f:
+                f.write('{"half": ')
+        with open(os.path.join(self.log_dir, "killed"), "w") as f:
+            json.dump({"pid": os.getpid(), "key": key, "serial": serial, "left": left}, f)
+        os.kill(os.getpid(), signal.SIGKILL)
+
+
+def leftovers(folder):
+    return sorted(str(p) for p in folder.rglob("*") if re.search(r"\.(tmp|bak)\.\d+$", p.name))
+
+
+def test_killed_worker_is_retried(fleet, tmp_path):
+    # Four units (SN3 and SN4 reuse the logs of SN1 and SN2) on 2 workers of one thread each.
+    text = (fleet / "fleet.toml").read_text()
+    for sn, logs in (("SN3", "SN1"), ("SN4", "SN2")):
+        text += (f'\n[[unit]]\nserial = "{sn}"\ncalibration = "logs/{logs}_cal.csv"\n'
+                 f'verification = ["logs/{logs}_ver.csv"]\n')
+    manifest = fleet / "fleet4.toml"
+    manifest.write_text(text)
+    serials = ["SN1", "SN2", "SN3", "SN4"]
+    log = tmp_path / "log"
+    log.mkdir()
+
+    from dask.distributed import Client, LocalCluster
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        reference = gyrodrift.fleet.calibrate(manifest, tmp_path / "ref", client=client)
+        pids = set(client.run(os.getpid).values())
+        client.register_worker_plugin(KillWorkerInUnit(log), name="kill-worker-in-unit")
+        r = gyrodrift.fleet.calibrate(manifest, tmp_path / "kill", client=client)
+
+    # One worker was killed in the middle of a unit, and that unit ran again in another process.
+    assert (log / "killed").exists(), "no worker was killed"
+    killed = json.loads((log / "killed").read_text())
+    assert killed["pid"] in pids
+    with pytest.raises(ProcessLookupError):
+        os.kill(killed["pid"], 0)
+    starts = {}
+    for p in log.glob("start.*"):
+        pid, key = p.name.split(".", 2)[1:]
+        starts.setdefault(key, []).append(int(pid))
+    assert len(starts) == 4
+    assert sorted(len(v) for v in starts.values()) == [1, 1, 1, 2], starts
+    assert len(set(starts[killed["key"]])) == 2 and killed["pid"] in starts[killed["key"]]
+
+    # The run completed: every unit calibrated (none skipped: the killed one wrote nothing) ...
+    assert r["units"] == 4 and r["calibrated"] == 4 and r["errors"] == 0, r["summary"]
+    assert reference["calibrated"] == 4, reference["summary"]
+    # ... with the files of a run without the kill, byte for byte apart from the timings ...
+    ref, kill = tmp_path / "ref", tmp_path / "kill"
+    assert without_unit_seconds(kill / "fleet.csv") == without_unit_seconds(ref / "fleet.csv")
+    for sn in serials:
+        names = sorted(p.name for p in (ref / sn).iterdir())
+        assert sorted(p.name for p in (kill / sn).iterdir()) == names, sn
+        assert "model.json" in names and "verification_1_compensated.csv" in names
+        for name in names:
+            if name == "summary.json":
+                a, b = (json.loads((d / sn / name).read_text()) for d in (ref, kill))
+                k = a["columns"].index("unit_seconds")
+                for s in (a, b):
+                    s["rows"] = [row[:k] + row[k + 1:] for row in s["rows"]]
+                assert a == b, f"{sn}/{name}"
+            else:
+                assert (kill / sn / name).read_bytes() == (ref / sn / name).read_bytes(), \
+                    f"{sn}/{name}"
+    # ... and no temporary left: the retry's write removed those of the killed process.
+    assert all(not os.path.exists(p) for p in killed["left"])
+    assert leftovers(kill) == [] and leftovers(ref) == []

@@ -137,6 +137,11 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   }
   drift::DriftOptions options = m.FitOptions();
   options.features.rate_hz = cal.front().rate_hz;
+  // Units run in parallel (RunFleet's threads, or one Dask task per worker thread), so a unit
+  // runs on one thread: a decomposing method (ms-elm, emd-elm) would otherwise take every core
+  // per unit, T units x every core on the machine, and a one-thread Dask worker would use them
+  // all. The results do not depend on it; the model records threads = 1, as `fit --threads 1`.
+  options.threads = 1;
   std::vector<io::LoadedModel> models;
   for (const AxisSpec& axis : m.axes) {
     // The calibration logs one after the other: the target, then the temperatures.
