@@ -253,7 +253,7 @@ TEST_F(KillSafety, Decompose) {
 TEST_F(KillSafety, Fit) {
   const std::string log = dir_ + "/log.csv";
   // Long enough (about 0.5 s) for most kill points to strike before it ends.
-  io::WriteFileAtomically(log, test::ThermalLogCsv(Sanitized() ? 8000 : 80000, 2));
+  io::WriteFileAtomically(log, test::ThermalLogCsv(Sanitized() ? 40000 : 80000, 2));
   Run({"fit",
        {log, "-t", "rate_dph", "-T", "temperature_c", "--mode", "compensate", "-q", "-o",
         dir_ + "/out/model.json"},
