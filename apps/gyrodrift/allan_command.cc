@@ -111,8 +111,10 @@ void Run(const AllanArgs& a) {
   fit_options.Validate();  // every option error before any file is read
 
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
-  const Eigen::VectorXd data = table.Column(a.column);
+  // Only the analysed column and time_s are kept, and the column is used in place: at 1e8
+  // samples each copy is 800 MB (docs/errors.md, Memory).
+  const io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
+  const Eigen::VectorXd& data = table.ColumnRef(a.column);
   RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
                        "its Allan deviation is zero at every tau (a logging fault?)");
   const al::AllanResult r = al::Compute(data, o);
