@@ -12,15 +12,6 @@
 #include "gyrodrift/common/statistics.h"
 
 namespace gyrodrift::io {
-namespace {
-
-double MedianStep(const Eigen::VectorXd& t) {
-  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
-  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
-  return Median(std::move(steps));
-}
-
-}  // namespace
 
 std::string_view ToString(GapPolicy policy) {
   switch (policy) {
