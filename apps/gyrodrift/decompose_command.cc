@@ -106,8 +106,8 @@ void Run(const DecomposeArgs& a) {
   // Only the column (and time_s) is read, and the table is dropped once the column is out.
   std::string notes;
   const Eigen::VectorXd x = [&] {
-    const io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
-    Eigen::VectorXd column = table.Column(a.column);
+    io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
+    Eigen::VectorXd column = table.TakeColumn(a.column);
     const std::string name = "column '" + ColumnName(table, a.column) + "'";
     RequireVaryingSignal(name, column, "it has no oscillation to decompose");
     RequireDecomposableSize(name, column.size());

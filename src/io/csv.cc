@@ -352,6 +352,16 @@ const Eigen::VectorXd& CsvTable::ColumnRef(int index) const {
   return columns_[c];
 }
 
+Eigen::VectorXd CsvTable::TakeColumn(const std::string& spec) {
+  const int index = ResolveColumn(spec);
+  (void)ColumnRef(index);  // the checks
+  const size_t c = static_cast<size_t>(index);
+  Eigen::VectorXd values = std::move(columns_[c]);
+  columns_[c] = Eigen::VectorXd();
+  kept_[c] = false;
+  return values;
+}
+
 CsvTable CsvTable::WithInterpolatedRows(
     const std::vector<std::pair<Eigen::Index, int>>& insert) const {
   CsvTable out;

@@ -78,6 +78,9 @@ class CsvTable {
   // caller that only reads a long column uses.
   const Eigen::VectorXd& ColumnRef(const std::string& spec) const;
   const Eigen::VectorXd& ColumnRef(int index) const;
+  // Moves the values out of the table (checked as Column, no copy); the column then counts as not
+  // kept. For a caller that needs one long column and not the rest of the table.
+  Eigen::VectorXd TakeColumn(const std::string& spec);
 
   // A copy with rows inserted by linear interpolation: for each (row, count), `count` rows evenly
   // spaced between data rows `row` and `row + 1` (0-based), in every kept column. Messages about

@@ -73,6 +73,10 @@ TEST(CsvTable, NonNumericAndNonFiniteCellsNameTheRow) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("data row 2 is 'nan'"), std::string::npos) << e.what();
   }
+  // Taking a bad column out is refused the same way, and leaves it in the table.
+  CsvTable u = t;
+  EXPECT_THROW(u.TakeColumn("b"), DataError);
+  EXPECT_TRUE(u.IsKept(1));
 }
 
 TEST(CsvTable, DuplicateHeaderNamesAreErrors) {
@@ -193,6 +197,15 @@ TEST(CsvTable, KeepsOnlyTheNamedColumnsAndStillRefusesRaggedRows) {
   EXPECT_EQ(t.ColumnRef("rate_dph"), (Eigen::VectorXd(3) << 1, 2, 3).finished());
   EXPECT_EQ(&t.ColumnRef("rate_dph"), &t.ColumnRef(1));  // no copy
   EXPECT_THROW(t.Column("time_s"), UsageError);
+  // Taken out without a copy: the table no longer has it.
+  CsvTable taken = t;
+  const double* stored = taken.ColumnRef("4").data();
+  const Eigen::VectorXd temp = taken.TakeColumn("temp");
+  EXPECT_EQ(temp.data(), stored);
+  EXPECT_EQ(temp, (Eigen::VectorXd(3) << 20, 21, 22).finished());
+  EXPECT_FALSE(taken.IsKept(3));
+  EXPECT_THROW(taken.TakeColumn("temp"), UsageError);
+  EXPECT_EQ(taken.ColumnRef("rate_dph"), t.ColumnRef("rate_dph"));
   try {
     t.Column("nope");
     ADD_FAILURE() << "an unknown column was read";
