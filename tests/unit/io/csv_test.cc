@@ -149,6 +149,7 @@ void ExpectSameReading(const Reading& whole, const Reading& blocks, const std::s
     }
     EXPECT_EQ(error_a, error_b) << label << " column " << c;
     ASSERT_EQ(va.size(), vb.size()) << label << " column " << c;
+    if (va.size() == 0) continue;  // refused: no values (and memcmp must not see null)
     EXPECT_EQ(std::memcmp(va.data(), vb.data(), sizeof(double) * static_cast<size_t>(va.size())), 0)
         << label << " column " << c;
   }
