@@ -110,11 +110,19 @@ void Run(const AllanArgs& a) {
   const al::NoiseFitOptions fit_options{.tau_min_s = a.fit_tau_min_s, .tau_max_s = a.fit_tau_max_s};
   fit_options.Validate();  // every option error before any file is read
 
-  std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
-  const Eigen::VectorXd data = table.Column(a.column);
-  RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", data,
-                       "its Allan deviation is zero at every tau (a logging fault?)");
+  // Only the analysed column and time_s are read; the column is moved out of the table, and
+  // time_s is dropped with the table before the analysis, which needs as much again for the
+  // phase: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
+  // worked out while time_s is there, and printed at the end.
+  std::string notes, time_note;
+  const Eigen::VectorXd data = [&] {
+    io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
+    if (!a.quiet) time_note = NonUniformTimeNote(table);
+    Eigen::VectorXd column = table.TakeColumn(a.column);
+    RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", column,
+                         "its Allan deviation is zero at every tau (a logging fault?)");
+    return column;
+  }();
   const al::AllanResult r = al::Compute(data, o);
 
   // Noise terms need an Allan-variance curve; for the other estimators fit an OADEV on the same
@@ -224,7 +232,6 @@ void Run(const AllanArgs& a) {
   } else {
     fmt::print("noise terms not fitted: {}\n", fit_error);
   }
-  const std::string time_note = NonUniformTimeNote(table);
   if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("{}", notes);
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));

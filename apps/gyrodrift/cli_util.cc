@@ -191,9 +191,10 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split) {
 }
 
 io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
-                     std::vector<Eigen::Index>* record_starts) {
+                     std::vector<Eigen::Index>* record_starts,
+                     const std::vector<std::string>& columns) {
   std::string note;
-  io::CsvTable table = io::ReadLog(path, log.Options(), &note, record_starts);
+  io::CsvTable table = io::ReadLog(path, log.Options(), &note, record_starts, columns);
   if (!note.empty()) *notes += note + "\n";
   return table;
 }

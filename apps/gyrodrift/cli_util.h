@@ -65,9 +65,11 @@ struct LogArgs {
 // --delimiter auto|comma|tab|semicolon.
 void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split);
 // ReadLog under those choices; the note on filled or split gaps, if any, is appended (with a
-// newline) to *notes; record_starts as io::ReadLog's.
+// newline) to *notes; record_starts and columns (the only ones kept, with time_s; empty = all) as
+// io::ReadLog's.
 io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
-                     std::vector<Eigen::Index>* record_starts = nullptr);
+                     std::vector<Eigen::Index>* record_starts = nullptr,
+                     const std::vector<std::string>& columns = {});
 
 // The one-line message for an option error: the library names its field (`ensemble_size = 0:
 // must be ...`); when the user gave the subcommand's flag that sets that field, the message

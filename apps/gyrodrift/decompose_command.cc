@@ -103,11 +103,11 @@ void Run(const DecomposeArgs& a) {
   o.noise_stages = a.noise_stages;
   o.Validate();  // option errors before any file is read
 
-  // The table (every column of the log) is dropped once the one column is out.
+  // Only the column (and time_s) is read, and the table is dropped once the column is out.
   std::string notes;
   const Eigen::VectorXd x = [&] {
-    const io::CsvTable table = ReadLog(a.input, a.log, &notes);
-    Eigen::VectorXd column = table.Column(a.column);
+    io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
+    Eigen::VectorXd column = table.TakeColumn(a.column);
     const std::string name = "column '" + ColumnName(table, a.column) + "'";
     RequireVaryingSignal(name, column, "it has no oscillation to decompose");
     RequireDecomposableSize(name, column.size());

@@ -1,7 +1,12 @@
 #include "gyrodrift/io/csv.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <istream>
 #include <limits>
 #include <string_view>
 
@@ -59,6 +64,20 @@ bool IsSkippable(std::string_view line) {
   return t.empty() || t.front() == '#';
 }
 
+// Index of the column a spec names: a header name, else a 1-based index; -1 for none.
+int FindColumn(const std::vector<std::string>& header, const std::string& spec) {
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (header[i] == spec) return static_cast<int>(i);
+  }
+  int index = 0;
+  auto [end, ec] = std::from_chars(spec.data(), spec.data() + spec.size(), index);
+  if (ec == std::errc() && end == spec.data() + spec.size() && index >= 1 &&
+      index <= static_cast<int>(header.size())) {
+    return index - 1;
+  }
+  return -1;
+}
+
 }  // namespace
 
 std::string_view ToString(Delimiter delimiter) {
@@ -78,72 +97,218 @@ Delimiter DelimiterFromString(std::string_view text) {
   throw OptionError("delimiter", "'" + std::string(text) + "'", "auto, comma, tab or semicolon");
 }
 
-CsvTable CsvTable::Read(const std::string& path, Delimiter delimiter) {
-  return Parse(ReadTextFile(path), path, delimiter);
+void CsvReadOptions::Validate() const {
+  if (block_bytes < 1 || block_bytes > (size_t{1} << 30)) {
+    throw OptionError("block_bytes", std::to_string(block_bytes), "an integer in [1, 1073741824]");
+  }
 }
 
-CsvTable CsvTable::Parse(const std::string& text, const std::string& source,
-                         Delimiter given) {
-  CsvTable table;
-  table.source_ = source;
-  std::string_view rest(text);
-  if (rest.size() >= 3 && rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // BOM
-  std::vector<std::string_view> cells;
-  bool have_header = false;
-  char delimiter = ',';
-  Eigen::Index line_number = 0;
-  while (!rest.empty()) {
-    const size_t eol = rest.find('\n');
-    const std::string_view line = rest.substr(0, eol);
-    rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 1);
-    ++line_number;
-    if (IsSkippable(line)) continue;
-    if (!have_header) {
-      delimiter = given == Delimiter::kComma       ? ','
-                  : given == Delimiter::kTab       ? '\t'
-                  : given == Delimiter::kSemicolon ? ';'
-                                                   : DetectDelimiter(line);
-    }
-    SplitLine(line, delimiter, cells);
-    if (!have_header) {
-      for (auto cell : cells) table.header_.emplace_back(Unquote(cell));
-      for (size_t i = 0; i < table.header_.size(); ++i) {
-        if (table.header_[i].empty()) {
-          throw DataError(source + ": header column " + std::to_string(i + 1) + " has no name");
-        }
-        for (size_t j = 0; j < i; ++j) {
-          // A column is chosen by name: two of one name would make the choice silent guesswork.
-          if (table.header_[j] == table.header_[i]) {
-            throw DataError(source + ": header names column '" + table.header_[i] + "' twice (" +
-                            std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
-          }
-        }
-      }
-      table.columns_.resize(table.header_.size());
-      table.first_bad_.resize(table.header_.size());
-      have_header = true;
-      continue;
-    }
-    if (cells.size() != table.header_.size()) {
-      throw DataError(source + ": line " + std::to_string(line_number) + " has " +
-                      std::to_string(cells.size()) + " cells, the header has " +
-                      std::to_string(table.header_.size()));
-    }
-    ++table.rows_;
-    for (size_t c = 0; c < cells.size(); ++c) {
-      double value;
-      if (!ParseDouble(cells[c], value)) {
-        value = std::numeric_limits<double>::quiet_NaN();
-        if (table.first_bad_[c].row < 0) table.first_bad_[c] = {table.rows_, std::string(cells[c])};
-      } else if (!std::isfinite(value) && table.first_bad_[c].row < 0) {
-        table.first_bad_[c] = {table.rows_, std::string(cells[c])};
-      }
-      table.columns_[c].push_back(value);
+// Lines in, a table out. The text comes in blocks of any size (a whole string is one block); a
+// line cut by a block's end is carried to the next, so the table, and every message with its line
+// number, is the same for every block size.
+class CsvTable::Parser {
+ public:
+  // `size_hint`: the bytes to come (0 = unknown), to reserve the kept columns.
+  Parser(const std::string& source, Delimiter delimiter, const std::vector<std::string>& columns,
+         std::uint64_t size_hint)
+      : given_(delimiter), specs_(columns), size_hint_(size_hint) {
+    table_.source_ = source;
+  }
+
+  void Feed(std::string_view block) {
+    if (started_) {
+      Scan(block);
+    } else if (head_.empty() && block.size() >= 3) {
+      started_ = true;
+      Scan(WithoutBom(block));
+    } else {
+      // The byte-order mark is told from the first three bytes, wherever the blocks end.
+      head_.append(block);
+      if (head_.size() >= 3) Start();
     }
   }
-  if (!have_header) throw DataError(source + ": empty file (no header row)");
-  if (table.rows_ == 0) throw DataError(source + ": header but no data rows");
-  return table;
+
+  CsvTable Finish() {
+    if (!started_) Start();
+    if (!carry_.empty()) Line(carry_);  // the last line has no newline
+    if (!have_header_) throw DataError(table_.source_ + ": empty file (no header row)");
+    if (table_.rows_ == 0) throw DataError(table_.source_ + ": header but no data rows");
+    for (size_t c = 0; c < table_.columns_.size(); ++c) {
+      // Gives back the reserve beyond the last row (realloc shrinks a large block in place).
+      if (table_.kept_[c]) table_.columns_[c].conservativeResize(table_.rows_);
+    }
+    return std::move(table_);
+  }
+
+ private:
+  static std::string_view WithoutBom(std::string_view text) {
+    if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+    return text;
+  }
+
+  void Start() {
+    started_ = true;
+    const std::string head = std::move(head_);
+    Scan(WithoutBom(head));
+  }
+
+  // Parses the complete lines of `block`; the bytes after its last newline wait in carry_.
+  void Scan(std::string_view block) {
+    size_t eol = block.find('\n');
+    if (eol == std::string_view::npos) {
+      carry_.append(block);
+      return;
+    }
+    if (!carry_.empty()) {
+      carry_.append(block.substr(0, eol));
+      Line(carry_);
+      carry_.clear();
+    } else {
+      Line(block.substr(0, eol));
+    }
+    for (;;) {
+      block.remove_prefix(eol + 1);
+      eol = block.find('\n');
+      if (eol == std::string_view::npos) break;
+      Line(block.substr(0, eol));
+    }
+    carry_.assign(block);
+  }
+
+  void Line(std::string_view line) {
+    ++line_number_;
+    parsed_bytes_ += line.size() + 1;
+    if (IsSkippable(line)) return;
+    if (!have_header_) {
+      Header(line);
+      return;
+    }
+    CsvTable& t = table_;
+    SplitLine(line, delimiter_, cells_);
+    if (cells_.size() != t.header_.size()) {
+      throw DataError(t.source_ + ": line " + std::to_string(line_number_) + " has " +
+                      std::to_string(cells_.size()) + " cells, the header has " +
+                      std::to_string(t.header_.size()));
+    }
+    if (t.rows_ == capacity_) Reserve();
+    const Eigen::Index row = t.rows_++;
+    for (const size_t c : kept_) {
+      double value;
+      if (!ParseDouble(cells_[c], value)) {
+        value = std::numeric_limits<double>::quiet_NaN();
+        if (t.first_bad_[c].row < 0) t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
+      } else if (!std::isfinite(value) && t.first_bad_[c].row < 0) {
+        t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
+      }
+      t.columns_[c][row] = value;
+    }
+  }
+
+  void Header(std::string_view line) {
+    CsvTable& t = table_;
+    delimiter_ = given_ == Delimiter::kComma       ? ','
+                 : given_ == Delimiter::kTab       ? '\t'
+                 : given_ == Delimiter::kSemicolon ? ';'
+                                                   : DetectDelimiter(line);
+    SplitLine(line, delimiter_, cells_);
+    for (auto cell : cells_) t.header_.emplace_back(Unquote(cell));
+    for (size_t i = 0; i < t.header_.size(); ++i) {
+      if (t.header_[i].empty()) {
+        throw DataError(t.source_ + ": header column " + std::to_string(i + 1) + " has no name");
+      }
+      for (size_t j = 0; j < i; ++j) {
+        // A column is chosen by name: two of one name would make the choice silent guesswork.
+        if (t.header_[j] == t.header_[i]) {
+          throw DataError(t.source_ + ": header names column '" + t.header_[i] + "' twice (" +
+                          std::to_string(j + 1) + " and " + std::to_string(i + 1) + ")");
+        }
+      }
+    }
+    t.columns_.resize(t.header_.size());
+    t.first_bad_.resize(t.header_.size());
+    t.kept_.assign(t.header_.size(), specs_.empty());
+    for (const auto& spec : specs_) {
+      const int c = FindColumn(t.header_, spec);
+      if (c >= 0) t.kept_[static_cast<size_t>(c)] = true;
+    }
+    for (size_t c = 0; c < t.header_.size(); ++c) {
+      if (t.kept_[c]) kept_.push_back(c);
+    }
+    have_header_ = true;
+  }
+
+  // Room for more rows in every kept column. From the bytes per row so far and the bytes still to
+  // come (10 % over, for rows that get longer), else half as many again. Untouched reserve costs
+  // address space, not memory, and is given back by Finish.
+  void Reserve() {
+    const Eigen::Index rows = table_.rows_;
+    Eigen::Index next = std::max<Eigen::Index>(1024, capacity_ + capacity_ / 2);
+    if (rows >= 1024 && size_hint_ > parsed_bytes_) {
+      const double bytes_per_row = static_cast<double>(parsed_bytes_) / static_cast<double>(rows);
+      const double to_come = static_cast<double>(size_hint_ - parsed_bytes_) / bytes_per_row;
+      next = std::max(capacity_ + 1024, rows + static_cast<Eigen::Index>(1.1 * to_come) + 1024);
+    }
+    for (const size_t c : kept_) table_.columns_[c].conservativeResize(next);
+    capacity_ = next;
+  }
+
+  const Delimiter given_;
+  const std::vector<std::string> specs_;
+  const std::uint64_t size_hint_;
+  CsvTable table_;
+  bool started_ = false;
+  std::string head_;   // the first bytes, until the byte-order mark can be told
+  std::string carry_;  // a line cut by the end of a block
+  bool have_header_ = false;
+  char delimiter_ = ',';
+  Eigen::Index line_number_ = 0;
+  std::uint64_t parsed_bytes_ = 0;
+  Eigen::Index capacity_ = 0;
+  std::vector<size_t> kept_;  // indices of the kept columns
+  std::vector<std::string_view> cells_;
+};
+
+CsvTable CsvTable::Read(const std::string& path, Delimiter delimiter) {
+  return Read(path, CsvReadOptions{.delimiter = delimiter});
+}
+
+CsvTable CsvTable::Read(const std::string& path, const CsvReadOptions& options) {
+  options.Validate();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw IoError(path + ": cannot open for reading (" + std::strerror(errno) + ")");
+  }
+  return Read(in, path, options);
+}
+
+CsvTable CsvTable::Read(std::istream& in, const std::string& source,
+                        const CsvReadOptions& options) {
+  options.Validate();
+  std::uint64_t size_hint = 0;
+  const std::istream::pos_type start = in.tellg();
+  if (start != std::istream::pos_type(-1) && in.seekg(0, std::ios::end)) {
+    const std::istream::pos_type end = in.tellg();
+    if (end != std::istream::pos_type(-1) && end > start) {
+      size_hint = static_cast<std::uint64_t>(end - start);
+    }
+    in.seekg(start);
+  }
+  in.clear();
+  Parser parser(source, options.delimiter, options.columns, size_hint);
+  std::string block(options.block_bytes, '\0');
+  while (in) {
+    in.read(block.data(), static_cast<std::streamsize>(block.size()));
+    const std::streamsize got = in.gcount();
+    if (got > 0) parser.Feed(std::string_view(block.data(), static_cast<size_t>(got)));
+  }
+  if (in.bad()) throw IoError(source + ": read failed");
+  return parser.Finish();
+}
+
+CsvTable CsvTable::Parse(const std::string& text, const std::string& source, Delimiter delimiter) {
+  Parser parser(source, delimiter, {}, text.size());
+  parser.Feed(text);
+  return parser.Finish();
 }
 
 bool CsvTable::HasColumn(const std::string& name) const {
@@ -154,60 +319,86 @@ bool CsvTable::HasColumn(const std::string& name) const {
 }
 
 int CsvTable::ResolveColumn(const std::string& spec) const {
-  for (size_t i = 0; i < header_.size(); ++i) {
-    if (header_[i] == spec) return static_cast<int>(i);
-  }
-  int index = 0;
-  auto [end, ec] = std::from_chars(spec.data(), spec.data() + spec.size(), index);
-  if (ec == std::errc() && end == spec.data() + spec.size() && index >= 1 &&
-      index <= static_cast<int>(header_.size())) {
-    return index - 1;
-  }
+  const int index = FindColumn(header_, spec);
+  if (index >= 0) return index;
   std::string names;
   for (const auto& h : header_) names += (names.empty() ? "" : ", ") + h;
   throw UsageError("column '" + spec + "' not found in " + source_ + " (columns: " + names +
                    "; or a 1-based index up to " + std::to_string(header_.size()) + ")");
 }
 
-Eigen::VectorXd CsvTable::Column(const std::string& spec) const {
-  return Column(ResolveColumn(spec));
+bool CsvTable::IsKept(int index) const { return kept_.at(static_cast<size_t>(index)); }
+
+Eigen::VectorXd CsvTable::Column(const std::string& spec) const { return ColumnRef(spec); }
+
+Eigen::VectorXd CsvTable::Column(int index) const { return ColumnRef(index); }
+
+const Eigen::VectorXd& CsvTable::ColumnRef(const std::string& spec) const {
+  return ColumnRef(ResolveColumn(spec));
 }
 
-Eigen::VectorXd CsvTable::Column(int index) const {
-  const auto& bad = first_bad_.at(static_cast<size_t>(index));
+const Eigen::VectorXd& CsvTable::ColumnRef(int index) const {
+  const size_t c = static_cast<size_t>(index);
+  if (!kept_.at(c)) {
+    throw UsageError(source_ + ": column '" + header_[c] +
+                     "' was not kept by the reader (CsvReadOptions::columns)");
+  }
+  const auto& bad = first_bad_[c];
   if (bad.row >= 0) {
-    throw DataError(source_ + ": column '" + header_[static_cast<size_t>(index)] + "' data row " +
+    throw DataError(source_ + ": column '" + header_[c] + "' data row " +
                     std::to_string(bad.row) + " is '" + bad.text +
                     "': every value must be a finite number");
   }
-  const auto& values = columns_[static_cast<size_t>(index)];
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  return columns_[c];
+}
+
+Eigen::VectorXd CsvTable::TakeColumn(const std::string& spec) {
+  const int index = ResolveColumn(spec);
+  (void)ColumnRef(index);  // the checks
+  const size_t c = static_cast<size_t>(index);
+  Eigen::VectorXd values = std::move(columns_[c]);
+  columns_[c] = Eigen::VectorXd();
+  kept_[c] = false;
+  return values;
 }
 
 CsvTable CsvTable::WithInterpolatedRows(
     const std::vector<std::pair<Eigen::Index, int>>& insert) const {
-  CsvTable out = *this;
-  size_t added = 0;
-  for (const auto& [row, count] : insert) added += static_cast<size_t>(count);
+  CsvTable out;
+  out.source_ = source_;
+  out.header_ = header_;
+  out.kept_ = kept_;
+  out.first_bad_ = first_bad_;
+  out.columns_.resize(columns_.size());
+  // The rows the loop below adds: it takes the insertions in order, each at a row after the
+  // previous one and before the last row (an insertion out of order stops it).
+  Eigen::Index added = 0;
+  Eigen::Index previous = -1;
+  for (const auto& [row, count] : insert) {
+    if (row <= previous || row + 1 >= rows_) break;
+    added += std::max(count, 0);
+    previous = row;
+  }
+  out.rows_ = rows_ + added;
   for (size_t c = 0; c < columns_.size(); ++c) {
-    const std::vector<double>& in = columns_[c];
-    std::vector<double>& v = out.columns_[c];
-    v.clear();
-    v.reserve(in.size() + added);
+    if (!kept_[c]) continue;
+    const Eigen::VectorXd& in = columns_[c];
+    Eigen::VectorXd& v = out.columns_[c];
+    v.resize(out.rows_);
+    Eigen::Index k = 0;
     size_t next = 0;
-    for (size_t r = 0; r < in.size(); ++r) {
-      v.push_back(in[r]);
-      if (next < insert.size() && static_cast<size_t>(insert[next].first) == r && r + 1 < in.size()) {
+    for (Eigen::Index r = 0; r < rows_; ++r) {
+      v[k++] = in[r];
+      if (next < insert.size() && insert[next].first == r && r + 1 < rows_) {
         const int m = insert[next].second;
-        for (int k = 1; k <= m; ++k) {
-          const double f = static_cast<double>(k) / static_cast<double>(m + 1);
-          v.push_back(in[r] + f * (in[r + 1] - in[r]));
+        for (int j = 1; j <= m; ++j) {
+          const double f = static_cast<double>(j) / static_cast<double>(m + 1);
+          v[k++] = in[r] + f * (in[r + 1] - in[r]);
         }
         ++next;
       }
     }
   }
-  out.rows_ = static_cast<Eigen::Index>(out.columns_.empty() ? 0 : out.columns_[0].size());
   return out;
 }
 

@@ -12,15 +12,6 @@
 #include "gyrodrift/common/statistics.h"
 
 namespace gyrodrift::io {
-namespace {
-
-double MedianStep(const Eigen::VectorXd& t) {
-  std::vector<double> steps(static_cast<size_t>(t.size() - 1));
-  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) steps[static_cast<size_t>(i)] = t[i + 1] - t[i];
-  return Median(std::move(steps));
-}
-
-}  // namespace
 
 std::string_view ToString(GapPolicy policy) {
   switch (policy) {
@@ -39,7 +30,7 @@ GapPolicy GapPolicyFromString(std::string_view text) {
 }
 
 CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,
-                 std::vector<Eigen::Index>* record_starts) {
+                 std::vector<Eigen::Index>* record_starts, const std::vector<std::string>& columns) {
   const GapPolicy gaps = options.gaps;
   if (gap_note) gap_note->clear();
   if (record_starts) record_starts->clear();
@@ -48,14 +39,17 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
                      "model's fit or compensation); a decomposition or an Allan analysis needs "
                      "one uniform record: fill the gaps by interpolation or split the file");
   }
-  CsvTable table = CsvTable::Read(path, options.delimiter);
+  CsvReadOptions read{.delimiter = options.delimiter, .columns = columns};
+  if (!columns.empty()) read.columns.push_back("time_s");
+  CsvTable table = CsvTable::Read(path, read);
   if (!table.HasColumn("time_s")) return table;
-  Eigen::VectorXd t;
+  const Eigen::VectorXd* time = nullptr;
   try {
-    t = table.Column("time_s");
+    time = &table.ColumnRef("time_s");
   } catch (const Error&) {
     return table;  // unreadable: refused where the rate is read from it (ResolveSampleRate)
   }
+  const Eigen::VectorXd& t = *time;
   for (Eigen::Index i = 1; i < t.size(); ++i) {
     if (t[i] > t[i - 1]) continue;
     throw DataError(fmt::format(
@@ -123,7 +117,7 @@ double ResolveSampleRate(const CsvTable& table, double given, std::string* how) 
     *how = "default";
     return 1.0;
   }
-  const double median = MedianStep(table.Column("time_s"));
+  const double median = MedianStep(table.ColumnRef("time_s"));
   if (!(median > 0.0)) {
     throw DataError(table.source() + ": column 'time_s' has a median step of " +
                     FormatValue(median) +
@@ -150,12 +144,13 @@ void RequireSameSampleRate(const std::string& first, double first_hz, const std:
 
 std::string NonUniformTimeNote(const CsvTable& table) {
   if (!table.HasColumn("time_s") || table.rows() < 3) return "";
-  Eigen::VectorXd t;
+  const Eigen::VectorXd* time = nullptr;
   try {
-    t = table.Column("time_s");
+    time = &table.ColumnRef("time_s");
   } catch (const Error&) {
     return "";  // a note never fails a command; where time_s is needed it is read and refused
   }
+  const Eigen::VectorXd& t = *time;
   const double median = MedianStep(t);  // > 0: ReadLog refused a time_s that does not increase
   long off = 0;
   double shortest = t[1] - t[0];

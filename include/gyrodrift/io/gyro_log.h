@@ -39,13 +39,15 @@ struct LogOptions {
 // options.gaps; when rows were interpolated or the log was split, *gap_note (if given) says so,
 // else it is cleared. With kSplit, *record_starts receives the first row (0-based) of every
 // record after the first (empty: no gap); kSplit without record_starts is a UsageError. Shorter
-// irregular steps stay a note (NonUniformTimeNote).
+// irregular steps stay a note (NonUniformTimeNote). `columns`: the columns the caller needs
+// (CsvReadOptions::columns; time_s is kept with them); empty = every column.
 CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
                  std::string* gap_note = nullptr,
-                 std::vector<Eigen::Index>* record_starts = nullptr);
+                 std::vector<Eigen::Index>* record_starts = nullptr,
+                 const std::vector<std::string>& columns = {});
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
-// column) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
+// column, which the table must have kept) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
 // its median step is not positive or gives a rate outside [1e-9, 1e6] Hz.
 double ResolveSampleRate(const CsvTable& table, double given, std::string* how);
 

@@ -6,7 +6,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -70,6 +73,10 @@ TEST(CsvTable, NonNumericAndNonFiniteCellsNameTheRow) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("data row 2 is 'nan'"), std::string::npos) << e.what();
   }
+  // Taking a bad column out is refused the same way, and leaves it in the table.
+  CsvTable u = t;
+  EXPECT_THROW(u.TakeColumn("b"), DataError);
+  EXPECT_TRUE(u.IsKept(1));
 }
 
 TEST(CsvTable, DuplicateHeaderNamesAreErrors) {
@@ -87,6 +94,157 @@ TEST(CsvTable, RaggedRowsAndEmptyFilesAreErrors) {
   EXPECT_THROW(CsvTable::Parse("", "f"), DataError);
   EXPECT_THROW(CsvTable::Parse("a,b\n", "f"), DataError);
   EXPECT_THROW(CsvTable::Read("/nonexistent/file.csv"), IoError);
+  // A file that opens but cannot be read (a directory) is an I/O error, not an empty file.
+  EXPECT_THROW(CsvTable::Read(test::TempDir("csv_directory")), IoError);
+}
+
+// What a reading gave: the table, or the message it was refused with.
+struct Reading {
+  std::optional<CsvTable> table;
+  std::string error;
+};
+
+Reading ParseText(const std::string& text, Delimiter delimiter = Delimiter::kAuto) {
+  try {
+    return {CsvTable::Parse(text, "f.csv", delimiter), ""};
+  } catch (const Error& e) {
+    return {std::nullopt, e.what()};
+  }
+}
+
+Reading ReadBlocks(const std::string& text, const CsvReadOptions& options) {
+  std::istringstream in(text);
+  try {
+    return {CsvTable::Read(in, "f.csv", options), ""};
+  } catch (const Error& e) {
+    return {std::nullopt, e.what()};
+  }
+}
+
+// The block reader gave what the whole-text parse gives: the same message, or the same header,
+// rows and, in every column it kept, the same values to the bit or the same bad-cell message.
+void ExpectSameReading(const Reading& whole, const Reading& blocks, const std::string& label) {
+  ASSERT_EQ(whole.table.has_value(), blocks.table.has_value()) << label << whole.error << blocks.error;
+  if (!whole.table) {
+    EXPECT_EQ(whole.error, blocks.error) << label;
+    return;
+  }
+  const CsvTable& a = *whole.table;
+  const CsvTable& b = *blocks.table;
+  ASSERT_EQ(a.header(), b.header()) << label;
+  ASSERT_EQ(a.rows(), b.rows()) << label;
+  for (int c = 0; c < static_cast<int>(a.header().size()); ++c) {
+    if (!b.IsKept(c)) continue;
+    std::string error_a, error_b;
+    Eigen::VectorXd va, vb;
+    try {
+      va = a.Column(c);
+    } catch (const DataError& e) {
+      error_a = e.what();
+    }
+    try {
+      vb = b.Column(c);
+    } catch (const DataError& e) {
+      error_b = e.what();
+    }
+    EXPECT_EQ(error_a, error_b) << label << " column " << c;
+    ASSERT_EQ(va.size(), vb.size()) << label << " column " << c;
+    if (va.size() == 0) continue;  // refused: no values (and memcmp must not see null)
+    EXPECT_EQ(std::memcmp(va.data(), vb.data(), sizeof(double) * static_cast<size_t>(va.size())), 0)
+        << label << " column " << c;
+  }
+}
+
+TEST(CsvTable, BlockReaderGivesTheWholeTextTableForEveryBlockSize) {
+  // A byte-order mark, comments, blank lines, CRLF ends, quoted and padded names, a bad and a
+  // non-finite cell, a last line without its newline: every line crosses some block end.
+  const std::vector<std::string> texts = {
+      "\xEF\xBB\xBF# logged 2026-11-25\r\n\"time_s\", rate_dph ,temp\r\n0,1.5,20\r\n\r\n"
+      "0.01,-2e-3,x\r\n# pause\n0.02,+3,21\r\n0.03,inf,22",
+      "a;b\n1;2\n3;4\n",
+      "\xEF\xBB\xBF" "a\tb\r\n1\t2\r\n",
+      "\xEF\xBB",  // the start of a byte-order mark only: a one-column header, no rows
+      "a,b\n1,2\n3\n4,5\n",   // ragged: line 3 is named
+      "a,b,a\n1,2,3\n",       // a name twice
+      "a,,c\n1,2,3\n",        // a header cell without a name
+      "a,b\n",                // no data rows
+      "\n# only a comment\n",  // no header
+      "",
+  };
+  for (size_t i = 0; i < texts.size(); ++i) {
+    for (const Delimiter d : {Delimiter::kAuto, Delimiter::kComma, Delimiter::kTab}) {
+      const Reading whole = ParseText(texts[i], d);
+      for (const size_t block : {1, 2, 3, 5, 7, 64, 4 << 20}) {
+        ExpectSameReading(whole, ReadBlocks(texts[i], {.delimiter = d, .block_bytes = block}),
+                          "text " + std::to_string(i) + " block " + std::to_string(block));
+      }
+    }
+  }
+  EXPECT_THROW(CsvTable::Read("x.csv", CsvReadOptions{.block_bytes = 0}), OptionError);
+}
+
+TEST(CsvTable, KeepsOnlyTheNamedColumnsAndStillRefusesRaggedRows) {
+  const std::string text = "time_s,rate_dph,status,temp\n0,1,ok,20\n1,2,ok,21\n2,3,ok,22\n";
+  const Reading whole = ParseText(text);
+  // By name, by 1-based index, and a name that is not there (ignored by the reader, refused by
+  // Column with the message it gives for any unknown name).
+  const Reading some = ReadBlocks(text, {.columns = {"rate_dph", "4", "nope"}, .block_bytes = 5});
+  ExpectSameReading(whole, some, "rate_dph,4");
+  const CsvTable& t = *some.table;
+  EXPECT_FALSE(t.IsKept(0));
+  EXPECT_TRUE(t.IsKept(1));
+  EXPECT_FALSE(t.IsKept(2));  // a text column nobody asked for costs nothing
+  EXPECT_TRUE(t.IsKept(3));
+  EXPECT_EQ(t.ColumnRef("rate_dph"), (Eigen::VectorXd(3) << 1, 2, 3).finished());
+  EXPECT_EQ(&t.ColumnRef("rate_dph"), &t.ColumnRef(1));  // no copy
+  EXPECT_THROW(t.Column("time_s"), UsageError);
+  // Taken out without a copy: the table no longer has it.
+  CsvTable taken = t;
+  const double* stored = taken.ColumnRef("4").data();
+  const Eigen::VectorXd temp = taken.TakeColumn("temp");
+  EXPECT_EQ(temp.data(), stored);
+  EXPECT_EQ(temp, (Eigen::VectorXd(3) << 20, 21, 22).finished());
+  EXPECT_FALSE(taken.IsKept(3));
+  EXPECT_THROW(taken.TakeColumn("temp"), UsageError);
+  EXPECT_EQ(taken.ColumnRef("rate_dph"), t.ColumnRef("rate_dph"));
+  try {
+    t.Column("nope");
+    ADD_FAILURE() << "an unknown column was read";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "column 'nope' not found in f.csv (columns: time_s, rate_dph, status, temp; or a "
+              "1-based index up to 4)");
+  }
+  // A row short of a cell in a column that is not kept is refused as the whole parse refuses it.
+  const std::string ragged = "a,b,c\n1,2,3\n4,5\n";
+  const Reading refused = ReadBlocks(ragged, {.columns = {"a"}, .block_bytes = 3});
+  ASSERT_FALSE(refused.table.has_value());
+  EXPECT_EQ(refused.error, "f.csv: line 3 has 2 cells, the header has 3");
+  EXPECT_EQ(refused.error, ParseText(ragged).error);
+}
+
+TEST(CsvTable, FileReadInBlocksEqualsTheParseOfItsText) {
+  // About 12 MiB of rows of varying length: lines cross the 4-MiB block ends of a file read with
+  // the default options; CRLF ends, a comment now and then.
+  const std::string dir = test::TempDir("csv_blocks");
+  std::string text = "\xEF\xBB\xBF" "time_s,rate_dph,temperature_c\r\n";
+  for (int i = 0; i < 400000; ++i) {
+    text += FormatDouble(i * 0.01) + "," + FormatDouble(std::sin(i * 1e-3) / 3.0) + "," +
+            FormatDouble(20.0 + i % 97) + "\r\n";
+    if (i % 99991 == 0) text += "# marker\r\n";
+  }
+  ASSERT_GT(text.size(), size_t{12} << 20);
+  WriteFileAtomically(dir + "/big.csv", text);
+  const Reading whole = ParseText(text);
+  Reading read;
+  read.table = CsvTable::Read(dir + "/big.csv", CsvReadOptions{});
+  // The source names the file, the text parse names "f.csv": compare the values.
+  ExpectSameReading(whole, read, "default blocks");
+  Reading kept;
+  kept.table = CsvTable::Read(dir + "/big.csv", CsvReadOptions{.columns = {"rate_dph"}});
+  ExpectSameReading(whole, kept, "rate_dph only");
+  EXPECT_EQ(kept.table->ColumnRef("rate_dph").size(), 400000);
+  EXPECT_FALSE(kept.table->IsKept(0));
 }
 
 TEST(Csv, WriteReadRoundTripIsExact) {
