@@ -220,7 +220,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
                   "unit of the --input target for the Allan noise terms: dph|dps|rads")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed,
-                  "seed of the simulation (run B uses seed + 1), decomposition and learners")
+                  "seed of the simulation (run A; run B derives its own), decomposition and learners")
       ->capture_default_str()
       ->check(kSeed);
   cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")

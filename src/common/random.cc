@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 namespace gyrodrift {
 namespace {
@@ -72,5 +73,16 @@ std::uint64_t Fnv1a64(std::string_view text) {
 }
 
 std::uint64_t StreamId(std::string_view name) { return Fnv1a64(name); }
+
+std::uint64_t SeedFor(std::uint64_t seed, std::string_view path) {
+  return Rng(seed, StreamId(path)).NextU64();
+}
+
+std::uint64_t SeedFor(std::uint64_t seed, std::string_view path, std::uint64_t index) {
+  std::string indexed(path);
+  indexed += '/';
+  indexed += std::to_string(index);
+  return SeedFor(seed, indexed);
+}
 
 }  // namespace gyrodrift

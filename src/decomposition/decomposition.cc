@@ -8,9 +8,10 @@
 #include <utility>
 
 #include "common/enum_names.h"
-#include "decomposition/internal.h"
+#include "decomposition/drivers.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/decomposition/energy_band.h"
 
 namespace gyrodrift::decomposition {
 namespace {
@@ -116,10 +117,7 @@ void DecompositionOptions::Validate() const {
   if (threads < 0 || threads > 1024) {
     ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
   }
-  if (band_confidence != 0.95 && band_confidence != 0.99) {
-    ThrowOption("band_confidence", FormatValue(band_confidence),
-                "0.95 or 0.99 (the bands fitted by Flandrin et al. 2004)");
-  }
+  ValidateBandConfidence(band_confidence);
   if (noise_stages < 1 || noise_stages > 1000) {
     ThrowOption("noise_stages", std::to_string(noise_stages), "an integer in [1, 1000]");
   }
@@ -211,8 +209,9 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
     case Method::kCeemdan:
       return internal::RunCeemdan(x, options);
     case Method::kIceemdan:
-    case Method::kBeemdan:
       return internal::RunIceemdan(x, options);
+    case Method::kBeemdan:
+      return internal::RunBeemdan(x, options);
   }
   throw UsageError("unknown decomposition method");
 }

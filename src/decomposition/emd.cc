@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "decomposition/internal.h"
+#include "decomposition/drivers.h"
 
 namespace gyrodrift::decomposition::internal {
 

@@ -108,11 +108,13 @@ Sifter::Sifter(Eigen::Index n, const SiftingOptions& options)
   const size_t size = static_cast<size_t>(n);
   indmin_.resize(size + 2);
   indmax_.resize(size + 2);
-  // Padded (zeros) for the fused sift's fixed-width blocks.
-  h_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
-  next_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
-  env_min_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
-  env_max_ = Eigen::VectorXd::Zero(n + EnvelopeSpline::kPadding);
+  // Padded (zeros) for the fused sift's fixed-width blocks. Only the padding is zeroed: the
+  // first n values are written before they are read, and env_max_, which the fused sift never
+  // stores, then costs no memory.
+  for (Eigen::VectorXd* v : {&h_, &next_, &env_min_, &env_max_}) {
+    v->resize(n + EnvelopeSpline::kPadding);
+    v->tail(EnvelopeSpline::kPadding).setZero();
+  }
 }
 
 void Sifter::Envelopes() {
@@ -152,7 +154,7 @@ ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
               static_cast<int>(i);
         }
       });
-      auto merge_back = [cap](std::vector<int>& ind, int strict, int extra) {
+      auto merge_back = [cap](UninitialisedVector<int>& ind, int strict, int extra) {
         int a = strict - 1, b = extra - 1, out = strict + extra - 1;
         const size_t base = cap - static_cast<size_t>(extra);
         while (b >= 0) {

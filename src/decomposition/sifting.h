@@ -62,7 +62,7 @@ class Sifter {
   Eigen::Index n_;
   SiftingOptions options_;
   int max_sifts_;
-  std::vector<int> indmin_, indmax_;
+  UninitialisedVector<int> indmin_, indmax_;
   int nmin_ = 0, nmax_ = 0;  // counts of the last FindExtrema
   EnvelopeSpline lower_, upper_;  // node sets (t, y) and fits of the two envelopes
   Eigen::VectorXd h_, next_, env_min_, env_max_;

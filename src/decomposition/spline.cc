@@ -16,7 +16,7 @@ EnvelopeSpline::EnvelopeSpline(Eigen::Index max_nodes, int phase) {
   // them (of both splines) at once, would compete for the same cache sets.
   const size_t stride = (size + 511) / 512 * 512 + 40;
   const size_t offset = 20 * static_cast<size_t>(phase);
-  storage_.assign(7 * stride + offset, 0.0);
+  storage_.resize(7 * stride + offset);  // written before read, node by node
   double* base = storage_.data() + offset;
   for (double** p : {&inv_dx_, &dd_, &slope_, &diag_, &rhs_, &c1_, &c2_}) {
     *p = base;

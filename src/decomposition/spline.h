@@ -10,11 +10,36 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "decomposition/simd_kernels.h"
 
 namespace gyrodrift::decomposition::internal {
+
+// An allocator whose resize() leaves new elements uninitialised: the sifter's buffers are sized
+// for the worst case (n nodes), and pages the signal never reaches are then never touched, so
+// they cost no memory (a 1e7-sample decomposition would otherwise hold ~1.5 GB of zeros).
+template <class T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <class U>
+  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+template <class T>
+using UninitialisedVector = std::vector<T, UninitialisedAllocator<T>>;
 
 class EnvelopeSpline {
  public:
@@ -42,7 +67,7 @@ class EnvelopeSpline {
   void Prepare();
   SplineView view() const;
   std::vector<double> t_, y_;
-  std::vector<double> storage_;                               // the per-node arrays below
+  UninitialisedVector<double> storage_;                       // the per-node arrays below
   double *inv_dx_, *dd_, *slope_, *diag_, *rhs_, *c1_, *c2_;  // diag_: inverse pivots
 };
 

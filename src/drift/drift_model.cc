@@ -15,6 +15,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
+#include "gyrodrift/common/random.h"
 
 namespace gyrodrift::drift {
 namespace {
@@ -84,10 +85,15 @@ Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eige
   return x;
 }
 
+// Sub-model g's own random stream (common/random.h: the seed rule).
+std::uint64_t SubModelSeed(const DriftOptions& o, size_t g) {
+  return SeedFor(o.seed, "sub-model", g);
+}
+
 LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
   LearnerOptions l = o.learner;
   l.kind = KindOf(o.method);
-  l.seed = o.seed + g;
+  l.seed = SubModelSeed(o, g);
   l.threads = o.threads;
   return l;
 }
@@ -275,6 +281,9 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
   } else {
     selection::SelectionOptions sopt = o.selection;
     sopt.threads = o.threads;
+    // The white-noise level, when it cannot reuse the decomposition's noise, draws the same
+    // realisations itself: the user's seed, not the Monte-Carlo's default.
+    sopt.monte_carlo.seed = o.seed;
     selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt);
     d = std::move(grouped.decomposition);
     sel = std::move(grouped.selection);
@@ -314,8 +323,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-                               o.features.rate_hz, o.thermal, !o.linear_compensation, o.seed,
-                               record_starts));
+                               o.features.rate_hz, o.thermal, !o.linear_compensation,
+                               SubModelSeed(o, g), record_starts));
     }
     return;
   }

@@ -8,8 +8,14 @@
 #include "drift/internal.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
 
 namespace gyrodrift::drift {
+
+std::uint64_t RepeatSeed(std::uint64_t seed, int r) {
+  return r == 0 ? seed : SeedFor(seed, "repeat", static_cast<std::uint64_t>(r));
+}
+
 namespace {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
@@ -185,16 +191,15 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
       }
       std::vector<double> rmse;
       for (int r = 0; r < options.repeats; ++r) {
-        if (options.progress) {
-          options.progress(done / total,
-                           std::string(ToString(method)) + " / " + std::string(ToString(protocol)) +
-                               " / seed " +
-                               std::to_string(base.seed + static_cast<std::uint64_t>(r)));
-        }
         DriftOptions o = base;
         o.progress = nullptr;  // Evaluate reports through EvaluationOptions::progress
         o.method = method;
-        o.seed = base.seed + static_cast<std::uint64_t>(r);
+        o.seed = RepeatSeed(base.seed, r);
+        if (options.progress) {
+          options.progress(done / total, std::string(ToString(method)) + " / " +
+                                             std::string(ToString(protocol)) + " / seed " +
+                                             std::to_string(o.seed));
+        }
         CausalOptions causal = options.causal;
         if (options.progress) {
           // The causal trial's windows are most of an evaluation's time: report within it too.

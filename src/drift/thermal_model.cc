@@ -369,7 +369,7 @@ std::shared_ptr<const Learner> FitCorrection(const CrossValidation& cv, const Ei
   elm::ElmOptions eo;
   eo.hidden_units = kCorrectionUnits.back();
   eo.ridge_c = 1.0;
-  eo.seed = Rng(seed, StreamId("thermal-correction")).NextU64();
+  eo.seed = SeedFor(seed, "thermal-correction");
   eo.threads = 1;
   const elm::ElmFit widest = elm::Fit(z, yc, eo);
   const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);

@@ -12,6 +12,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
+#include "gyrodrift/decomposition/energy_band.h"
 #include "selection/internal.h"
 
 namespace gyrodrift::selection {
@@ -64,9 +65,7 @@ void SelectionOptions::Validate() const {
   }
   kde.Validate();
   monte_carlo.Validate();
-  if (band_confidence != 0.99 && band_confidence != 0.95) {
-    ThrowOption("band_confidence", FormatValue(band_confidence), "0.95 or 0.99");
-  }
+  decomposition::ValidateBandConfidence(band_confidence);
   if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
 }
 
@@ -222,35 +221,23 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
   result.k_star = k_star;
 
-  // Energy curve and the white-noise band (Flandrin, Goncalves & Rilling 2004).
+  // Energy curve and the white-noise band (Flandrin, Goncalves & Rilling 2004), with the same
+  // robust mode-1 energy as BEEMDAN.
   {
-    const double band_a = options.band_confidence == 0.99 ? 0.46 : 0.474;
-    const double band_b = options.band_confidence == 0.99 ? -1.919 : -2.449;
-    // Robust E_1: N * (median|imf_1| / 0.6745)^2, as BEEMDAN (METHOD.md section 3).
-    std::vector<double> a(static_cast<size_t>(n));
-    for (Eigen::Index t = 0; t < n; ++t) a[static_cast<size_t>(t)] = std::abs(imfs(t, 0));
-    const size_t mid = a.size() / 2;
-    std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid), a.end());
-    double med = a[mid];
-    if (a.size() % 2 == 0) {
-      med =
-          0.5 * (med + *std::max_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(mid)));
-    }
-    const double e1 = static_cast<double>(n) * (med / 0.6745) * (med / 0.6745);
-    const double log2_e1 = std::log2(e1);
+    decomposition::EnergyBand band;
+    band.confidence = options.band_confidence;
+    band.log2_e1 = decomposition::RobustLog2NoiseEnergy(imfs.col(0));
     result.energy_signal_start = k_count + 1;
     for (int k = 1; k <= k_count; ++k) {
-      const double e = imfs.col(k - 1).squaredNorm();
-      result.log2_energy.push_back(std::log2(e));
+      const double log2_energy = std::log2(imfs.col(k - 1).squaredNorm());
+      result.log2_energy.push_back(log2_energy);
       if (k == 1) {
         result.energy_band_log2_upper.push_back(std::numeric_limits<double>::quiet_NaN());
         continue;
       }
-      const double upper =
-          log2_e1 - std::log2(0.719) - k * std::log2(2.01) + std::pow(2.0, band_a * k + band_b);
-      result.energy_band_log2_upper.push_back(upper);
+      result.energy_band_log2_upper.push_back(band.Log2Upper(k));
       // A zero mode 1 (median 0) gives log2 E_1 = -inf: every later mode is outside the band.
-      if (result.energy_signal_start == k_count + 1 && !(std::log2(e) <= upper)) {
+      if (result.energy_signal_start == k_count + 1 && !band.Contains(k, log2_energy)) {
         result.energy_signal_start = k;
       }
     }

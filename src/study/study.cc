@@ -10,11 +10,15 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "study_internal.h"
 
 namespace gyrodrift::study {
+
+std::uint64_t RunBSeed(std::uint64_t seed) { return SeedFor(seed, "run-b"); }
+
 namespace {
 
 namespace sim = gyrodrift::simulation;
@@ -100,7 +104,7 @@ void SimulateRuns(const StudyOptions& a, StudyResult& s) {
   so.rate_hz = 1.0;
   so.seed = a.seed;
   s.run_a = sim::Simulate(sim::BuiltinProgramme("chamber"), fog, so);
-  so.seed = a.seed + 1;
+  so.seed = RunBSeed(a.seed);
   s.run_b = sim::Simulate(sim::BuiltinProgramme("chamber-b"), fog, so);
   s.source = "simulation";
   s.target_name = "rate_dph";

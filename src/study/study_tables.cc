@@ -136,7 +136,7 @@ void FillSettingsTable(StudyResult& s) {
                                        RoundedText(s.time_h[s.time_h.size() - 1]) + " h"});
   }
   settings.Add({"seed", std::to_string(a.seed) +
-                            (s.simulated ? " (run A), " + std::to_string(a.seed + 1) + " (run B)"
+                            (s.simulated ? " (run A), " + std::to_string(RunBSeed(a.seed)) + " (run B)"
                                          : " (decomposition and learners)")});
   settings.Add(
       {"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble_size) +

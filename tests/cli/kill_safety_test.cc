@@ -279,7 +279,7 @@ TEST_F(KillSafety, Calibrate) {
   fs::create_directories(dir_ + "/logs");
   for (const char* run : {"cal", "ver"}) {
     io::WriteFileAtomically(dir_ + "/logs/SN1_" + run + ".csv",
-                            test::ThermalLogCsv(Sanitized() ? 1500 : 4000, run[0] == 'c' ? 3 : 4));
+                            test::ThermalLogCsv(Sanitized() ? 12000 : 40000, run[0] == 'c' ? 3 : 4));
   }
   io::WriteFileAtomically(dir_ + "/fleet.toml",
                           "method = \"thermal\"\nrate_unit = \"dph\"\n"

@@ -41,4 +41,15 @@ std::uint64_t Fnv1a64(std::string_view text);
 // Stable 64-bit id of a named stream (FNV-1a of the name), for sources such as "arw" or "bias".
 std::uint64_t StreamId(std::string_view name);
 
+// The project's one seed rule. A call takes one seed from the user; the streams (seed, i), i =
+// 0, 1, ..., are the decomposition's white-noise realisations (and the noise-level Monte-Carlo's,
+// which reuses them); every other consumer draws from a seed derived by a named path: sub-model g
+// of a drift model from SeedFor(seed, "sub-model", g), evaluation repeat r from SeedFor(seed,
+// "repeat", r), the demo's run B from SeedFor(seed, "run-b"). Distinct paths give independent
+// seeds for every seed, where offsets (seed + g, seed + r) made repeat r + 1's sub-model g - 1
+// reuse repeat r's sub-model g, and sub-model 0's hidden units reuse the decomposition's noise.
+// SeedFor(seed, path, index) is SeedFor(seed, path + "/" + decimal index).
+std::uint64_t SeedFor(std::uint64_t seed, std::string_view path);
+std::uint64_t SeedFor(std::uint64_t seed, std::string_view path, std::uint64_t index);
+
 }  // namespace gyrodrift

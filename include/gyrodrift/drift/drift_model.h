@@ -74,7 +74,11 @@ struct DriftOptions {
   // estimate to thermal equilibrium there instead: the model's output for a record that sits at
   // that temperature is subtracted, for users who calibrate the bias separately.
   double reference_c = std::numeric_limits<double>::quiet_NaN();
-  std::uint64_t seed = 1;  // decomposition and learners (sub-model g uses seed + g)
+  // The fit's one seed: the decomposition's noise draws streams (seed, i), sub-model g's learner
+  // (or thermal correction) SeedFor(seed, "sub-model", g), the white-noise level the
+  // decomposition's streams (common/random.h); decomposition.seed, learner.seed and
+  // selection.monte_carlo.seed are overwritten with these.
+  std::uint64_t seed = 1;
   int threads = 0;         // 0 = every core
   // FitDriftModel reports its progress here (fraction of the whole fit in [0, 1], and the step:
   // "decompose" (the grouping included), "fit sub-models"), from the calling thread or the thread

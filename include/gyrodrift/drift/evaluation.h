@@ -27,9 +27,13 @@ struct Metrics {
 };
 Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error);
 
+// The seed of evaluation repeat r of a fit seeded `seed`: the seed itself for r = 0 (a one-repeat
+// evaluation scores the model `fit` writes with that seed), SeedFor(seed, "repeat", r) after.
+std::uint64_t RepeatSeed(std::uint64_t seed, int r);
+
 struct EvaluationOptions {
   double split = 0.7;  // training share, in [0.1, 0.95]
-  int repeats = 1;     // seeds seed, seed+1, ...; mean and std over repeats, in [1, 1000]
+  int repeats = 1;     // seeds RepeatSeed(seed, r); mean and std over repeats, in [1, 1000]
   std::vector<Method> methods = AllMethods(Mode::kPredict);
   std::vector<Protocol> protocols{Protocol::kPaper, Protocol::kCausal};
   // Predict mode: score horizon-step-ahead predictions (PredictAhead), in [1, 100000].

@@ -43,6 +43,10 @@
 
 namespace gyrodrift::study {
 
+// The seed of the simulated run B (a different thermal history, the held-out run): derived from
+// the study's seed by the named path "run-b" (common/random.h), so it never coincides with run A's.
+std::uint64_t RunBSeed(std::uint64_t seed);
+
 // The size of the study. The defaults are smaller than the library's (docs/demo.md, "Settings
 // and cost"): they keep the simulated study near 25 s on 2 cores. Ranges the library owns are
 // checked by the library's own Validate (named as it names them); the rest here.
@@ -67,7 +71,8 @@ struct StudyOptions {
   // Unit of the analysed output, for the Allan noise terms (reported in deg/h). The simulated
   // output is in deg/h, so any other value only fits a log (see the note in docs/demo.md).
   allan::RateUnit units = allan::RateUnit::kDegPerHour;
-  // Seed of the simulation (run B uses seed + 1), the decompositions and the learners. Default 1.
+  // Seed of the simulation (run B uses RunBSeed(seed)), the decompositions and the learners.
+  // Default 1.
   std::uint64_t seed = 1;
   // Worker threads, 0 = all cores; DriftOptions' range [0, 1024]. Default 0.
   int threads = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 namespace gyrodrift {
 namespace {
@@ -50,6 +51,24 @@ TEST(Rng, NormalHasUnitMomentsAndGaussianTails) {
 TEST(StreamId, StableAndDistinct) {
   EXPECT_EQ(StreamId("arw"), StreamId("arw"));
   EXPECT_NE(StreamId("arw"), StreamId("rrw"));
+}
+
+// Derived seeds are a pure function of (seed, path, index), differ between paths, indices and
+// seeds, and an index is the path with "/index" appended (so "a/1" and ("a", 1) agree, by rule).
+TEST(SeedFor, NamedPathsGiveDistinctReproducibleSeeds) {
+  EXPECT_EQ(SeedFor(5, "sub-model", 2), SeedFor(5, "sub-model", 2));
+  EXPECT_EQ(SeedFor(5, "sub-model", 2), SeedFor(5, "sub-model/2"));
+  EXPECT_EQ(SeedFor(5, "thermal-correction"), Rng(5, StreamId("thermal-correction")).NextU64());
+  std::set<std::uint64_t> seen;
+  for (std::uint64_t seed : {0ULL, 1ULL, 2ULL, 0xFFFFFFFFFFFFFFFFULL}) {
+    for (const char* path : {"sub-model", "repeat", "run-b"}) {
+      for (std::uint64_t i = 0; i < 64; ++i) {
+        const std::uint64_t derived = SeedFor(seed, path, i);
+        EXPECT_TRUE(seen.insert(derived).second) << seed << " " << path << " " << i;
+        EXPECT_GT(derived, 1000u);  // never a small integer, such as a user's seed or seed + g
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <set>
+#include <string>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
@@ -171,6 +173,38 @@ TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
   }
   EXPECT_EQ(PredictOneStep(reused, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
             PredictOneStep(reference, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
+}
+
+// The seed rule (common/random.h): each random stream of a fit has its own seed. Sub-model g's
+// learner draws from SeedFor(seed, "sub-model", g), never from the seed itself, whose streams
+// (seed, i) are the decomposition's white noise; over an evaluation's repeats no two (repeat,
+// sub-model) pairs share a seed, as seed + r + g made repeat r + 1's sub-model g - 1 repeat r's
+// sub-model g. The white-noise level, computed apart here (ensemble 10 < 20 realisations), draws
+// the user's seed, not the Monte-Carlo's default 1.
+TEST(DriftModel, NoTwoRandomStreamsOfAFitCoincide) {
+  const Log log = MakeLog(1500, 1);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  o.seed = 7;
+  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
+  std::set<std::string> seeds{std::to_string(o.seed)};
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    ASSERT_TRUE(model.sub_models[g].learner) << g;
+    const std::string used = model.sub_models[g].learner->Save().texts.at("seed");
+    EXPECT_EQ(used, std::to_string(SeedFor(o.seed, "sub-model", g)));
+    EXPECT_TRUE(seeds.insert(used).second) << "sub-model " << g << " reuses seed " << used;
+  }
+  EXPECT_NE(model.selection_summary.find("seed=7)"), std::string::npos) << model.selection_summary;
+
+  std::set<std::uint64_t> all;
+  for (int r = 0; r < 100; ++r) {
+    const std::uint64_t repeat = RepeatSeed(o.seed, r);
+    EXPECT_TRUE(all.insert(repeat).second) << "repeat " << r;
+    for (std::uint64_t g = 0; g < 8; ++g) {
+      EXPECT_TRUE(all.insert(SeedFor(repeat, "sub-model", g)).second) << r << ", " << g;
+    }
+  }
+  EXPECT_EQ(RepeatSeed(o.seed, 0), o.seed);  // one repeat scores the model fit writes
 }
 
 // An MS-ELM predict model fitted on the first 500 samples of a 700-sample log, and causal options

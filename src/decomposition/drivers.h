@@ -1,7 +1,9 @@
-// Private: the per-method drivers behind Decompose() and the incremental white-noise EMD.
+// Private: the per-method drivers behind Decompose() (one file each: emd.cc, eemd.cc,
+// ceemdan.cc, iceemdan.cc, beemdan.cc) and the incremental white-noise EMD.
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "decomposition/sifting.h"
@@ -48,8 +50,18 @@ Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd 
 Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
 Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
 Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
-// ICEEMDAN, and BEEMDAN (o.method == kBeemdan) which bounds its noise-assisted stages.
-Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
-                          const DecompositionOptions& o);
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+
+// What ends the noise assistance of the ICEEMDAN stages, asked before every stage k >= 1 with
+// the modes so far (normalised input), the residue r, a free sifter and N-vector: true goes on
+// with noise; false ends it, after the policy has set report.stop_reason and appended to modes
+// (taking it from r) any mode it extracted to decide. Plain EMD then finishes the decomposition.
+using NoiseStagePolicy =
+    std::function<bool(int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r,
+                       Sifter& sifter, Eigen::VectorXd& scratch, DecompositionReport& report)>;
+// ICEEMDAN's stages under a policy (empty: noise assistance to the end, ICEEMDAN itself).
+Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                const DecompositionOptions& o, const NoiseStagePolicy& go_on);
 
 }  // namespace gyrodrift::decomposition::internal

@@ -1,0 +1,117 @@
+// ICEEMDAN (Colominas, Schlotthauer & Torres 2014): stage k's mode is r_k minus the ensemble mean
+// of the local means of r_k + beta_k E_k(w_i), E_k the k-th EMD mode of realisation i, as the
+// reference iceemdan.m computes it. BEEMDAN (beemdan.cc) runs these stages under a policy that
+// ends the noise assistance.
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "decomposition/drivers.h"
+#include "decomposition/noise_ensemble.h"
+#include "gyrodrift/common/parallel.h"
+
+namespace gyrodrift::decomposition::internal {
+
+Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                const DecompositionOptions& o, const NoiseStagePolicy& go_on) {
+  const Eigen::Index n = x.size();
+  const int ensemble = EnsembleSize(o);
+  const double eps = o.noise_strength;
+  const bool constant_snr = o.noise_scaling == NoiseScaling::kConstantSnr;
+  const double sx = SampleStd(x.data(), n);
+  const Eigen::VectorXd xn = x / sx;
+  auto workers = MakeWorkers(ensemble, o, n);
+  std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
+  DecompositionReport report;
+  report.method = o.method;
+  report.ensemble_size = ensemble;
+  report.seed = o.seed;
+  report.supplied_noise = static_cast<bool>(o.supplied_noise);
+  const double nr = static_cast<double>(ensemble);
+
+  std::vector<Eigen::VectorXd> modes;
+  Eigen::VectorXd r = xn;
+  double reported = 0.0;  // progress shown so far
+  for (int stage = 0;; ++stage) {
+    if (o.max_imfs > 0 && static_cast<int>(modes.size()) >= o.max_imfs) {
+      report.stop_reason = "IMF cap (" + std::to_string(o.max_imfs) + ") reached";
+      break;
+    }
+    if (stage > 0 && CountExtrema(r.data(), n).extrema() < 3) {
+      report.stop_reason = "residue has fewer than 3 extrema";
+      break;
+    }
+    if (stage > 0 && go_on && !go_on(stage, modes, r, workers[0].sifter, workers[0].imf, report)) {
+      // The policy ended the noise assistance: plain EMD finishes the decomposition.
+      const std::string reason = report.stop_reason;
+      const int remaining =
+          o.max_imfs > 0 ? std::max(0, o.max_imfs - static_cast<int>(modes.size())) : 0;
+      if (o.max_imfs == 0 || remaining > 0) {
+        EmdLoop(workers[0].sifter, r, o.max_imfs > 0 ? remaining : 0, modes, report);
+      }
+      report.stop_reason = reason + "; then " + report.stop_reason;
+      break;
+    }
+
+    const double sr = stage > 0 ? SampleStd(r.data(), n) : 0.0;
+    Eigen::VectorXd next = Eigen::VectorXd::Zero(n);
+    StageStats stats;
+    ParallelOrderedReduce(
+        ensemble, o.threads,
+        [&](int i, int w) {
+          Worker& wk = workers[static_cast<size_t>(w)];
+          auto& modes_i = noise[static_cast<size_t>(i)];
+          if (stage == 0) modes_i.emplace(o, i, n);
+          // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
+          const bool has_noise = NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data());
+          if (stage == 0) {
+            const double se = SampleStd(wk.noise.data(), n);
+            for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = xn[j] + (eps * wk.noise[j]) / se;
+          } else if (has_noise) {
+            if (constant_snr) {
+              const double se = SampleStd(wk.noise.data(), n);
+              for (Eigen::Index j = 0; j < n; ++j)
+                wk.input[j] = r[j] + sr * (eps * (wk.noise[j] / se));
+            } else {
+              for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = r[j] + sr * (eps * wk.noise[j]);
+            }
+          } else {
+            wk.input = r;  // fewer noise modes than stages: the local mean of r_k without noise
+          }
+          StageTerm term;
+          term.outcome = wk.sifter.ExtractImf(wk.input.data(), wk.imf.data());
+          // Local mean M(y) = y - E1(y). Without an IMF (< 3 extrema) ceemdan.m takes 0 at the
+          // first stage and y itself later.
+          if (term.outcome.extracted) {
+            term.value = wk.input - wk.imf;
+          } else if (stage == 0) {
+            term.value = Eigen::VectorXd::Zero(n);
+          } else {
+            term.value = wk.input;
+          }
+          return term;
+        },
+        [&](int i, StageTerm term) {
+          for (Eigen::Index j = 0; j < n; ++j) next[j] = next[j] + term.value[j] / nr;
+          stats.Add(term.outcome);
+          ReportProgress(o, stage, i, ensemble, n, reported);
+        });
+    stats.Report(report, ensemble);
+    Eigen::VectorXd mode = r - next;
+    modes.push_back(std::move(mode));
+    r = std::move(next);
+    ++report.noise_assisted_stages;
+  }
+  // The realisations' noise state (one N-vector each) is the bulk of the memory: free it first.
+  std::vector<std::optional<NoiseRows>>().swap(noise);
+  Scale(modes, r, sx);
+  return AssembleResult(std::move(modes), std::move(r), std::move(report));
+}
+
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
+                          const DecompositionOptions& o) {
+  return RunIceemdanStages(x, o, {});
+}
+
+}  // namespace gyrodrift::decomposition::internal

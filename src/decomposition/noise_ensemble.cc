@@ -1,0 +1,94 @@
+#include "decomposition/noise_ensemble.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/parallel.h"
+#include "gyrodrift/common/random.h"
+
+namespace gyrodrift::decomposition::internal {
+
+int EnsembleSize(const DecompositionOptions& o) {
+  return o.supplied_noise ? static_cast<int>(o.supplied_noise->cols()) : o.ensemble_size;
+}
+
+Eigen::VectorXd DrawNoise(const DecompositionOptions& o, int i, Eigen::Index n) {
+  if (o.supplied_noise) return o.supplied_noise->col(i);
+  Eigen::VectorXd w(n);
+  Rng rng(o.seed, static_cast<std::uint64_t>(i));
+  rng.FillNormal(w);
+  return w;
+}
+
+bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseRows& modes, Sifter& sifter,
+                  double* out) {
+  if (!modes.Next(sifter, out)) return false;
+  if (o.noise_imf_observer && modes.last_imf() > 0) o.noise_imf_observer(i, modes.last_imf(), out);
+  return true;
+}
+
+std::vector<Worker> MakeWorkers(int ensemble, const DecompositionOptions& o, Eigen::Index n) {
+  const int count = std::min(ResolveThreads(o.threads), ensemble);
+  std::vector<Worker> workers;
+  workers.reserve(static_cast<size_t>(count));
+  for (int w = 0; w < count; ++w) workers.emplace_back(n, o.sifting);
+  return workers;
+}
+
+void Scale(std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& residue, double factor) {
+  for (auto& m : modes) m *= factor;
+  residue *= factor;
+}
+
+void ReportProgress(const DecompositionOptions& o, int stage, int realisation, int ensemble,
+                    Eigen::Index n, double& reported) {
+  if (!o.progress) return;
+  const double expected =
+      std::max<double>(stage + 2, std::floor(std::log2(static_cast<double>(n))) - 1);
+  const double estimate =
+      std::min(0.99, (stage + static_cast<double>(realisation + 1) / ensemble) / expected);
+  reported = std::max(reported, estimate);
+  o.progress(reported);
+}
+
+}  // namespace gyrodrift::decomposition::internal
+
+namespace gyrodrift::decomposition {
+
+NoiseEmds::NoiseEmds(Eigen::Index length, const DecompositionOptions& options)
+    : length_(length), seed_(options.seed), sifting_(options.sifting) {
+  options.Validate();
+  if (options.supplied_noise) {
+    throw UsageError(
+        "NoiseEmds draws its own white noise: compute the EMDs of supplied noise "
+        "by decomposing with it");
+  }
+  if (length < 4) {
+    throw DataError("NoiseEmds length " + std::to_string(length) + ": must be >= 4 samples");
+  }
+  internal::RequireNoiseStateFits(options.ensemble_size, length, RowsPerRealisation(length));
+  realisations_.resize(static_cast<size_t>(options.ensemble_size));
+  std::vector<std::optional<internal::Sifter>> sifters(
+      static_cast<size_t>(ResolveThreads(options.threads)));
+  ParallelFor(options.ensemble_size, options.threads, [&](int i, int w) {
+    auto& sifter = sifters[static_cast<size_t>(w)];
+    if (!sifter) sifter.emplace(length, options.sifting);
+    Realisation& r = realisations_[static_cast<size_t>(i)];
+    r.white = internal::DrawNoise(options, i, length);
+    internal::NoiseModes modes(r.white);
+    Eigen::VectorXd row(length);
+    while (modes.Next(*sifter, row.data())) {
+      r.rows.push_back(row);
+      if (modes.last_imf() > 0) r.imfs = modes.last_imf();
+    }
+  });
+}
+
+bool NoiseEmds::Matches(Eigen::Index n, const DecompositionOptions& o) const {
+  return n == length_ && o.seed == seed_ && o.ensemble_size == ensemble_size() &&
+         o.sifting == sifting_ && !o.supplied_noise;
+}
+
+}  // namespace gyrodrift::decomposition
