@@ -5,7 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "drift/internal.h"
+#include "drift/fit_steps.h"
+#include "drift/prediction_steps.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"

@@ -10,8 +10,8 @@
 #include <utility>
 
 #include "common/enum_names.h"
-#include "elm/internal.h"
 #include "elm/kernels.h"
+#include "elm/training.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"

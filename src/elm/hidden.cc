@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "elm/internal.h"
 #include "elm/kernels.h"
+#include "elm/training.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"
 

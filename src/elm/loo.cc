@@ -13,8 +13,8 @@
 #include <limits>
 #include <vector>
 
-#include "elm/internal.h"
 #include "elm/kernels.h"
+#include "elm/training.h"
 #include "gyrodrift/common/parallel.h"
 
 namespace gyrodrift::elm::internal {

@@ -13,7 +13,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"
-#include "selection/internal.h"
+#include "selection/density_scratch.h"
 
 namespace gyrodrift::selection {
 

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstdio>
-#include <limits>
 #include <string>
 #include <utility>
 
@@ -13,7 +11,8 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/decomposition/energy_band.h"
-#include "selection/internal.h"
+#include "selection/criteria.h"
+#include "selection/density_scratch.h"
 
 namespace gyrodrift::selection {
 
@@ -32,17 +31,13 @@ constexpr std::array<std::pair<GroupKind, std::string_view>, 3> kKinds{{
 
 using gyrodrift::internal::EnumFromName;
 using gyrodrift::internal::EnumName;
+using internal::AppendNote;
 
 // "1-4" or "5" or "" for a list of consecutive indices.
 std::string Range(const std::vector<int>& imfs) {
   if (imfs.empty()) return "";
   if (imfs.size() == 1) return std::to_string(imfs.front());
   return std::to_string(imfs.front()) + "-" + std::to_string(imfs.back());
-}
-
-void AppendNote(std::string* note, const std::string& text) {
-  if (!note->empty()) *note += "; ";
-  *note += text;
 }
 
 }  // namespace
@@ -211,89 +206,19 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
   if (constant_imf) AppendNote(&result.note, "constant IMF (density given one grid step)");
 
-  // k* = first maximum of D_k.
-  int k_star = 1;
-  for (int k = 2; k <= k_count; ++k) {
-    if (result.pdf_distance[static_cast<size_t>(k - 1)] >
-        result.pdf_distance[static_cast<size_t>(k_star - 1)]) {
-      k_star = k;
-    }
-  }
-  result.k_star = k_star;
-
-  // Energy curve and the white-noise band (Flandrin, Goncalves & Rilling 2004), with the same
-  // robust mode-1 energy as BEEMDAN.
-  {
-    decomposition::EnergyBand band;
-    band.confidence = options.band_confidence;
-    band.log2_e1 = decomposition::RobustLog2NoiseEnergy(imfs.col(0));
-    result.energy_signal_start = k_count + 1;
-    for (int k = 1; k <= k_count; ++k) {
-      const double log2_energy = std::log2(imfs.col(k - 1).squaredNorm());
-      result.log2_energy.push_back(log2_energy);
-      if (k == 1) {
-        result.energy_band_log2_upper.push_back(std::numeric_limits<double>::quiet_NaN());
-        continue;
-      }
-      result.energy_band_log2_upper.push_back(band.Log2Upper(k));
-      // A zero mode 1 (median 0) gives log2 E_1 = -inf: every later mode is outside the band.
-      if (result.energy_signal_start == k_count + 1 && !band.Contains(k, log2_energy)) {
-        result.energy_signal_start = k;
-      }
-    }
-  }
+  result.k_star = internal::KStar(result.pdf_distance);
+  internal::EnergyCurve(imfs, options.band_confidence, &result);
 
   // Boundaries per criterion.
   switch (options.criterion) {
-    case Criterion::kPdfSimilarity: {
-      std::shared_ptr<const NoiseLevel> level = options.noise_level;
-      if (!level) {
-        level = NoiseLevelCache::Global().Get(static_cast<int>(n), options.monte_carlo, kde,
-                                              options.distance, &result.noise_level_computed);
-      }
-      int k_noise = 0;
-      for (int k = 1; k <= k_count; ++k) {
-        if (level->partial && k > static_cast<int>(level->level.size()) && k_noise == k - 1) {
-          // The noise run outlasted a level collected from the decomposition: the rest needs
-          // the Monte-Carlo (modes 1..k-1 agree with it when the seeds do).
-          AppendNote(&result.note, "white-noise level of modes 1.." + std::to_string(k - 1) +
-                                       " from the decomposition's noise (seed " +
-                                       std::to_string(level->seed) +
-                                       "), later modes from the Monte-Carlo");
-          level = NoiseLevelCache::Global().Get(static_cast<int>(n), options.monte_carlo, kde,
-                                                options.distance, &result.noise_level_computed);
-        }
-        const double lk = level->LevelFor(k);
-        result.noise_level.push_back(lk);
-        // A NaN level (the noise rarely had a mode k) or G_k above it ends the run.
-        if (k_noise == k - 1 && result.self_distance[static_cast<size_t>(k - 1)] <= lk) {
-          k_noise = k;
-        }
-      }
-      result.k_noise = k_noise;
-      result.noise_level_realisations = level->realisations;
-      result.noise_level_seed = level->seed;
-      if (level->partial && static_cast<int>(level->level.size()) < k_count) {
-        AppendNote(&result.note,
-                   "white-noise level reused from the decomposition's noise EMDs, "
-                   "known for modes 1.." +
-                       std::to_string(level->level.size()));
-      }
-      result.mixed_end = std::max(k_noise, k_star);
-      if (k_noise == 0)
-        AppendNote(&result.note, "no IMF passes the white-noise test: no noise group");
-      if (k_star <= k_noise) {
-        AppendNote(&result.note, "k* <= k_N: no mixed group, drift starts after k_N");
-      }
+    case Criterion::kPdfSimilarity:
+      internal::PdfSimilarityBoundaries(static_cast<int>(n), options, &result);
       break;
-    }
     case Criterion::kKomaty:
-      result.k_noise = k_star;
-      result.mixed_end = k_star;
+      internal::KomatyBoundaries(&result);
       break;
     case Criterion::kEnergyModel:
-      result.k_noise = result.energy_signal_start - 1;
-      result.mixed_end = result.k_noise;
+      internal::EnergyModelBoundaries(&result);
       break;
   }
   if (result.mixed_end == k_count) AppendNote(&result.note, "drift group is the residue alone");

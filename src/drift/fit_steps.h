@@ -1,12 +1,31 @@
-// Private: the steps FitDriftModel is made of, shared with the evaluation's paper protocol (which
-// decomposes the whole record but fits on the training rows only).
+// Private: the steps FitDriftModel is made of (drift_fit.cc), shared with the evaluation's paper
+// protocol (which decomposes the whole record but fits on the training rows only), with
+// DriftOptions::Validate (the learner kind) and with prediction (the thermal inputs).
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "gyrodrift/drift/drift_model.h"
 
 namespace gyrodrift::drift::internal {
+
+// The learner kind of a method's sub-models: kPoly, kSvr and kBp their own, every other an ELM.
+LearnerKind KindOf(Method method);
+
+// Throws DataError unless temperature_c has n rows, at least one column, and finite values.
+void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, Eigen::Index n);
+
+// Throws OptionError when `channels` temperature columns are given to the options' method, which
+// takes one unless it identifies thermal models.
+void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels);
+
+// The thermal features (N x F) a model's learners take from a temperature record (N x C), or an
+// N x 0 matrix when it takes none (no temperature, or identified sub-models, which read the
+// channels themselves). Checks the record as RequireTemperatureFor and RequireChannelsFor.
+Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
+                               const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                               Eigen::Index n);
 
 struct SubSeries {
   DriftModel model;        // options and sub-model definitions, no learners yet
@@ -19,18 +38,6 @@ constexpr double kDecomposeShare = 0.7;
 constexpr double kGroupsDoneShare = 0.85;  // the decomposition and the grouping done
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
                            bool report = false);
-
-// Throws OptionError naming `horizon` unless it is in [1, kMaxHorizon].
-void RequireHorizon(int horizon);
-
-// The one history rule of prediction: the first sample (0-based) predictable `horizon` steps
-// ahead with `lags` lags, its origin first - horizon + 1 needing the lags before it and, when
-// `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
-Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
-
-// Throws OptionError when `channels` temperature columns are given to the options' method, which
-// takes one unless it identifies thermal models.
-void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels);
 
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
 // identified sub-models read the temperature channels, N x C, instead, as records: features.h).

@@ -1,6 +1,7 @@
-// Internals of the ELM: hidden units, the streamed Gram matrix, ridge solvers and the
-// leave-one-out grid. Everything that touches the N rows works on fixed row blocks of
-// kBlockRows, so the floating-point operations do not depend on the number of threads.
+// Private: the training steps of the ELM (elm::Fit; the hidden layer also serves Predict): hidden
+// units, the streamed Gram matrix, ridge solvers and the leave-one-out grid. Everything that
+// touches the N rows works on fixed row blocks of kBlockRows, so the floating-point operations do
+// not depend on the number of threads.
 #pragma once
 
 #include <Eigen/Core>

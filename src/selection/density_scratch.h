@@ -1,4 +1,5 @@
-// Private helpers shared by the selection sources.
+// Private: per-thread density buffers, shared by the selection sources (SelectModes, the
+// white-noise level), and the self-similarity G_k computed in them.
 #pragma once
 
 #include <Eigen/Core>

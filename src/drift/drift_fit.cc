@@ -1,0 +1,254 @@
+// FitDriftModel and the steps it is made of (fit_steps.h): the checks of the temperature input,
+// the decomposition and grouping into sub-series (PrepareSubSeries), and one learner or
+// identified thermal model per sub-series (FitLearners), with the automatic choice of lags.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "drift/fit_steps.h"
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/drift_model.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+// Rows of inputs of sub-model g for t = first .. first + count - 1 (predict mode).
+Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& s,
+                            const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index first,
+                            Eigen::Index count) {
+  Eigen::MatrixXd x(count, model.lags + thermal.cols());
+  x.leftCols(model.lags) = LagRows(s, model.lags, first, count);
+  if (thermal.cols() > 0) x.rightCols(thermal.cols()) = thermal.middleRows(first - 1, count);
+  return x;
+}
+
+// Sub-model g's own random stream (common/random.h: the seed rule).
+std::uint64_t SubModelSeed(const DriftOptions& o, size_t g) {
+  return SeedFor(o.seed, "sub-model", g);
+}
+
+LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
+  LearnerOptions l = o.learner;
+  l.kind = internal::KindOf(o.method);
+  l.seed = SubModelSeed(o, g);
+  l.threads = o.threads;
+  return l;
+}
+
+}  // namespace
+
+namespace internal {
+
+LearnerKind KindOf(Method method) {
+  switch (method) {
+    case Method::kPoly:
+      return LearnerKind::kPoly;
+    case Method::kSvr:
+      return LearnerKind::kSvr;
+    case Method::kBp:
+      return LearnerKind::kBp;
+    default:
+      return LearnerKind::kElm;
+  }
+}
+
+void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, Eigen::Index n) {
+  if (temperature_c.rows() != n || temperature_c.cols() < 1) {
+    throw DataError("temperature has " + std::to_string(temperature_c.rows()) +
+                    " samples, the target " + std::to_string(n) + ": they must match");
+  }
+  for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+    RequireFiniteSignal("temperature", temperature_c.col(c), n);
+  }
+}
+
+void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels) {
+  if (channels <= 1 || IdentifiesThermalModel(o)) return;
+  ThrowOption("temperature channels", std::to_string(channels),
+              "one for method " + std::string(ToString(o.method)) + " in " +
+                  std::string(ToString(o.mode)) +
+                  " mode (several channels: compensate mode with thermal, ms-elm or emd-elm)");
+}
+
+Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
+                               const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                               Eigen::Index n) {
+  if (!model.uses_temperature() || IdentifiesThermalModel(model.options)) {
+    return Eigen::MatrixXd(n, 0);
+  }
+  RequireTemperatureFor(temperature_c, n);
+  internal::RequireChannelsFor(model.options, temperature_c.cols());
+  return ThermalFeatures(temperature_c.col(0), EffectiveFeatures(model.options));
+}
+
+SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
+                           bool report) {
+  report = report && static_cast<bool>(o.progress);
+  SubSeries out;
+  out.model.options = o;
+  // A model keeps no caller callbacks (it may run later, from other threads, after they are
+  // gone) and no shared noise EMDs (they serve one record length; a model predicts on any).
+  out.model.options.progress = nullptr;
+  out.model.options.decomposition.progress = nullptr;
+  out.model.options.decomposition.noise_imf_observer = nullptr;
+  out.model.options.decomposition.noise_emds = nullptr;
+  if (!UsesDecomposition(o.method)) {
+    out.model.sub_models.push_back({"signal", {}, true, nullptr});
+    out.series = y;
+    return out;
+  }
+  decomposition::DecompositionOptions dopt = o.decomposition;
+  dopt.seed = o.seed;
+  dopt.threads = o.threads;
+  if (report) {
+    o.progress(0.0, "decompose");
+    dopt.progress = [&o](double fraction) { o.progress(kDecomposeShare * fraction, "decompose"); };
+  }
+  decomposition::Decomposition d;
+  std::optional<selection::SelectionResult> sel;
+  if (o.method == Method::kEmdElm) {
+    d = decomposition::Decompose(y, dopt);
+  } else {
+    selection::SelectionOptions sopt = o.selection;
+    sopt.threads = o.threads;
+    // The white-noise level, when it cannot reuse the decomposition's noise, draws the same
+    // realisations itself: the user's seed, not the Monte-Carlo's default.
+    sopt.monte_carlo.seed = o.seed;
+    selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt);
+    d = std::move(grouped.decomposition);
+    sel = std::move(grouped.selection);
+  }
+  out.model.training_imfs = d.num_imfs();
+  out.model.decomposition_summary = d.report.Summary();
+  if (d.num_imfs() == 0) {
+    out.model.sub_models.push_back({"signal", {}, true, nullptr});
+  } else if (o.method == Method::kEmdElm) {
+    for (int k = 1; k <= d.num_imfs(); ++k) {
+      out.model.sub_models.push_back({"imf" + std::to_string(k), {k}, false, nullptr});
+    }
+    out.model.sub_models.push_back({"residue", {}, true, nullptr});
+  } else {
+    out.model.selection_summary = sel->Summary();
+    for (const auto& group : sel->groups) {
+      out.model.sub_models.push_back(
+          {std::string(selection::ToString(group.kind)), group.imfs, group.has_residue, nullptr});
+    }
+  }
+  out.series = GroupSeries(out.model, d);
+  return out;
+}
+
+void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
+                 const Eigen::Ref<const Eigen::VectorXd>& y,
+                 const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                 const std::vector<Eigen::Index>& record_starts) {
+  const DriftOptions& o = model.options;
+  model.training_samples = fit_end;
+  const size_t groups = model.sub_models.size();
+  if (IdentifiesThermalModel(o)) {
+    // Every sub-series chooses its own thermal states: fast rate terms for the noise and mixed
+    // groups, slow levels for the drift group, if the data say so.
+    for (size_t g = 0; g < groups; ++g) {
+      model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
+          IdentifyThermalModel(temperature_c.topRows(fit_end),
+                               series.col(static_cast<Eigen::Index>(g)).head(fit_end),
+                               o.features.rate_hz, o.thermal, !o.linear_compensation,
+                               SubModelSeed(o, g), record_starts));
+    }
+    return;
+  }
+  if (o.mode == Mode::kCompensate) {  // a single learner on the thermal features
+    model.sub_models.front().learner =
+        FitLearner(thermal.topRows(fit_end), series.col(0).head(fit_end),
+                   SubModelLearner(o, 0));
+    return;
+  }
+  auto fit_with_lags = [&](int p, Eigen::Index end) {
+    model.lags = p;
+    if (end - p < 8) {
+      throw DataError("training block of " + std::to_string(end) + " samples is too short for " +
+                      std::to_string(p) + " lags (at least " + std::to_string(p + 8) + " needed)");
+    }
+    for (size_t g = 0; g < groups; ++g) {
+      const auto s = series.col(static_cast<Eigen::Index>(g));
+      model.sub_models[g].learner =
+          FitLearner(PredictRows(model, s, thermal, p, end - p), s.segment(p, end - p),
+                     SubModelLearner(o, g));
+    }
+  };
+  if (!o.auto_lags) {
+    fit_with_lags(o.features.lags, fit_end);
+    return;
+  }
+  const Eigen::Index validation =
+      static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
+  const Eigen::Index inner_end = fit_end - validation;
+  double best = std::numeric_limits<double>::infinity();
+  int best_p = o.lag_candidates.front();
+  model.lag_validation_rmse.clear();
+  for (int p : o.lag_candidates) {
+    fit_with_lags(p, inner_end);
+    const Eigen::VectorXd pred = PredictFromSeries(model, series, thermal, inner_end, validation);
+    const double rmse =
+        std::sqrt((pred - y.segment(inner_end, validation)).squaredNorm() / validation);
+    model.lag_validation_rmse.push_back(rmse);
+    if (rmse < best) {
+      best = rmse;
+      best_p = p;
+    }
+  }
+  fit_with_lags(best_p, fit_end);
+}
+
+}  // namespace internal
+
+DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
+                         const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                         const DriftOptions& options,
+                         const std::vector<Eigen::Index>& record_starts) {
+  options.Validate();
+  if (!record_starts.empty() &&
+      !(options.mode == Mode::kCompensate && options.method == Method::kThermal)) {
+    throw UsageError(
+        "several records (calibration logs, or a log split at its gaps) are fitted by method "
+        "thermal in compensate mode only: method " + std::string(ToString(options.method)) +
+        " in " + std::string(ToString(options.mode)) +
+        " mode needs one uniform record (decompositions and lags run across a break)");
+  }
+  RequireFiniteSignal("target", y, 32);
+  CheckRecordStarts(record_starts, y.size());
+  RequireVaryingSignal("target", y, "there is nothing to model");
+  if (options.uses_temperature()) {
+    // Checked before the decomposition, which is the slow part.
+    internal::RequireTemperatureFor(temperature_c, y.size());
+    internal::RequireChannelsFor(options, temperature_c.cols());
+    for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+      RequireVaryingSignal("temperature", temperature_c.col(c),
+                           "a drift model on temperature needs a record whose temperature changes");
+    }
+  }
+  DriftOptions o = options;
+  o.features = ForTrainingRecord(o.features, y.size());
+  internal::SubSeries prepared = internal::PrepareSubSeries(y, o, /*report=*/true);
+  const Eigen::MatrixXd thermal = internal::ThermalOrEmpty(prepared.model, temperature_c, y.size());
+  const bool decomposed = UsesDecomposition(options.method);
+  if (options.progress)
+    options.progress(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
+  internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c,
+                        record_starts);
+  if (prepared.model.uses_temperature()) {
+    prepared.model.temperature_min_c = temperature_c.col(0).minCoeff();
+    prepared.model.temperature_max_c = temperature_c.col(0).maxCoeff();
+  }
+  if (options.progress) options.progress(1.0, "fit sub-models");
+  return std::move(prepared.model);
+}
+
+}  // namespace gyrodrift::drift

@@ -1,0 +1,34 @@
+// Private: the parts of predict mode shared between prediction.cc, causal_protocol.cc and the
+// evaluation: the history rule (how much record a prediction needs) and the causal protocol's
+// lags (each origin's sub-series from its trailing window alone).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "gyrodrift/drift/drift_model.h"
+
+namespace gyrodrift::drift::internal {
+
+// Throws OptionError naming `horizon` unless it is in [1, kMaxHorizon].
+void RequireHorizon(int horizon);
+
+// The one history rule of prediction: the first sample (0-based) predictable `horizon` steps
+// ahead with `lags` lags, its origin first - horizon + 1 needing the lags before it and, when
+// `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
+Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
+
+// The decomposition a fitted model applies to new data: its options with its seed, and no noise
+// EMDs a caller may have left in them (they serve one record length; the causal windows build
+// their own).
+decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
+
+// Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
+// trailing window y[o-W .. o-1] alone: lags[g](r, k) = s_g[o - 1 - k] of that window's groups
+// (count x lags per sub-model g). Windows run in parallel on causal.threads.
+std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
+                                        const Eigen::Ref<const Eigen::VectorXd>& y,
+                                        Eigen::Index origin, Eigen::Index count,
+                                        const CausalOptions& causal);
+
+}  // namespace gyrodrift::drift::internal
