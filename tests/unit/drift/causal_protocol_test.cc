@@ -1,0 +1,190 @@
+// The causal protocol (causal_protocol.cc): nothing after a prediction's origin reaches it,
+// windows sharing the white-noise EMDs predict as windows decomposed alone, the ensemble and
+// progress options, the note on sub-models a window cannot feed, and the option ranges.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "unit/drift/drift_fixtures.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+using fixtures::Fast;
+using fixtures::Log;
+using fixtures::MakeLog;
+
+// An MS-ELM predict model fitted on the first 500 samples of a 700-sample log, and causal options
+// with 64-sample windows on 2 threads.
+struct CausalCase {
+  Log log;
+  DriftModel model;
+  CausalOptions causal;
+};
+
+CausalCase MakeCausalCase(std::uint64_t seed) {
+  CausalCase c{MakeLog(700, seed), {}, {}};
+  c.model =
+      FitDriftModel(c.log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  c.causal.window = 64;
+  c.causal.threads = 2;
+  return c;
+}
+
+TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
+  auto [log, model, causal] = MakeCausalCase(5);
+  const Eigen::VectorXd quiet =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  std::vector<double> seen;
+  causal.progress = [&seen](double f) { seen.push_back(f); };
+  const Eigen::VectorXd reported =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  EXPECT_EQ(quiet, reported);
+  ASSERT_GE(seen.size(), 10u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+}
+
+// Full windows share one set of white-noise EMDs (computed once, not per window): each
+// prediction is still the one a lone decomposition of its window gives, to the bit.
+TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
+  const auto [log, model, causal] = MakeCausalCase(6);
+  const Eigen::VectorXd all =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  for (Eigen::Index t : {500, 563, 699}) {
+    // A record ending at t has a single full window: nothing to share.
+    const Eigen::VectorXd alone = PredictOneStep(model, log.rate.head(t + 1), Eigen::VectorXd(), t,
+                                                 Protocol::kCausal, causal);
+    ASSERT_EQ(alone.size(), 1);
+    EXPECT_EQ(alone[0], all[t - 500]) << t;
+  }
+}
+
+// Ensemble 0 is the model's own (the fit's decomposition.ensemble_size), to the bit; another
+// ensemble decomposes the windows differently.
+TEST(DriftModel, CausalEnsembleZeroIsTheModelsOwn) {
+  auto [log, model, causal] = MakeCausalCase(9);
+  ASSERT_EQ(model.options.decomposition.ensemble_size, 10);
+  causal.ensemble_size = 0;
+  const Eigen::VectorXd own =
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+  causal.ensemble_size = 10;
+  EXPECT_EQ(PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal),
+            own);
+  causal.ensemble_size = 20;
+  EXPECT_NE(PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal),
+            own);
+}
+
+// The H-step prediction of y[t] uses samples before t - H + 1 only (causal protocol, with the
+// decomposition of trailing windows and the recursion): changing samples from c on leaves every
+// prediction up to y[c + H - 1] unchanged to the bit.
+TEST(DriftModel, PredictAheadIgnoresSamplesAfterItsOrigin) {
+  const Log log = MakeLog(900, 7);
+  const DriftModel model =
+      FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
+  CausalOptions causal;
+  causal.window = 128;
+  const int horizon = 5;
+  const Eigen::VectorXd base =
+      PredictAhead(model, log.rate, Eigen::VectorXd(), 600, horizon, Protocol::kCausal, causal);
+  Eigen::VectorXd changed = log.rate;
+  changed.tail(150).array() += 5.0;  // samples 750.. change
+  const Eigen::VectorXd after =
+      PredictAhead(model, changed, Eigen::VectorXd(), 600, horizon, Protocol::kCausal, causal);
+  // y[t] for t <= 754 starts at t - 4 <= 750, from samples up to 749.
+  EXPECT_EQ(base.head(155), after.head(155));
+  EXPECT_NE(base.segment(155, 5), after.segment(155, 5));
+  const Eigen::VectorXd one =
+      PredictAhead(model, log.rate, Eigen::VectorXd(), 600, 1, Protocol::kCausal, causal);
+  EXPECT_NE(base, one);
+}
+
+// The causal windows cannot resolve slow IMFs: a note names a sub-model that sums them (not the
+// noise group, whose energy is in its first IMFs, nor the residue's), and the window that would.
+TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
+  DriftModel model;
+  model.options.method = Method::kMsElm;
+  model.sub_models = {{"noise", {1, 2, 3}, false, nullptr},
+                      {"mixed", {4, 5, 6, 7, 8, 9, 10, 11, 12}, false, nullptr},
+                      {"drift", {13}, true, nullptr}};
+  const std::string note = CausalWindowNote(model, 512);
+  EXPECT_NE(note.find("resolves about 8 IMFs; sub-model 'mixed' (IMFs 4-12) holds slower ones"),
+            std::string::npos)
+      << note;
+  EXPECT_NE(note.find("a window of 8192 samples would resolve them"), std::string::npos) << note;
+  EXPECT_EQ(CausalWindowNote(model, 8192), "");
+  model.sub_models = {{"noise", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13}, false, nullptr},
+                      {"drift", {}, true, nullptr}};
+  EXPECT_EQ(CausalWindowNote(model, 512), "");  // the default grouping on a 1 Hz FOG log
+  model.options.method = Method::kElm;
+  model.sub_models = {{"signal", {}, true, nullptr}};
+  EXPECT_EQ(CausalWindowNote(model, 16), "");
+}
+
+TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
+  const Log log = MakeLog(900, 2);
+  for (Method method : {Method::kMsElm, Method::kEmdElm, Method::kElm}) {
+    const DriftModel model =
+        FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, method));
+    CausalOptions causal;
+    causal.window = 128;
+    const Eigen::VectorXd base =
+        PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    Eigen::VectorXd changed = log.rate;
+    changed.tail(150).array() += 5.0;  // samples 750.. change
+    const Eigen::VectorXd after =
+        PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kCausal, causal);
+    // Predictions for t <= 750 use samples up to 749 only: unchanged to the bit.
+    EXPECT_EQ(base.head(151), after.head(151)) << ToString(method);
+    EXPECT_NE(base.tail(10), after.tail(10)) << ToString(method);
+    if (UsesDecomposition(method)) {
+      // The paper protocol decomposes the whole record: the same change leaks into earlier
+      // predictions, which is exactly the leakage the causal protocol removes.
+      const Eigen::VectorXd paper =
+          PredictOneStep(model, log.rate, Eigen::VectorXd(), 600, Protocol::kPaper);
+      const Eigen::VectorXd paper_changed =
+          PredictOneStep(model, changed, Eigen::VectorXd(), 600, Protocol::kPaper);
+      EXPECT_NE(paper.head(150), paper_changed.head(150)) << ToString(method);
+    }
+  }
+}
+
+TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
+  // The option error's message, "" when the options are accepted.
+  auto refusal = [](const CausalOptions& c) -> std::string {
+    try {
+      c.Validate();
+    } catch (const OptionError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const CausalOptions defaults;
+  EXPECT_EQ(refusal(defaults), "");
+  for (int window : {16, 1000000, 15, 1000001}) {
+    CausalOptions c;
+    c.window = window;
+    const bool allowed = window >= 16 && window <= 1000000;
+    const std::string message = refusal(c);
+    EXPECT_TRUE(allowed ? message.empty() : message.find("causal window") != std::string::npos)
+        << window << ": " << message;
+  }
+  for (int ensemble : {0, 100000, -1, 100001}) {  // 0 = the model's own
+    CausalOptions c;
+    c.ensemble_size = ensemble;
+    const bool allowed = ensemble >= 0 && ensemble <= 100000;
+    const std::string message = refusal(c);
+    EXPECT_TRUE(allowed ? message.empty()
+                        : message.find("causal ensemble_size") != std::string::npos)
+        << ensemble << ": " << message;
+  }
+}
+
+}  // namespace
+}  // namespace gyrodrift::drift

@@ -1,0 +1,177 @@
+// FitDriftModel (drift_fit.cc): the white-noise level taken from the decomposition, the seed
+// rule of its random streams, its progress, automatic lags, records, what a model keeps, and the
+// input it refuses.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/evaluation.h"
+#include "unit/drift/drift_fixtures.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+using fixtures::Fast;
+using fixtures::Log;
+using fixtures::MakeLog;
+
+// The white-noise level comes from the decomposition's own noise EMDs: the fit runs no
+// Monte-Carlo and equals, bit for bit, a fit given the Monte-Carlo level of the same seed.
+TEST(DriftModel, MsElmReusesTheDecompositionsNoiseForTheWhiteNoiseLevel) {
+  const Log log = MakeLog(1500, 3);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  o.decomposition.ensemble_size = 20;
+  // ICEEMDAN decomposes the noise to full depth; BEEMDAN's bound may stop before the noise run
+  // does, and then SelectModes completes the level by the Monte-Carlo (selection_test).
+  o.decomposition.method = decomposition::Method::kIceemdan;
+  o.seed = 4;
+  // No level of its own: the process-wide cache (other tests in this process may have filled it)
+  // does not grow.
+  const size_t cached_levels = selection::NoiseLevelCache::Global().Size();
+  const DriftModel reused = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  EXPECT_EQ(selection::NoiseLevelCache::Global().Size(), cached_levels) << reused.selection_summary;
+  DriftOptions given = o;
+  selection::MonteCarloOptions mc = o.selection.monte_carlo;
+  mc.seed = o.seed;
+  given.selection.noise_level = std::make_shared<const selection::NoiseLevel>(
+      selection::ComputeNoiseLevel(1500, mc, o.selection.kde, o.selection.distance));
+  const DriftModel reference = FitDriftModel(log.rate, Eigen::VectorXd(), given);
+  EXPECT_EQ(reused.selection_summary, reference.selection_summary);
+  ASSERT_EQ(reused.sub_models.size(), reference.sub_models.size());
+  for (size_t g = 0; g < reused.sub_models.size(); ++g) {
+    EXPECT_EQ(reused.sub_models[g].imfs, reference.sub_models[g].imfs) << g;
+  }
+  EXPECT_EQ(PredictOneStep(reused, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
+            PredictOneStep(reference, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
+}
+
+// The seed rule (common/random.h): each random stream of a fit has its own seed. Sub-model g's
+// learner draws from SeedFor(seed, "sub-model", g), never from the seed itself, whose streams
+// (seed, i) are the decomposition's white noise; over an evaluation's repeats no two (repeat,
+// sub-model) pairs share a seed, as seed + r + g made repeat r + 1's sub-model g - 1 repeat r's
+// sub-model g. The white-noise level, computed apart here (ensemble 10 < 20 realisations), draws
+// the user's seed, not the Monte-Carlo's default 1.
+TEST(DriftModel, NoTwoRandomStreamsOfAFitCoincide) {
+  const Log log = MakeLog(1500, 1);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  o.seed = 7;
+  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
+  std::set<std::string> seeds{std::to_string(o.seed)};
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    ASSERT_TRUE(model.sub_models[g].learner) << g;
+    const std::string used = model.sub_models[g].learner->Save().texts.at("seed");
+    EXPECT_EQ(used, std::to_string(SeedFor(o.seed, "sub-model", g)));
+    EXPECT_TRUE(seeds.insert(used).second) << "sub-model " << g << " reuses seed " << used;
+  }
+  EXPECT_NE(model.selection_summary.find("seed=7)"), std::string::npos) << model.selection_summary;
+
+  std::set<std::uint64_t> all;
+  for (int r = 0; r < 100; ++r) {
+    const std::uint64_t repeat = RepeatSeed(o.seed, r);
+    EXPECT_TRUE(all.insert(repeat).second) << "repeat " << r;
+    for (std::uint64_t g = 0; g < 8; ++g) {
+      EXPECT_TRUE(all.insert(SeedFor(repeat, "sub-model", g)).second) << r << ", " << g;
+    }
+  }
+  EXPECT_EQ(RepeatSeed(o.seed, 0), o.seed);  // one repeat scores the model fit writes
+}
+
+// Progress runs from the decomposition (0) through the grouping to the sub-model fits (1), in
+// order, naming the two steps; it changes nothing in the model.
+TEST(DriftModel, FitReportsItsProgressInOrderAndUnchanged) {
+  const Log log = MakeLog(1500, 2);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  const DriftModel quiet = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  std::mutex mutex;
+  std::vector<std::pair<double, std::string>> seen;
+  o.progress = [&](double fraction, const std::string& step) {
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.emplace_back(fraction, step);
+  };
+  const DriftModel reported = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  EXPECT_EQ(reported.Summary(), quiet.Summary());
+  EXPECT_EQ(PredictOneStep(reported, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
+            PredictOneStep(quiet, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
+  EXPECT_FALSE(reported.options.progress);  // a model keeps no callback
+  ASSERT_GE(seen.size(), 3u);
+  EXPECT_EQ(seen.front(), std::make_pair(0.0, std::string("decompose")));
+  EXPECT_EQ(seen.back(), std::make_pair(1.0, std::string("fit sub-models")));
+  for (size_t i = 1; i < seen.size(); ++i) {
+    EXPECT_GE(seen[i].first, seen[i - 1].first) << i;
+    // Never back from fitting to decomposing.
+    EXPECT_FALSE(seen[i - 1].second == "fit sub-models" && seen[i].second == "decompose") << i;
+  }
+}
+
+TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {
+  const Log log = MakeLog(1200, 5);
+  DriftOptions o = Fast(Mode::kPredict, Method::kElm);
+  o.auto_lags = true;
+  o.lag_candidates = {1, 3, 6};
+  const DriftModel model = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  ASSERT_EQ(model.lag_validation_rmse.size(), 3u);
+  const auto best =
+      std::min_element(model.lag_validation_rmse.begin(), model.lag_validation_rmse.end());
+  EXPECT_EQ(model.lags,
+            o.lag_candidates[static_cast<size_t>(best - model.lag_validation_rmse.begin())]);
+}
+
+// Several records are for the thermal method in compensate mode (its lag states restart at each);
+// every other method needs one uniform record.
+TEST(DriftModel, SeveralRecordsAreFittedByTheThermalMethodOnly) {
+  const Log log = MakeLog(3000, 9);
+  const std::vector<Eigen::Index> starts{1500};
+  const DriftModel thermal =
+      FitDriftModel(log.rate, log.temperature, Fast(Mode::kCompensate, Method::kThermal), starts);
+  ASSERT_TRUE(thermal.identified());
+  EXPECT_EQ(thermal.sub_models.front().thermal->report.records, 2);
+  EXPECT_THROW(
+      FitDriftModel(log.rate, log.temperature, Fast(Mode::kCompensate, Method::kPoly), starts),
+      UsageError);
+  EXPECT_THROW(
+      FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kPredict, Method::kElm), starts),
+      UsageError);
+}
+
+// Shared white-noise EMDs serve one record length: a model fitted with a set in its options does
+// not keep it, and predicts on records of any length.
+TEST(DriftModel, AModelKeepsNoSharedNoiseEmds) {
+  const Log log = MakeLog(600, 4);
+  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  decomposition::DecompositionOptions d = o.decomposition;
+  d.seed = o.seed;
+  o.decomposition.noise_emds = std::make_shared<const decomposition::NoiseEmds>(500, d);
+  const DriftModel model = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
+  EXPECT_EQ(model.options.decomposition.noise_emds, nullptr);
+  o.decomposition.noise_emds = nullptr;
+  const DriftModel plain = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
+  EXPECT_EQ(PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper),
+            PredictOneStep(plain, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper));
+}
+
+TEST(DriftModel, BadInputIsRejected) {
+  const Log log = MakeLog(500, 6);
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kCompensate, Method::kElm)),
+               DataError);
+  EXPECT_THROW(
+      FitDriftModel(log.rate.head(10), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kElm)),
+      DataError);
+  DriftOptions bad = Fast(Mode::kPredict, Method::kElm);
+  bad.features.lags = 0;
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), bad), UsageError);
+  EXPECT_THROW(MethodFromString("lstm"), UsageError);
+  EXPECT_THROW(ModeFromString("guess"), UsageError);
+}
+
+}  // namespace
+}  // namespace gyrodrift::drift
