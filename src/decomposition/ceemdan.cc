@@ -20,25 +20,14 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report;
-  report.method = Method::kCeemdan;
-  report.ensemble_size = ensemble;
-  report.seed = o.seed;
-  report.supplied_noise = static_cast<bool>(o.supplied_noise);
+  DecompositionReport report = EnsembleReport(Method::kCeemdan, o);
   const double inv = 1.0 / ensemble;
 
   std::vector<Eigen::VectorXd> modes;
   Eigen::VectorXd r = xn;
   double reported = 0.0;  // progress shown so far
   for (int stage = 0;; ++stage) {
-    if (o.max_imfs > 0 && static_cast<int>(modes.size()) >= o.max_imfs) {
-      report.stop_reason = "IMF cap (" + std::to_string(o.max_imfs) + ") reached";
-      break;
-    }
-    if (CountExtrema(r.data(), n).extrema() < 3) {
-      report.stop_reason = "residue has fewer than 3 extrema";
-      break;
-    }
+    if (StagesEnd(o, modes.size(), r, true, report)) break;
     const double sr = SampleStd(r.data(), n);
     Eigen::VectorXd mode = Eigen::VectorXd::Zero(n);
     StageStats stats;

@@ -51,11 +51,7 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
         mean_residue += m.residue * inv;
       });
 
-  DecompositionReport report;
-  report.method = Method::kEemd;
-  report.ensemble_size = ensemble;
-  report.seed = o.seed;
-  report.supplied_noise = static_cast<bool>(o.supplied_noise);
+  DecompositionReport report = EnsembleReport(Method::kEemd, o);
   for (const auto& s : stats) s.Report(report, ensemble);
   report.stop_reason =
       "fixed IMF count " + std::to_string(max_imfs) + " (EEMD aligns every member's modes)";

@@ -23,25 +23,14 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report;
-  report.method = o.method;
-  report.ensemble_size = ensemble;
-  report.seed = o.seed;
-  report.supplied_noise = static_cast<bool>(o.supplied_noise);
+  DecompositionReport report = EnsembleReport(o.method, o);
   const double nr = static_cast<double>(ensemble);
 
   std::vector<Eigen::VectorXd> modes;
   Eigen::VectorXd r = xn;
   double reported = 0.0;  // progress shown so far
   for (int stage = 0;; ++stage) {
-    if (o.max_imfs > 0 && static_cast<int>(modes.size()) >= o.max_imfs) {
-      report.stop_reason = "IMF cap (" + std::to_string(o.max_imfs) + ") reached";
-      break;
-    }
-    if (stage > 0 && CountExtrema(r.data(), n).extrema() < 3) {
-      report.stop_reason = "residue has fewer than 3 extrema";
-      break;
-    }
+    if (StagesEnd(o, modes.size(), r, stage > 0, report)) break;
     if (stage > 0 && go_on && !go_on(stage, modes, r, workers[0].sifter, workers[0].imf, report)) {
       // The policy ended the noise assistance: plain EMD finishes the decomposition.
       const std::string reason = report.stop_reason;

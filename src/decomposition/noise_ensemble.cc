@@ -29,6 +29,28 @@ bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseRows& modes, Sifter
   return true;
 }
 
+DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o) {
+  DecompositionReport report;
+  report.method = method;
+  report.ensemble_size = EnsembleSize(o);
+  report.seed = o.seed;
+  report.supplied_noise = static_cast<bool>(o.supplied_noise);
+  return report;
+}
+
+bool StagesEnd(const DecompositionOptions& o, size_t modes, const Eigen::VectorXd& r,
+               bool check_extrema, DecompositionReport& report) {
+  if (o.max_imfs > 0 && static_cast<int>(modes) >= o.max_imfs) {
+    report.stop_reason = "IMF cap (" + std::to_string(o.max_imfs) + ") reached";
+    return true;
+  }
+  if (check_extrema && CountExtrema(r.data(), r.size()).extrema() < 3) {
+    report.stop_reason = "residue has fewer than 3 extrema";
+    return true;
+  }
+  return false;
+}
+
 std::vector<Worker> MakeWorkers(int ensemble, const DecompositionOptions& o, Eigen::Index n) {
   const int count = std::min(ResolveThreads(o.threads), ensemble);
   std::vector<Worker> workers;

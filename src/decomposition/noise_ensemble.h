@@ -73,6 +73,14 @@ struct Worker {
   Eigen::VectorXd noise, input, imf;
 };
 
+// A report of `method` with the ensemble's size, seed and whether its noise was supplied.
+DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o);
+
+// The stage-wise methods' end before a stage: the IMF cap reached, or (when check_extrema) a
+// residue with fewer than 3 extrema. Sets report.stop_reason and returns true when it is the end.
+bool StagesEnd(const DecompositionOptions& o, size_t modes, const Eigen::VectorXd& r,
+               bool check_extrema, DecompositionReport& report);
+
 // One worker per thread the ensemble can use.
 std::vector<Worker> MakeWorkers(int ensemble, const DecompositionOptions& o, Eigen::Index n);
 

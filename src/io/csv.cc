@@ -11,6 +11,7 @@
 #include <limits>
 #include <string_view>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
 
@@ -79,23 +80,21 @@ int FindColumn(const std::vector<std::string>& header, const std::string& spec) 
   return -1;
 }
 
+constexpr gyrodrift::internal::EnumNames<Delimiter, 4> kDelimiters{{
+    {Delimiter::kAuto, "auto"},
+    {Delimiter::kComma, "comma"},
+    {Delimiter::kTab, "tab"},
+    {Delimiter::kSemicolon, "semicolon"},
+}};
+
 }  // namespace
 
 std::string_view ToString(Delimiter delimiter) {
-  switch (delimiter) {
-    case Delimiter::kComma: return "comma";
-    case Delimiter::kTab: return "tab";
-    case Delimiter::kSemicolon: return "semicolon";
-    case Delimiter::kAuto: break;
-  }
-  return "auto";
+  return gyrodrift::internal::EnumName(delimiter, kDelimiters);
 }
 
 Delimiter DelimiterFromString(std::string_view text) {
-  for (Delimiter d : {Delimiter::kAuto, Delimiter::kComma, Delimiter::kTab, Delimiter::kSemicolon}) {
-    if (text == ToString(d)) return d;
-  }
-  throw OptionError("delimiter", "'" + std::string(text) + "'", "auto, comma, tab or semicolon");
+  return gyrodrift::internal::EnumFromName(text, "delimiter", kDelimiters);
 }
 
 void CsvReadOptions::Validate() const {

@@ -7,26 +7,28 @@
 #include <utility>
 #include <vector>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/statistics.h"
 
 namespace gyrodrift::io {
+namespace {
+
+constexpr gyrodrift::internal::EnumNames<GapPolicy, 3> kGapPolicies{{
+    {GapPolicy::kError, "error"},
+    {GapPolicy::kInterpolate, "interpolate"},
+    {GapPolicy::kSplit, "split"},
+}};
+
+}  // namespace
 
 std::string_view ToString(GapPolicy policy) {
-  switch (policy) {
-    case GapPolicy::kInterpolate: return "interpolate";
-    case GapPolicy::kSplit: return "split";
-    case GapPolicy::kError: break;
-  }
-  return "error";
+  return gyrodrift::internal::EnumName(policy, kGapPolicies);
 }
 
 GapPolicy GapPolicyFromString(std::string_view text) {
-  for (GapPolicy p : {GapPolicy::kError, GapPolicy::kInterpolate, GapPolicy::kSplit}) {
-    if (text == ToString(p)) return p;
-  }
-  throw OptionError("gaps", "'" + std::string(text) + "'", "error, interpolate or split");
+  return gyrodrift::internal::EnumFromName(text, "gaps", kGapPolicies);
 }
 
 CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,

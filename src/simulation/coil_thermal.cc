@@ -3,19 +3,26 @@
 #include <cmath>
 #include <string>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::simulation {
+namespace {
+
+constexpr gyrodrift::internal::EnumNames<ThermalScheme, 2> kSchemes{{
+    {ThermalScheme::kBackwardEuler, "backward-euler"},
+    {ThermalScheme::kCrankNicolson, "crank-nicolson"},
+}};
+
+}  // namespace
 
 std::string_view ToString(ThermalScheme scheme) {
-  return scheme == ThermalScheme::kBackwardEuler ? "backward-euler" : "crank-nicolson";
+  return gyrodrift::internal::EnumName(scheme, kSchemes);
 }
 
 ThermalScheme ThermalSchemeFromString(std::string_view name) {
-  if (name == "backward-euler") return ThermalScheme::kBackwardEuler;
-  if (name == "crank-nicolson") return ThermalScheme::kCrankNicolson;
-  ThrowOption("thermal.scheme", name, "backward-euler or crank-nicolson");
+  return gyrodrift::internal::EnumFromName(name, "thermal.scheme", kSchemes);
 }
 
 void ThermalParameters::Validate() const {

@@ -4,19 +4,24 @@
 #include <cstdio>
 #include <numbers>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::simulation {
+namespace {
 
-std::string_view ToString(Preset preset) {
-  return preset == Preset::kNavigation ? "navigation" : "tactical";
-}
+constexpr gyrodrift::internal::EnumNames<Preset, 2> kPresets{{
+    {Preset::kNavigation, "navigation"},
+    {Preset::kTactical, "tactical"},
+}};
+
+}  // namespace
+
+std::string_view ToString(Preset preset) { return gyrodrift::internal::EnumName(preset, kPresets); }
 
 Preset PresetFromString(std::string_view name) {
-  if (name == "navigation") return Preset::kNavigation;
-  if (name == "tactical") return Preset::kTactical;
-  ThrowOption("preset", name, "navigation or tactical");
+  return gyrodrift::internal::EnumFromName(name, "preset", kPresets);
 }
 
 ShupeConstants CoilParameters::Shupe() const {

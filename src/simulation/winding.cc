@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
@@ -27,29 +28,26 @@ std::string_view PatternRoles(WindingPattern pattern) {
 
 }  // namespace
 
+namespace {
+
+// "helical" is read as conventional; conventional's name is the first entry's.
+constexpr gyrodrift::internal::EnumNames<WindingPattern, 6> kPatterns{{
+    {WindingPattern::kQuadrupole, "quadrupole"},
+    {WindingPattern::kDipole, "dipole"},
+    {WindingPattern::kOctupole, "octupole"},
+    {WindingPattern::kConventional, "conventional"},
+    {WindingPattern::kConventional, "helical"},
+    {WindingPattern::kSymmetric, "symmetric"},
+}};
+
+}  // namespace
+
 std::string_view ToString(WindingPattern pattern) {
-  switch (pattern) {
-    case WindingPattern::kQuadrupole:
-      return "quadrupole";
-    case WindingPattern::kDipole:
-      return "dipole";
-    case WindingPattern::kOctupole:
-      return "octupole";
-    case WindingPattern::kConventional:
-      return "conventional";
-    case WindingPattern::kSymmetric:
-      return "symmetric";
-  }
-  return "?";
+  return gyrodrift::internal::EnumName(pattern, kPatterns);
 }
 
 WindingPattern WindingPatternFromString(std::string_view name) {
-  if (name == "quadrupole") return WindingPattern::kQuadrupole;
-  if (name == "dipole") return WindingPattern::kDipole;
-  if (name == "octupole") return WindingPattern::kOctupole;
-  if (name == "conventional" || name == "helical") return WindingPattern::kConventional;
-  if (name == "symmetric") return WindingPattern::kSymmetric;
-  ThrowOption("winding", name, "one of quadrupole, dipole, octupole, conventional, symmetric");
+  return gyrodrift::internal::EnumFromName(name, "winding", kPatterns);
 }
 
 int PatternPeriod(WindingPattern pattern) { return static_cast<int>(PatternRoles(pattern).size()); }

@@ -393,8 +393,9 @@ std::string GroupOf(const sel::SelectionResult& selection, int k) {
 }  // namespace internal
 
 void StudyOptions::Validate() const {
-  if (ensemble_size < 1 || ensemble_size > 10000)
-    ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 10000]");
+  // Ranges the library owns are its own Validate's, one home: the drift options' first, so that
+  // ensemble_size, which also sizes the causal windows, is named as the decomposition's.
+  internal::StudyDriftOptions(*this, 1.0, true).Validate();
   EvaluationFor(*this, methods).causal.Validate();
   if (!(duration_s >= kMinDurationS)) {
     ThrowOption("duration_s", FormatValue(duration_s),
@@ -407,7 +408,6 @@ void StudyOptions::Validate() const {
                   "a list without repeats (each method saves one model file)");
     }
   }
-  internal::StudyDriftOptions(*this, 1.0, true).Validate();
 }
 
 StudyResult RunStudy(const StudyOptions& options, const StudyObserver& observer) {

@@ -251,7 +251,7 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
       {"split, not thermal", "method = \"ms-elm\"\ngaps = \"split\"\n" + std::string(kAxes) + unit,
        "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
-       "bad.toml:1: delimiter = 'pipe': must be auto, comma, tab or semicolon"},
+       "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
       {"serial with a slash", std::string(kAxes) + "\n[[unit]]\nserial = \"a/b\"\ncalibration = "
        "\"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n", "must be usable as a folder"},
   };

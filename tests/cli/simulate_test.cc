@@ -139,7 +139,7 @@ TEST_F(SimulateCli, BadProfileFilesAreDataErrors) {
 TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--profile oven", 2, "--profile = oven");
   ExpectFailure("--profile '" + Path("missing.csv") + "'", 2, "missing.csv");
-  ExpectFailure("--preset strategic", 2, "preset = strategic");
+  ExpectFailure("--preset strategic", 2, "preset = 'strategic'");
   ExpectFailure("--duration 8x", 2, "--duration = 8x");
   ExpectFailure("--duration -5s", 2, "--duration");
   ExpectFailure("--duration 0", 2, "--duration = 0");
@@ -151,7 +151,7 @@ TEST_F(SimulateCli, BadOptionsAreUsageErrors) {
   ExpectFailure("--duration 3000h", 2, "1e7 samples");
   ExpectFailure("--rate-hz 0", 2, "--rate-hz = 0");
   ExpectFailure("--rate-hz abc", 2, "rate-hz");
-  ExpectFailure("--winding sextupole", 2, "winding = sextupole");
+  ExpectFailure("--winding sextupole", 2, "winding = 'sextupole'");
   ExpectFailure("--asymmetry 0.7", 2, "--asymmetry = 0.7");
   ExpectFailure("--asymmetry nan", 2, "--asymmetry = nan");
   ExpectFailure("--seed -1", 2, "--seed: -1: must be an integer");

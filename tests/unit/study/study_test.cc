@@ -117,7 +117,7 @@ TEST(StudyOptions, ValidateNamesTheField) {
     return RefusedOption([&] { o.Validate(); });
   };
   EXPECT_EQ(refused([](StudyOptions& o) { o.ensemble_size = 0; }), "ensemble_size");
-  EXPECT_EQ(refused([](StudyOptions& o) { o.ensemble_size = 10001; }), "ensemble_size");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.ensemble_size = 100001; }), "ensemble_size");
   EXPECT_EQ(refused([](StudyOptions& o) { o.duration_s = 5400.0; }), "duration_s");
   EXPECT_EQ(refused([](StudyOptions& o) { o.duration_s = std::nan(""); }), "duration_s");
   EXPECT_EQ(refused([](StudyOptions& o) { o.methods.clear(); }), "methods");
