@@ -17,7 +17,9 @@ void ValidateBandConfidence(double confidence, const char* field) {
 
 double RobustLog2NoiseEnergy(const Eigen::Ref<const Eigen::VectorXd>& mode1) {
   std::vector<double> magnitude(static_cast<size_t>(mode1.size()));
-  for (Eigen::Index t = 0; t < mode1.size(); ++t) magnitude[static_cast<size_t>(t)] = std::abs(mode1[t]);
+  for (Eigen::Index t = 0; t < mode1.size(); ++t) {
+    magnitude[static_cast<size_t>(t)] = std::abs(mode1[t]);
+  }
   const double median = Median(std::move(magnitude));
   return std::log2(static_cast<double>(mode1.size())) + 2.0 * std::log2(median / 0.6745);
 }

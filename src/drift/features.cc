@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
@@ -62,20 +63,10 @@ void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, doubl
   }
 }
 
-std::string_view ToString(ThermalSet set) {
-  for (const auto& [v, name] : kSets) {
-    if (v == set) return name;
-  }
-  return "?";
-}
+std::string_view ToString(ThermalSet set) { return gyrodrift::internal::EnumName(set, kSets); }
 
 ThermalSet ThermalSetFromString(std::string_view name) {
-  std::string allowed;
-  for (const auto& [v, n] : kSets) {
-    if (n == name) return v;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(n);
-  }
-  ThrowOption("thermal_set", "'" + std::string(name) + "'", "one of " + allowed);
+  return gyrodrift::internal::EnumFromName(name, "thermal_set", kSets);
 }
 
 int FeatureOptions::NumThermalFeatures() const {

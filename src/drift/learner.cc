@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "common/enum_names.h"
 #include "drift/learner_internal.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -42,20 +43,10 @@ void CheckTrainingData(const Eigen::Ref<const Eigen::MatrixXd>& x,
 
 }  // namespace
 
-std::string_view ToString(LearnerKind kind) {
-  for (const auto& [k, name] : kKinds) {
-    if (k == kind) return name;
-  }
-  return "?";
-}
+std::string_view ToString(LearnerKind kind) { return gyrodrift::internal::EnumName(kind, kKinds); }
 
 LearnerKind LearnerKindFromString(std::string_view name) {
-  std::string allowed;
-  for (const auto& [k, text] : kKinds) {
-    if (text == name) return k;
-    allowed += (allowed.empty() ? "" : ", ") + std::string(text);
-  }
-  ThrowOption("learner", "'" + std::string(name) + "'", "one of " + allowed);
+  return gyrodrift::internal::EnumFromName(name, "learner", kKinds);
 }
 
 void LearnerOptions::Validate() const {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 
 namespace gyrodrift::selection {
@@ -13,32 +14,22 @@ namespace {
 // a * ln(a / b) with the limits 0 ln 0 = 0; b >= a / 2 > 0 whenever a > 0 (b is the mixture).
 double KlTerm(double a, double b) { return a > 0.0 ? a * std::log(a / b) : 0.0; }
 
+constexpr gyrodrift::internal::EnumNames<PdfDistance, 5> kDistances{{
+    {PdfDistance::kL2, "l2"},
+    {PdfDistance::kL1, "l1"},
+    {PdfDistance::kHellinger, "hellinger"},
+    {PdfDistance::kJensenShannon, "jensen-shannon"},
+    {PdfDistance::kBhattacharyya, "bhattacharyya"},
+}};
+
 }  // namespace
 
 std::string_view ToString(PdfDistance distance) {
-  switch (distance) {
-    case PdfDistance::kL2:
-      return "l2";
-    case PdfDistance::kL1:
-      return "l1";
-    case PdfDistance::kHellinger:
-      return "hellinger";
-    case PdfDistance::kJensenShannon:
-      return "jensen-shannon";
-    case PdfDistance::kBhattacharyya:
-      return "bhattacharyya";
-  }
-  return "unknown";
+  return gyrodrift::internal::EnumName(distance, kDistances);
 }
 
 PdfDistance PdfDistanceFromString(std::string_view name) {
-  if (name == "l2") return PdfDistance::kL2;
-  if (name == "l1") return PdfDistance::kL1;
-  if (name == "hellinger") return PdfDistance::kHellinger;
-  if (name == "jensen-shannon") return PdfDistance::kJensenShannon;
-  if (name == "bhattacharyya") return PdfDistance::kBhattacharyya;
-  ThrowOption("distance", "'" + std::string(name) + "'",
-              "one of l2, l1, hellinger, jensen-shannon, bhattacharyya");
+  return gyrodrift::internal::EnumFromName(name, "distance", kDistances);
 }
 
 double Distance(PdfDistance distance, const Eigen::Ref<const Eigen::VectorXd>& p,

@@ -5,6 +5,7 @@
 #include <string>
 #include <unsupported/Eigen/FFT>
 
+#include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
@@ -60,20 +61,21 @@ KdeWorkspace::~KdeWorkspace() = default;
 KdeWorkspace::KdeWorkspace(KdeWorkspace&&) noexcept = default;
 KdeWorkspace& KdeWorkspace::operator=(KdeWorkspace&&) noexcept = default;
 
+namespace {
+
+constexpr gyrodrift::internal::EnumNames<KdeMethod, 2> kKdeMethods{{
+    {KdeMethod::kBinnedFft, "binned-fft"},
+    {KdeMethod::kDirect, "direct"},
+}};
+
+}  // namespace
+
 std::string_view ToString(KdeMethod method) {
-  switch (method) {
-    case KdeMethod::kBinnedFft:
-      return "binned-fft";
-    case KdeMethod::kDirect:
-      return "direct";
-  }
-  return "unknown";
+  return gyrodrift::internal::EnumName(method, kKdeMethods);
 }
 
 KdeMethod KdeMethodFromString(std::string_view name) {
-  if (name == "binned-fft") return KdeMethod::kBinnedFft;
-  if (name == "direct") return KdeMethod::kDirect;
-  ThrowOption("kde method", "'" + std::string(name) + "'", "one of binned-fft, direct");
+  return gyrodrift::internal::EnumFromName(name, "kde.method", kKdeMethods);
 }
 
 void KdeOptions::Validate() const {
@@ -88,7 +90,7 @@ void KdeOptions::Validate() const {
   RequirePositive("bandwidth_scale", bandwidth_scale);
   RequireInRange("padding_bandwidths", padding_bandwidths, 0.0, 20.0);
   if (method != KdeMethod::kBinnedFft && method != KdeMethod::kDirect) {
-    ThrowOption("kde method", std::to_string(static_cast<int>(method)), "binned-fft or direct");
+    ThrowOption("kde.method", std::to_string(static_cast<int>(method)), "binned-fft or direct");
   }
 }
 

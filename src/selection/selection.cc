@@ -57,7 +57,7 @@ void SelectionOptions::Validate() const {
       criterion != Criterion::kEnergyModel) {
     ThrowOption("criterion", std::to_string(static_cast<int>(criterion)), "pdf, komaty or energy");
   }
-  if (ToString(distance) == "unknown") {
+  if (ToString(distance) == "?") {
     ThrowOption("distance", std::to_string(static_cast<int>(distance)),
                 "l2, l1, hellinger, jensen-shannon or bhattacharyya");
   }
