@@ -1,5 +1,6 @@
 // Plain EMD (Rilling & Flandrin's emd.m main loop) and the incremental noise EMD.
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "decomposition/drivers.h"
@@ -81,7 +82,9 @@ Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd 
   Decomposition result;
   const Eigen::Index n = residue.size();
   result.imfs.resize(n, static_cast<Eigen::Index>(imfs.size()));
+  assert(report.sifts_per_imf.size() == imfs.size() && report.sift_cap_hit.size() == imfs.size());
   for (size_t k = 0; k < imfs.size(); ++k) {
+    assert(imfs[k].size() == n);
     result.imfs.col(static_cast<Eigen::Index>(k)) = imfs[k];
     Eigen::VectorXd().swap(imfs[k]);  // free as we go: the peak holds one copy of the modes
   }

@@ -1,5 +1,6 @@
 #include "gyrodrift/decomposition/energy_band.h"
 
+#include <cassert>
 #include <cmath>
 #include <vector>
 
@@ -25,6 +26,7 @@ double RobustLog2NoiseEnergy(const Eigen::Ref<const Eigen::VectorXd>& mode1) {
 }
 
 double EnergyBand::Log2Upper(int k) const {
+  assert(k >= 1 && (confidence == 0.95 || confidence == 0.99));
   const bool high = confidence == 0.99;
   const double a = high ? 0.46 : 0.474;
   const double b = high ? -1.919 : -2.449;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cassert>
 #include <optional>
 #include <vector>
 
@@ -46,6 +47,7 @@ class NoiseRows {
     }
     if (next_ >= cached_->rows.size()) return false;
     const Eigen::VectorXd& row = cached_->rows[next_];
+    assert(row.size() == cached_->white.size());
     std::copy(row.data(), row.data() + row.size(), out);
     ++next_;
     last_imf_ = static_cast<int>(next_) <= cached_->imfs ? static_cast<int>(next_) : 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstdint>
 #include <cstring>
 #if defined(__SSE2__)
@@ -288,6 +289,7 @@ bool Sifter::BoundaryConditions(const double* h) {
   auto assemble = [&](const List& left, const int* interior, int count, const List& right,
                       std::vector<double>& t, std::vector<double>& z) {
     const size_t total = static_cast<size_t>(left.size + count + right.size);
+    assert(total <= t.capacity() && total <= z.capacity());  // the sift loop allocates nothing
     t.resize(total);  // within the reserved capacity: no allocation
     z.resize(total);
     size_t k = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstdint>
 
 namespace gyrodrift::decomposition::internal {
@@ -298,6 +299,7 @@ void FitPair(EnvelopeSpline& a, EnvelopeSpline& b, size_t warm_up) {
   System system[2];
   size_t count = 0;  // the systems of 4 or more nodes; 2 and 3 need only divided differences
   for (EnvelopeSpline* e : {&a, &b}) {
+    assert(e->t_.size() == e->y_.size() && e->t_.size() >= 2);
     e->Prepare();
     if (e->t_.size() < 4) continue;
     system[count++] = {e->t_.size(), e->t_.data(), e->dd_, e->inv_dx_, e->diag_,
