@@ -22,7 +22,7 @@ Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
                                     const std::vector<Eigen::Index>& record_starts) {
   if (model.options.mode != Mode::kCompensate) {
     throw UsageError(
-        "model mode = predict: drift estimation needs a model fitted with --mode compensate");
+        "model mode = predict: drift estimation needs a model fitted in mode compensate");
   }
   if (!record_starts.empty()) {
     // Every record on its own: each starts in equilibrium at its first temperature.

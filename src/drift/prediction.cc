@@ -98,7 +98,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
                              const CausalOptions& causal) {
   if (model.options.mode != Mode::kPredict) {
     throw UsageError(
-        "model mode = compensate: prediction needs a model fitted with --mode predict");
+        "model mode = compensate: prediction needs a model fitted in mode predict");
   }
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();

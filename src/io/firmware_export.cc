@@ -231,7 +231,7 @@ class CWriter {
   // Shortest decimal that reads back to the constant in the header's precision.
   std::string Literal(double v) const {
     if (single_ && !(std::abs(v) <= std::numeric_limits<float>::max())) {
-      throw UsageError(fmt::format("constant {} is beyond float's range: export without --float",
+      throw UsageError(fmt::format("constant {} is beyond float's range: export in double precision",
                                    FormatValue(v)));
     }
     std::string s = single_ ? fmt::format("{}", static_cast<float>(v)) : fmt::format("{}", v);
@@ -487,20 +487,20 @@ void RequireExportable(const std::vector<LoadedModel>& axes) {
     if (model.options.mode != drift::Mode::kCompensate) {
       throw UsageError(axis +
                        " is a predict-mode model: firmware runs compensate-mode models, which "
-                       "need only temperature (fit with --mode compensate)");
+                       "need only temperature (fit in mode compensate)");
     }
     for (const drift::SubModel& sub : model.sub_models) {
       if (sub.learner) {
         throw UsageError(fmt::format(
             "{}: sub-model '{}' is a {} learner on thermal features, not an identified thermal "
-            "model: export takes --method thermal, ms-elm or emd-elm",
+            "model: export takes method thermal, ms-elm or emd-elm",
             axis, sub.name, drift::ToString(model.options.method)));
       }
       if (!sub.thermal) continue;
       if (sub.thermal->correction) {
         throw UsageError(fmt::format(
-            "{}: sub-model '{}' has a nonlinear correction (fitted with --nonlinear), whose "
-            "sigmoid units need exp at every sample: refit without --nonlinear to export",
+            "{}: sub-model '{}' has a nonlinear correction (linear_compensation = false), whose "
+            "sigmoid units need exp at every sample: refit linear to export",
             axis, sub.name));
       }
       if (rate_hz != 0.0 && sub.thermal->rate_hz != rate_hz) {

@@ -82,8 +82,8 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
           path, step, i + 2, samples, median,
           gaps == GapPolicy::kError
               ? "fill gaps by linear interpolation or split the log into records at its gaps "
-                "(--gaps interpolate|split; in a manifest gaps = \"interpolate\" or \"split\")"
-              : "too long to fill by interpolation: split the log at its gaps (--gaps split)"));
+                "(gaps = interpolate or split)"
+              : "too long to fill by interpolation: split the log at its gaps (gaps = split)"));
     }
     insert.push_back({i, static_cast<int>(samples)});
     missing += static_cast<long>(samples);
@@ -92,7 +92,7 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
     if (gap_note && !record_starts->empty()) {
       *gap_note = fmt::format(
           "note: time_s has {} gap{} (median step {:g} s, {} samples missing): the log is split "
-          "into {} records, and the thermal model's lag states restart after each gap (--gaps "
+          "into {} records, and the thermal model's lag states restart after each gap (gaps = "
           "split)",
           record_starts->size(), record_starts->size() == 1 ? "" : "s", median, missing,
           record_starts->size() + 1);
@@ -103,7 +103,7 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
   if (gap_note) {
     *gap_note = fmt::format(
         "note: time_s has {} gap{} (median step {:g} s): {} samples filled by linear "
-        "interpolation (--gaps interpolate)",
+        "interpolation (gaps = interpolate)",
         insert.size(), insert.size() == 1 ? "" : "s", median, missing);
   }
   return table.WithInterpolatedRows(insert);
@@ -123,14 +123,14 @@ double ResolveSampleRate(const CsvTable& table, double given, std::string* how) 
   if (!(median > 0.0)) {
     throw DataError(table.source() + ": column 'time_s' has a median step of " +
                     FormatValue(median) +
-                    " s: it must increase to give the sample rate (or pass --rate-hz)");
+                    " s: it must increase to give the sample rate (or give rate_hz)");
   }
   *how = "time_s";
   const double rate = 1.0 / median;
   if (!(rate >= 1e-9 && rate <= 1e6)) {
     throw DataError(table.source() + ": column 'time_s' has a median step of " +
                     FormatValue(median) + " s, a sample rate of " + FormatValue(rate) +
-                    " Hz outside [1e-09, 1e+06] Hz (seconds expected; or pass --rate-hz)");
+                    " Hz outside [1e-09, 1e+06] Hz (seconds expected; or give rate_hz)");
   }
   return rate;
 }

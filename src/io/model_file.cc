@@ -845,7 +845,7 @@ LoadedModel ParseModelFile(const std::string& text, const std::string& source) {
       names += (names.empty() ? "" : ", ") + axis.info.target_column;
     }
     throw UsageError(source + " holds " + std::to_string(axes.size()) + " axes (" + names +
-                     "): this command reads one-axis models; fit each --target apart");
+                     "): this command reads one-axis models; fit each axis apart");
   }
   return std::move(axes[0]);
 }

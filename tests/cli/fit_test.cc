@@ -142,7 +142,7 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("time_s jumps by 301 s before data row 101 (300 missing samples at the "
                        "median step 1 s): fill gaps by linear interpolation or split the log into "
-                       "records at its gaps (--gaps interpolate|split"),
+                       "records at its gaps (gaps = interpolate or split"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(test::FileExists(dir_ + "/g.json"));
@@ -214,7 +214,7 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"missing file", "fit %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
       {"missing mode", "fit %IN% -t rate_dph", 2, "--mode is required"},
       {"rate from time_s out of range", "fit %DIR%/microseconds.csv -t rate_dph --mode predict", 3,
-       "Hz outside [1e-09, 1e+06] Hz (seconds expected; or pass --rate-hz)"},
+       "Hz outside [1e-09, 1e+06] Hz (seconds expected; or give rate_hz)"},
       {"missing target", "fit %IN% --mode predict", 2, "--target is required"},
       {"unknown column", "fit %IN% -t gyro --mode predict", 2, "column 'gyro' not found"},
       {"unknown temperature", "fit %IN% -t rate_dph -T temp --mode compensate", 2,

@@ -326,7 +326,7 @@ TEST_F(FirmwareExport, RefusesWhatCannotRunInFirmware) {
   for (Method learner : {Method::kPoly, Method::kElm}) {
     ExpectThrows<UsageError>(
         [&] { RenderFirmwareC({Fit(log, Compensate(learner))}, {}); },
-        "learner on thermal features, not an identified thermal model: export takes --method "
+        "learner on thermal features, not an identified thermal model: export takes method "
         "thermal, ms-elm or emd-elm");
   }
   // A nonlinear correction (whichever network: the refusal looks at its presence only).

@@ -38,7 +38,7 @@ TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
   EXPECT_DOUBLE_EQ(t.Column("rate")[4], 5.0);
   EXPECT_DOUBLE_EQ(t.Column("rate")[7], 9.0);
   EXPECT_EQ(note, "note: time_s has 2 gaps (median step 1 s): 3 samples filled by linear "
-                  "interpolation (--gaps interpolate)");
+                  "interpolation (gaps = interpolate)");
   // A bad cell is still named by its row in the file.
   try {
     t.Column("status");
