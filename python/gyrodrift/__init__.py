@@ -30,11 +30,15 @@ __all__ = [
 def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, seed=1, threads=0,
               max_imfs=0, max_sifts=0, s_number=4, fixed_sifts=10, sd=0.2,
               noise_scaling="colominas2014", bound="energy", band=0.99, noise_stages=3,
-              noise_realisations=None):
+              noise_realisations=None, progress=None):
     """Splits a signal into IMFs and a residue (EMD, EEMD, CEEMDAN, ICEEMDAN, BEEMDAN).
 
     As ``gyrodrift decompose``; ``noise_realisations`` (an (N, I) array, one white-noise
     realisation per column) replaces ``--noise-file``. Results do not depend on ``threads``.
+    ``progress``: a callable given the fraction done (a float in [0, 1], not decreasing) as the
+    ensemble advances; it runs on a worker thread. Ctrl-C, or an exception the callable raises,
+    stops the call at its next report and is raised from it (plain EMD reports no progress and
+    stops only at its end).
 
     Returns ``(imfs, residue, report)``: imfs an (N, K) array, one IMF per column, so that
     ``imfs.sum(axis=1) + residue == x`` up to rounding; report a dict (summary, sifts_per_imf,
@@ -50,7 +54,7 @@ def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, s
         x, method=method, stop=stop, ensemble=ensemble, noise=noise, seed=seed, threads=threads,
         max_imfs=max_imfs, max_sifts=max_sifts, s_number=s_number, fixed_sifts=fixed_sifts,
         sd=sd, noise_scaling=noise_scaling, bound=bound, band=band, noise_stages=noise_stages,
-        noise_realisations=noise_realisations)
+        noise_realisations=noise_realisations, progress=progress)
 
 
 def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", confidence=0.683,
@@ -132,7 +136,7 @@ class DriftModel:
             decomposition="beemdan", lags=None, hidden="auto", rate_hz=1.0,
             thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
             threads=0, nonlinear=False, reference_temperature=None, target="rate_dph",
-            temperature_columns=None, source="python", record_starts=()):
+            temperature_columns=None, source="python", record_starts=(), progress=None):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
         Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
@@ -143,7 +147,8 @@ class DriftModel:
         Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
         one after the other with ``record_starts`` the first sample of each run after the first:
         the thermal model's lag states restart there (``fit A.csv B.csv``; method thermal in
-        compensate mode only). Returns self.
+        compensate mode only). ``progress``: a callable given the fraction of the fit done, as for
+        ``decompose`` (Ctrl-C stops the fit at its next report). Returns self.
         """
         self._core.fit(y, temperature, mode=mode, method=method, decomposition=decomposition,
                        lags=lags, hidden=hidden, rate_hz=rate_hz,
@@ -151,7 +156,7 @@ class DriftModel:
                        ensemble=ensemble, realisations=realisations, seed=seed, threads=threads,
                        nonlinear=nonlinear, reference_temperature=reference_temperature,
                        target=target, temperature_columns=temperature_columns, source=source,
-                       record_starts=list(record_starts))
+                       record_starts=list(record_starts), progress=progress)
         return self
 
     def estimate(self, temperature, *, record_starts=()):
@@ -166,11 +171,13 @@ class DriftModel:
         return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
     def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=512,
-                threads=0):
+                threads=0, progress=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
-        horizon-step-ahead predictions of y[first:], first being the model's history."""
+        horizon-step-ahead predictions of y[first:], first being the model's history.
+        ``progress``: a callable given the fraction of the causal windows decomposed, as for
+        ``decompose``."""
         return self._core.predict(y, temperature, horizon=horizon, protocol=protocol,
-                                  window=window, threads=threads)
+                                  window=window, threads=threads, progress=progress)
 
     def save(self, path):
         """Writes the model file ``gyrodrift fit`` writes (JSON, exact doubles, checksummed)."""

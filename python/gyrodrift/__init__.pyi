@@ -1,6 +1,6 @@
 # Type stub of the gyrodrift package (python/gyrodrift/__init__.py; docs/python.md).
 from os import PathLike
-from typing import Any, Literal, Sequence
+from typing import Any, Callable, Literal, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -23,6 +23,7 @@ def decompose(
     sd: float = ..., noise_scaling: Literal["colominas2014", "constant-snr"] = ...,
     bound: Literal["energy", "stages", "full"] = ..., band: float = ..., noise_stages: int = ...,
     noise_realisations: ArrayLike | None = ...,
+    progress: Callable[[float], object] | None = ...,
 ) -> tuple[Array, Array, dict[str, Any]]: ...
 
 def allan(
@@ -62,6 +63,7 @@ class DriftModel:
         reference_temperature: float | None = ..., target: str = ...,
         temperature_columns: Sequence[str] | None = ..., source: str = ...,
         record_starts: Sequence[int] = ...,
+        progress: Callable[[float], object] | None = ...,
     ) -> DriftModel: ...
     def estimate(
         self, temperature: ArrayLike, *, record_starts: Sequence[int] = ...
@@ -72,6 +74,7 @@ class DriftModel:
     def predict(
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *, horizon: int = ...,
         protocol: Literal["causal", "paper"] = ..., window: int = ..., threads: int = ...,
+        progress: Callable[[float], object] | None = ...,
     ) -> tuple[int, Array]: ...
     def save(self, path: str | PathLike[str]) -> None: ...
     @classmethod

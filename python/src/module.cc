@@ -4,7 +4,8 @@
 // The bindings only convert: numpy arrays to Eigen and back, keyword arguments to the library's
 // option structs (named as the CLI flags name them, `-` as `_`), results to dicts. Every number
 // comes from the same library calls the CLI makes, so the same inputs and options give the same
-// bits (python/tests/test_cli_parity.py). Long calls run without the GIL. Library errors become
+// bits (python/tests/test_cli_parity.py). Long calls run without the GIL, report progress to an
+// optional callable and stop at Ctrl-C (LongCall below). Library errors become
 // gyrodrift.UsageError (ValueError), DataError (ValueError) and FileError (OSError) with the
 // library's one-line message.
 #include <pybind11/eigen.h>
@@ -13,12 +14,19 @@
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -85,13 +93,103 @@ py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
   return a;
 }
 
+// ---- long calls: progress and Ctrl-C ---------------------------------------------------------
+
+// A long library call runs on a worker thread without the GIL, while the calling thread waits and
+// checks for Ctrl-C every 50 ms: Python runs signal handlers on the main thread only. The library
+// reports progress through its progress hooks (the decomposition per realisation and stage, the
+// fit per step, the causal prediction per window); each report calls the user's callable, with
+// the GIL, and once Ctrl-C was pressed or the callable raised, throws Cancelled instead. The
+// library carries that out of its worker threads to the call (ParallelOrderedReduce rethrows
+// the first exception; nothing half-done is kept), and the call raises the Python exception:
+// KeyboardInterrupt, or the callable's own. A call without progress reports (plain EMD, the
+// paper protocol) runs to its end, then raises.
+class LongCall {
+ public:
+  explicit LongCall(py::object progress) : progress_(std::move(progress)) {
+    if (!progress_.is_none() && !PyCallable_Check(progress_.ptr())) {
+      throw UsageError("progress: must be a callable taking the fraction done, or None");
+    }
+  }
+
+  // The library's progress hook.
+  std::function<void(double)> Hook() {
+    return [this](double fraction) { Report(fraction); };
+  }
+
+  // Runs work (library code only: it must not touch Python objects) to its end or its
+  // cancellation. Called with the GIL held; raises what cancelled it.
+  template <class Work>
+  void Run(Work&& work) {
+    std::exception_ptr failure;
+    {
+      py::gil_scoped_release release;
+      bool done = false;
+      std::mutex mutex;
+      std::condition_variable finished;
+      std::thread worker([&] {
+        try {
+          work();
+        } catch (...) {
+          failure = std::current_exception();
+        }
+        std::lock_guard<std::mutex> lock(mutex);
+        done = true;
+        finished.notify_one();
+      });
+      std::unique_lock<std::mutex> lock(mutex);
+      while (!finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
+        lock.unlock();
+        {
+          py::gil_scoped_acquire gil;
+          if (!cancel_ && PyErr_CheckSignals() != 0) {
+            error_.emplace();  // takes the KeyboardInterrupt the handler raised
+            cancel_ = true;
+          }
+        }
+        lock.lock();
+      }
+      lock.unlock();
+      worker.join();
+    }
+    if (error_) {  // Ctrl-C or the callable's exception, even when the work got to its end
+      py::error_already_set error = std::move(*error_);
+      error_.reset();
+      throw error;
+    }
+    if (failure) std::rethrow_exception(failure);
+  }
+
+ private:
+  struct Cancelled {};
+
+  void Report(double fraction) {
+    if (cancel_) throw Cancelled{};
+    if (progress_.is_none()) return;
+    py::gil_scoped_acquire gil;
+    if (cancel_) throw Cancelled{};
+    try {
+      progress_(fraction);
+    } catch (const py::error_already_set& e) {
+      error_.emplace(e);
+      cancel_ = true;
+      throw Cancelled{};
+    }
+  }
+
+  py::object progress_;  // None or a callable taking a float
+  std::atomic<bool> cancel_{false};
+  std::optional<py::error_already_set> error_;  // touched with the GIL only
+};
+
 // ---- decompose ------------------------------------------------------------------------------
 
 py::tuple Decompose(const Array& x_in, const std::string& method, const std::string& stop,
                     int ensemble, double noise, std::uint64_t seed, int threads, int max_imfs,
                     int max_sifts, int s_number, int fixed_sifts, double sd,
                     const std::string& noise_scaling, const std::string& bound, double band,
-                    int noise_stages, std::optional<Array> noise_realisations) {
+                    int noise_stages, std::optional<Array> noise_realisations,
+                    const py::object& progress) {
   // The same option mapping as `gyrodrift decompose` (apps/gyrodrift/decompose_command.cc).
   dec::DecompositionOptions o;
   o.method = dec::MethodFromString(method);
@@ -119,11 +217,10 @@ py::tuple Decompose(const Array& x_in, const std::string& method, const std::str
     o.supplied_noise = w;
     o.ensemble_size = static_cast<int>(w->cols());
   }
+  LongCall call(progress);
+  o.progress = call.Hook();
   dec::Decomposition d;
-  {
-    py::gil_scoped_release release;
-    d = dec::Decompose(x, o);
-  }
+  call.Run([&] { d = dec::Decompose(x, o); });
   const dec::DecompositionReport& r = d.report;
   py::dict report;
   report["summary"] = r.Summary();
@@ -401,7 +498,9 @@ class PyDriftModel {
            std::uint64_t seed, int threads, bool nonlinear,
            std::optional<double> reference_temperature, const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
-           const std::string& source, const std::vector<Eigen::Index>& record_starts) {
+           const std::string& source, const std::vector<Eigen::Index>& record_starts,
+           const py::object& progress) {
+    LongCall call(progress);
     drift::DriftOptions o;
     o.mode = drift::ModeFromString(mode);
     o.method = method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
@@ -491,10 +590,9 @@ class PyDriftModel {
       for (size_t c = 0; c < names.size(); ++c)
         loaded.info.temperature_column += (c ? "," : "") + names[c];
     }
-    {
-      py::gil_scoped_release release;
-      loaded.model = drift::FitDriftModel(y, temperature, o, record_starts);
-    }
+    const std::function<void(double)> report = call.Hook();
+    o.progress = [&report](double fraction, const std::string&) { report(fraction); };
+    call.Run([&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts); });
     loaded_ = std::move(loaded);
     fitted_ = true;
   }
@@ -545,8 +643,10 @@ class PyDriftModel {
 
   // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
-                    const std::string& protocol_name, int window, int threads) const {
+                    const std::string& protocol_name, int window, int threads,
+                    const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
+    LongCall call(progress);
     const drift::Protocol protocol = drift::ProtocolFromString(protocol_name);
     if (window < 16 || window > 1000000) {
       throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
@@ -567,11 +667,11 @@ class PyDriftModel {
     drift::CausalOptions causal;
     causal.window = window;
     causal.threads = threads;
+    causal.progress = call.Hook();
     Eigen::VectorXd prediction;
-    {
-      py::gil_scoped_release release;
+    call.Run([&] {
       prediction = drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal);
-    }
+    });
     return py::make_tuple(first, ToArray(prediction));
   }
 
@@ -756,7 +856,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
         arg("threads") = 0, arg("max_imfs") = 0, arg("max_sifts") = 0, arg("s_number") = 4,
         arg("fixed_sifts") = 10, arg("sd") = 0.2, arg("noise_scaling") = "colominas2014",
         arg("bound") = "energy", arg("band") = 0.99, arg("noise_stages") = 3,
-        arg("noise_realisations") = py::none());
+        arg("noise_realisations") = py::none(), arg("progress") = py::none());
   m.def("allan", &gp::Allan, arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = "rate",
         arg("dev") = "oadev", arg("taus") = "octave", arg("units") = "dph",
         arg("confidence") = 0.683, arg("threads") = 0, arg("fit_tau_min") = 0.0,
@@ -778,14 +878,15 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("ensemble") = 100, arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
            arg("nonlinear") = false, arg("reference_temperature") = py::none(),
            arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
-           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{})
+           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
+           arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"),
            py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal", arg("window") = 512,
-           arg("threads") = 0)
+           arg("threads") = 0, arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
