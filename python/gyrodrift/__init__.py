@@ -23,7 +23,7 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "noise_terms", "simulate",
+    "decompose", "evaluate", "noise_terms", "simulate",
 ]
 
 
@@ -224,6 +224,37 @@ class DriftModel:
 
     def __repr__(self):
         return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"
+
+
+def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
+             split=0.7, repeats=1, horizon=1, window=512, decomposition="beemdan", lags=None,
+             hidden="auto", rate_hz=1.0, thermal_features="auto", time_constants=(),
+             ensemble=100, realisations=100, seed=1, threads=0, nonlinear=False,
+             reference_temperature=None, progress=None):
+    """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
+    split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
+    paper and causal protocols (predict mode), against ``truth`` when given (else the output).
+
+    ``methods`` is "all" or a list (or comma-separated string) of method names; the model
+    keywords are ``DriftModel.fit``'s; ``progress`` as for ``decompose``. Returns a dict:
+    ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, train_s,
+    predict_s, the last repeat's ``estimate`` on the test block, model_summary, notes),
+    ``first_test_sample``, ``reference`` (what the rows were scored against), ``table`` (text).
+
+    >>> import gyrodrift as gd
+    >>> sim = gd.simulate(duration=7200, seed=3)
+    >>> r = gd.evaluate(sim["rate_dph"], truth=sim["truth"]["drift_dph"], methods=["poly"],
+    ...                 protocol="paper")
+    >>> r["rows"][0]["method"], r["first_test_sample"]
+    ('poly', 5040)
+    """
+    return _gyrodrift.evaluate(
+        y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,
+        repeats=repeats, horizon=horizon, window=window, decomposition=decomposition, lags=lags,
+        hidden=hidden, rate_hz=rate_hz, thermal_features=thermal_features,
+        time_constants=list(time_constants), ensemble=ensemble, realisations=realisations,
+        seed=seed, threads=threads, nonlinear=nonlinear,
+        reference_temperature=reference_temperature, progress=progress)
 
 
 def calibrate(manifest_path, output_dir, *, force=False, threads=0):

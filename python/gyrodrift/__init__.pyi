@@ -100,6 +100,20 @@ class DriftModel:
     @property
     def fitted(self) -> bool: ...
 
+def evaluate(
+    y: ArrayLike, temperature: ArrayLike | None = ..., truth: ArrayLike | None = ..., *,
+    mode: Literal["predict", "compensate"] = ...,
+    methods: Literal["all"] | str | Sequence[str] = ...,
+    protocol: Literal["both", "paper", "causal"] = ..., split: float = ..., repeats: int = ...,
+    horizon: int = ..., window: int = ..., decomposition: str = ...,
+    lags: int | Literal["auto"] | None = ..., hidden: int | Literal["auto"] = ...,
+    rate_hz: float = ..., thermal_features: Literal["auto", "ladder", "classic", "lag-bank"] = ...,
+    time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
+    seed: int = ..., threads: int = ..., nonlinear: bool = ...,
+    reference_temperature: float | None = ...,
+    progress: Callable[[float], object] | None = ...,
+) -> dict[str, Any]: ...
+
 def calibrate(
     manifest_path: str | PathLike[str], output_dir: str | PathLike[str], *, force: bool = ...,
     threads: int = ...,

@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -35,6 +36,7 @@
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/evaluation.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
 #include "gyrodrift/io/model_file.h"
@@ -483,14 +485,99 @@ std::vector<std::string> SplitColumns(const std::string& names) {
   }
 }
 
+// The model keywords of `DriftModel.fit` and `evaluate`, as `gyrodrift fit`'s flags.
+struct ModelArgs {
+  std::string mode, method, decomposition;
+  py::object lags, hidden;
+  double rate_hz = 1.0;
+  std::string thermal_features;
+  std::vector<double> time_constants;
+  int ensemble = 100, realisations = 100;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  bool nonlinear = false;
+  std::optional<double> reference_temperature;
+  bool has_temperature = false;
+};
+
+// The option mapping of `gyrodrift fit` (apps/gyrodrift/drift_cli.cc MakeDriftOptions and
+// fit_command.cc), with lags/hidden taking ints or "auto" and a given rate instead of time_s.
+drift::DriftOptions MakeDriftOptions(const ModelArgs& a) {
+  drift::DriftOptions o;
+  o.mode = drift::ModeFromString(a.mode);
+  o.method = a.method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
+                                                                      : drift::Method::kMsElm)
+                              : drift::MethodFromString(a.method);
+  o.decomposition.method = dec::MethodFromString(a.decomposition);
+  o.decomposition.ensemble_size = a.ensemble;
+  o.selection.monte_carlo.realisations = a.realisations;
+  o.seed = a.seed;
+  o.threads = a.threads;
+  const bool lags_given = !a.lags.is_none();
+  const int p = lags_given ? AutoOrInteger("lags", a.lags, 1, 256) : 4;
+  o.auto_lags = p < 0;
+  if (p > 0) o.features.lags = p;
+  const int h = AutoOrInteger("hidden", a.hidden, 1, 100000);
+  if (h > 0) {
+    const bool elm_based = o.method == drift::Method::kMsElm ||
+                           o.method == drift::Method::kEmdElm || o.method == drift::Method::kElm;
+    if (!elm_based) {
+      throw UsageError("hidden = " + std::to_string(h) +
+                       ": applies to the ELM methods (ms-elm, emd-elm, elm), not method " +
+                       std::string(drift::ToString(o.method)));
+    }
+    if (o.mode == drift::Mode::kCompensate && o.method != drift::Method::kElm && !a.nonlinear) {
+      throw UsageError("hidden = " + std::to_string(h) + ": compensate-mode " +
+                       std::string(drift::ToString(o.method)) +
+                       " fits linear sub-models; hidden applies to predict mode and to "
+                       "method 'elm'");
+    }
+    o.learner.elm.selection = elm::Selection::kFixed;
+    o.learner.elm.hidden_units = h;
+  }
+  if (o.mode == drift::Mode::kCompensate && lags_given) {
+    throw UsageError("lags: applies to mode 'predict' (a compensate-mode model sees "
+                     "temperature only)");
+  }
+  if (o.mode == drift::Mode::kCompensate && !a.has_temperature) {
+    throw UsageError("mode 'compensate' needs temperature (the compensation model runs on "
+                     "temperature alone)");
+  }
+  o.features.use_temperature = o.mode == drift::Mode::kPredict && a.has_temperature;
+  if (a.nonlinear) {
+    if (!drift::IdentifiesThermalModel(o)) {
+      throw UsageError("nonlinear applies to mode 'compensate' with method thermal, ms-elm or "
+                       "emd-elm");
+    }
+    o.linear_compensation = false;
+  }
+  if (a.reference_temperature) {
+    if (o.mode != drift::Mode::kCompensate) {
+      throw UsageError("reference_temperature applies to mode 'compensate'");
+    }
+    if (!(*a.reference_temperature >= -100.0 && *a.reference_temperature <= 200.0)) {
+      throw OptionError("reference_temperature", std::to_string(*a.reference_temperature),
+                        "in [-100, 200]");
+    }
+    o.reference_c = *a.reference_temperature;
+  }
+  o.features.rate_hz = a.rate_hz;
+  o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
+  if (!a.time_constants.empty()) {
+    o.features.time_constants_s = a.time_constants;
+    o.features.limit_time_constants = false;  // the user's constants, all of them
+  }
+  o.Validate();
+  return o;
+}
+
 // One axis of a model file: the fitted model and the column names it was fitted on.
 class PyDriftModel {
  public:
   PyDriftModel() = default;
   explicit PyDriftModel(io::LoadedModel loaded) : loaded_(std::move(loaded)), fitted_(true) {}
 
-  // The option mapping of `gyrodrift fit` (apps/gyrodrift/drift_cli.cc MakeDriftOptions and
-  // fit_command.cc), with lags/hidden taking ints or "auto" and a given rate instead of time_s.
+  // As `gyrodrift fit` (MakeDriftOptions above).
   void Fit(const Array& y_in, const std::optional<Array>& temperature_in, const std::string& mode,
            const std::string& method, const std::string& decomposition, const py::object& lags,
            const py::object& hidden, double rate_hz, const std::string& thermal_features,
@@ -501,71 +588,10 @@ class PyDriftModel {
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
            const py::object& progress) {
     LongCall call(progress);
-    drift::DriftOptions o;
-    o.mode = drift::ModeFromString(mode);
-    o.method = method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
-                                                                        : drift::Method::kMsElm)
-                                : drift::MethodFromString(method);
-    o.decomposition.method = dec::MethodFromString(decomposition);
-    o.decomposition.ensemble_size = ensemble;
-    o.selection.monte_carlo.realisations = realisations;
-    o.seed = seed;
-    o.threads = threads;
-    const bool lags_given = !lags.is_none();
-    const int p = lags_given ? AutoOrInteger("lags", lags, 1, 256) : 4;
-    o.auto_lags = p < 0;
-    if (p > 0) o.features.lags = p;
-    const int h = AutoOrInteger("hidden", hidden, 1, 100000);
-    if (h > 0) {
-      const bool elm_based = o.method == drift::Method::kMsElm ||
-                             o.method == drift::Method::kEmdElm || o.method == drift::Method::kElm;
-      if (!elm_based) {
-        throw UsageError("hidden = " + std::to_string(h) +
-                         ": applies to the ELM methods (ms-elm, emd-elm, elm), not method " +
-                         std::string(drift::ToString(o.method)));
-      }
-      if (o.mode == drift::Mode::kCompensate && o.method != drift::Method::kElm && !nonlinear) {
-        throw UsageError("hidden = " + std::to_string(h) + ": compensate-mode " +
-                         std::string(drift::ToString(o.method)) +
-                         " fits linear sub-models; hidden applies to predict mode and to "
-                         "method 'elm'");
-      }
-      o.learner.elm.selection = elm::Selection::kFixed;
-      o.learner.elm.hidden_units = h;
-    }
-    if (o.mode == drift::Mode::kCompensate && lags_given) {
-      throw UsageError("lags: applies to mode 'predict' (a compensate-mode model sees "
-                       "temperature only)");
-    }
-    if (o.mode == drift::Mode::kCompensate && !temperature_in) {
-      throw UsageError("mode 'compensate' needs temperature (the compensation model runs on "
-                       "temperature alone)");
-    }
-    o.features.use_temperature = o.mode == drift::Mode::kPredict && temperature_in.has_value();
-    if (nonlinear) {
-      if (!drift::IdentifiesThermalModel(o)) {
-        throw UsageError("nonlinear applies to mode 'compensate' with method thermal, ms-elm or "
-                         "emd-elm");
-      }
-      o.linear_compensation = false;
-    }
-    if (reference_temperature) {
-      if (o.mode != drift::Mode::kCompensate) {
-        throw UsageError("reference_temperature applies to mode 'compensate'");
-      }
-      if (!(*reference_temperature >= -100.0 && *reference_temperature <= 200.0)) {
-        throw OptionError("reference_temperature", std::to_string(*reference_temperature),
-                          "in [-100, 200]");
-      }
-      o.reference_c = *reference_temperature;
-    }
-    o.features.rate_hz = rate_hz;
-    o.features.thermal_set = drift::ThermalSetFromString(thermal_features);
-    if (!time_constants.empty()) {
-      o.features.time_constants_s = time_constants;
-      o.features.limit_time_constants = false;  // the user's constants, all of them
-    }
-    o.Validate();
+    drift::DriftOptions o = MakeDriftOptions(
+        {mode, method, decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
+         ensemble, realisations, seed, threads, nonlinear, reference_temperature,
+         temperature_in.has_value()});
 
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::MatrixXd temperature;
@@ -726,6 +752,98 @@ class PyDriftModel {
   io::LoadedModel loaded_;
   bool fitted_ = false;
 };
+
+// ---- evaluate -------------------------------------------------------------------------------
+
+std::vector<drift::Method> MethodList(const py::object& methods, drift::Mode mode) {
+  std::vector<std::string> names;
+  if (py::isinstance<py::str>(methods)) {
+    const std::string text = methods.cast<std::string>();
+    if (text == "all") return drift::AllMethods(mode);
+    names = SplitColumns(text);
+  } else {
+    names = methods.cast<std::vector<std::string>>();
+  }
+  std::vector<drift::Method> out;
+  for (const std::string& name : names) {
+    const drift::Method m = drift::MethodFromString(name);
+    if (std::find(out.begin(), out.end(), m) != out.end()) {
+      throw OptionError("methods", "'" + name + "' twice", "a list without repeats");
+    }
+    out.push_back(m);
+  }
+  if (out.empty()) throw OptionError("methods", "(empty)", "at least one method");
+  return out;
+}
+
+// As `gyrodrift evaluate`: the same options (the model's as for fit), the rows as dicts.
+py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
+                  const std::optional<Array>& truth_in, const std::string& mode,
+                  const py::object& methods, const std::string& protocol, double split,
+                  int repeats, int horizon, int window, const std::string& decomposition,
+                  const py::object& lags, const py::object& hidden, double rate_hz,
+                  const std::string& thermal_features, const std::vector<double>& time_constants,
+                  int ensemble, int realisations, std::uint64_t seed, int threads,
+                  bool nonlinear, std::optional<double> reference_temperature,
+                  const py::object& progress) {
+  LongCall call(progress);
+  const drift::DriftOptions base = MakeDriftOptions(
+      {mode, "ms-elm", decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
+       ensemble, realisations, seed, threads, nonlinear, reference_temperature,
+       temperature_in.has_value()});
+  drift::EvaluationOptions e;
+  e.split = split;
+  e.repeats = repeats;
+  e.methods = MethodList(methods, base.mode);
+  if (protocol == "both") {
+    e.protocols = {drift::Protocol::kPaper, drift::Protocol::kCausal};
+  } else if (protocol == "paper" || protocol == "causal") {
+    e.protocols = {drift::ProtocolFromString(protocol)};
+  } else {
+    throw OptionError("protocol", "'" + protocol + "'", "paper, causal or both");
+  }
+  e.causal.window = window;
+  e.causal.threads = threads;
+  e.horizon = horizon;
+  e.Validate();
+  const Eigen::VectorXd y = ToVector(y_in, "y");
+  Eigen::MatrixXd temperature;
+  if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
+  Eigen::VectorXd truth;
+  if (truth_in) truth = ToVector(*truth_in, "truth");
+  const std::function<void(double)> report = call.Hook();
+  e.progress = [&report](double fraction, const std::string&) { report(fraction); };
+  drift::EvaluationResult result;
+  call.Run([&] { result = drift::Evaluate(y, temperature, truth, base, e); });
+
+  py::list rows;
+  for (const drift::EvaluationRow& r : result.rows) {
+    py::dict row;
+    row["method"] = std::string(drift::ToString(r.method));
+    row["protocol"] = std::string(drift::ToString(r.protocol));
+    row["rmse"] = r.rmse;
+    row["rmse_std"] = r.rmse_std;
+    row["mae"] = r.mae;
+    row["max_abs"] = r.max_abs;
+    row["train_s"] = r.train_s;
+    row["predict_s"] = r.predict_s;
+    row["estimate"] = ToArray(r.estimate);
+    row["model_summary"] = r.model_summary;
+    row["notes"] = r.notes;
+    rows.append(row);
+  }
+  py::dict out;
+  out["mode"] = std::string(drift::ToString(result.mode));
+  out["first_test_sample"] = result.split_index;
+  out["against_truth"] = result.against_truth;
+  out["reference"] = ToArray(result.reference);
+  out["rows"] = rows;
+  out["training_temperature_range_c"] = py::make_tuple(result.training_temperature_min_c,
+                                                       result.training_temperature_max_c);
+  out["test_outside_training_temperature_share"] = result.test_outside_training_temperature_share;
+  out["table"] = result.Table();
+  return out;
+}
 
 // ---- fleet ----------------------------------------------------------------------------------
 
@@ -911,6 +1029,15 @@ PYBIND11_MODULE(_gyrodrift, m) {
                               d.Loaded().model.temperature_max_c);
       });
 
+  m.def("evaluate", &gp::Evaluate, arg("y"), arg("temperature") = py::none(),
+        arg("truth") = py::none(), py::kw_only(), arg("mode") = "predict", arg("methods") = "all",
+        arg("protocol") = "both", arg("split") = 0.7, arg("repeats") = 1, arg("horizon") = 1,
+        arg("window") = 512, arg("decomposition") = "beemdan", arg("lags") = py::none(),
+        arg("hidden") = "auto", arg("rate_hz") = 1.0, arg("thermal_features") = "auto",
+        arg("time_constants") = std::vector<double>{}, arg("ensemble") = 100,
+        arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
+        arg("nonlinear") = false, arg("reference_temperature") = py::none(),
+        arg("progress") = py::none());
   m.def("calibrate", &gp::Calibrate, arg("manifest_path"), arg("output_dir"), py::kw_only(),
         arg("force") = false, arg("threads") = 0);
   m.def("_calibrate_unit", &gp::CalibrateUnit, arg("manifest_path"), arg("index"),

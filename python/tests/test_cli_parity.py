@@ -1,5 +1,7 @@
 """The Python API and the CLI give the same numbers, to the bit, for the same inputs and options:
-simulate, decompose, allan, fit + compensate (and the model file itself)."""
+simulate, decompose, allan, fit + compensate (and the model file itself), evaluate."""
+
+import csv
 
 import numpy as np
 import pytest
@@ -137,3 +139,28 @@ def test_two_axis_model_file_matches_cli(cli, tmp_path):
     with pytest.raises(gd.UsageError, match="2 axes"):
         gd.DriftModel.load(tmp_path / "cli.json")
     assert gd.DriftModel.load(tmp_path / "cli.json", axis="gyro_y").summary == models[1].summary
+
+
+@pytest.mark.parametrize("mode,args,kwargs", [
+    ("predict", ["--methods", "ms-elm,poly", "--protocol", "both", "--window", "64",
+                 "--repeats", "2", "--ensemble", "10", "--realisations", "20"],
+     dict(methods=["ms-elm", "poly"], protocol="both", window=64, repeats=2, ensemble=10,
+          realisations=20)),
+    ("compensate", ["--methods", "thermal,poly", "--temperature", "temperature_c"],
+     dict(methods="thermal,poly")),
+])
+def test_evaluate_matches_cli(cli, sim_csv, tmp_path, mode, args, kwargs):
+    cli("evaluate", sim_csv, "--target", "rate_dph", "--truth", "drift_dph", "--mode", mode,
+        "--seed", "2", "-j", "2", "-q", *args, "-o", tmp_path / "eval.csv")
+    with open(tmp_path / "eval.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    log = read_csv(sim_csv)
+    temperature = log["temperature_c"] if mode == "compensate" else None
+    r = gd.evaluate(log["rate_dph"], temperature, log["drift_dph"], mode=mode, seed=2, threads=2,
+                    **kwargs)
+    assert len(r["rows"]) == len(table)
+    for row, cli_row in zip(r["rows"], table):
+        assert (row["method"], row["protocol"]) == (cli_row["method"], cli_row["protocol"])
+        for name in ("rmse", "rmse_std", "mae", "max_abs"):
+            assert row[name] == float(cli_row[name]), (row["method"], row["protocol"], name)
+    assert r["first_test_sample"] == round(0.7 * len(log["rate_dph"]))
