@@ -23,7 +23,7 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "noise_terms", "simulate",
+    "decompose", "evaluate", "noise_terms", "select_modes", "simulate",
 ]
 
 
@@ -224,6 +224,32 @@ class DriftModel:
 
     def __repr__(self):
         return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"
+
+
+def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisations=100,
+                 confidence=0.99, seed=1, band=0.99, threads=0):
+    """Groups a decomposition's IMFs into noise / mixed / drift, as MS-ELM does (docs/selection.md).
+
+    ``imfs`` (N, K) and ``residue`` (N) as ``decompose`` returns them; ``criterion`` "pdf" (the
+    PDF-similarity criterion, three groups), "komaty" or "energy" (two groups); ``distance`` l2,
+    l1, hellinger, jensen-shannon or bhattacharyya; ``realisations``, ``confidence`` and ``seed``
+    set the white-noise level's Monte-Carlo, ``band`` the energy band's confidence (0.95 or
+    0.99). Returns a dict: the curves per IMF (``pdf_distance`` D_k, ``self_distance`` G_k,
+    ``noise_level``, ``log2_energy``, ``energy_band_log2_upper``), the boundaries (``k_star``,
+    ``k_noise``, ``mixed_end``, ``energy_signal_start``), ``groups`` (kind, imfs, has_residue,
+    series) and ``summary``.
+
+    >>> import numpy as np, gyrodrift as gd
+    >>> t = np.arange(4096.0)
+    >>> x = np.random.default_rng(2).normal(size=t.size) + 3 * np.sin(t / 300)
+    >>> imfs, residue, _ = gd.decompose(x, method="emd")
+    >>> s = gd.select_modes(x, imfs, residue, realisations=20)
+    >>> [g["kind"] for g in s["groups"]][0]
+    'noise'
+    """
+    return _gyrodrift.select_modes(x, imfs, residue, criterion=criterion, distance=distance,
+                                   realisations=realisations, confidence=confidence, seed=seed,
+                                   band=band, threads=threads)
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",

@@ -100,6 +100,14 @@ class DriftModel:
     @property
     def fitted(self) -> bool: ...
 
+def select_modes(
+    x: ArrayLike, imfs: ArrayLike, residue: ArrayLike, *,
+    criterion: Literal["pdf", "komaty", "energy"] = ...,
+    distance: Literal["l2", "l1", "hellinger", "jensen-shannon", "bhattacharyya"] = ...,
+    realisations: int = ..., confidence: float = ..., seed: int = ..., band: float = ...,
+    threads: int = ...,
+) -> dict[str, Any]: ...
+
 def evaluate(
     y: ArrayLike, temperature: ArrayLike | None = ..., truth: ArrayLike | None = ..., *,
     mode: Literal["predict", "compensate"] = ...,

@@ -41,6 +41,7 @@
 #include "gyrodrift/fleet/manifest.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/io/report.h"
+#include "gyrodrift/selection/selection.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 
@@ -753,6 +754,65 @@ class PyDriftModel {
   bool fitted_ = false;
 };
 
+// ---- select_modes ---------------------------------------------------------------------------
+
+// The grouping MS-ELM makes of a decomposition (docs/selection.md), with every curve it decided
+// on: the selection result of the library, as a dict.
+py::dict SelectModesPy(const Array& x_in, const py::array_t<double, py::array::f_style |
+                                                                     py::array::forcecast>& imfs_in,
+                       const Array& residue_in, const std::string& criterion,
+                       const std::string& distance, int realisations, double confidence,
+                       std::uint64_t seed, double band, int threads) {
+  LongCall call{py::none()};  // no progress reports: the GIL's release, Ctrl-C at the end
+  selection::SelectionOptions o;
+  o.criterion = selection::CriterionFromString(criterion);
+  o.distance = selection::PdfDistanceFromString(distance);
+  o.monte_carlo.realisations = realisations;
+  o.monte_carlo.confidence = confidence;
+  o.monte_carlo.seed = seed;
+  o.monte_carlo.threads = threads;
+  o.band_confidence = band;
+  o.threads = threads;
+  o.Validate();
+  const Eigen::VectorXd x = ToVector(x_in, "x");
+  if (imfs_in.ndim() != 2) throw UsageError("imfs: must be an (N, K) array, one IMF per column");
+  const Eigen::MatrixXd imfs = Eigen::Map<const Eigen::MatrixXd>(imfs_in.data(), imfs_in.shape(0),
+                                                                 imfs_in.shape(1));
+  const Eigen::VectorXd residue = ToVector(residue_in, "residue");
+  selection::SelectionResult r;
+  call.Run([&] { r = selection::SelectModes(x, imfs, residue, o); });
+  py::list groups;
+  for (const selection::ModeGroup& g : r.groups) {
+    py::dict d;
+    d["kind"] = std::string(selection::ToString(g.kind));
+    d["imfs"] = g.imfs;
+    d["has_residue"] = g.has_residue;
+    d["series"] = ToArray(g.series);
+    groups.append(d);
+  }
+  py::dict out;
+  out["summary"] = r.Summary();
+  out["criterion"] = std::string(selection::ToString(r.criterion));
+  out["distance"] = std::string(selection::ToString(r.distance));
+  out["pdf_distance"] = r.pdf_distance;
+  out["self_distance"] = r.self_distance;
+  out["noise_level"] = r.noise_level;
+  out["log2_energy"] = r.log2_energy;
+  out["energy_band_log2_upper"] = r.energy_band_log2_upper;
+  out["k_star"] = r.k_star;
+  out["k_noise"] = r.k_noise;
+  out["mixed_end"] = r.mixed_end;
+  out["energy_signal_start"] = r.energy_signal_start;
+  out["groups"] = groups;
+  out["grid_points"] = r.grid_points;
+  out["grid_under_resolved"] = r.grid_under_resolved;
+  out["noise_level_realisations"] = r.noise_level_realisations;
+  out["noise_level_seed"] = r.noise_level_seed;
+  out["reconstruction_error"] = r.reconstruction_error;
+  out["note"] = r.note;
+  return out;
+}
+
 // ---- evaluate -------------------------------------------------------------------------------
 
 std::vector<drift::Method> MethodList(const py::object& methods, drift::Mode mode) {
@@ -1029,6 +1089,9 @@ PYBIND11_MODULE(_gyrodrift, m) {
                               d.Loaded().model.temperature_max_c);
       });
 
+  m.def("select_modes", &gp::SelectModesPy, arg("x"), arg("imfs"), arg("residue"), py::kw_only(),
+        arg("criterion") = "pdf", arg("distance") = "l2", arg("realisations") = 100,
+        arg("confidence") = 0.99, arg("seed") = 1, arg("band") = 0.99, arg("threads") = 0);
   m.def("evaluate", &gp::Evaluate, arg("y"), arg("temperature") = py::none(),
         arg("truth") = py::none(), py::kw_only(), arg("mode") = "predict", arg("methods") = "all",
         arg("protocol") = "both", arg("split") = 0.7, arg("repeats") = 1, arg("horizon") = 1,

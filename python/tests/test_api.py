@@ -103,3 +103,25 @@ def test_long_calls_release_the_gil():
         time.sleep(0.001)
     worker.join()
     assert done.is_set() and ticks > 10
+
+
+def test_select_modes_groups_a_decomposition_into_series_that_add_up():
+    rng = np.random.default_rng(5)
+    t = np.arange(8192.0)
+    slow = 2.0 * np.sin(2 * np.pi * t / 4000.0) + 1e-4 * t
+    x = rng.normal(size=t.size) + slow
+    imfs, residue, _ = gd.decompose(x, method="emd")
+    s = gd.select_modes(x, imfs, residue, realisations=20, seed=3)
+    kinds = [g["kind"] for g in s["groups"]]
+    assert kinds[0] == "noise" and kinds[-1] == "drift"
+    total = sum(g["series"] for g in s["groups"])
+    np.testing.assert_allclose(total, imfs.sum(axis=1) + residue, atol=1e-12 * np.abs(x).max())
+    # The noise group holds the white noise, the drift group the slow part.
+    noise = s["groups"][0]["series"]
+    drift = s["groups"][-1]["series"]
+    assert abs(np.std(noise) - 1.0) < 0.15
+    assert np.sqrt(np.mean((drift - slow) ** 2)) < 0.5 * np.std(slow)
+    assert len(s["pdf_distance"]) == imfs.shape[1] == len(s["self_distance"])
+    assert s["noise_level_seed"] == 3 and "noise{" in s["summary"]
+    with pytest.raises(gd.UsageError, match="criterion"):
+        gd.select_modes(x, imfs, residue, criterion="nope")
