@@ -13,12 +13,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <signal.h>
+
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -26,7 +27,6 @@
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -98,15 +98,71 @@ py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
 
 // ---- long calls: progress and Ctrl-C ---------------------------------------------------------
 
-// A long library call runs on a worker thread without the GIL, while the calling thread waits and
-// checks for Ctrl-C every 50 ms: Python runs signal handlers on the main thread only. The library
-// reports progress through its progress hooks (the decomposition per realisation and stage, the
-// fit per step, the causal prediction per window); each report calls the user's callable, with
-// the GIL, and once Ctrl-C was pressed or the callable raised, throws Cancelled instead. The
-// library carries that out of its worker threads to the call (ParallelOrderedReduce rethrows
-// the first exception; nothing half-done is kept), and the call raises the Python exception:
-// KeyboardInterrupt, or the callable's own. A call without progress reports (plain EMD, the
-// paper protocol) runs to its end, then raises.
+// Ctrl-C during a long call. Python runs its SIGINT handler's work on the main thread only, between
+// bytecodes, which a call inside the library never reaches. So while any long call runs, SIGINT
+// first goes to InterruptHandler: it counts the interrupt, which every running call's progress
+// hook sees, and hands the signal on to the handler it replaced (Python's, which marks the
+// KeyboardInterrupt pending as usual). The last call to end puts that handler back.
+std::atomic<unsigned> g_interrupts{0};
+std::mutex g_sigint_mutex;
+int g_running_calls = 0;            // guarded by g_sigint_mutex
+bool g_handler_installed = false;   // guarded by g_sigint_mutex
+struct sigaction g_replaced_sigint;  // written before ours is installed, read by it
+
+extern "C" void InterruptHandler(int signal, siginfo_t* info, void* context) {
+  g_interrupts.fetch_add(1, std::memory_order_relaxed);
+  if (g_replaced_sigint.sa_flags & SA_SIGINFO) {
+    g_replaced_sigint.sa_sigaction(signal, info, context);
+  } else {
+    g_replaced_sigint.sa_handler(signal);
+  }
+}
+
+class InterruptWatch {
+ public:
+  InterruptWatch() {
+    std::lock_guard<std::mutex> lock(g_sigint_mutex);
+    if (g_running_calls++ == 0) {
+      struct sigaction current;
+      ::sigaction(SIGINT, nullptr, &current);
+      // Only a handler function is wrapped: under SIG_DFL or SIG_IGN (Python not handling
+      // SIGINT) Ctrl-C keeps its usual effect.
+      const bool function = (current.sa_flags & SA_SIGINFO) ||
+                            (current.sa_handler != SIG_DFL && current.sa_handler != SIG_IGN);
+      if (function) {
+        g_replaced_sigint = current;
+        struct sigaction ours = current;
+        ours.sa_flags |= SA_SIGINFO;
+        ours.sa_sigaction = InterruptHandler;
+        g_handler_installed = ::sigaction(SIGINT, &ours, nullptr) == 0;
+      }
+    }
+    start_ = g_interrupts.load(std::memory_order_relaxed);
+  }
+  ~InterruptWatch() {
+    std::lock_guard<std::mutex> lock(g_sigint_mutex);
+    if (--g_running_calls == 0 && g_handler_installed) {
+      ::sigaction(SIGINT, &g_replaced_sigint, nullptr);
+      g_handler_installed = false;
+    }
+  }
+  InterruptWatch(const InterruptWatch&) = delete;
+  InterruptWatch& operator=(const InterruptWatch&) = delete;
+
+  bool Interrupted() const { return g_interrupts.load(std::memory_order_relaxed) != start_; }
+
+ private:
+  unsigned start_ = 0;
+};
+
+// A long library call: runs without the GIL on the calling thread, reports progress to the
+// user's callable (with the GIL) and stops at Ctrl-C or at an exception the callable raises. The
+// library reports progress through its hooks (the decomposition per realisation and stage, the
+// fit per step, the causal prediction per window); once stopped, the next report throws
+// Cancelled, which the library carries out of its worker threads to the call
+// (ParallelOrderedReduce rethrows the first exception; nothing half-done is kept), and the call
+// raises KeyboardInterrupt or the callable's exception. A call without progress reports (plain
+// EMD, the paper protocol) runs to its end, then raises.
 class LongCall {
  public:
   explicit LongCall(py::object progress) : progress_(std::move(progress)) {
@@ -121,44 +177,35 @@ class LongCall {
   }
 
   // Runs work (library code only: it must not touch Python objects) to its end or its
-  // cancellation. Called with the GIL held; raises what cancelled it.
+  // cancellation. Called with the GIL held; raises what stopped it.
   template <class Work>
   void Run(Work&& work) {
     std::exception_ptr failure;
+    bool interrupted = false;
     {
-      py::gil_scoped_release release;
-      bool done = false;
-      std::mutex mutex;
-      std::condition_variable finished;
-      std::thread worker([&] {
+      InterruptWatch watch;
+      watch_ = &watch;
+      {
+        py::gil_scoped_release release;
         try {
           work();
         } catch (...) {
           failure = std::current_exception();
         }
-        std::lock_guard<std::mutex> lock(mutex);
-        done = true;
-        finished.notify_one();
-      });
-      std::unique_lock<std::mutex> lock(mutex);
-      while (!finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
-        lock.unlock();
-        {
-          py::gil_scoped_acquire gil;
-          if (!cancel_ && PyErr_CheckSignals() != 0) {
-            error_.emplace();  // takes the KeyboardInterrupt the handler raised
-            cancel_ = true;
-          }
-        }
-        lock.lock();
       }
-      lock.unlock();
-      worker.join();
+      interrupted = watch.Interrupted();
+      watch_ = nullptr;
     }
-    if (error_) {  // Ctrl-C or the callable's exception, even when the work got to its end
+    if (error_) {  // the callable's exception, even when the work got to its end
       py::error_already_set error = std::move(*error_);
       error_.reset();
       throw error;
+    }
+    if (interrupted) {
+      // On the main thread Python's own handler raises the pending KeyboardInterrupt here;
+      // elsewhere the call raises it.
+      if (PyErr_CheckSignals() == 0) PyErr_SetNone(PyExc_KeyboardInterrupt);
+      throw py::error_already_set();
     }
     if (failure) std::rethrow_exception(failure);
   }
@@ -167,7 +214,7 @@ class LongCall {
   struct Cancelled {};
 
   void Report(double fraction) {
-    if (cancel_) throw Cancelled{};
+    if (cancel_ || (watch_ != nullptr && watch_->Interrupted())) throw Cancelled{};
     if (progress_.is_none()) return;
     py::gil_scoped_acquire gil;
     if (cancel_) throw Cancelled{};
@@ -181,6 +228,7 @@ class LongCall {
   }
 
   py::object progress_;  // None or a callable taking a float
+  const InterruptWatch* watch_ = nullptr;
   std::atomic<bool> cancel_{false};
   std::optional<py::error_already_set> error_;  // touched with the GIL only
 };
