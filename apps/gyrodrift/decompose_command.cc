@@ -149,6 +149,7 @@ void Run(const DecomposeArgs& a) {
       {"sift_cap_hits", d.report.sift_cap_hits},
       {"ensemble_size", d.report.ensemble_size},
       {"seed", d.report.seed},
+      {"threads_used", d.report.threads},
       {"supplied_noise", d.report.supplied_noise},
       {"noise_assisted_stages", d.report.noise_assisted_stages},
       {"stop_reason", d.report.stop_reason},

@@ -282,6 +282,7 @@ py::tuple Decompose(const Array& x_in, const std::string& method, const std::str
   report["sift_cap_hits"] = r.sift_cap_hits;
   report["ensemble_size"] = r.ensemble_size;
   report["seed"] = r.seed;
+  report["threads_used"] = r.threads;
   report["supplied_noise"] = r.supplied_noise;
   report["noise_assisted_stages"] = r.noise_assisted_stages;
   report["stop_reason"] = r.stop_reason;

@@ -20,7 +20,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report = EnsembleReport(Method::kCeemdan, o);
+  DecompositionReport report = EnsembleReport(Method::kCeemdan, o, workers);
   const double inv = 1.0 / ensemble;
 
   std::vector<Eigen::VectorXd> modes;

@@ -51,7 +51,7 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
         mean_residue += m.residue * inv;
       });
 
-  DecompositionReport report = EnsembleReport(Method::kEemd, o);
+  DecompositionReport report = EnsembleReport(Method::kEemd, o, workers);
   for (const auto& s : stats) s.Report(report, ensemble);
   report.stop_reason =
       "fixed IMF count " + std::to_string(max_imfs) + " (EEMD aligns every member's modes)";

@@ -23,7 +23,7 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
   const Eigen::VectorXd xn = x / sx;
   auto workers = MakeWorkers(ensemble, o, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report = EnsembleReport(o.method, o);
+  DecompositionReport report = EnsembleReport(o.method, o, workers);
   const double nr = static_cast<double>(ensemble);
 
   std::vector<Eigen::VectorXd> modes;

@@ -29,9 +29,11 @@ bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseRows& modes, Sifter
   return true;
 }
 
-DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o) {
+DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o,
+                                   const std::vector<Worker>& workers) {
   DecompositionReport report;
   report.method = method;
+  report.threads = static_cast<int>(workers.size());
   report.ensemble_size = EnsembleSize(o);
   report.seed = o.seed;
   report.supplied_noise = static_cast<bool>(o.supplied_noise);

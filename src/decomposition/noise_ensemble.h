@@ -75,8 +75,10 @@ struct Worker {
   Eigen::VectorXd noise, input, imf;
 };
 
-// A report of `method` with the ensemble's size, seed and whether its noise was supplied.
-DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o);
+// A report of `method` with the ensemble's size, seed, whether its noise was supplied and the
+// worker threads used.
+DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o,
+                                   const std::vector<Worker>& workers);
 
 // The stage-wise methods' end before a stage: the IMF cap reached, or (when check_extrema) a
 // residue with fewer than 3 extrema. Sets report.stop_reason and returns true when it is the end.

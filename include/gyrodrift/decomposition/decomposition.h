@@ -127,6 +127,9 @@ struct DecompositionReport {
   int sift_cap_hits = 0;           // total number of one-mode extractions that hit the cap
   int ensemble_size = 0;           // 0 for plain EMD
   std::uint64_t seed = 0;
+  // Worker threads used (options.threads is the number asked for, 0 = every core; an ensemble
+  // uses no more than its realisations). Not in Summary(): it never changes a result.
+  int threads = 1;
   bool supplied_noise = false;
   int noise_assisted_stages = 0;  // CEEMDAN family: stages run with noise
   std::string stop_reason;        // why the decomposition (or BEEMDAN's noise assistance) ended
