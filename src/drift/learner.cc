@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "common/enum_names.h"
-#include "drift/learner_internal.h"
+#include "drift/learner_kinds.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <utility>
 
-#include "drift/learner_internal.h"
+#include "drift/learner_kinds.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/elm/elm.h"
 

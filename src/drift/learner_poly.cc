@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "drift/learner_internal.h"
+#include "drift/learner_kinds.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 

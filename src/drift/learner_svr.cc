@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "drift/learner_internal.h"
+#include "drift/learner_kinds.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
 

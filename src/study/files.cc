@@ -13,7 +13,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
-#include "study_internal.h"
+#include "study_steps.h"
 
 namespace gyrodrift::study {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "gyrodrift/simulation/gyro_noise.h"
 #include "gyrodrift/study/files.h"
-#include "study_internal.h"
+#include "study_steps.h"
 
 namespace gyrodrift::study {
 namespace {

@@ -13,7 +13,7 @@
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/simulation/temperature_programme.h"
-#include "study_internal.h"
+#include "study_steps.h"
 
 namespace gyrodrift::study {
 

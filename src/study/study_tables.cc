@@ -5,7 +5,7 @@
 #include <string>
 
 #include "gyrodrift/simulation/gyro_noise.h"
-#include "study_internal.h"
+#include "study_steps.h"
 
 namespace gyrodrift::study::internal {
 
