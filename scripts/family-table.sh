@@ -5,8 +5,10 @@
 # generate the units. Usage: scripts/family-table.sh [FIRST LAST [HOURS [METHODS]]]
 #   FIRST LAST  units (default 1 20); HOURS calibration length (default 16)
 #   METHODS     comma-separated fit methods (default thermal,poly; ms-elm takes about 8 s a unit)
+# FIT_ARGS adds fit options to the identified methods (thermal, ms-elm, emd-elm), for example
+# FIT_ARGS="--hysteresis off" (docs/drift.md 4.7); WORK keeps the generated units between runs.
 set -euo pipefail
-first=${1:-1}; last=${2:-20}; hours=${3:-16}; methods=${4:-thermal,poly}
+first=${1:-1}; last=${2:-20}; hours=${3:-16}; methods=${4:-thermal,poly}; fit_args=${FIT_ARGS:-}
 top=$(cd "$(dirname "$0")/.." && pwd)
 B=${GYRODRIFT:-$top/build/apps/gyrodrift/gyrodrift}
 G=$top/../shared/testdata/gyro_thermal_family/generate.py
@@ -28,7 +30,11 @@ for u in $(seq "$first" "$last"); do
   fi
   printf "%s" "$u"
   for m in ${methods//,/ }; do
-    "$B" fit "$train" -t rate_dph -T temperature_c --mode compensate -m "$m" -q -o "$work/m_${u}_$m.json"
+    extra=""
+    case $m in thermal|ms-elm|emd-elm) extra=$fit_args ;; esac
+    # shellcheck disable=SC2086
+    "$B" fit "$train" -t rate_dph -T temperature_c --mode compensate -m "$m" $extra -q \
+      -o "$work/m_${u}_$m.json"
     removed=$("$B" compensate "$work/m_${u}_$m.json" "$test" --truth drift_dph -o "$work/c_${u}_$m.csv" \
       | sed -n 's/.*(\(-*[0-9.]*\) % removed).*/\1/p')
     printf ",%s" "$removed"

@@ -81,7 +81,31 @@ nlohmann::json SidecarHeader(const std::string& command) {
 
 bool IsTerminal() { return ::isatty(STDERR_FILENO) != 0; }
 
+namespace {
+
+// Every binding of BindSetting: a name and the flag that sets it.
+std::vector<std::pair<std::string, const CLI::Option*>>& Bindings() {
+  static std::vector<std::pair<std::string, const CLI::Option*>> bindings;
+  return bindings;
+}
+
+}  // namespace
+
+CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_view> names) {
+  for (std::string_view name : names) Bindings().emplace_back(name, flag);
+  return flag;
+}
+
 std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
+  // Only a flag the user gave: a value the command derived (a rate read from time_s, a duration
+  // from a profile file) keeps the library's name rather than blaming a flag nobody typed.
+  for (const auto& [name, flag] : Bindings()) {
+    if (name == error.option() && flag->count() > 0) {
+      const std::string shown = flag->get_lnames().empty() ? "-" + flag->get_snames().front()
+                                                            : "--" + flag->get_lnames().front();
+      return shown + " = " + error.value() + ": must be " + error.rule();
+    }
+  }
   // Library field -> the flags that may set it, the first one the subcommand has wins.
   static const std::map<std::string, std::vector<std::string>, std::less<>> kFlags = {
       {"band_confidence", {"--band"}},

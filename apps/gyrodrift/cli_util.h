@@ -71,8 +71,14 @@ io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* n
                      std::vector<Eigen::Index>* record_starts = nullptr,
                      const std::vector<std::string>& columns = {});
 
-// The one-line message for an option error: the library names its field (`ensemble_size = 0:
-// must be ...`); when the user gave the subcommand's flag that sets that field, the message
+// Binds `flag` to the names under which the library refers to what it sets (a
+// drift::FitSettings setting such as "lags", an options field such as "ensemble_size"), where
+// the flag is declared: an OptionError naming one of them is then reported with the flag.
+// Returns `flag`.
+CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_view> names);
+
+// The one-line message for an option error: the library names its field or setting
+// (`ensemble_size = 0: must be ...`); when the user gave a flag bound to that name, the message
 // names the flag instead (`--ensemble = 0: must be ...`).
 std::string OptionErrorMessage(const CLI::App& app, const OptionError& error);
 

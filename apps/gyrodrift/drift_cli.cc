@@ -3,7 +3,6 @@
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -14,19 +13,6 @@
 
 namespace gyrodrift::cli {
 namespace {
-
-// "auto" or an integer in [lo, hi]; -1 for auto.
-int AutoOrInteger(const std::string& option, const std::string& text, int lo, int hi) {
-  if (text == "auto") return -1;
-  int value = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
-  if (text.empty() || ec != std::errc() || ptr != end || value < lo || value > hi) {
-    ThrowOption(option, "'" + text + "'",
-                "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  return value;
-}
 
 std::string Columns(const io::CsvTable& table) {
   std::string names;
@@ -58,107 +44,103 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
                   "temperature column(s), degC, comma-separated (needed by --mode compensate, "
                   "where the thermal, ms-elm and emd-elm methods take several; in predict mode "
                   "one column adds the thermal history to the lags)");
-  a->reference_option = cmd->add_option(
-      "--reference-temperature", a->reference_c,
-      "compensate mode: reference the estimate to thermal equilibrium at this temperature, degC "
-      "(for a bias calibrated separately); default: keep the fitted intercept, the unit's "
-      "repeatable bias");
-  cmd->add_flag("--nonlinear", a->nonlinear,
-                "compensate mode, identified methods: each thermal model may add a sigmoid ELM "
-                "of its regressors, kept only where the blocked cross-validation says it helps");
-  cmd->add_option(
-         "--mode", a->mode,
-         "predict (one-step-ahead from past samples) | compensate (drift from temperature)")
-      ->required();
-  cmd->add_option("--decomposition", a->decomposition, "beemdan|iceemdan|ceemdan|eemd|emd")
-      ->capture_default_str();
-  a->lags_option =
+  a->reference_option = BindSetting(
+      cmd->add_option(
+          "--reference-temperature", a->reference_c,
+          "compensate mode: reference the estimate to thermal equilibrium at this temperature, "
+          "degC (for a bias calibrated separately); default: keep the fitted intercept, the "
+          "unit's repeatable bias"),
+      {"reference_temperature"});
+  BindSetting(cmd->add_flag("--nonlinear", a->nonlinear,
+                            "compensate mode, identified methods: each thermal model may add a "
+                            "sigmoid ELM of its regressors, kept only where the blocked "
+                            "cross-validation says it helps"),
+              {"nonlinear"});
+  BindSetting(cmd->add_option("--hysteresis", a->hysteresis,
+                              "compensate mode, identified methods: the thermal models' "
+                              "hysteresis term (a bias that differs between heating and "
+                              "cooling), auto (tried on calibrations of 12 h or more) | on | off; "
+                              "docs/drift.md 4.7")
+                  ->capture_default_str(),
+              {"hysteresis"});
+  BindSetting(cmd->add_option("--mode", a->mode,
+                              "predict (one-step-ahead from past samples) | compensate (drift "
+                              "from temperature)")
+                  ->required(),
+              {"mode"});
+  BindSetting(cmd->add_option("--decomposition", a->decomposition,
+                              "beemdan|iceemdan|ceemdan|eemd|emd")
+                  ->capture_default_str(),
+              {"decomposition"});
+  a->lags_option = BindSetting(
       cmd->add_option("--lags,-p", a->lags,
-                      "own lags per sub-model: auto (chosen on the last 20% of the training record "
-                      "among 1,2,4,8,16) or p in [1,256] (predict mode)")
-          ->capture_default_str();
-  a->hidden_option =
+                      "own lags per sub-model: auto (chosen on the last 20% of the training "
+                      "record among 1,2,4,8,16) or p in [1,256] (predict mode)")
+          ->capture_default_str(),
+      {"lags"});
+  a->hidden_option = BindSetting(
       cmd->add_option("--hidden", a->hidden,
-                      "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed L")
-          ->capture_default_str();
-  a->rate_option = cmd->add_option("--rate-hz", a->rate_hz,
-                                   "sample rate, Hz (default: from the median step of a time_s "
-                                   "column, else 1)");
-  cmd->add_option("--thermal-features", a->thermal_features,
-                  "temperature inputs: auto (classic for poly, ladder otherwise) | ladder (rungs "
-                  "between first-order lags of T, the slowest lag, (T - 20)^2) | classic (T and "
-                  "its smoothed rate) | lag-bank (T, each lag and its rate); docs/drift.md 1.1")
-      ->capture_default_str();
-  cmd->add_option("--time-constants", a->time_constants_s,
-                  "time constants of the thermal lags, seconds, comma-separated (default "
-                  "60,300,900,1800,3600)")
-      ->delimiter(',');
-  cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
-      ->capture_default_str();
-  cmd->add_option("--realisations", a->realisations,
-                  "white-noise realisations of the ms-elm grouping's Monte-Carlo level, >= 20")
-      ->capture_default_str();
+                      "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed "
+                      "L")
+          ->capture_default_str(),
+      {"hidden"});
+  a->rate_option = BindSetting(cmd->add_option("--rate-hz", a->rate_hz,
+                                               "sample rate, Hz (default: from the median step "
+                                               "of a time_s column, else 1)"),
+                               {"rate_hz"});
+  BindSetting(cmd->add_option("--thermal-features", a->thermal_features,
+                              "temperature inputs: auto (classic for poly, ladder otherwise) | "
+                              "ladder (rungs between first-order lags of T, the slowest lag, "
+                              "(T - 20)^2) | classic (T and its smoothed rate) | lag-bank (T, "
+                              "each lag and its rate); docs/drift.md 1.1")
+                  ->capture_default_str(),
+              {"thermal_features"});
+  BindSetting(cmd->add_option("--time-constants", a->time_constants_s,
+                              "time constants of the thermal lags, seconds, comma-separated "
+                              "(default 60,300,900,1800,3600)")
+                  ->delimiter(','),
+              {"time_constants"});
+  BindSetting(
+      cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
+          ->capture_default_str(),
+      {"ensemble"});
+  BindSetting(cmd->add_option("--realisations", a->realisations,
+                              "white-noise realisations of the ms-elm grouping's Monte-Carlo "
+                              "level, >= 20")
+                  ->capture_default_str(),
+              {"realisations"});
   cmd->add_option("--seed", a->seed, "seed of the decomposition and the learners")
       ->check(kSeed)
       ->capture_default_str();
-  cmd->add_option("--threads,-j", a->threads,
-                  "worker threads (0 = all cores); results do not "
-                  "depend on it")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--threads,-j", a->threads,
+                              "worker threads (0 = all cores); results do not depend on it")
+                  ->capture_default_str(),
+              {"threads"});
   AddLogOptions(cmd, &a->log, split_records);
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 
-drift::DriftOptions MakeDriftOptions(const DriftArgs& a, drift::Method method) {
-  drift::DriftOptions o;
-  o.mode = drift::ModeFromString(a.mode);
-  o.method = method;
-  o.decomposition.method = decomposition::MethodFromString(a.decomposition);
-  o.decomposition.ensemble_size = a.ensemble;
-  o.selection.monte_carlo.realisations = a.realisations;
-  o.seed = a.seed;
-  o.threads = a.threads;
-  const int p = AutoOrInteger("--lags", a.lags, 1, 256);
-  o.auto_lags = p < 0;
-  if (p > 0) o.features.lags = p;
-  const int hidden = AutoOrInteger("--hidden", a.hidden, 1, 100000);
-  if (hidden > 0) {
-    o.learner.elm.selection = elm::Selection::kFixed;
-    o.learner.elm.hidden_units = hidden;
-  }
-  if (o.mode == drift::Mode::kCompensate && a.lags_option != nullptr &&
-      a.lags_option->count() > 0) {
-    throw UsageError("--lags = " + a.lags +
-                     ": applies to --mode predict (a compensate-mode model sees temperature only)");
-  }
-  if (o.mode == drift::Mode::kCompensate && a.temperature.empty()) {
-    throw UsageError(
-        "--mode compensate needs --temperature COL (the compensation model runs on temperature "
-        "alone)");
-  }
-  o.features.use_temperature = o.mode == drift::Mode::kPredict && !a.temperature.empty();
-  if (a.nonlinear) {
-    if (!drift::IdentifiesThermalModel(o)) {
-      throw UsageError(
-          "--nonlinear applies to --mode compensate with --method thermal, ms-elm or emd-elm");
-    }
-    o.linear_compensation = false;
-  }
+drift::FitSettings Settings(const DriftArgs& a, const std::string& method) {
+  drift::FitSettings s;
+  s.mode = a.mode;
+  s.method = method;
+  s.decomposition = a.decomposition;
+  if (a.lags_option != nullptr && a.lags_option->count() > 0) s.lags = a.lags;
+  if (a.hidden_option != nullptr && a.hidden_option->count() > 0) s.hidden = a.hidden;
+  if (a.rate_option != nullptr && a.rate_option->count() > 0) s.rate_hz = a.rate_hz;
+  s.thermal_features = a.thermal_features;
+  s.time_constants = a.time_constants_s;
+  s.ensemble = a.ensemble;
+  s.realisations = a.realisations;
+  s.seed = a.seed;
+  s.threads = a.threads;
+  s.nonlinear = a.nonlinear;
   if (a.reference_option != nullptr && a.reference_option->count() > 0) {
-    if (o.mode != drift::Mode::kCompensate) {
-      throw UsageError("--reference-temperature applies to --mode compensate");
-    }
-    RequireInRange("--reference-temperature", a.reference_c, -100.0, 200.0);
-    o.reference_c = a.reference_c;
+    s.reference_temperature = a.reference_c;
   }
-  if (a.rate_option != nullptr && a.rate_option->count() > 0) o.features.rate_hz = a.rate_hz;
-  o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
-  if (!a.time_constants_s.empty()) {
-    o.features.time_constants_s = a.time_constants_s;
-    o.features.limit_time_constants = false;  // the user's constants, all of them
-  }
-  o.Validate();
-  return o;
+  s.hysteresis = a.hysteresis;
+  s.has_temperature = !a.temperature.empty();
+  return s;
 }
 
 double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string* how) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
 #include "cli_util.h"
@@ -24,6 +25,7 @@ struct DriftArgs {
   std::string temperature;  // "" = none; several columns comma-separated
   double reference_c = 0.0;
   bool nonlinear = false;  // --nonlinear: identified sub-models may add a nonlinear correction
+  std::string hysteresis = "auto";  // --hysteresis: drift::HysteresisTerm name
   CLI::Option* reference_option = nullptr;  // "--reference-temperature given"
   std::string mode;
   std::string decomposition = "beemdan";
@@ -44,14 +46,15 @@ struct DriftArgs {
 };
 
 // Adds the input(s) (several with `split_records`: fit's calibration logs, and --gaps split),
-// --target, --temperature, --mode, --decomposition, --lags, --hidden, --rate-hz,
-// --thermal-features, --time-constants, --ensemble, --realisations, --seed, --threads and
-// --quiet to cmd.
+// --target, --temperature, --reference-temperature, --nonlinear, --hysteresis, --mode,
+// --decomposition, --lags, --hidden, --rate-hz, --thermal-features, --time-constants,
+// --ensemble, --realisations, --seed, --threads, --gaps, --delimiter and --quiet to cmd, each
+// flag bound to its drift::FitSettings setting.
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
-// DriftOptions from the arguments (method = `method`), before any file is read; the sample rate
-// is settled later by ResolveRateHz. Throws UsageError naming the option.
-drift::DriftOptions MakeDriftOptions(const DriftArgs& args, drift::Method method);
+// The settings of the arguments with `method` ("auto" or a method name), before any file is
+// read (drift::MakeDriftOptions maps them; the sample rate is settled later by ResolveRateHz).
+drift::FitSettings Settings(const DriftArgs& args, const std::string& method);
 
 // --rate-hz if given; else 1 / (median step of a `time_s` column) if the file has one; else 1.
 // `how` receives "given", "time_s" or "default". Throws DataError on a time_s column whose

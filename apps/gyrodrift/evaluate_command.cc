@@ -52,7 +52,7 @@ std::string TableCsv(const drift::EvaluationResult& result) {
 
 void Run(const EvaluateArgs& a) {
   RequireOutputsAreNotInputs(a.inputs, {a.output, SidecarPath(a.output)});
-  drift::DriftOptions base = MakeDriftOptions(a, drift::Method::kMsElm);
+  drift::DriftOptions base = drift::MakeDriftOptions(Settings(a, "ms-elm"));
   drift::EvaluationOptions e;
   e.split = a.split;
   e.repeats = a.repeats;

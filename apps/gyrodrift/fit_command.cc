@@ -68,33 +68,10 @@ struct FitArgs : DriftArgs {
   std::string output;
 };
 
-// "auto": ms-elm in predict mode (the paper's model); in compensate mode the identified thermal
-// model of the whole output, which beat the per-group identification of ms-elm on the gyro family
-// and on the simulator (docs/drift.md 4.5).
-drift::Method ResolveMethod(const FitArgs& a) {
-  if (a.method != "auto") return drift::MethodFromString(a.method);
-  return drift::ModeFromString(a.mode) == drift::Mode::kCompensate ? drift::Method::kThermal
-                                                                   : drift::Method::kMsElm;
-}
-
 void Run(const FitArgs& a) {
   RequireOutputsAreNotInputs(a.inputs, {a.output});
-  const drift::Method method = ResolveMethod(a);
-  drift::DriftOptions o = MakeDriftOptions(a, method);
-  const bool elm_based = method == drift::Method::kMsElm || method == drift::Method::kEmdElm ||
-                         method == drift::Method::kElm;
-  if (!elm_based && a.hidden_option->count() > 0 && a.hidden != "auto") {
-    throw UsageError("--hidden = " + a.hidden +
-                     ": applies to the ELM methods (ms-elm, emd-elm, elm), not --method " +
-                     std::string(drift::ToString(method)));
-  }
-  if (o.mode == drift::Mode::kCompensate && o.linear_compensation &&
-      method != drift::Method::kElm && elm_based && a.hidden_option->count() > 0 &&
-      a.hidden != "auto") {
-    throw UsageError("--hidden = " + a.hidden + ": compensate-mode " + a.method +
-                     " fits linear sub-models (docs/drift.md 1.2); --hidden applies to predict "
-                     "mode and to --method elm");
-  }
+  drift::DriftOptions o = drift::MakeDriftOptions(Settings(a, a.method));
+  const drift::Method method = o.method;
 
   // Several calibration logs (or one split at its gaps) become one run of several records: the
   // targets' columns, then the temperatures', of every log one after the other.
@@ -197,10 +174,11 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "lag states restart at the start of each.\n"
       "See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/true);
-  cmd->add_option("--method,-m", args->method,
-                  "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in predict mode, "
-                  "thermal in compensate mode)")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--method,-m", args->method,
+                              "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in "
+                              "predict mode, thermal in compensate mode)")
+                  ->capture_default_str(),
+              {"method"});
   cmd->add_option("--units", args->units,
                   "unit of the target column(s), recorded in the model file and used in reports: "
                   "dph (deg/h) | dps (deg/s) | rads (rad/s)")

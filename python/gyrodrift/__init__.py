@@ -135,13 +135,18 @@ class DriftModel:
     def fit(self, y, temperature=None, *, mode="compensate", method="auto",
             decomposition="beemdan", lags=None, hidden="auto", rate_hz=1.0,
             thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
-            threads=0, nonlinear=False, reference_temperature=None, target="rate_dph",
-            temperature_columns=None, source="python", record_starts=(), progress=None):
+            threads=0, nonlinear=False, reference_temperature=None, hysteresis="auto",
+            target="rate_dph", temperature_columns=None, source="python", record_starts=(),
+            progress=None):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
         Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
         ``hidden`` "auto" or an int, ``time_constants`` seconds. ``method="auto"`` is ms-elm in
-        predict mode and thermal in compensate mode. ``rate_hz`` is the sample rate (the CLI
+        predict mode and thermal in compensate mode. ``hysteresis`` ("auto", "on" or "off") is
+        the thermal models' hysteresis term (auto: tried on calibrations of 12 h or more; the
+        fitted term is in ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the
+        library's options as the CLI's flags do, and a refusal names the keyword.
+        ``rate_hz`` is the sample rate (the CLI
         reads it from a time_s column). ``target`` and ``temperature_columns`` are the column
         names written into the model file (the CLI's compensate reads those columns).
         Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
@@ -155,7 +160,8 @@ class DriftModel:
                        thermal_features=thermal_features, time_constants=list(time_constants),
                        ensemble=ensemble, realisations=realisations, seed=seed, threads=threads,
                        nonlinear=nonlinear, reference_temperature=reference_temperature,
-                       target=target, temperature_columns=temperature_columns, source=source,
+                       hysteresis=hysteresis, target=target,
+                       temperature_columns=temperature_columns, source=source,
                        record_starts=list(record_starts), progress=progress)
         return self
 
@@ -256,7 +262,7 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
              split=0.7, repeats=1, horizon=1, window=512, decomposition="beemdan", lags=None,
              hidden="auto", rate_hz=1.0, thermal_features="auto", time_constants=(),
              ensemble=100, realisations=100, seed=1, threads=0, nonlinear=False,
-             reference_temperature=None, progress=None):
+             reference_temperature=None, hysteresis="auto", progress=None):
     """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
     paper and causal protocols (predict mode), against ``truth`` when given (else the output).
@@ -280,7 +286,7 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
         hidden=hidden, rate_hz=rate_hz, thermal_features=thermal_features,
         time_constants=list(time_constants), ensemble=ensemble, realisations=realisations,
         seed=seed, threads=threads, nonlinear=nonlinear,
-        reference_temperature=reference_temperature, progress=progress)
+        reference_temperature=reference_temperature, hysteresis=hysteresis, progress=progress)
 
 
 def calibrate(manifest_path, output_dir, *, force=False, threads=0):

@@ -36,6 +36,7 @@
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/drift/evaluation.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
@@ -504,24 +505,15 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
 
 // ---- DriftModel -----------------------------------------------------------------------------
 
-// "auto" or an integer in [lo, hi]; -1 for auto. Ints pass as they are.
-int AutoOrInteger(const char* option, const py::object& value, int lo, int hi) {
-  if (py::isinstance<py::str>(value)) {
-    const std::string text = value.cast<std::string>();
-    if (text == "auto") return -1;
-    throw OptionError(option, "'" + text + "'",
-                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+// A setting that takes "auto" or an integer (lags, hidden), as FitSettings holds it: None is
+// "not given", ints and strings pass as text.
+std::string AutoOrIntegerSetting(const char* name, const py::object& value) {
+  if (value.is_none()) return "";
+  if (py::isinstance<py::str>(value) ||
+      (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value))) {
+    return py::str(value).cast<std::string>();
   }
-  if (!py::isinstance<py::int_>(value)) {
-    throw OptionError(option, py::str(value).cast<std::string>(),
-                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  const long long v = value.cast<long long>();
-  if (v < lo || v > hi) {
-    throw OptionError(option, std::to_string(v),
-                      "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  }
-  return static_cast<int>(v);
+  throw OptionError(name, py::repr(value).cast<std::string>(), "auto or an integer");
 }
 
 std::vector<std::string> SplitColumns(const std::string& names) {
@@ -535,7 +527,8 @@ std::vector<std::string> SplitColumns(const std::string& names) {
   }
 }
 
-// The model keywords of `DriftModel.fit` and `evaluate`, as `gyrodrift fit`'s flags.
+// The model keywords of `DriftModel.fit` and `evaluate`: drift::FitSettings by name, as
+// `gyrodrift fit`'s flags (one mapping onto the options, drift::MakeDriftOptions).
 struct ModelArgs {
   std::string mode, method, decomposition;
   py::object lags, hidden;
@@ -547,78 +540,29 @@ struct ModelArgs {
   int threads = 0;
   bool nonlinear = false;
   std::optional<double> reference_temperature;
+  std::string hysteresis;
   bool has_temperature = false;
 };
 
-// The option mapping of `gyrodrift fit` (apps/gyrodrift/drift_cli.cc MakeDriftOptions and
-// fit_command.cc), with lags/hidden taking ints or "auto" and a given rate instead of time_s.
 drift::DriftOptions MakeDriftOptions(const ModelArgs& a) {
-  drift::DriftOptions o;
-  o.mode = drift::ModeFromString(a.mode);
-  o.method = a.method == "auto" ? (o.mode == drift::Mode::kCompensate ? drift::Method::kThermal
-                                                                      : drift::Method::kMsElm)
-                              : drift::MethodFromString(a.method);
-  o.decomposition.method = dec::MethodFromString(a.decomposition);
-  o.decomposition.ensemble_size = a.ensemble;
-  o.selection.monte_carlo.realisations = a.realisations;
-  o.seed = a.seed;
-  o.threads = a.threads;
-  const bool lags_given = !a.lags.is_none();
-  const int p = lags_given ? AutoOrInteger("lags", a.lags, 1, 256) : 4;
-  o.auto_lags = p < 0;
-  if (p > 0) o.features.lags = p;
-  const int h = AutoOrInteger("hidden", a.hidden, 1, 100000);
-  if (h > 0) {
-    const bool elm_based = o.method == drift::Method::kMsElm ||
-                           o.method == drift::Method::kEmdElm || o.method == drift::Method::kElm;
-    if (!elm_based) {
-      throw UsageError("hidden = " + std::to_string(h) +
-                       ": applies to the ELM methods (ms-elm, emd-elm, elm), not method " +
-                       std::string(drift::ToString(o.method)));
-    }
-    if (o.mode == drift::Mode::kCompensate && o.method != drift::Method::kElm && !a.nonlinear) {
-      throw UsageError("hidden = " + std::to_string(h) + ": compensate-mode " +
-                       std::string(drift::ToString(o.method)) +
-                       " fits linear sub-models; hidden applies to predict mode and to "
-                       "method 'elm'");
-    }
-    o.learner.elm.selection = elm::Selection::kFixed;
-    o.learner.elm.hidden_units = h;
-  }
-  if (o.mode == drift::Mode::kCompensate && lags_given) {
-    throw UsageError("lags: applies to mode 'predict' (a compensate-mode model sees "
-                     "temperature only)");
-  }
-  if (o.mode == drift::Mode::kCompensate && !a.has_temperature) {
-    throw UsageError("mode 'compensate' needs temperature (the compensation model runs on "
-                     "temperature alone)");
-  }
-  o.features.use_temperature = o.mode == drift::Mode::kPredict && a.has_temperature;
-  if (a.nonlinear) {
-    if (!drift::IdentifiesThermalModel(o)) {
-      throw UsageError("nonlinear applies to mode 'compensate' with method thermal, ms-elm or "
-                       "emd-elm");
-    }
-    o.linear_compensation = false;
-  }
-  if (a.reference_temperature) {
-    if (o.mode != drift::Mode::kCompensate) {
-      throw UsageError("reference_temperature applies to mode 'compensate'");
-    }
-    if (!(*a.reference_temperature >= -100.0 && *a.reference_temperature <= 200.0)) {
-      throw OptionError("reference_temperature", std::to_string(*a.reference_temperature),
-                        "in [-100, 200]");
-    }
-    o.reference_c = *a.reference_temperature;
-  }
-  o.features.rate_hz = a.rate_hz;
-  o.features.thermal_set = drift::ThermalSetFromString(a.thermal_features);
-  if (!a.time_constants.empty()) {
-    o.features.time_constants_s = a.time_constants;
-    o.features.limit_time_constants = false;  // the user's constants, all of them
-  }
-  o.Validate();
-  return o;
+  drift::FitSettings s;
+  s.mode = a.mode;
+  s.method = a.method;
+  s.decomposition = a.decomposition;
+  s.lags = AutoOrIntegerSetting("lags", a.lags);
+  s.hidden = AutoOrIntegerSetting("hidden", a.hidden);
+  s.rate_hz = a.rate_hz;
+  s.thermal_features = a.thermal_features;
+  s.time_constants = a.time_constants;
+  s.ensemble = a.ensemble;
+  s.realisations = a.realisations;
+  s.seed = a.seed;
+  s.threads = a.threads;
+  s.nonlinear = a.nonlinear;
+  s.reference_temperature = a.reference_temperature;
+  s.hysteresis = a.hysteresis;
+  s.has_temperature = a.has_temperature;
+  return drift::MakeDriftOptions(s);
 }
 
 // One axis of a model file: the fitted model and the column names it was fitted on.
@@ -633,14 +577,15 @@ class PyDriftModel {
            const py::object& hidden, double rate_hz, const std::string& thermal_features,
            const std::vector<double>& time_constants, int ensemble, int realisations,
            std::uint64_t seed, int threads, bool nonlinear,
-           std::optional<double> reference_temperature, const std::string& target,
+           std::optional<double> reference_temperature, const std::string& hysteresis,
+           const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
            const py::object& progress) {
     LongCall call(progress);
     drift::DriftOptions o = MakeDriftOptions(
         {mode, method, decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
-         ensemble, realisations, seed, threads, nonlinear, reference_temperature,
+         ensemble, realisations, seed, threads, nonlinear, reference_temperature, hysteresis,
          temperature_in.has_value()});
 
     const Eigen::VectorXd y = ToVector(y_in, "y");
@@ -790,6 +735,15 @@ class PyDriftModel {
         th["sd"] = ToArray(sd);
         th["calibration"] = t.report.Summary();
         th["warnings"] = t.report.warnings;
+        if (t.has_hysteresis()) {
+          py::dict h;
+          h["tau_s"] = t.states[static_cast<size_t>(t.hysteresis_state)].tau_s;
+          h["width_k"] = t.hysteresis_width_k;
+          h["coefficient"] = t.coefficients[t.coefficients.size() - 1];
+          th["hysteresis"] = h;
+        } else {
+          th["hysteresis"] = py::none();
+        }
         d["thermal"] = th;
       } else {
         d["thermal"] = py::none();
@@ -894,11 +848,11 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const std::string& thermal_features, const std::vector<double>& time_constants,
                   int ensemble, int realisations, std::uint64_t seed, int threads,
                   bool nonlinear, std::optional<double> reference_temperature,
-                  const py::object& progress) {
+                  const std::string& hysteresis, const py::object& progress) {
   LongCall call(progress);
   const drift::DriftOptions base = MakeDriftOptions(
       {mode, "ms-elm", decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
-       ensemble, realisations, seed, threads, nonlinear, reference_temperature,
+       ensemble, realisations, seed, threads, nonlinear, reference_temperature, hysteresis,
        temperature_in.has_value()});
   drift::EvaluationOptions e;
   e.split = split;
@@ -1104,7 +1058,8 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("thermal_features") = "auto", arg("time_constants") = std::vector<double>{},
            arg("ensemble") = 100, arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
            arg("nonlinear") = false, arg("reference_temperature") = py::none(),
-           arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
+           arg("hysteresis") = "auto", arg("target") = "rate_dph",
+           arg("temperature_columns") = py::none(),
            arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
            arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
@@ -1149,7 +1104,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
         arg("time_constants") = std::vector<double>{}, arg("ensemble") = 100,
         arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
         arg("nonlinear") = false, arg("reference_temperature") = py::none(),
-        arg("progress") = py::none());
+        arg("hysteresis") = "auto", arg("progress") = py::none());
   m.def("calibrate", &gp::Calibrate, arg("manifest_path"), arg("output_dir"), py::kw_only(),
         arg("force") = false, arg("threads") = 0);
   m.def("_calibrate_unit", &gp::CalibrateUnit, arg("manifest_path"), arg("index"),

@@ -119,6 +119,26 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     assert np.all(np.isfinite(thermal["sd"]))
 
 
+def test_fit_settings_map_as_the_cli_flags(cli, sim_csv, tmp_path):
+    # One mapping of the settings (drift::MakeDriftOptions): the same model file, and the same
+    # refusal naming the keyword where the CLI names the flag.
+    cli("fit", sim_csv, "-t", "rate_dph", "-T", "temperature_c", "--mode", "compensate",
+        "--hysteresis", "on", "--reference-temperature", "20", "-q", "-o", tmp_path / "cli.json")
+    log = read_csv(sim_csv)
+    model = gd.DriftModel().fit(log["rate_dph"], log["temperature_c"], mode="compensate",
+                                hysteresis="on", reference_temperature=20, target="rate_dph",
+                                temperature_columns=["temperature_c"], source=str(sim_csv))
+    model.save(tmp_path / "py.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert read_json(tmp_path / "py.json")["options"]["thermal"]["hysteresis"] == "on"
+    assert "hysteresis" in model.sub_models[0]["thermal"]
+    with pytest.raises(ValueError, match=r"^hysteresis = 'off': must be auto unless mode"):
+        gd.DriftModel().fit(log["rate_dph"], log["temperature_c"], mode="compensate",
+                            method="poly", hysteresis="off")
+    with pytest.raises(ValueError, match=r"^lags = 8: must be left unset in mode 'compensate'"):
+        gd.DriftModel().fit(log["rate_dph"], log["temperature_c"], mode="compensate", lags=8)
+
+
 def test_two_axis_model_file_matches_cli(cli, tmp_path):
     # Two axes of one IMU: the simulator's output and a second unit's, each with its own sensor.
     a, b = gd.simulate(duration=3600, seed=1), gd.simulate(duration=3600, seed=2, preset="tactical")

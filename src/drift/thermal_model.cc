@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "../common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
@@ -36,6 +37,10 @@ constexpr double kRelativeRidge = 1e-10;     // on the unit-diagonal Gram of a s
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
 constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
 constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
+constexpr size_t kMostHysteresisWidths = 8;
+
+constexpr internal::EnumNames<HysteresisTerm, 3> kHysteresisTerms{{
+    {HysteresisTerm::kAuto, "auto"}, {HysteresisTerm::kOn, "on"}, {HysteresisTerm::kOff, "off"}}};
 
 // Standard deviation about the mean (population).
 double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
@@ -56,12 +61,33 @@ void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order
   }
 }
 
+// H_w of a state's level (degC) for each half-width w (K): (s - P_w[s]) / w, the play operator
+// P_w starting at the level of each record's first sample.
+void HysteresisColumns(const Eigen::Ref<const Eigen::VectorXd>& level,
+                       const std::vector<double>& widths_k,
+                       const std::vector<Eigen::Index>& record_starts,
+                       Eigen::Ref<Eigen::MatrixXd> out) {
+  for (size_t w = 0; w < widths_k.size(); ++w) {
+    const double width = widths_k[w];
+    auto col = out.col(static_cast<Eigen::Index>(w));
+    ForEachRecord(level.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+      double play = level[begin];
+      for (Eigen::Index i = begin; i < begin + length; ++i) {
+        play = std::clamp(play, level[i] - width, level[i] + width);
+        col[i] = (level[i] - play) / width;
+      }
+    });
+  }
+}
+
 // Columns of one state: its standardised level to the powers 1..max_power (the powers >= 2
-// continued along their tangent beyond [s.level_min, s.level_max]), then its rate (K/s). With
-// `learn_range` the range is first set to the level's own (the calibration run).
+// continued along their tangent beyond [s.level_min, s.level_max]), its rate (K/s), then H_w of
+// its level for each of widths_k. With `learn_range` the range is first set to the level's own
+// (the calibration run).
 void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
                   int max_power, double dt_s, double centre, double scale, bool learn_range,
-                  const std::vector<Eigen::Index>& record_starts, Eigen::Ref<Eigen::MatrixXd> out) {
+                  const std::vector<Eigen::Index>& record_starts,
+                  const std::vector<double>& widths_k, Eigen::Ref<Eigen::MatrixXd> out) {
   Eigen::VectorXd previous, state;
   StateOf(t, s.tau_s, order, dt_s, record_starts, previous, state);
   const Eigen::ArrayXd z = (state.array() - centre) / scale;
@@ -78,6 +104,8 @@ void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, i
     }
   }
   out.col(max_power) = (previous - state) / s.tau_s;
+  HysteresisColumns(state, widths_k, record_starts,
+                    out.middleCols(max_power + 1, static_cast<Eigen::Index>(widths_k.size())));
 }
 
 // A partition of the run into folds: contiguous groups of whole units (regimes or time blocks),
@@ -199,13 +227,15 @@ std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorX
 }
 
 // Every candidate column: the intercept, the channels' standardised linear terms, then per
-// candidate state its powers and rate (each candidate learning its level's range).
+// candidate state its powers, its rate and H_w for each of widths_k (each candidate learning its
+// level's range).
 Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                 double rate_hz, const std::vector<Eigen::Index>& record_starts,
                                 const ThermalRegression& model,
+                                const std::vector<double>& widths_k,
                                 std::vector<ThermalState>& candidates) {
   const int channels = static_cast<int>(temperatures_c.cols());
-  const int per_state = model.max_power + 1;
+  const int per_state = model.max_power + 1 + static_cast<int>(widths_k.size());
   const Eigen::Index first_state = 1 + channels;
   Eigen::MatrixXd x(temperatures_c.rows(),
                     first_state + static_cast<Eigen::Index>(candidates.size()) * per_state);
@@ -218,7 +248,7 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
     const auto c = static_cast<size_t>(candidates[j].channel);
     StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
                  model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
-                 /*learn_range=*/true, record_starts,
+                 /*learn_range=*/true, record_starts, widths_k,
                  x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
   }
   return x;
@@ -321,15 +351,19 @@ struct Subset {
   std::vector<int> cols{0};  // the intercept first
   std::vector<int> states;   // candidate indices
   bool linear = false;       // the channels' linear terms
+  int hysteresis_state = -1;  // position in `states` of the state whose H_w is the last column
+  int hysteresis_width = -1;  // index of w in the widths tried
   double mse = std::numeric_limits<double>::infinity();
 };
 
 // Every subset of at most max_states candidates (combinations in increasing order), with or
-// without the channels' linear terms, the intercept alone included: the one of least
-// cross-validated error.
-Subset BestSubset(const CrossValidation& cv, int channels, int candidates, int per_state,
-                  int max_states) {
+// without the channels' linear terms, the intercept alone included, each also with H_w of each
+// of its states for each of `widths` widths: the one of least cross-validated error. A
+// candidate's block of columns holds state_columns (powers and rate), then its widths.
+Subset BestSubset(const CrossValidation& cv, int channels, int candidates, int state_columns,
+                  int widths, int max_states) {
   max_states = std::min(max_states, candidates);
+  const int per_state = state_columns + widths;
   Subset best;
   std::vector<int> chosen;
   auto visit = [&](auto&& self, int next) -> void {
@@ -341,9 +375,24 @@ Subset BestSubset(const CrossValidation& cv, int channels, int candidates, int p
         for (int c = 0; c < channels; ++c) s.cols.push_back(1 + c);
       }
       for (int j : chosen) {
-        for (int p = 0; p < per_state; ++p) s.cols.push_back(1 + channels + j * per_state + p);
+        for (int p = 0; p < state_columns; ++p) {
+          s.cols.push_back(1 + channels + j * per_state + p);
+        }
       }
       s.mse = cv.Mse(s.cols);
+      for (size_t k = 0; k < chosen.size(); ++k) {
+        for (int w = 0; w < widths; ++w) {
+          s.cols.push_back(1 + channels + chosen[k] * per_state + state_columns + w);
+          const double mse = cv.Mse(s.cols);
+          if (mse < best.mse) {
+            best = s;
+            best.hysteresis_state = static_cast<int>(k);
+            best.hysteresis_width = w;
+            best.mse = mse;
+          }
+          s.cols.pop_back();
+        }
+      }
       if (s.mse < best.mse) best = std::move(s);
     }
     if (static_cast<int>(chosen.size()) == max_states) return;
@@ -493,6 +542,35 @@ void ThermalModelOptions::Validate() const {
   if (!(ramp_rate_k_per_min > 0.0 && ramp_rate_k_per_min <= 100.0)) {
     ThrowOption("ramp_rate_k_per_min", FormatValue(ramp_rate_k_per_min), "in (0, 100]");
   }
+  if (hysteresis_widths_k.size() > kMostHysteresisWidths) {
+    ThrowOption("hysteresis_widths_k", std::to_string(hysteresis_widths_k.size()) + " widths",
+                "at most " + std::to_string(kMostHysteresisWidths));
+  }
+  for (double w : hysteresis_widths_k) RequireInRange("hysteresis_widths_k", w, 1e-9, 100.0);
+  if (hysteresis == HysteresisTerm::kOn && hysteresis_widths_k.empty()) {
+    ThrowOption("hysteresis_widths_k", "none", "at least one width with hysteresis 'on'");
+  }
+}
+
+bool ThermalModelOptions::TriesHysteresis(double duration_s) const {
+  if (hysteresis_widths_k.empty()) return false;
+  switch (hysteresis) {
+    case HysteresisTerm::kOn:
+      return true;
+    case HysteresisTerm::kOff:
+      return false;
+    case HysteresisTerm::kAuto:
+      break;
+  }
+  return duration_s >= kHysteresisAutoMinDurationS;
+}
+
+std::string_view ToString(HysteresisTerm term) {
+  return internal::EnumName(term, kHysteresisTerms);
+}
+
+HysteresisTerm HysteresisTermFromString(std::string_view name) {
+  return internal::EnumFromName(name, "thermal.hysteresis", kHysteresisTerms);
 }
 
 std::vector<double> ThermalModelOptions::Grid(double duration_s) const {
@@ -545,10 +623,12 @@ std::string CalibrationReport::Summary() const {
   for (size_t c = 0; c < span_k.size(); ++c) span += Format("%s%.3g", c ? "/" : "", span_k[c]);
   return Format(
       "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d folds; "
-      "cross-validated RMSE %.4g (constant %.4g), skill %.1f %% of the slow drift, condition %.2g",
+      "cross-validated RMSE %.4g (constant %.4g), skill %.1f %% of the slow drift, condition "
+      "%.2g; hysteresis term %s",
       duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
       span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps,
-      dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition) +
+      dwells, folds, cv_rmse, cv_rmse_constant, 100.0 * skill, condition,
+      hysteresis_tried ? "tried" : "not tried") +
          (std::isnan(cv_rmse_nonlinear)
               ? std::string()
               : nonlinear_units > 0
@@ -582,8 +662,16 @@ Eigen::MatrixXd ThermalRegression::Regressors(
   for (ThermalState s : states) {
     const auto c = static_cast<size_t>(s.channel);
     StateColumns(temperatures_c.col(s.channel), s, order, max_power, 1.0 / rate_hz, centre_c[c],
-                 scale_k[c], /*learn_range=*/false, record_starts, x.middleCols(col, max_power + 1));
+                 scale_k[c], /*learn_range=*/false, record_starts, {},
+                 x.middleCols(col, max_power + 1));
     col += max_power + 1;
+  }
+  if (has_hysteresis()) {
+    const ThermalState& s = states[static_cast<size_t>(hysteresis_state)];
+    Eigen::VectorXd previous, level;
+    StateOf(temperatures_c.col(s.channel), s.tau_s, order, 1.0 / rate_hz, record_starts, previous,
+            level);
+    HysteresisColumns(level, {hysteresis_width_k}, record_starts, x.middleCols(col, 1));
   }
   return x;
 }
@@ -605,6 +693,11 @@ std::vector<std::string> ThermalRegression::RegressorNames(
     names.push_back(state);
     for (int p = 2; p <= max_power; ++p) names.push_back(Format("%s^%d", state.c_str(), p));
     names.push_back("d/dt " + state);
+  }
+  if (has_hysteresis()) {
+    const ThermalState& s = states[static_cast<size_t>(hysteresis_state)];
+    names.push_back(Format("H(L%d(%s; %.4g s); %g K)", order, channel(s.channel).c_str(), s.tau_s,
+                           hysteresis_width_k));
   }
   return names;
 }
@@ -642,9 +735,14 @@ std::string ThermalRegression::Summary() const {
     if (channels() > 1) chosen += Format(" (T%d)", s.channel + 1);
   }
   const bool any_linear = std::any_of(linear.begin(), linear.end(), [](bool b) { return b; });
-  return Format("thermal states [%s] of order %d to power %d%s, cross-validated RMSE %.4g",
+  const std::string hysteresis =
+      has_hysteresis()
+          ? Format(", hysteresis of the %.4g-s state (play %g K)",
+                   states[static_cast<size_t>(hysteresis_state)].tau_s, hysteresis_width_k)
+          : std::string();
+  return Format("thermal states [%s] of order %d to power %d%s%s, cross-validated RMSE %.4g",
                 chosen.empty() ? "none" : chosen.c_str(), order, max_power,
-                any_linear ? ", linear in T" : "", report.cv_rmse);
+                any_linear ? ", linear in T" : "", hysteresis.c_str(), report.cv_rmse);
 }
 
 void ThermalRegression::Validate() const {
@@ -669,9 +767,13 @@ void ThermalRegression::Validate() const {
           "thermal model: a state names a channel, time constant or level range out of range");
     }
   }
+  if (hysteresis_state < -1 || hysteresis_state >= static_cast<int>(states.size()) ||
+      (has_hysteresis() && !(hysteresis_width_k > 0.0 && std::isfinite(hysteresis_width_k)))) {
+    throw DataError("thermal model: the hysteresis term names no state or a width out of range");
+  }
   const Eigen::Index m = static_cast<Eigen::Index>(
       1 + std::count(linear.begin(), linear.end(), true) +
-      static_cast<long>(states.size()) * (max_power + 1));
+      static_cast<long>(states.size()) * (max_power + 1) + (has_hysteresis() ? 1 : 0));
   if (correction && correction->num_inputs() != m - 1) {
     throw DataError("thermal model: the nonlinear correction takes " +
                     std::to_string(correction->num_inputs()) + " inputs, not the " +
@@ -739,14 +841,22 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   for (int c = 0; c < channels; ++c) {
     for (double tau : options.Grid(report.duration_s)) candidates.push_back({c, tau});
   }
+  report.hysteresis_tried = options.TriesHysteresis(report.duration_s);
+  const std::vector<double> widths_k =
+      report.hysteresis_tried ? options.hysteresis_widths_k : std::vector<double>{};
   const Eigen::MatrixXd x =
-      CandidateDesign(temperatures_c, rate_hz, record_starts, model, candidates);
+      CandidateDesign(temperatures_c, rate_hz, record_starts, model, widths_k, candidates);
   const Eigen::VectorXd yc = y.array() - y.mean();
   const CrossValidation cv(x, yc, units, folds);
-  const Subset best = BestSubset(cv, channels, static_cast<int>(candidates.size()),
-                                 options.max_power + 1, options.max_states);
+  const Subset best =
+      BestSubset(cv, channels, static_cast<int>(candidates.size()), options.max_power + 1,
+                 static_cast<int>(widths_k.size()), options.max_states);
   model.linear.assign(static_cast<size_t>(channels), best.linear);
   for (int j : best.states) model.states.push_back(candidates[static_cast<size_t>(j)]);
+  if (best.hysteresis_state >= 0) {
+    model.hysteresis_state = best.hysteresis_state;
+    model.hysteresis_width_k = widths_k[static_cast<size_t>(best.hysteresis_width)];
+  }
 
   // Refit the chosen columns on the whole run (QR of the unit-scaled design).
   const Eigen::Index p = static_cast<Eigen::Index>(best.cols.size());

@@ -6,10 +6,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <toml++/toml.h>
 
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
@@ -161,13 +163,15 @@ std::vector<std::string> UnitSpec::Logs() const {
 }
 
 drift::DriftOptions Manifest::FitOptions() const {
-  drift::DriftOptions o;
-  o.mode = drift::Mode::kCompensate;
-  o.method = method;
-  o.seed = seed;
-  o.linear_compensation = !nonlinear;
-  o.reference_c = reference_c;
-  return o;
+  drift::FitSettings s;
+  s.mode = "compensate";
+  s.method = std::string(drift::ToString(method));
+  s.seed = seed;
+  s.nonlinear = nonlinear;
+  if (!std::isnan(reference_c)) s.reference_temperature = reference_c;
+  s.hysteresis = std::string(drift::ToString(hysteresis));
+  s.has_temperature = true;
+  return drift::MakeDriftOptions(s);
 }
 
 Manifest ParseManifest(const std::string& text, const std::string& path) {
@@ -182,8 +186,9 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
   Manifest m;
   m.path = path;
   const Table top(root, c, "",
-                  {"method", "rate_unit", "rate_hz", "gaps", "delimiter", "seed", "nonlinear", "reference_temperature_c",
-                   "drift_window_s", "limits", "axis", "unit"});
+                  {"method", "rate_unit", "rate_hz", "gaps", "delimiter", "seed", "nonlinear",
+                   "reference_temperature_c", "hysteresis", "drift_window_s", "limits", "axis",
+                   "unit"});
   if (top.Find("method")) {
     const std::string name = top.String("method");
     try {
@@ -233,7 +238,30 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     m.seed = static_cast<std::uint64_t>(*n->value<std::int64_t>());
   }
   m.nonlinear = top.Bool("nonlinear", false);
-  m.reference_c = top.Number("reference_temperature_c", m.reference_c, -273.15, 1000.0);
+  // Its range is the fit settings' (checked below, with the other fit keys).
+  m.reference_c = top.Number("reference_temperature_c", m.reference_c,
+                             -std::numeric_limits<double>::max(),
+                             std::numeric_limits<double>::max());
+  if (top.Find("hysteresis")) {
+    const std::string term = top.String("hysteresis");
+    try {
+      m.hysteresis = drift::HysteresisTermFromString(term);
+    } catch (const UsageError&) {
+      c.Fail(*top.Find("hysteresis"),
+             fmt::format("hysteresis = '{}': must be auto, on or off (as fit --hysteresis)", term));
+    }
+  }
+  // The fit keys together, as fit's flags are checked (drift::MakeDriftOptions); a refusal is
+  // placed at the key it names.
+  try {
+    (void)m.FitOptions();
+  } catch (const OptionError& e) {
+    const std::string key =
+        e.option() == "reference_temperature" ? "reference_temperature_c" : e.option();
+    const std::string message = fmt::format("{} = {}: must be {}", key, e.value(), e.rule());
+    if (const toml::node* n = top.Find(key)) c.Fail(*n, message);
+    c.Fail(top.line(), message);
+  }
   m.drift_window_s = top.Number("drift_window_s", m.drift_window_s, 1.0, 1e5);
 
   if (const toml::node* n = top.Find("limits")) {
@@ -386,6 +414,9 @@ std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
   if (m.log.delimiter != io::Delimiter::kAuto) {
     text += fmt::format("delimiter={};", io::ToString(m.log.delimiter));
   }
+  // Always: models identified before the term existed were fitted without it, which the default
+  // (auto) no longer does for long calibrations, so their units are fitted again.
+  text += fmt::format("hysteresis={};", drift::ToString(m.hysteresis));
   text += "serial=" + u.serial + ";";
   if (u.calibration.size() > 1) text += fmt::format("calibration_logs={};", u.calibration.size());
   for (const std::string& log : u.Logs()) {

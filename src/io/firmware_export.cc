@@ -23,7 +23,8 @@ constexpr internal::EnumNames<ExportFormat, 2> kFormats{{
 }};
 constexpr size_t kLongestPrefix = 32;
 constexpr std::string_view kCoefficientsFormat = "gyrodrift-coefficients";
-constexpr int kCoefficientsFormatVersion = 1;
+// 2: a sub-model may hold a hysteresis term.
+constexpr int kCoefficientsFormatVersion = 2;
 
 // ---------------------------------------------------------------------------------------------
 // The models reduced to what the step computes, shared by both renderers.
@@ -53,6 +54,14 @@ struct Linear {
   double coefficient = 0.0;
 };
 
+// The hysteresis term of a sub-model: the play operator of one of its states' level.
+struct Hysteresis {
+  int state = -1;  // index in Sub::states; -1: none
+  int slot = 0;    // index of its play in the step's state arrays
+  double width_k = 0.0;
+  double coefficient = 0.0;
+};
+
 struct Sub {
   std::string name;
   bool zero = false;  // a sub-model without a model (old files' noise group): contributes 0
@@ -60,6 +69,7 @@ struct Sub {
   double reference_estimate = 0.0;  // subtracted when the model has a reference temperature
   std::vector<Linear> linear;
   std::vector<State> states;
+  Hysteresis hysteresis;
 };
 
 struct Axis {
@@ -78,6 +88,7 @@ struct Plan {
   std::vector<Axis> axes;
   int lag_stages = 0;
   int states = 0;
+  int plays = 0;  // hysteresis terms
 };
 
 std::vector<std::string> SplitNames(const std::string& names) {
@@ -156,6 +167,9 @@ Plan MakePlan(const std::vector<LoadedModel>& axes) {
         state.rate = t.coefficients[k++];
         s.states.push_back(std::move(state));
         ++plan.states;
+      }
+      if (t.has_hysteresis()) {
+        s.hysteresis = {t.hysteresis_state, plan.plays++, t.hysteresis_width_k, t.coefficients[k++]};
       }
       if (referenced) {
         // The library's own estimate of a record in equilibrium at the reference.
@@ -278,8 +292,10 @@ class CWriter {
         " * thermal states are cascaded first-order lags started in equilibrium at the first\n"
         " * sample; a state's standardised level z has its powers continued along their tangent\n"
         " * beyond the calibration's range; its rate is (input - output of its last lag) / tau,\n"
-        " * K/s. The lags run on each stage's deviation u below its input, the same recursion\n"
-        " * rewritten so that a slow lag's small increments do not vanish against T in float.\n"
+        " * K/s; a hysteresis term is the play operator (backlash) of half-width w on a state's\n"
+        " * level, (level - play) / w, started with no direction. The lags run on each stage's\n"
+        " * deviation u below its input, the same recursion rewritten so that a slow lag's small\n"
+        " * increments do not vanish against T in float.\n"
         " * See docs/firmware.md.\n"
         " * Arithmetic: {}. No allocation, no libm (the lag gains 1 - exp(-dt/tau) are\n"
         " * precomputed literals), no other header: C99, also valid C++.\n"
@@ -292,6 +308,7 @@ class CWriter {
     out_ += fmt::format("#define {}_N_AXES {}\n", P_, plan_.axes.size());
     out_ += fmt::format("#define {}_N_CHANNELS {}\n", P_, plan_.channels.size());
     out_ += fmt::format("#define {}_N_LAGS {}\n", P_, plan_.lag_stages);
+    if (plan_.plays > 0) out_ += fmt::format("#define {}_N_PLAYS {}\n", P_, plan_.plays);
     out_ += fmt::format("#define {}_RATE_HZ {}\n", P_, Literal(plan_.rate_hz));
     for (size_t a = 0; a < plan_.axes.size(); ++a) {
       out_ += fmt::format("#define {}_AXIS_{}_NAME {}\n", P_, a, CString(plan_.axes[a].name));
@@ -307,6 +324,11 @@ class CWriter {
     if (plan_.lag_stages > 0) {
       out_ += fmt::format("  {} lag[{}_N_LAGS]; /* each lag stage's input minus its output, K */\n",
                           real_, P_);
+    }
+    if (plan_.plays > 0) {
+      out_ += fmt::format(
+          "  {} play[{}_N_PLAYS]; /* each hysteresis term's play output less its centre, K */\n",
+          real_, P_);
     }
     out_ += fmt::format("}} {}_state;\n", p_);
   }
@@ -351,6 +373,15 @@ class CWriter {
     if (plan_.lag_stages > 0) {
       out_ += fmt::format("  for (i = 0; i < {}_N_LAGS; ++i) s->lag[i] = {};\n", P_, Literal(0.0));
     }
+    for (const Axis& a : plan_.axes) {
+      for (const Sub& sub : a.subs) {
+        if (sub.hysteresis.state < 0) continue;
+        const State& st = sub.states[static_cast<size_t>(sub.hysteresis.state)];
+        const Chain& chain = plan_.chains[static_cast<size_t>(st.chain)];
+        out_ += fmt::format("  s->play[{}] = temperature_c[{}] - {};\n", sub.hysteresis.slot,
+                            chain.channel, Literal(st.centre_c));
+      }
+    }
     out_ += "}\n";
   }
 
@@ -370,6 +401,7 @@ class CWriter {
       }
     }
     if (!plan_.chains.empty()) out_ += fmt::format("  {} d, w;\n", real_);
+    if (plan_.plays > 0) out_ += fmt::format("  {} v;\n", real_);
     if (any_power) out_ += fmt::format("  {} z;\n", real_);
     if (any_estimate) out_ += fmt::format("  {} e;\n", real_);
     // Lags: stage k of a chain sees its input move by d; its deviation u = input - output becomes
@@ -408,9 +440,21 @@ class CWriter {
     out_ += "}\n";
   }
 
+  // The level of a state less its centre, K: the input less the deviations of the stages up to
+  // the state's order.
+  std::string LevelLessCentre(const State& st) const {
+    const Chain& chain = plan_.chains[static_cast<size_t>(st.chain)];
+    std::string deviations;
+    for (int k = 0; k < st.order; ++k) {
+      deviations += fmt::format("{}s->lag[{}]", k ? " + " : "", chain.first + k);
+    }
+    return fmt::format("(temperature_c[{}] - {}) - ({})", chain.channel, Literal(st.centre_c),
+                       deviations);
+  }
+
   // One sub-model's estimate in the library's order: the regressors' columns (intercept, linear
-  // terms, then per state its powers and rate) times their coefficients, summed into the axis,
-  // less its estimate in equilibrium at the reference temperature.
+  // terms, per state its powers and rate, then the hysteresis term) times their coefficients,
+  // summed into the axis, less its estimate in equilibrium at the reference temperature.
   void SubModel(size_t a, const Sub& sub, bool referenced) {
     out_ += fmt::format("  /* sub-model {} */\n  e = {};\n", CommentText(sub.name),
                         Literal(sub.intercept));
@@ -422,14 +466,8 @@ class CWriter {
     }
     for (const State& st : sub.states) {
       const Chain& chain = plan_.chains[static_cast<size_t>(st.chain)];
-      // The level: the input less the deviations of the stages up to the state's order.
-      std::string deviations;
-      for (int k = 0; k < st.order; ++k) {
-        deviations += fmt::format("{}s->lag[{}]", k ? " + " : "", chain.first + k);
-      }
       out_ += fmt::format("  /* {} */\n", CommentText(StateName(st)));
-      out_ += fmt::format("  z = ((temperature_c[{}] - {}) - ({})) / {};\n", chain.channel,
-                          Literal(st.centre_c), deviations, Literal(st.scale_k));
+      out_ += fmt::format("  z = ({}) / {};\n", LevelLessCentre(st), Literal(st.scale_k));
       out_ += fmt::format("  e += {} * z;\n", Literal(st.powers[0]));
       for (size_t p = 2; p <= st.powers.size(); ++p) {
         out_ += fmt::format("  e += {} * {}_power{}(z, {}, {});\n", Literal(st.powers[p - 1]), p_,
@@ -437,6 +475,22 @@ class CWriter {
       }
       out_ += fmt::format("  e += {} * (s->lag[{}] / {});\n", Literal(st.rate),
                           chain.first + st.order - 1, Literal(chain.tau_s));
+    }
+    if (sub.hysteresis.state >= 0) {
+      // The play p follows the level v only where v is more than w away: p is held or set to
+      // v -+ w, so no rounding accumulates.
+      const Hysteresis& h = sub.hysteresis;
+      const State& st = sub.states[static_cast<size_t>(h.state)];
+      const std::string w = Literal(h.width_k);
+      out_ += fmt::format("  /* hysteresis: play of {} K on {} */\n", h.width_k,
+                          CommentText(StateName(st)));
+      out_ += fmt::format(
+          "  v = {level};\n"
+          "  if (s->play[{i}] < v - {w}) s->play[{i}] = v - {w};\n"
+          "  if (v + {w} < s->play[{i}]) s->play[{i}] = v + {w};\n"
+          "  e += {c} * ((v - s->play[{i}]) / {w});\n",
+          fmt::arg("level", LevelLessCentre(st)), fmt::arg("i", h.slot), fmt::arg("w", w),
+          fmt::arg("c", Literal(h.coefficient)));
     }
     out_ += fmt::format("  drift[{}] += e;\n", a);
     if (referenced) {
@@ -557,12 +611,17 @@ std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                           {"powers", st.powers},
                           {"rate", st.rate}});
       }
+      const Hysteresis& h = sub.hysteresis;
       subs.push_back({{"name", sub.name},
                       {"zero", sub.zero},
                       {"intercept", sub.intercept},
                       {"reference_estimate", sub.reference_estimate},
                       {"linear", std::move(linear)},
-                      {"states", std::move(states)}});
+                      {"states", std::move(states)},
+                      {"hysteresis", h.state < 0 ? json(nullptr)
+                                                 : json{{"state", h.state},
+                                                        {"width_k", h.width_k},
+                                                        {"coefficient", h.coefficient}}}});
     }
     out_axes.push_back(
         {{"name", axis.name},

@@ -142,7 +142,9 @@ json ThermalOptionsJson(const drift::ThermalModelOptions& t) {
           {"max_power", t.max_power},
           {"folds", t.folds},
           {"folds_at_regimes", t.folds_at_regimes},
-          {"ramp_rate_k_per_min", Number(t.ramp_rate_k_per_min)}};
+          {"ramp_rate_k_per_min", Number(t.ramp_rate_k_per_min)},
+          {"hysteresis", drift::ToString(t.hysteresis)},
+          {"hysteresis_widths_k", Numbers(t.hysteresis_widths_k)}};
 }
 
 json ThermalJson(const drift::ThermalRegression& t) {
@@ -162,6 +164,9 @@ json ThermalJson(const drift::ThermalRegression& t) {
           {"scale_k", Numbers(t.scale_k)},
           {"linear", std::move(linear)},
           {"states", std::move(states)},
+          {"hysteresis", t.has_hysteresis() ? json{{"state", t.hysteresis_state},
+                                                   {"width_k", Number(t.hysteresis_width_k)}}
+                                            : json(nullptr)},
           {"regressors", t.RegressorNames()},
           {"coefficients", Array(t.coefficients)},
           {"covariance", Array(t.covariance)},
@@ -180,6 +185,7 @@ json ThermalJson(const drift::ThermalRegression& t) {
             {"skill", Number(r.skill)},
             {"condition", Number(r.condition)},
             {"nonlinear_units", r.nonlinear_units},
+            {"hysteresis_tried", r.hysteresis_tried},
             {"nonlinear_ridge_c", Number(r.nonlinear_ridge_c)},
             {"cv_rmse_nonlinear", Number(r.cv_rmse_nonlinear)},
             {"warnings", r.warnings}}}};
@@ -470,6 +476,13 @@ drift::ThermalModelOptions ReadThermalOptions(const Node& n) {
   t.folds = n["folds"].Int();
   t.folds_at_regimes = n["folds_at_regimes"].Bool();
   t.ramp_rate_k_per_min = n["ramp_rate_k_per_min"].Double();
+  // Files before version 5 were identified without the hysteresis term.
+  t.hysteresis = n.raw().contains("hysteresis")
+                     ? n["hysteresis"].Enum(drift::HysteresisTermFromString)
+                     : drift::HysteresisTerm::kOff;
+  if (n.raw().contains("hysteresis_widths_k")) {
+    t.hysteresis_widths_k = n["hysteresis_widths_k"].Doubles();
+  }
   return t;
 }
 
@@ -486,6 +499,11 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
     if (range.size() != 2) s["level_range"].Fail("must hold [min, max]");
     t->states.push_back(
         {static_cast<int>(s["channel"].Int(0, 1024)), s["tau_s"].Double(), range[0], range[1]});
+  }
+  if (n.raw().contains("hysteresis") && !n["hysteresis"].IsNull()) {
+    const Node h = n["hysteresis"];
+    t->hysteresis_state = static_cast<int>(h["state"].Int(0, 1024));
+    t->hysteresis_width_k = h["width_k"].Double();
   }
   const Eigen::MatrixXd coefficients = n["coefficients"].Matrix();
   if (coefficients.cols() != 1) n["coefficients"].Fail("must be a column (cols = 1)");
@@ -507,6 +525,7 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   report.skill = r["skill"].Double();
   report.condition = r["condition"].Double();
   report.nonlinear_units = r["nonlinear_units"].Int(0, 100000);
+  report.hysteresis_tried = r.raw().contains("hysteresis_tried") && r["hysteresis_tried"].Bool();
   report.nonlinear_ridge_c = r["nonlinear_ridge_c"].Double();
   report.cv_rmse_nonlinear = r["cv_rmse_nonlinear"].Double();
   for (const Node& w : r["warnings"].Items()) report.warnings.push_back(w.String());

@@ -126,7 +126,7 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"allan %D%/constant.csv -c rate_dph --rate-hz 1 -o %O%", 3, "constant"},
       {"allan %D%/cell_nan.csv -c rate_dph --rate-hz 1 -o %O%", 3, "data row 100"},
       {"allan %D%/backwards.csv -c rate_dph --rate-hz 1 -o %O%", 3, "goes backwards"},
-      {"fit %D%/good.csv -t rate_dph --mode compensate -o %O%", 2, "needs --temperature"},
+      {"fit %D%/good.csv -t rate_dph --mode compensate -o %O%", 2, "needs a temperature channel"},
       {"fit %D%/good.csv -t rate_dph -T temperature_c --mode foo -o %O%", 2, "--mode = 'foo'"},
       {"fit %D%/good.csv -t rate_dph -T rate_dph --mode compensate -o %O%", 2, "must differ"},
       {"fit %D%/good.csv -t rate_dph -T temperature_c, --mode compensate -o %O%", 2,

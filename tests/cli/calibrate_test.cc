@@ -252,6 +252,12 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
        "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
+      {"bad hysteresis", "hysteresis = \"sometimes\"\n" + std::string(kAxes) + unit,
+       "bad.toml:1: hysteresis = 'sometimes': must be auto, on or off"},
+      {"hysteresis, not identified", "method = \"poly\"\nhysteresis = \"on\"\n" +
+       std::string(kAxes) + unit, "bad.toml:2: hysteresis = 'on': must be auto unless"},
+      {"reference out of range", "reference_temperature_c = 500\n" + std::string(kAxes) + unit,
+       "bad.toml:1: reference_temperature_c = 500: must be in [-100, 200]"},
       {"serial with a slash", std::string(kAxes) + "\n[[unit]]\nserial = \"a/b\"\ncalibration = "
        "\"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n", "must be usable as a folder"},
   };

@@ -122,7 +122,7 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"zero repeats", p + "--repeats 0", 2, "--repeats = 0"},
       {"small window", p + "--window 4", 2, "--window = 4"},
       {"compensate without temperature", "evaluate %IN% -t rate_dph --mode compensate", 2,
-       "needs --temperature"},
+       "needs a temperature channel"},
       {"missing truth", p + "--truth drift", 2, "column 'drift' not found"},
       {"truth is target", p + "--truth rate_dph", 2, "must differ from --target"},
       {"too short", "evaluate %DIR%/short.csv -t rate_dph --mode predict --methods poly", 3,

@@ -50,7 +50,7 @@ TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   EXPECT_NE(r.out.find("wrote " + model), std::string::npos) << r.out;
   const auto json = nlohmann::json::parse(io::ReadTextFile(model));
   EXPECT_EQ(json["format"], "gyrodrift-model");
-  EXPECT_EQ(json["format_version"], 4);
+  EXPECT_EQ(json["format_version"], 5);
   EXPECT_EQ(json["training"]["target_column"], "rate_dph");
   EXPECT_EQ(json["training"]["temperature_column"], "temperature_c");
   EXPECT_EQ(json["training"]["samples"], 400);
@@ -224,7 +224,7 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"unknown decomposition", "fit %IN% -t rate_dph --mode predict --decomposition wavelet", 2,
        "--decomposition = 'wavelet'"},
       {"compensate without temperature", "fit %IN% -t rate_dph --mode compensate", 2,
-       "needs --temperature"},
+       "needs a temperature channel"},
       {"temperature is target", "fit %IN% -t rate_dph -T rate_dph --mode compensate", 2,
        "must differ from --target"},
       {"zero lags", "fit %IN% -t rate_dph --mode predict --lags 0", 2, "--lags = '0'"},
@@ -235,11 +235,17 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"hidden for linear compensation",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--hidden 20",
-       2, "not --method thermal"},
+       2, "--hidden = 20: must be auto for method 'thermal'"},
       {"lags in compensate mode",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--lags 8",
-       2, "--lags = 8: applies to --mode predict"},
+       2, "--lags = 8: must be left unset in mode 'compensate'"},
+      {"bad hysteresis",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate --hysteresis sometimes", 2,
+       "--hysteresis = 'sometimes': must be one of auto, on, off"},
+      {"hysteresis for poly",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate -m poly --hysteresis off", 2,
+       "--hysteresis = 'off': must be auto unless mode is 'compensate'"},
       {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "--ensemble = 0"},
       {"few realisations", "fit %IN% -t rate_dph --mode predict --realisations 5", 2,
        "--realisations = 5"},

@@ -7,11 +7,18 @@
 // thermal states s_j = L^q(T_c(j); tau_j) (q cascaded first-order lags of one channel: the
 // temperature at some depth of a winding pack, or of a board behind the case),
 //   drift(t) = b0 + sum_c a_c z_c(t) + sum_j [ sum_{p=1..P} g_jp zs_j(t)^p + r_j ds_j/dt (t) ]
+//              [ + h H_w(s_k)(t) ]
 // where zs_j is s_j standardised like its channel and ds_j/dt = (L^(q-1) - L^q)(T; tau_j) / tau_j
 // the state's rate (K/s). The levels and their powers carry the stress and static-bias
 // curvature (the coating stress follows the coil's mean temperature, the electronics their own),
 // the rates the Shupe drift (temperature rates inside the pack), the difference of two levels
 // the static gradient; METHOD.md section 1. The intercept b0 is the unit's repeatable bias.
+// The optional last term is thermal hysteresis, a bias that differs between heating and cooling
+// through the same temperature (coil adhesive and potting relax with a memory of the direction):
+// H_w(s) = (s - P_w[s]) / w in [-1, 1], where P_w is the play operator (backlash) of half-width
+// w K on the level of one chosen state s_k, the elementary hysteron of the Prandtl-Ishlinskii
+// model (Brokate & Sprekels, Hysteresis and Phase Transitions, 1996, ch. 2): +1 after the state
+// has risen by 2w, -1 after it has fallen by 2w, held through dwells.
 //
 // Identification: every candidate state (channel, tau) with tau on a geometric grid
 // (shortest_tau_s .. longest_tau_s, taus_per_octave per factor 2, and at most
@@ -19,7 +26,9 @@
 // P + 1 columns; every subset of at most max_states candidates, with or without the channels'
 // linear terms (the intercept alone included), is scored by K-fold cross-validation over
 // contiguous blocks of the run (or groups of whole regimes: Segments below), and the subset of
-// least cross-validated error is refitted on the whole run by least squares (QR). The search
+// least cross-validated error is refitted on the whole run by least squares (QR). Where the
+// hysteresis term is tried (HysteresisTerm), each subset is also scored with H_w of each of its
+// states for every w in hysteresis_widths_k. The search
 // works on per-block Gram matrices, so it costs one pass over the data (O(N M^2), M = all
 // candidate columns) plus a small solve per subset and fold.
 //
@@ -41,8 +50,9 @@
 // dwells, regimes, cross-validated skill against the intercept alone, the conditioning of the
 // chosen regressors and how far the candidate states can lag, with warnings where the run cannot
 // identify the model.
-// Cost: O(N (C G (q + P)) + N M^2) for G grid constants and M = 1 + C + C G (P + 1) columns; a
-// 16-h 1 Hz run with one channel takes about 0.12 s (bench_drift's BM_ThermalFit).
+// Cost: O(N (C G (q + P + W)) + N M^2) for G grid constants, W hysteresis widths tried and
+// M = 1 + C + C G (P + 1 + W) columns; a 16-h 1 Hz run with one channel takes about 0.3 s
+// (bench_drift's BM_ThermalFit).
 #pragma once
 
 #include <Eigen/Core>
@@ -50,11 +60,27 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrodrift/drift/learner.h"
 
 namespace gyrodrift::drift {
+
+// Whether the identification tries the hysteresis term H_w (header comment).
+enum class HysteresisTerm {
+  kAuto,  // for calibration runs of at least kHysteresisAutoMinDurationS
+  kOn,    // always
+  kOff,   // never
+};
+std::string_view ToString(HysteresisTerm term);
+HysteresisTerm HysteresisTermFromString(std::string_view name);  // "auto", "on", "off"
+
+// kAuto's shortest calibration run, s [choice, measured on the independent gyro family,
+// docs/drift.md 4.7]: on 16-h and 12-h calibrations the term lowered the error on the median and
+// the worst units; on 8-h ones it fitted slow noise on units without hysteresis and lost more in
+// the worst tenth than it won.
+inline constexpr double kHysteresisAutoMinDurationS = 12.0 * 3600.0;
 
 struct ThermalModelOptions {
   double shortest_tau_s = 30.0;   // first grid constant, s, in [1, 1e6]
@@ -73,10 +99,17 @@ struct ThermalModelOptions {
   bool folds_at_regimes = false;
   // A sample belongs to a ramp when its 60-s smoothed rate exceeds this, K/min, in (0, 100].
   double ramp_rate_k_per_min = 0.1;
+  HysteresisTerm hysteresis = HysteresisTerm::kAuto;
+  // Half-widths w of the play operator tried, K, each in (0, 100], at most 8 [choice, docs/drift.md
+  // 4.7: a wide play on a slow state acts as one more slow state and imitates the run's slow
+  // noise; 8 K failed, 4 K did no better than these on the family].
+  std::vector<double> hysteresis_widths_k{0.5, 1.0, 2.0};
   bool operator==(const ThermalModelOptions&) const = default;
   void Validate() const;  // throws OptionError naming the field
   // The candidate constants for a run of `duration_s` seconds.
   std::vector<double> Grid(double duration_s) const;
+  // Whether a run of `duration_s` seconds tries the hysteresis term.
+  bool TriesHysteresis(double duration_s) const;
 };
 
 // One thermal state: `order` cascaded first-order lags of channel `channel` with constant tau_s.
@@ -122,6 +155,7 @@ struct CalibrationReport {
   int nonlinear_units = 0;
   double nonlinear_ridge_c = 0.0;
   double cv_rmse_nonlinear = std::numeric_limits<double>::quiet_NaN();
+  bool hysteresis_tried = false;               // the search tried the hysteresis term
   std::vector<std::string> warnings;           // empty: the run identifies the model
   std::string Summary() const;                 // one line
 };
@@ -133,7 +167,12 @@ struct ThermalRegression {
   std::vector<double> centre_c, scale_k;  // per channel
   std::vector<bool> linear;               // per channel: z_c is a regressor
   std::vector<ThermalState> states;
-  Eigen::VectorXd coefficients;  // b0, the linear terms, then per state its powers and rate
+  // The hysteresis term H_w(states[hysteresis_state]) with w = hysteresis_width_k, the last
+  // coefficient; hysteresis_state = -1: none. The play operator starts at the state's level at
+  // each record's first sample (no direction yet).
+  int hysteresis_state = -1;
+  double hysteresis_width_k = 0.0;
+  Eigen::VectorXd coefficients;  // b0, the linear terms, per state its powers and rate, then h
   Eigen::MatrixXd covariance;    // of the coefficients
   double cv_slow_sd = 0.0;       // s_cv above, target units
   // Nonlinear option: an ELM of the regressors but the intercept (columns 1.. of Regressors),
@@ -142,12 +181,13 @@ struct ThermalRegression {
   CalibrationReport report;
 
   int channels() const { return static_cast<int>(centre_c.size()); }
+  bool has_hysteresis() const { return hysteresis_state >= 0; }
   // N x coefficients() design of temperatures (N x channels()), the lag states restarting at
   // every record start (see IdentifyThermalModel).
   Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                              const std::vector<Eigen::Index>& record_starts = {}) const;
-  // "1", "T1", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)"; with one name per channel, the channels
-  // are named by them ("L2(coil_c; 480 s)").
+  // "1", "T1", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)", "H(L2(T1; 480 s); 1 K)"; with one name
+  // per channel, the channels are named by them ("L2(coil_c; 480 s)").
   std::vector<std::string> RegressorNames(const std::vector<std::string>& channel_names = {}) const;
   Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                            const std::vector<Eigen::Index>& record_starts = {}) const;

@@ -11,6 +11,7 @@
 //   seed = 1                      # optional
 //   nonlinear = false             # optional, fit --nonlinear
 //   reference_temperature_c = 20  # optional, fit --reference-temperature
+//   hysteresis = "auto"           # optional, fit --hysteresis: auto | on | off
 //   drift_window_s = 100          # optional: residual drift = RMS of block means this long
 //
 //   [limits]                      # optional; a limit left out is not checked
@@ -78,12 +79,14 @@ struct Manifest {
   std::uint64_t seed = 1;
   bool nonlinear = false;
   double reference_c = std::numeric_limits<double>::quiet_NaN();
+  drift::HysteresisTerm hysteresis = drift::HysteresisTerm::kAuto;
   double drift_window_s = 100.0;  // in [1, 1e5]
   Limits limits;
   std::vector<AxisSpec> axes;  // 1 to io::kMaxModelAxes
   std::vector<UnitSpec> units;  // at least one
 
-  // The drift options every axis is fitted with (compensate mode); rate_hz is settled per log.
+  // The drift options every axis is fitted with (compensate mode; drift::MakeDriftOptions, as
+  // fit's flags); rate_hz is settled per log.
   drift::DriftOptions FitOptions() const;
 };
 

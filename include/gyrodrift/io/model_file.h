@@ -47,7 +47,9 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // their identification; older files read with the defaults.
 // Version 4 adds files of several axes ("axes"; a one-axis file keeps the version-3 layout) and
 // the target's rate unit (training.rate_unit).
-inline constexpr int kModelFormatVersion = 4;
+// Version 5 adds the thermal models' hysteresis term and the options that choose it (older files
+// read as identified without it).
+inline constexpr int kModelFormatVersion = 5;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 

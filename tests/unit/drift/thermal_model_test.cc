@@ -1,11 +1,13 @@
 // The identification of a thermal drift model (thermal_model.h): it finds the state a synthetic
-// drift was built from, among the grid's candidates, by cross-validation; regimes are told
+// drift was built from, among the grid's candidates, by cross-validation, and a hysteresis term
+// where the drift has one; regimes are told
 // apart; beyond the calibration's range the powers continue along their tangent; bad options and
 // runs too short to cross-validate are refused; a run without cooling or dwells is flagged.
 #include "gyrodrift/drift/thermal_model.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "gyrodrift/common/error.h"
@@ -113,6 +115,88 @@ TEST(ThermalModel, SeveralRecordsRestartTheirStates) {
                DataError);
   EXPECT_THROW(m.Estimate(t, {0}), DataError);
   EXPECT_THROW(m.Estimate(t, {2 * n}), DataError);
+}
+
+// The play operator of half-width w (K) of x, (x - play) / w, started at x[0].
+Eigen::VectorXd Play(const Eigen::VectorXd& x, double w) {
+  Eigen::VectorXd h(x.size());
+  double play = x[0];
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    play = std::clamp(play, x[i] - w, x[i] + w);
+    h[i] = (x[i] - play) / w;
+  }
+  return h;
+}
+
+// A gyro whose bias on cooling sits 0.16 deg/h below its bias on heating through the same
+// temperature (a backlash of 1 K on the state's level): the identification finds the term, its
+// state and width, and without it the estimate is several times worse.
+TEST(ThermalModel, FindsAHysteresisTheDriftHas) {
+  const Eigen::VectorXd t = Programme(16.0);
+  const Eigen::VectorXd s = State(t, 480.0);
+  Eigen::VectorXd a(t.size());
+  FirstOrderLag(t, 480.0, 1.0, a);
+  const Eigen::VectorXd hysteresis = Play(s, 1.0);
+  Rng rng(4, 0);
+  Eigen::VectorXd drift(t.size()), y(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double d = s[i] - 20.0;
+    drift[i] = 0.1 + 2e-3 * d + 4e-5 * d * d + 30.0 * (a[i] - s[i]) / 480.0 + 0.08 * hysteresis[i];
+    y[i] = drift[i] + 0.2 * rng.Normal();
+  }
+  auto rms = [&](const Eigen::VectorXd& e) {
+    return std::sqrt((e - drift).squaredNorm() / static_cast<double>(drift.size()));
+  };
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  EXPECT_TRUE(m.report.hysteresis_tried);
+  ASSERT_TRUE(m.has_hysteresis()) << m.Summary();
+  EXPECT_EQ(m.hysteresis_width_k, 1.0);
+  EXPECT_EQ(m.states[static_cast<size_t>(m.hysteresis_state)].tau_s, 480.0) << m.Summary();
+  EXPECT_NEAR(m.coefficients[m.coefficients.size() - 1], 0.08, 0.01);
+  EXPECT_EQ(m.RegressorNames().back(), "H(L2(T1; 480 s); 1 K)");
+  EXPECT_NE(m.Summary().find("hysteresis of the 480-s state (play 1 K)"), std::string::npos)
+      << m.Summary();
+  const double with_term = rms(m.Estimate(t));
+  EXPECT_LT(with_term, 0.01) << m.Summary();
+
+  ThermalModelOptions off;
+  off.hysteresis = HysteresisTerm::kOff;
+  const ThermalRegression without = IdentifyThermalModel(t, y, 1.0, off);
+  EXPECT_FALSE(without.report.hysteresis_tried);
+  EXPECT_FALSE(without.has_hysteresis());
+  EXPECT_GT(rms(without.Estimate(t)), 3.0 * with_term) << without.Summary();
+
+  // The play starts afresh with every record, as the lags do.
+  const Eigen::Index half = t.size() / 2;
+  EXPECT_EQ(m.Estimate(t, {half}).tail(t.size() - half), m.Estimate(t.tail(t.size() - half)));
+}
+
+TEST(ThermalModel, HysteresisIsTriedOnLongRunsOrWhenAsked) {
+  ThermalModelOptions o;
+  EXPECT_EQ(o.hysteresis, HysteresisTerm::kAuto);
+  EXPECT_FALSE(o.TriesHysteresis(kHysteresisAutoMinDurationS - 1.0));
+  EXPECT_TRUE(o.TriesHysteresis(kHysteresisAutoMinDurationS));
+  o.hysteresis = HysteresisTerm::kOn;
+  EXPECT_TRUE(o.TriesHysteresis(3600.0));
+  o.hysteresis = HysteresisTerm::kOff;
+  EXPECT_FALSE(o.TriesHysteresis(1e6));
+  o.hysteresis = HysteresisTerm::kAuto;
+  o.hysteresis_widths_k.clear();
+  EXPECT_FALSE(o.TriesHysteresis(1e6));  // nothing to try
+  EXPECT_NO_THROW(o.Validate());
+  o.hysteresis = HysteresisTerm::kOn;
+  EXPECT_THROW(o.Validate(), OptionError);  // on, with no width
+  o.hysteresis_widths_k = {1.0, 0.0};
+  EXPECT_THROW(o.Validate(), OptionError);
+  o.hysteresis_widths_k.assign(9, 1.0);
+  EXPECT_THROW(o.Validate(), OptionError);
+  EXPECT_EQ(HysteresisTermFromString("on"), HysteresisTerm::kOn);
+  EXPECT_EQ(ToString(HysteresisTerm::kAuto), "auto");
+  EXPECT_THROW(HysteresisTermFromString("sometimes"), OptionError);
+  // An 8-h run does not try it by default; the report says so.
+  const Eigen::VectorXd t = Programme(8.0);
+  const Eigen::VectorXd y = 0.01 * (State(t, 240.0).array() - 20.0);
+  EXPECT_FALSE(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}).report.hysteresis_tried);
 }
 
 TEST(ThermalModel, SegmentsTellRampsFromDwells) {

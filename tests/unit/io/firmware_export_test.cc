@@ -1,6 +1,6 @@
 // Firmware export: the coefficients JSON, evaluated with the equation docs/firmware.md documents,
-// reproduces drift::EstimateDrift (one and two channels, ms-elm, a reference temperature, several
-// axes); rendering is deterministic; the C header has the documented shape; models that cannot
+// reproduces drift::EstimateDrift (one and two channels, ms-elm, a reference temperature, a
+// hysteresis term, several axes); rendering is deterministic; the C header has the documented shape; models that cannot
 // run in firmware and bad options are refused with one line naming the reason. The C header's
 // arithmetic is checked by compiling it: tests/cli/export_test.cc.
 #include "gyrodrift/io/firmware_export.h"
@@ -33,18 +33,23 @@ struct Log {
   Eigen::MatrixXd temperature;  // case, board (a lag of the case, warmer)
 };
 
-// Temperature swings, a drift following a lagged case temperature, its rate and the board.
-Log MakeLog(Eigen::Index n, std::uint64_t seed, double offset_c = 0.0) {
+// Temperature swings, a drift following a lagged case temperature, its rate and the board, and
+// with hysteresis_dph a bias that differs between heating and cooling (a backlash of 1 K on the
+// lagged temperature).
+Log MakeLog(Eigen::Index n, std::uint64_t seed, double offset_c = 0.0,
+            double hysteresis_dph = 0.0) {
   Log log{Eigen::VectorXd(n), Eigen::MatrixXd(n, 2)};
   Rng rng(seed, 0);
-  double lagged = 20.0 + offset_c;
+  double lagged = 20.0 + offset_c, play = lagged;
   for (Eigen::Index t = 0; t < n; ++t) {
     const double x = static_cast<double>(t) / static_cast<double>(n);
     log.temperature(t, 0) = offset_c + 20.0 + 15.0 * std::sin(2 * std::numbers::pi * 1.5 * x);
     const double previous = lagged;
     lagged += (log.temperature(t, 0) - lagged) / 40.0;
+    play = std::clamp(play, lagged - 1.0, lagged + 1.0);
     log.rate[t] = 0.01 * (lagged - 20.0) + 0.0004 * (lagged - 20.0) * (lagged - 20.0) +
-                  4.0 * (lagged - previous) + 0.02 * rng.Normal();
+                  4.0 * (lagged - previous) + hysteresis_dph * (lagged - play) +
+                  0.02 * rng.Normal();
   }
   Eigen::VectorXd board(n);
   drift::FirstOrderLag(log.temperature.col(0), 200.0, 1.0, board);
@@ -74,7 +79,8 @@ LoadedModel Fit(const Log& log, drift::DriftOptions o, int channels = 1,
 }
 
 // The estimate of every axis from the coefficients JSON, with the equation of docs/firmware.md:
-// per sub-model b0 + sum a_c z_c + sum_j [sum_p g_jp P_p(zs_j) + r_j ds_j/dt] - reference_estimate.
+// per sub-model b0 + sum a_c z_c + sum_j [sum_p g_jp P_p(zs_j) + r_j ds_j/dt] + h H_w(s_k)
+// - reference_estimate.
 Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& temperature_c) {
   const Eigen::Index n = temperature_c.rows();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(j["axes"].size()));
@@ -90,8 +96,10 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
               l["scale_k"].get<double>())
                  .matrix();
       }
+      std::vector<Eigen::VectorXd> levels;  // of each state, degC
       for (const json& s : sub["states"]) {
         const auto c = s["channel"].get<Eigen::Index>();
+        Eigen::VectorXd& level = levels.emplace_back(n);
         const double gain = s["gain"].get<double>(), tau = s["tau_s"].get<double>();
         const double lo = s["level_min"].get<double>(), hi = s["level_max"].get<double>();
         const std::vector<double> powers = s["powers"].get<std::vector<double>>();
@@ -103,6 +111,7 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
             x += gain * (input - x);
             input = x;
           }
+          level[t] = input;
           const double z = (input - s["centre_c"].get<double>()) / s["scale_k"].get<double>();
           const double edge = std::clamp(z, lo, hi);
           double sum = 0.0;
@@ -111,6 +120,16 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
             sum += powers[p - 1] * (std::pow(edge, pp) + pp * std::pow(edge, pp - 1) * (z - edge));
           }
           e[t] += sum + s["rate"].get<double>() * (before_last - input) / tau;
+        }
+      }
+      if (!sub["hysteresis"].is_null()) {
+        const json& h = sub["hysteresis"];
+        const Eigen::VectorXd& level = levels[h["state"].get<size_t>()];
+        const double w = h["width_k"].get<double>();
+        double play = level[0];
+        for (Eigen::Index t = 0; t < n; ++t) {
+          play = std::clamp(play, level[t] - w, level[t] + w);
+          e[t] += h["coefficient"].get<double>() * (level[t] - play) / w;
         }
       }
       out.col(static_cast<Eigen::Index>(a)) += e;
@@ -146,29 +165,38 @@ class FirmwareExport : public ::testing::Test {
     drift::DriftOptions ref = Compensate(Method::kThermal);
     ref.reference_c = 25.0;
     referenced_ = new LoadedModel(Fit(log, ref));
+    drift::DriftOptions hyst = Compensate(Method::kThermal);
+    hyst.thermal.hysteresis = drift::HysteresisTerm::kOn;
+    hyst.thermal.max_states = 1;  // no pair of nearly collinear states, whose float rounding
+                                  // the other models already exercise
+    hysteresis_ = new LoadedModel(Fit(MakeLog(3000, 3, 0.0, 0.3), hyst));
   }
   static void TearDownTestSuite() {
-    for (LoadedModel* m : {thermal_, two_, ms_, referenced_}) delete m;
+    for (LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_}) delete m;
   }
   static LoadedModel* thermal_;
   static LoadedModel* two_;
   static LoadedModel* ms_;
   static LoadedModel* referenced_;
+  static LoadedModel* hysteresis_;  // with a hysteresis term
 };
 LoadedModel* FirmwareExport::thermal_ = nullptr;
 LoadedModel* FirmwareExport::two_ = nullptr;
 LoadedModel* FirmwareExport::ms_ = nullptr;
 LoadedModel* FirmwareExport::referenced_ = nullptr;
+LoadedModel* FirmwareExport::hysteresis_ = nullptr;
 
 const ExportOptions kJson{.format = ExportFormat::kCoefficientsJson};
 
 TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
   // The test run 8 K warmer than the calibration: the powers continue along their tangents.
   const Log test = MakeLog(2000, 4, 8.0);
-  for (const LoadedModel* m : {thermal_, two_, ms_, referenced_}) {
+  ASSERT_TRUE(hysteresis_->model.sub_models[0].thermal->has_hysteresis())
+      << hysteresis_->model.Summary();
+  for (const LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_}) {
     const json j = json::parse(RenderCoefficientsJson({*m}, kJson));
     EXPECT_EQ(j["format"], "gyrodrift-coefficients");
-    EXPECT_EQ(j["format_version"], 1);
+    EXPECT_EQ(j["format_version"], 2);
     EXPECT_EQ(j["rate_hz"], 1.0);
     const int channels = m->model.temperature_channels();
     const Eigen::MatrixXd t = test.temperature.leftCols(channels);
@@ -230,15 +258,17 @@ TEST_F(FirmwareExport, AxesShareTheChannelsAndLagsTheyHaveInCommon) {
 }
 
 // The header is C: the only test of its text is a compiler (the system's, as a user's would be).
-// Several axes with two channels, ms-elm, a reference and a model without states (no lag stage)
-// in one header, and that last model alone (a state struct without lags), double and float.
+// Several axes with two channels, ms-elm, a reference, a hysteresis term and a model without
+// states (no lag stage) in one header, and that last model alone (a state struct without lags),
+// double and float.
 TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
   drift::DriftOptions flat = Compensate(Method::kThermal);
   flat.thermal.max_states = 0;
   const LoadedModel stateless = Fit(MakeLog(3000, 3), flat, 2, "rate_z_dph");
   ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
-  const std::vector<LoadedModel> axes{*thermal_, *two_, *ms_, *referenced_, stateless};
+  const std::vector<LoadedModel> axes{*thermal_, *two_, *ms_, *referenced_, *hysteresis_,
+                                      stateless};
   const Log test = MakeLog(2000, 4, 8.0);
   const std::string dir = test::TempDir("firmware_header");
   for (const bool single : {false, true}) {

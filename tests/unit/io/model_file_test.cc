@@ -194,6 +194,42 @@ TEST(ModelFile, IdentifiedModelsOfTwoChannelsWithACorrectionComeBackExactly) {
   }
 }
 
+TEST(ModelFile, AHysteresisTermComesBackExactlyAndOlderFilesReadWithout) {
+  // A bias that differs between heating and cooling: a backlash of 1 K on the temperature.
+  Log log = MakeLog(4000, 17);
+  double play = log.temperature[0];
+  for (Eigen::Index t = 0; t < log.rate.size(); ++t) {
+    play = std::clamp(play, log.temperature[t] - 1.0, log.temperature[t] + 1.0);
+    log.rate[t] += 0.3 * (log.temperature[t] - play);
+  }
+  drift::DriftOptions o = Small(Mode::kCompensate, Method::kThermal);
+  o.thermal.hysteresis = drift::HysteresisTerm::kOn;
+  const drift::DriftModel model = drift::FitDriftModel(log.rate, log.temperature, o);
+  ASSERT_TRUE(model.sub_models[0].thermal->has_hysteresis()) << model.Summary();
+  const std::string text = RenderModelFile(model, Info());
+  const LoadedModel loaded = ParseModelFile(text, "m.json");
+  EXPECT_EQ(RenderModelFile(loaded.model, loaded.info), text);
+  EXPECT_EQ(loaded.model.options.thermal, o.thermal);
+  EXPECT_EQ(drift::EstimateDriftWithSd(model, log.temperature),
+            drift::EstimateDriftWithSd(loaded.model, log.temperature));
+  // A term naming a state the model does not have is refused.
+  json j = json::parse(text);
+  j["model"]["sub_models"][0]["thermal"]["hysteresis"]["state"] = 7;
+  ExpectRefused(Reseal(j), "hysteresis");
+  // Files before version 5 were identified without the term: their options say so.
+  j = json::parse(RenderModelFile(
+      drift::FitDriftModel(log.rate, log.temperature, Small(Mode::kCompensate, Method::kThermal)),
+      Info()));
+  j["format_version"] = 4;
+  j["options"]["thermal"].erase("hysteresis");
+  j["options"]["thermal"].erase("hysteresis_widths_k");
+  j["model"]["sub_models"][0]["thermal"].erase("hysteresis");
+  j["model"]["sub_models"][0]["thermal"]["report"].erase("hysteresis_tried");
+  const LoadedModel old = ParseModelFile(Reseal(j), "v4.json");
+  EXPECT_EQ(old.model.options.thermal.hysteresis, drift::HysteresisTerm::kOff);
+  EXPECT_FALSE(old.model.sub_models[0].thermal->has_hysteresis());
+}
+
 TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   drift::DriftOptions o;
   o.mode = Mode::kCompensate;
@@ -246,6 +282,8 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.thermal.longest_tau_share = 0.1 + 0.2;
   o.thermal.max_states = 3;
   o.thermal.folds_at_regimes = true;
+  o.thermal.hysteresis = drift::HysteresisTerm::kOn;
+  o.thermal.hysteresis_widths_k = {0.1 + 0.2, 3.0};
   o.seed = 123456789012345ULL;
   o.threads = 3;
   const json j = DriftOptionsToJson(o);
@@ -338,9 +376,9 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 5;
+  j["format_version"] = 6;
   ExpectRefused(Reseal(j),
-                "format_version 5 is not supported (this gyrodrift reads versions 1 to 4)");
+                "format_version 6 is not supported (this gyrodrift reads versions 1 to 5)");
   j["format_version"] = 0;
   ExpectRefused(Reseal(j), "format_version 0 is not supported");
   // A version-1 file (before the feature set, the limit flag and the range were stored) loads,

@@ -1,0 +1,136 @@
+#include "gyrodrift/drift/fit_settings.h"
+
+#include <charconv>
+#include <string>
+#include <utility>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+// "auto" or an integer in [lo, hi], the value of setting `name`; -1 for "auto".
+int AutoOrInteger(std::string_view name, const std::string& text, int lo, int hi) {
+  if (text == "auto") return -1;
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || value < lo || value > hi) {
+    ThrowOption(name, "'" + text + "'",
+                "auto or an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return value;
+}
+
+// The enum named `text`, a refusal naming the setting rather than the field it sets.
+template <class Parse>
+auto Named(std::string_view name, const std::string& text, Parse parse) {
+  try {
+    return parse(text);
+  } catch (const OptionError& e) {
+    throw OptionError(std::string(name), e.value(), e.rule());
+  }
+}
+
+// The fields of DriftOptions a setting sets, as DriftOptions::Validate names them: a refusal of
+// one names the setting instead.
+constexpr std::pair<std::string_view, std::string_view> kSettingOfField[] = {
+    {"ensemble_size", "ensemble"},         {"realisations", "realisations"},
+    {"threads", "threads"},                {"time constant (s)", "time_constants"},
+    {"time constants", "time_constants"},  {"rate_hz", "rate_hz"},
+};
+
+bool ElmBased(Method method) {
+  return method == Method::kMsElm || method == Method::kEmdElm || method == Method::kElm;
+}
+
+}  // namespace
+
+Method ResolveMethod(std::string_view method, Mode mode) {
+  if (method != "auto") return MethodFromString(method);
+  return mode == Mode::kCompensate ? Method::kThermal : Method::kMsElm;
+}
+
+DriftOptions MakeDriftOptions(const FitSettings& s) {
+  DriftOptions o;
+  o.mode = Named("mode", s.mode, ModeFromString);
+  o.method = Named("method", s.method, [&](const std::string& m) { return ResolveMethod(m, o.mode); });
+  const std::string method(ToString(o.method));
+  o.decomposition.method = Named("decomposition", s.decomposition, decomposition::MethodFromString);
+  o.decomposition.ensemble_size = s.ensemble;
+  o.selection.monte_carlo.realisations = s.realisations;
+  o.seed = s.seed;
+  o.threads = s.threads;
+  o.features.rate_hz = s.rate_hz;
+  o.features.thermal_set = Named("thermal_features", s.thermal_features, ThermalSetFromString);
+  if (!s.time_constants.empty()) {
+    o.features.time_constants_s = s.time_constants;
+    o.features.limit_time_constants = false;  // the user's constants, all of them
+  }
+  const bool compensate = o.mode == Mode::kCompensate;
+  if (compensate && !s.has_temperature) {
+    throw UsageError(
+        "mode 'compensate' needs a temperature channel (the compensation model runs on "
+        "temperature alone)");
+  }
+  o.features.use_temperature = !compensate && s.has_temperature;
+
+  if (!s.lags.empty()) {
+    const int p = AutoOrInteger("lags", s.lags, 1, 256);
+    if (compensate) {
+      ThrowOption("lags", s.lags,
+                  "left unset in mode 'compensate' (a compensate-mode model sees temperature "
+                  "only; lags apply to mode 'predict')");
+    }
+    o.auto_lags = p < 0;
+    if (p > 0) o.features.lags = p;
+  }
+  if (s.nonlinear) {
+    if (!IdentifiesThermalModel(o)) {
+      ThrowOption("nonlinear", "true",
+                  "false unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
+    }
+    o.linear_compensation = false;
+  }
+  if (!s.hidden.empty()) {
+    const int hidden = AutoOrInteger("hidden", s.hidden, 1, 100000);
+    if (hidden > 0) {
+      if (!ElmBased(o.method)) {
+        ThrowOption("hidden", s.hidden,
+                    "auto for method '" + method +
+                        "' (it applies to the ELM methods: ms-elm, emd-elm, elm)");
+      }
+      if (compensate && o.method != Method::kElm && o.linear_compensation) {
+        ThrowOption("hidden", s.hidden,
+                    "auto for compensate-mode " + method +
+                        ", which fits linear sub-models (docs/drift.md 1.2; it applies to mode "
+                        "'predict', method 'elm' and the nonlinear correction)");
+      }
+      o.learner.elm.selection = elm::Selection::kFixed;
+      o.learner.elm.hidden_units = hidden;
+    }
+  }
+  if (s.reference_temperature) {
+    const std::string value = FormatValue(*s.reference_temperature);
+    if (!compensate) ThrowOption("reference_temperature", value, "unset in mode 'predict'");
+    RequireInRange("reference_temperature", *s.reference_temperature, -100.0, 200.0);
+    o.reference_c = *s.reference_temperature;
+  }
+  o.thermal.hysteresis = Named("hysteresis", s.hysteresis, HysteresisTermFromString);
+  if (o.thermal.hysteresis != HysteresisTerm::kAuto && !IdentifiesThermalModel(o)) {
+    ThrowOption("hysteresis", "'" + s.hysteresis + "'",
+                "auto unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
+  }
+  try {
+    o.Validate();
+  } catch (const OptionError& e) {
+    for (const auto& [field, setting] : kSettingOfField) {
+      if (e.option() == field) throw OptionError(std::string(setting), e.value(), e.rule());
+    }
+    throw;
+  }
+  return o;
+}
+
+}  // namespace gyrodrift::drift
