@@ -258,24 +258,37 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
       ->required()
       ->check(kInputFile);
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
-  cmd->add_option("--rate-hz", args->rate_hz, "sample rate in Hz (tau0 = 1 / rate)")->required();
+  BindSetting(cmd->add_option("--rate-hz", args->rate_hz, "sample rate in Hz (tau0 = 1 / rate)")
+                  ->required(),
+              {"rate_hz"});
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  cmd->add_option("--type", args->type, "rate (gyro output) | angle (integrated)")
-      ->capture_default_str();
-  cmd->add_option("--dev", args->dev, "oadev|adev|mdev|hdev|ohdev|tdev|totdev")
-      ->capture_default_str();
-  cmd->add_option("--taus", args->taus, "all | octave | decade | comma-separated taus in s")
-      ->capture_default_str();
-  cmd->add_option("--units", args->units, "rate unit: dph (deg/h) | dps (deg/s) | rads (rad/s)")
-      ->capture_default_str();
-  cmd->add_option("--confidence", args->confidence, "two-sided confidence of the bounds, in (0,1)")
-      ->capture_default_str();
-  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
-      ->capture_default_str();
-  cmd->add_option("--fit-tau-min", args->fit_tau_min_s, "noise fit: smallest tau in s")
-      ->capture_default_str();
-  cmd->add_option("--fit-tau-max", args->fit_tau_max_s, "noise fit: largest tau in s");
+  BindSetting(cmd->add_option("--type", args->type, "rate (gyro output) | angle (integrated)")
+                  ->capture_default_str(),
+              {"type"});
+  BindSetting(cmd->add_option("--dev", args->dev, "oadev|adev|mdev|hdev|ohdev|tdev|totdev")
+                  ->capture_default_str(),
+              {"dev", "deviation"});
+  BindSetting(
+      cmd->add_option("--taus", args->taus, "all | octave | decade | comma-separated taus in s")
+          ->capture_default_str(),
+      {"taus", "tau_list_s"});
+  BindSetting(
+      cmd->add_option("--units", args->units, "rate unit: dph (deg/h) | dps (deg/s) | rads (rad/s)")
+          ->capture_default_str(),
+      {"units"});
+  BindSetting(cmd->add_option("--confidence", args->confidence,
+                              "two-sided confidence of the bounds, in (0,1)")
+                  ->capture_default_str(),
+              {"confidence"});
+  BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+                  ->capture_default_str(),
+              {"threads"});
+  BindSetting(cmd->add_option("--fit-tau-min", args->fit_tau_min_s, "noise fit: smallest tau in s")
+                  ->capture_default_str(),
+              {"tau_min_s"});
+  BindSetting(cmd->add_option("--fit-tau-max", args->fit_tau_max_s, "noise fit: largest tau in s"),
+              {"tau_max_s"});
   AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <map>
 #include <regex>
 #include <sstream>
 #include <vector>
@@ -96,79 +95,14 @@ CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_vi
   return flag;
 }
 
-std::string OptionErrorMessage(const CLI::App& app, const OptionError& error) {
+std::string OptionErrorMessage(const OptionError& error) {
   // Only a flag the user gave: a value the command derived (a rate read from time_s, a duration
   // from a profile file) keeps the library's name rather than blaming a flag nobody typed.
   for (const auto& [name, flag] : Bindings()) {
     if (name == error.option() && flag->count() > 0) {
       const std::string shown = flag->get_lnames().empty() ? "-" + flag->get_snames().front()
-                                                            : "--" + flag->get_lnames().front();
+                                                           : "--" + flag->get_lnames().front();
       return shown + " = " + error.value() + ": must be " + error.rule();
-    }
-  }
-  // Library field -> the flags that may set it, the first one the subcommand has wins.
-  static const std::map<std::string, std::vector<std::string>, std::less<>> kFlags = {
-      {"band_confidence", {"--band"}},
-      {"BEEMDAN bound", {"--bound"}},
-      {"causal ensemble_size", {"--ensemble"}},
-      {"causal window", {"--window"}},
-      {"coil.winding_asymmetry", {"--asymmetry"}},
-      {"confidence", {"--confidence"}},
-      {"decomposition method", {"--decomposition", "--method"}},
-      {"dev", {"--dev"}},
-      {"deviation", {"--dev"}},
-      {"duration_s", {"--duration"}},
-      {"ensemble_size", {"--ensemble"}},
-      {"fixed_sifts", {"--fixed-sifts"}},
-      {"format", {"--format"}},
-      {"hidden_units", {"--hidden"}},
-      {"horizon", {"--horizon"}},
-      {"input_rate_dph", {"--input-rate-dph"}},
-      {"lags", {"--lags"}},
-      {"max_imfs", {"--max-imfs"}},
-      {"max_sifts", {"--max-sifts"}},
-      {"method", {"--method"}},
-      {"methods", {"--methods"}},
-      {"mode", {"--mode"}},
-      {"noise scaling", {"--noise-scaling"}},
-      {"noise_stages", {"--noise-stages"}},
-      {"noise_strength", {"--noise"}},
-      {"prefix", {"--prefix"}},
-      {"preset", {"--preset"}},
-      {"profile", {"--profile"}},
-      {"protocol", {"--protocol"}},
-      {"protocols", {"--protocol"}},
-      {"rate_hz", {"--rate-hz"}},
-      {"realisations", {"--realisations"}},
-      {"repeats", {"--repeats"}},
-      {"s_number", {"--s-number"}},
-      {"sd_threshold", {"--sd"}},
-      {"single_precision", {"--float"}},
-      {"split", {"--split"}},
-      {"stop rule", {"--stop"}},
-      {"tau_list_s", {"--taus"}},
-      {"tau_max_s", {"--fit-tau-max"}},
-      {"tau_min_s", {"--fit-tau-min"}},
-      {"taus", {"--taus"}},
-      {"thermal_set", {"--thermal-features"}},
-      {"threads", {"--threads"}},
-      {"time constant (s)", {"--time-constants"}},
-      {"time constants", {"--time-constants"}},
-      {"type", {"--type"}},
-      {"units", {"--units"}},
-      {"winding", {"--winding"}},
-  };
-  // Only a flag the user gave: a value the command derived (a rate read from time_s, a duration
-  // from a profile file) keeps the library's name rather than blaming a flag nobody typed.
-  const auto flags = kFlags.find(error.option());
-  if (flags != kFlags.end()) {
-    for (const CLI::App* command : app.get_subcommands()) {
-      for (const std::string& flag : flags->second) {
-        const CLI::Option* option = command->get_option_no_throw(flag);
-        if (option != nullptr && option->count() > 0) {
-          return flag + " = " + error.value() + ": must be " + error.rule();
-        }
-      }
     }
   }
   return error.what();
@@ -247,6 +181,5 @@ void ParseTaus(const std::string& text, allan::AllanOptions* o) {
   }
   if (o->tau_list_s.empty()) ThrowOption("--taus", text, "all, octave, decade or a list of taus");
 }
-
 
 }  // namespace gyrodrift::cli

@@ -80,7 +80,7 @@ CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_vi
 // The one-line message for an option error: the library names its field or setting
 // (`ensemble_size = 0: must be ...`); when the user gave a flag bound to that name, the message
 // names the flag instead (`--ensemble = 0: must be ...`).
-std::string OptionErrorMessage(const CLI::App& app, const OptionError& error);
+std::string OptionErrorMessage(const OptionError& error);
 
 // Header name of a column spec (name or 1-based index). Throws UsageError like CsvTable.
 std::string ColumnName(const io::CsvTable& table, const std::string& spec);

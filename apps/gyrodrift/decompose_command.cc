@@ -184,38 +184,59 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  cmd->add_option("--method,-m", args->method, "emd|eemd|ceemdan|iceemdan|beemdan")
-      ->capture_default_str();
-  cmd->add_option("--stop", args->stop, "sifting stop rule: rilling|snumber|fixed|sd")
-      ->capture_default_str();
-  cmd->add_option("--max-sifts", args->max_sifts,
-                  "sift cap per IMF (0 = rule default: 2000 rilling/sd, 50 snumber)")
-      ->capture_default_str();
-  cmd->add_option("--s-number", args->s_number, "S of the S-number rule")->capture_default_str();
-  cmd->add_option("--fixed-sifts", args->fixed_sifts, "sifts per IMF for --stop fixed")
-      ->capture_default_str();
-  cmd->add_option("--sd", args->sd, "Cauchy SD threshold for --stop sd")->capture_default_str();
-  cmd->add_option("--max-imfs", args->max_imfs, "IMF cap (0 = until the residue is monotone)")
-      ->capture_default_str();
-  cmd->add_option("--ensemble,-I", args->ensemble, "ensemble size (noise-assisted methods)")
-      ->capture_default_str();
-  cmd->add_option("--noise", args->noise, "noise strength eps (relative to the signal's std)")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--method,-m", args->method, "emd|eemd|ceemdan|iceemdan|beemdan")
+                  ->capture_default_str(),
+              {"method"});
+  BindSetting(cmd->add_option("--stop", args->stop, "sifting stop rule: rilling|snumber|fixed|sd")
+                  ->capture_default_str(),
+              {"stop_rule", "sifting.stop_rule"});
+  BindSetting(cmd->add_option("--max-sifts", args->max_sifts,
+                              "sift cap per IMF (0 = rule default: 2000 rilling/sd, 50 snumber)")
+                  ->capture_default_str(),
+              {"sifting.max_sifts"});
+  BindSetting(cmd->add_option("--s-number", args->s_number, "S of the S-number rule")
+                  ->capture_default_str(),
+              {"sifting.s_number"});
+  BindSetting(cmd->add_option("--fixed-sifts", args->fixed_sifts, "sifts per IMF for --stop fixed")
+                  ->capture_default_str(),
+              {"sifting.fixed_sifts"});
+  BindSetting(
+      cmd->add_option("--sd", args->sd, "Cauchy SD threshold for --stop sd")->capture_default_str(),
+      {"sifting.sd_threshold"});
+  BindSetting(
+      cmd->add_option("--max-imfs", args->max_imfs, "IMF cap (0 = until the residue is monotone)")
+          ->capture_default_str(),
+      {"max_imfs"});
+  BindSetting(
+      cmd->add_option("--ensemble,-I", args->ensemble, "ensemble size (noise-assisted methods)")
+          ->capture_default_str(),
+      {"ensemble_size"});
+  BindSetting(
+      cmd->add_option("--noise", args->noise, "noise strength eps (relative to the signal's std)")
+          ->capture_default_str(),
+      {"noise_strength"});
   cmd->add_option("--seed", args->seed, "seed; realisation i uses stream (seed, i)")
       ->check(kSeed)
       ->capture_default_str();
-  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
-      ->capture_default_str();
-  cmd->add_option("--noise-scaling", args->scaling,
-                  "ICEEMDAN/BEEMDAN noise scaling: colominas2014|constant-snr")
-      ->capture_default_str();
-  cmd->add_option("--bound", args->bound,
-                  "BEEMDAN noise bound: energy (white-noise band) | stages | full (= ICEEMDAN)")
-      ->capture_default_str();
-  cmd->add_option("--band", args->band, "BEEMDAN energy band confidence: 0.95 or 0.99")
-      ->capture_default_str();
-  cmd->add_option("--noise-stages", args->noise_stages, "BEEMDAN stages with --bound stages")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+                  ->capture_default_str(),
+              {"threads"});
+  BindSetting(cmd->add_option("--noise-scaling", args->scaling,
+                              "ICEEMDAN/BEEMDAN noise scaling: colominas2014|constant-snr")
+                  ->capture_default_str(),
+              {"noise_scaling"});
+  BindSetting(
+      cmd->add_option("--bound", args->bound,
+                      "BEEMDAN noise bound: energy (white-noise band) | stages | full (= ICEEMDAN)")
+          ->capture_default_str(),
+      {"beemdan_bound"});
+  BindSetting(cmd->add_option("--band", args->band, "BEEMDAN energy band confidence: 0.95 or 0.99")
+                  ->capture_default_str(),
+              {"band_confidence"});
+  BindSetting(
+      cmd->add_option("--noise-stages", args->noise_stages, "BEEMDAN stages with --bound stages")
+          ->capture_default_str(),
+      {"noise_stages"});
   cmd->add_option("--noise-file", args->noise_file,
                   "CSV of white-noise realisations (one per column) to use instead of drawing")
       ->check(kInputFile);

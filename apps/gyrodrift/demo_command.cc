@@ -213,38 +213,51 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   cmd->add_option("--target", args->target,
                   "with --input: the gyro output column (name or 1-based index)");
   cmd->add_option("--temperature", args->temperature, "with --input: the temperature column");
-  args->rate_option =
+  args->rate_option = BindSetting(
       cmd->add_option("--rate-hz", args->rate_hz,
-                      "with --input: sample rate, Hz (default: from a time_s column, else 1)");
-  args->units_option = cmd->add_option("--units", args->units,
-                  "unit of the --input target for the Allan noise terms: dph|dps|rads")
-      ->capture_default_str();
+                      "with --input: sample rate, Hz (default: from a time_s column, else 1)"),
+      {"rate_hz"});
+  args->units_option = BindSetting(
+      cmd->add_option("--units", args->units,
+                      "unit of the --input target for the Allan noise terms: dph|dps|rads")
+          ->capture_default_str(),
+      {"units"});
   cmd->add_option("--seed", args->seed,
                   "seed of the simulation (run A; run B derives its own), decomposition and learners")
       ->capture_default_str()
       ->check(kSeed);
-  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+                  ->capture_default_str(),
+              {"threads"});
   AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
-  cmd->add_option("--duration", args->duration,
-                  "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
-      ->capture_default_str()
-      ->group("Advanced");
-  cmd->add_option("--ensemble", args->ensemble, "advanced: BEEMDAN ensemble size")
-      ->capture_default_str()
-      ->group("Advanced");
-  cmd->add_option("--realisations", args->realisations,
-                  "advanced: white-noise realisations of the selection's Monte-Carlo level (>= 20)")
-      ->capture_default_str()
-      ->group("Advanced");
-  cmd->add_option("--window", args->window,
-                  "advanced: trailing window of the causal protocol, samples")
-      ->capture_default_str()
-      ->group("Advanced");
-  cmd->add_option("--methods", args->methods, "advanced: all, or a list such as ms-elm,elm,poly")
-      ->capture_default_str()
-      ->group("Advanced");
+  BindSetting(
+      cmd->add_option("--duration", args->duration,
+                      "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
+          ->capture_default_str()
+          ->group("Advanced"),
+      {"duration_s"});
+  BindSetting(cmd->add_option("--ensemble", args->ensemble, "advanced: BEEMDAN ensemble size")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"ensemble_size"});
+  BindSetting(
+      cmd->add_option(
+             "--realisations", args->realisations,
+             "advanced: white-noise realisations of the selection's Monte-Carlo level (>= 20)")
+          ->capture_default_str()
+          ->group("Advanced"),
+      {"realisations"});
+  BindSetting(cmd->add_option("--window", args->window,
+                              "advanced: trailing window of the causal protocol, samples")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_window"});
+  BindSetting(cmd->add_option("--methods", args->methods,
+                              "advanced: all, or a list such as ms-elm,elm,poly")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"methods"});
   cmd->callback([args] { Run(*args); });
 });
 

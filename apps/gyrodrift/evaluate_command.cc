@@ -184,19 +184,29 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       "(method,protocol,rmse,rmse_std,mae,max_abs,train_s,predict_s) and table.csv.json.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/false);
   cmd->add_option("--truth", args->truth, "column to score against (e.g. drift_dph)");
-  cmd->add_option("--protocol", args->protocol, "paper|causal|both")->capture_default_str();
-  cmd->add_option("--split", args->split, "training share of the record, in [0.1, 0.95]")
-      ->capture_default_str();
-  cmd->add_option("--methods", args->methods,
-                  "all, or a comma-separated list of ms-elm,elm,emd-elm,poly,svr,bp")
-      ->capture_default_str();
-  cmd->add_option("--repeats,-r", args->repeats, "seeds seed..seed+R-1; mean and std over them")
-      ->capture_default_str();
-  cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
-      ->capture_default_str();
-  cmd->add_option("--horizon,-H", args->horizon,
-                  "predict mode: score H-step-ahead predictions (recursive for H > 1)")
-      ->capture_default_str();
+  BindSetting(
+      cmd->add_option("--protocol", args->protocol, "paper|causal|both")->capture_default_str(),
+      {"protocol", "protocols"});
+  BindSetting(
+      cmd->add_option("--split", args->split, "training share of the record, in [0.1, 0.95]")
+          ->capture_default_str(),
+      {"split"});
+  BindSetting(cmd->add_option("--methods", args->methods,
+                              "all, or a comma-separated list of ms-elm,elm,emd-elm,poly,svr,bp")
+                  ->capture_default_str(),
+              {"methods"});
+  BindSetting(
+      cmd->add_option("--repeats,-r", args->repeats, "seeds seed..seed+R-1; mean and std over them")
+          ->capture_default_str(),
+      {"repeats"});
+  BindSetting(
+      cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
+          ->capture_default_str(),
+      {"causal.window"});
+  BindSetting(cmd->add_option("--horizon,-H", args->horizon,
+                              "predict mode: score H-step-ahead predictions (recursive for H > 1)")
+                  ->capture_default_str(),
+              {"horizon"});
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
   cmd->callback([args] { Run(*args); });

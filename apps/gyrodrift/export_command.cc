@@ -69,12 +69,18 @@ const RegisterCommand kRegister("export", 75, [](CLI::App& app) {
       ->required()
       ->check(kInputFile);
   cmd->add_option("-o,--output", args->output, "file to write (C header or JSON)")->required();
-  cmd->add_option("--format,-f", args->format, "c|json-coefficients")->capture_default_str();
-  cmd->add_option("--prefix", args->prefix,
-                  "C: prefix of every identifier (a C identifier, at most 32 characters)")
-      ->capture_default_str();
-  cmd->add_flag("--float", args->single_precision,
-                "C: float arithmetic instead of double (FPUs without double precision)");
+  BindSetting(
+      cmd->add_option("--format,-f", args->format, "c|json-coefficients")->capture_default_str(),
+      {"format"});
+  BindSetting(
+      cmd->add_option("--prefix", args->prefix,
+                      "C: prefix of every identifier (a C identifier, at most 32 characters)")
+          ->capture_default_str(),
+      {"prefix"});
+  BindSetting(
+      cmd->add_flag("--float", args->single_precision,
+                    "C: float arithmetic instead of double (FPUs without double precision)"),
+      {"single_precision"});
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
     return gyrodrift::ExitCode(gyrodrift::ErrorKind::kUsage);
   } catch (const gyrodrift::OptionError& e) {
-    fmt::print(stderr, "gyrodrift: error: {}\n", gyrodrift::cli::OptionErrorMessage(app, e));
+    fmt::print(stderr, "gyrodrift: error: {}\n", gyrodrift::cli::OptionErrorMessage(e));
     return gyrodrift::ExitCode(e.kind());
   } catch (const gyrodrift::Error& e) {
     fmt::print(stderr, "gyrodrift: error: {}\n", e.what());

@@ -139,14 +139,20 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->check(kInputFile);
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  cmd->add_option("--protocol", args->protocol, "causal|paper")->capture_default_str();
-  cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
-      ->capture_default_str();
-  cmd->add_option("--horizon,-H", args->horizon,
-                  "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")
-      ->capture_default_str();
-  cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
-      ->capture_default_str();
+  BindSetting(cmd->add_option("--protocol", args->protocol, "causal|paper")->capture_default_str(),
+              {"protocol"});
+  BindSetting(
+      cmd->add_option("--window,-W", args->window, "causal protocol: trailing window W, samples")
+          ->capture_default_str(),
+      {"window"});
+  BindSetting(
+      cmd->add_option("--horizon,-H", args->horizon,
+                      "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")
+          ->capture_default_str(),
+      {"horizon"});
+  BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
+                  ->capture_default_str(),
+              {"threads"});
   AddLogOptions(cmd, &args->log, /*split=*/false);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });

@@ -209,22 +209,33 @@ const RegisterCommand kRegister("simulate", 10, [](CLI::App& app) {
       "Physics, defaults and checks: docs/simulation.md.");
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  cmd->add_option("--preset", args->preset, "navigation|tactical")->capture_default_str();
-  cmd->add_option("--profile", args->profile, "chamber|chamber-b|sine|FILE.csv")
-      ->capture_default_str();
-  cmd->add_option("--duration", args->duration,
-                  "length, e.g. 30s, 10min, 8h, 3600 (default: the profile's, 8 h)");
-  cmd->add_option("--rate-hz", args->rate_hz, "output rate, Hz")->capture_default_str();
+  BindSetting(
+      cmd->add_option("--preset", args->preset, "navigation|tactical")->capture_default_str(),
+      {"preset"});
+  BindSetting(cmd->add_option("--profile", args->profile, "chamber|chamber-b|sine|FILE.csv")
+                  ->capture_default_str(),
+              {"profile"});
+  BindSetting(cmd->add_option("--duration", args->duration,
+                              "length, e.g. 30s, 10min, 8h, 3600 (default: the profile's, 8 h)"),
+              {"duration_s"});
+  BindSetting(cmd->add_option("--rate-hz", args->rate_hz, "output rate, Hz")->capture_default_str(),
+              {"rate_hz"});
   cmd->add_option("--seed", args->seed, "seed of the noise and sensor streams")
       ->check(kSeed)
       ->capture_default_str();
-  cmd->add_option("--winding", args->winding,
-                  "override the preset: quadrupole|dipole|octupole|conventional|symmetric");
-  args->asymmetry_option = cmd->add_option("--asymmetry", args->asymmetry,
-                  "override the preset's winding asymmetry (fraction, |a| < 0.5)");
-  cmd->add_option("--input-rate-dph", args->input_rate_dph,
-                  "true rate on the sensitive axis, e.g. an Earth-rate component, deg/h")
-      ->capture_default_str();
+  BindSetting(
+      cmd->add_option("--winding", args->winding,
+                      "override the preset: quadrupole|dipole|octupole|conventional|symmetric"),
+      {"winding"});
+  args->asymmetry_option =
+      BindSetting(cmd->add_option("--asymmetry", args->asymmetry,
+                                  "override the preset's winding asymmetry (fraction, |a| < 0.5)"),
+                  {"coil.winding_asymmetry"});
+  BindSetting(
+      cmd->add_option("--input-rate-dph", args->input_rate_dph,
+                      "true rate on the sensitive axis, e.g. an Earth-rate component, deg/h")
+          ->capture_default_str(),
+      {"input_rate_dph"});
   cmd->add_flag("--no-noise", args->no_noise, "noise-free rate and an ideal temperature reading");
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });

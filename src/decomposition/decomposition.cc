@@ -49,19 +49,19 @@ bool UsesNoiseEmds(Method method) {
   return method == Method::kCeemdan || method == Method::kIceemdan || method == Method::kBeemdan;
 }
 Method MethodFromString(std::string_view name) {
-  return EnumFromName(name, "decomposition method", kMethods);
+  return EnumFromName(name, "method", kMethods);
 }
 std::string_view ToString(StopRule rule) { return EnumName(rule, kStopRules); }
 StopRule StopRuleFromString(std::string_view name) {
-  return EnumFromName(name, "stop rule", kStopRules);
+  return EnumFromName(name, "stop_rule", kStopRules);
 }
 std::string_view ToString(BeemdanBound bound) { return EnumName(bound, kBounds); }
 BeemdanBound BeemdanBoundFromString(std::string_view name) {
-  return EnumFromName(name, "BEEMDAN bound", kBounds);
+  return EnumFromName(name, "beemdan_bound", kBounds);
 }
 std::string_view ToString(NoiseScaling scaling) { return EnumName(scaling, kScalings); }
 NoiseScaling NoiseScalingFromString(std::string_view name) {
-  return EnumFromName(name, "noise scaling", kScalings);
+  return EnumFromName(name, "noise_scaling", kScalings);
 }
 
 int SiftingOptions::EffectiveMaxSifts() const {
@@ -103,7 +103,7 @@ void SiftingOptions::Validate() const {
 }
 
 void DecompositionOptions::Validate() const {
-  sifting.Validate();
+  ValidateNested("sifting", [&] { sifting.Validate(); });
   if (max_imfs < 0 || max_imfs > 1000) {
     ThrowOption("max_imfs", std::to_string(max_imfs), "an integer in [0, 1000] (0 = no cap)");
   }

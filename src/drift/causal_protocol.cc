@@ -19,10 +19,10 @@ namespace gyrodrift::drift {
 
 void CausalOptions::Validate() const {
   if (window < 16 || window > 1000000) {
-    ThrowOption("causal window", std::to_string(window), "an integer in [16, 1000000]");
+    ThrowOption("window", std::to_string(window), "an integer in [16, 1000000]");
   }
   if (ensemble_size < 0 || ensemble_size > 100000) {
-    ThrowOption("causal ensemble_size", std::to_string(ensemble_size),
+    ThrowOption("ensemble_size", std::to_string(ensemble_size),
                 "an integer in [0, 100000] (0 = the model's)");
   }
 }

@@ -70,7 +70,7 @@ void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_
 
 void RequireChannelsFor(const DriftOptions& o, Eigen::Index channels) {
   if (channels <= 1 || IdentifiesThermalModel(o)) return;
-  ThrowOption("temperature channels", std::to_string(channels),
+  ThrowOption("temperature", std::to_string(channels) + " channels",
               "one for method " + std::string(ToString(o.method)) + " in " +
                   std::string(ToString(o.mode)) +
                   " mode (several channels: compensate mode with thermal, ms-elm or emd-elm)");

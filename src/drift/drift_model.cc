@@ -86,21 +86,21 @@ DriftOptions::DriftOptions() {
 }
 
 void DriftOptions::Validate() const {
-  decomposition.Validate();
-  selection.Validate();
-  EffectiveFeatures(*this).Validate();
+  ValidateNested("decomposition", [&] { decomposition.Validate(); });
+  ValidateNested("selection", [&] { selection.Validate(); });
+  ValidateNested("features", [&] { EffectiveFeatures(*this).Validate(); });
   if (!std::isnan(reference_c)) RequireInRange("reference_c", reference_c, -100.0, 200.0);
   if (!SupportsMode(method, mode)) {
     ThrowOption("method", std::string(ToString(method)),
                 "a method of " + std::string(ToString(mode)) +
                     " mode (thermal identifies a compensation model: mode = compensate)");
   }
-  thermal.Validate();
+  ValidateNested("thermal", [&] { thermal.Validate(); });
   LearnerOptions l = learner;
   l.kind = internal::KindOf(method);
-  l.Validate();
+  ValidateNested("learner", [&] { l.Validate(); });
   for (int p : lag_candidates) {
-    if (p < 1 || p > 256) ThrowOption("lag candidate", std::to_string(p), "an integer in [1, 256]");
+    if (p < 1 || p > 256) ThrowOption("lag_candidates", std::to_string(p), "an integer in [1, 256]");
   }
   if (auto_lags && lag_candidates.empty()) {
     ThrowOption("lag_candidates", "(empty)", "at least one candidate when lags are 'auto'");

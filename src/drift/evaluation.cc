@@ -101,7 +101,7 @@ void EvaluationOptions::Validate() const {
     ThrowOption("repeats", std::to_string(repeats), "an integer in [1, 1000]");
   if (methods.empty()) ThrowOption("methods", "(empty)", "at least one method");
   if (protocols.empty()) ThrowOption("protocols", "(empty)", "at least one protocol");
-  causal.Validate();
+  ValidateNested("causal", [&] { causal.Validate(); });
   internal::RequireHorizon(horizon);
 }
 

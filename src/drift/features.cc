@@ -83,14 +83,14 @@ int FeatureOptions::NumThermalFeatures() const {
 
 void FeatureOptions::Validate() const {
   if (lags < 1 || lags > 256) ThrowOption("lags", std::to_string(lags), "an integer in [1, 256]");
-  for (double tau : time_constants_s) RequireInRange("time constant (s)", tau, 1.0, 1e6);
+  for (double tau : time_constants_s) RequireInRange("time_constants_s", tau, 1.0, 1e6);
   if (time_constants_s.size() > 32) {
-    ThrowOption("time constants", std::to_string(time_constants_s.size()) + " values",
+    ThrowOption("time_constants_s", std::to_string(time_constants_s.size()) + " values",
                 "at most 32");
   }
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
   if (thermal_set == ThermalSet::kClassic && time_constants_s.empty()) {
-    ThrowOption("time constants", "(empty)",
+    ThrowOption("time_constants_s", "(empty)",
                 "at least one value with thermal_set = classic (the first smooths the rate)");
   }
 }

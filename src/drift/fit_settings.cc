@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <string>
-#include <utility>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -32,14 +31,6 @@ auto Named(std::string_view name, const std::string& text, Parse parse) {
     throw OptionError(std::string(name), e.value(), e.rule());
   }
 }
-
-// The fields of DriftOptions a setting sets, as DriftOptions::Validate names them: a refusal of
-// one names the setting instead.
-constexpr std::pair<std::string_view, std::string_view> kSettingOfField[] = {
-    {"ensemble_size", "ensemble"},         {"realisations", "realisations"},
-    {"threads", "threads"},                {"time constant (s)", "time_constants"},
-    {"time constants", "time_constants"},  {"rate_hz", "rate_hz"},
-};
 
 bool ElmBased(Method method) {
   return method == Method::kMsElm || method == Method::kEmdElm || method == Method::kElm;
@@ -122,14 +113,14 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
     ThrowOption("hysteresis", "'" + s.hysteresis + "'",
                 "auto unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
   }
-  try {
-    o.Validate();
-  } catch (const OptionError& e) {
-    for (const auto& [field, setting] : kSettingOfField) {
-      if (e.option() == field) throw OptionError(std::string(setting), e.value(), e.rule());
-    }
-    throw;
-  }
+  // The fields of DriftOptions a setting sets: a refusal of one names the setting.
+  ValidateAsSettings({{"decomposition.ensemble_size", "ensemble"},
+                      {"selection.monte_carlo.realisations", "realisations"},
+                      {"features.lags", "lags"},
+                      {"features.time_constants_s", "time_constants"},
+                      {"features.rate_hz", "rate_hz"},
+                      {"learner.elm.hidden_units", "hidden"}},
+                     [&] { o.Validate(); });
   return o;
 }
 

@@ -56,12 +56,7 @@ void LearnerOptions::Validate() const {
   elm::ElmOptions elm_options = elm;
   elm_options.seed = seed;
   elm_options.threads = threads;
-  try {
-    elm_options.Validate();
-  } catch (const UsageError& e) {
-    // The ELM's messages name its own fields; here they sit under "elm.".
-    throw UsageError("elm." + std::string(e.what()));
-  }
+  ValidateNested("elm", [&] { elm_options.Validate(); });
   if (poly_degree < 1 || poly_degree > 4) {
     ThrowOption("poly_degree", std::to_string(poly_degree), "an integer in [1, 4]");
   }

@@ -570,7 +570,7 @@ std::string_view ToString(HysteresisTerm term) {
 }
 
 HysteresisTerm HysteresisTermFromString(std::string_view name) {
-  return internal::EnumFromName(name, "thermal.hysteresis", kHysteresisTerms);
+  return internal::EnumFromName(name, "hysteresis", kHysteresisTerms);
 }
 
 std::vector<double> ThermalModelOptions::Grid(double duration_s) const {

@@ -84,6 +84,17 @@ class Table {
     }
     return v;
   }
+  // The value of a string key that names an enum, parsed by `parse` (a FromString helper); a
+  // refusal names the key: "key = 'text': must be one of ...".
+  template <class Parse>
+  auto Enum(const std::string& key, Parse parse) const {
+    const std::string text = String(key);
+    try {
+      return parse(text);
+    } catch (const OptionError& e) {
+      c_.Fail(*Find(key), fmt::format("{} = '{}': must be {}", key, text, e.rule()));
+    }
+  }
   bool Bool(const std::string& key, bool fallback) const {
     const toml::node* n = Find(key);
     if (!n) return fallback;
@@ -190,47 +201,23 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
                    "reference_temperature_c", "hysteresis", "drift_window_s", "limits", "axis",
                    "unit"});
   if (top.Find("method")) {
-    const std::string name = top.String("method");
-    try {
-      m.method = drift::MethodFromString(name);
-    } catch (const UsageError& e) {
-      c.Fail(*top.Find("method"), fmt::format("method = '{}': {}", name, e.what()));
-    }
+    m.method = top.Enum("method", drift::MethodFromString);
     if (!drift::SupportsMode(m.method, drift::Mode::kCompensate)) {
-      c.Fail(*top.Find("method"), fmt::format("method = '{}' does not compensate", name));
+      c.Fail(*top.Find("method"),
+             fmt::format("method = '{}' does not compensate", drift::ToString(m.method)));
     }
   }
-  if (top.Find("rate_unit")) {
-    const std::string unit = top.String("rate_unit");
-    try {
-      m.rate_unit = allan::RateUnitFromString(unit);
-    } catch (const UsageError&) {
-      c.Fail(*top.Find("rate_unit"),
-             fmt::format("rate_unit = '{}': must be dph, dps or rads (as allan --units)", unit));
-    }
-  }
+  if (top.Find("rate_unit")) m.rate_unit = top.Enum("rate_unit", allan::RateUnitFromString);
   m.rate_hz = top.Number("rate_hz", 0.0, 1e-9, 1e6);
   if (top.Find("gaps")) {
-    const std::string gaps = top.String("gaps");
-    try {
-      m.log.gaps = io::GapPolicyFromString(gaps);
-    } catch (const UsageError& e) {
-      c.Fail(*top.Find("gaps"), e.what());
-    }
+    m.log.gaps = top.Enum("gaps", io::GapPolicyFromString);
     if (m.log.gaps == io::GapPolicy::kSplit && m.method != drift::Method::kThermal) {
       c.Fail(*top.Find("gaps"), fmt::format("gaps = 'split' needs method = 'thermal', not '{}' (a "
                                             "decomposition would run across the gaps)",
                                             drift::ToString(m.method)));
     }
   }
-  if (top.Find("delimiter")) {
-    const std::string delimiter = top.String("delimiter");
-    try {
-      m.log.delimiter = io::DelimiterFromString(delimiter);
-    } catch (const UsageError& e) {
-      c.Fail(*top.Find("delimiter"), e.what());
-    }
-  }
+  if (top.Find("delimiter")) m.log.delimiter = top.Enum("delimiter", io::DelimiterFromString);
   if (const toml::node* n = top.Find("seed")) {
     if (!n->is_integer() || *n->value<std::int64_t>() < 0) {
       c.Fail(*n, "'seed' must be a non-negative integer");
@@ -242,15 +229,7 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
   m.reference_c = top.Number("reference_temperature_c", m.reference_c,
                              -std::numeric_limits<double>::max(),
                              std::numeric_limits<double>::max());
-  if (top.Find("hysteresis")) {
-    const std::string term = top.String("hysteresis");
-    try {
-      m.hysteresis = drift::HysteresisTermFromString(term);
-    } catch (const UsageError&) {
-      c.Fail(*top.Find("hysteresis"),
-             fmt::format("hysteresis = '{}': must be auto, on or off (as fit --hysteresis)", term));
-    }
-  }
+  if (top.Find("hysteresis")) m.hysteresis = top.Enum("hysteresis", drift::HysteresisTermFromString);
   // The fit keys together, as fit's flags are checked (drift::MakeDriftOptions); a refusal is
   // placed at the key it names.
   try {

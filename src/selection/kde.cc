@@ -75,7 +75,7 @@ std::string_view ToString(KdeMethod method) {
 }
 
 KdeMethod KdeMethodFromString(std::string_view name) {
-  return gyrodrift::internal::EnumFromName(name, "kde.method", kKdeMethods);
+  return gyrodrift::internal::EnumFromName(name, "method", kKdeMethods);
 }
 
 void KdeOptions::Validate() const {
@@ -90,7 +90,7 @@ void KdeOptions::Validate() const {
   RequirePositive("bandwidth_scale", bandwidth_scale);
   RequireInRange("padding_bandwidths", padding_bandwidths, 0.0, 20.0);
   if (method != KdeMethod::kBinnedFft && method != KdeMethod::kDirect) {
-    ThrowOption("kde.method", std::to_string(static_cast<int>(method)), "binned-fft or direct");
+    ThrowOption("method", std::to_string(static_cast<int>(method)), "binned-fft or direct");
   }
 }
 

@@ -130,7 +130,7 @@ void MonteCarloOptions::Validate() const {
   }
   if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
   if (max_imfs < 0) ThrowOption("max_imfs", std::to_string(max_imfs), ">= 0 (0 = no cap)");
-  sifting.Validate();
+  ValidateNested("sifting", [&] { sifting.Validate(); });
 }
 
 double NoiseLevel::LevelFor(int k) const {

@@ -61,8 +61,8 @@ void SelectionOptions::Validate() const {
     ThrowOption("distance", std::to_string(static_cast<int>(distance)),
                 "l2, l1, hellinger, jensen-shannon or bhattacharyya");
   }
-  kde.Validate();
-  monte_carlo.Validate();
+  ValidateNested("kde", [&] { kde.Validate(); });
+  ValidateNested("monte_carlo", [&] { monte_carlo.Validate(); });
   decomposition::ValidateBandConfidence(band_confidence);
   if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
 }

@@ -46,7 +46,7 @@ RadialConduction::RadialConduction(double inner_radius_m, double outer_radius_m,
   params.Validate();
   RequirePositive("coil inner radius (m)", inner_radius_m);
   if (!(outer_radius_m > inner_radius_m) || !std::isfinite(outer_radius_m)) {
-    ThrowOption("coil outer radius (m)", FormatValue(outer_radius_m),
+    ThrowOption("outer_radius_m", FormatValue(outer_radius_m),
                 "finite and > the inner radius " + FormatValue(inner_radius_m));
   }
   if (cells < 1 || cells > 100000) ThrowOption("cells", std::to_string(cells), "in [1, 100000]");

@@ -288,7 +288,9 @@ StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyObs
   options.Validate();
   const bool simulated = log == nullptr;
   if (log) {
-    internal::StudyDriftOptions(options, log->rate_hz, false).Validate();
+    ValidateAsSettings({{"features.rate_hz", "rate_hz"}}, [&] {
+      internal::StudyDriftOptions(options, log->rate_hz, false).Validate();
+    });
     if (log->output.size() < kMinLogSamples) {
       throw DataError(log->source + ": " + std::to_string(log->output.size()) +
                       " samples; the study needs at least 64 (a 70/30 split with 32 training and "
@@ -394,9 +396,15 @@ std::string GroupOf(const sel::SelectionResult& selection, int k) {
 
 void StudyOptions::Validate() const {
   // Ranges the library owns are its own Validate's, one home: the drift options' first, so that
-  // ensemble_size, which also sizes the causal windows, is named as the decomposition's.
-  internal::StudyDriftOptions(*this, 1.0, true).Validate();
-  EvaluationFor(*this, methods).causal.Validate();
+  // ensemble_size, which also sizes the causal windows, is named as the decomposition's; a
+  // refusal names the study's field that set it.
+  ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
+                      {"selection.monte_carlo.realisations", "realisations"},
+                      {"window", "causal_window"}},
+                     [&] {
+                       internal::StudyDriftOptions(*this, 1.0, true).Validate();
+                       EvaluationFor(*this, methods).causal.Validate();
+                     });
   if (!(duration_s >= kMinDurationS)) {
     ThrowOption("duration_s", FormatValue(duration_s),
                 "at least 2h (run A needs a ramp and a dwell)");

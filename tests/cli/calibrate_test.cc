@@ -253,7 +253,7 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
       {"bad hysteresis", "hysteresis = \"sometimes\"\n" + std::string(kAxes) + unit,
-       "bad.toml:1: hysteresis = 'sometimes': must be auto, on or off"},
+       "bad.toml:1: hysteresis = 'sometimes': must be one of auto, on, off"},
       {"hysteresis, not identified", "method = \"poly\"\nhysteresis = \"on\"\n" +
        std::string(kAxes) + unit, "bad.toml:2: hysteresis = 'on': must be auto unless"},
       {"reference out of range", "reference_temperature_c = 500\n" + std::string(kAxes) + unit,

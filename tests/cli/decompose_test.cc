@@ -109,6 +109,11 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"negative noise", "decompose %IN% -c 2 --noise -1", 2, "--noise = -1"},
       {"bad band", "decompose %IN% -c 2 --band 0.5", 2, "--band = 0.5"},
       {"negative imfs", "decompose %IN% -c 2 --max-imfs -2", 2, "--max-imfs = -2"},
+      // Fields of the nested sifting options (sifting.s_number, ...), named by their flags.
+      {"zero s-number", "decompose %IN% -c 2 --stop snumber --s-number 0", 2,
+       "--s-number = 0: must be"},
+      {"negative sift cap", "decompose %IN% -c 2 --max-sifts -5", 2, "--max-sifts = -5: must be"},
+      {"zero sd", "decompose %IN% -c 2 --stop sd --sd 0", 2, "--sd = 0: must be"},
       {"not a number", "decompose %IN% -c 2 --seed many", 2, "seed"},
       {"negative seed", "decompose %IN% -c 2 --seed -1", 2, "[0, 2^64)"},
       {"noise rows", "decompose %IN% -c 2 --noise-file %DIR%/w_short.csv", 3, "supplied noise"},

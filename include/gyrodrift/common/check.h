@@ -3,8 +3,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "gyrodrift/common/error.h"
 
@@ -21,6 +23,34 @@ void RequirePositive(std::string_view name, double value);
 void RequireNonNegative(std::string_view name, double value);
 // Throws UsageError with "<name> = <value>: must be <rule>".
 [[noreturn]] void ThrowOption(std::string_view name, std::string_view value, std::string_view rule);
+
+// Runs validate(), the Validate() of an options struct held in field `field` of another: an
+// OptionError from it is thrown again with its option named by the dotted path
+// ("sifting.max_sifts"), so every refusal names the field as a caller reaches it.
+template <class Validate>
+void ValidateNested(std::string_view field, Validate&& validate) {
+  try {
+    validate();
+  } catch (const OptionError& e) {
+    throw OptionError(std::string(field) + "." + e.option(), e.value(), e.rule());
+  }
+}
+
+// Runs validate(), the Validate() of options derived from a flat settings struct (a front end's
+// names for some of their fields): an OptionError naming one of the derived fields (`names`: field
+// path, setting) is thrown again naming the setting, so a refusal names what the caller set.
+template <class Validate>
+void ValidateAsSettings(std::initializer_list<std::pair<std::string_view, std::string_view>> names,
+                        Validate&& validate) {
+  try {
+    validate();
+  } catch (const OptionError& e) {
+    for (const auto& [field, setting] : names) {
+      if (e.option() == field) throw OptionError(std::string(setting), e.value(), e.rule());
+    }
+    throw;
+  }
+}
 
 // Throws DataError naming `what` unless every sample is finite and there are at least
 // `min_samples` of them.

@@ -172,7 +172,7 @@ TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
     c.window = window;
     const bool allowed = window >= 16 && window <= 1000000;
     const std::string message = refusal(c);
-    EXPECT_TRUE(allowed ? message.empty() : message.find("causal window") != std::string::npos)
+    EXPECT_TRUE(allowed ? message.empty() : message.find("window = ") != std::string::npos)
         << window << ": " << message;
   }
   for (int ensemble : {0, 100000, -1, 100001}) {  // 0 = the model's own
@@ -181,7 +181,7 @@ TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
     const bool allowed = ensemble >= 0 && ensemble <= 100000;
     const std::string message = refusal(c);
     EXPECT_TRUE(allowed ? message.empty()
-                        : message.find("causal ensemble_size") != std::string::npos)
+                        : message.find("ensemble_size = ") != std::string::npos)
         << ensemble << ": " << message;
   }
 }

@@ -447,7 +447,7 @@ TEST_F(Refusal, WrongTypesShapesAndValuesAreNamed) {
   ExpectRefused(Reseal(j), "field 'options.method' = 'wavelet' is not understood");
   j = Json();
   j["options"]["features"]["rate_hz"] = -1.0;
-  ExpectRefused(Reseal(j), "holds an invalid option: rate_hz");
+  ExpectRefused(Reseal(j), "holds an invalid option: features.rate_hz");
   j = Json();
   auto& array = j["model"]["sub_models"][0]["learner"]["arrays"]["output_weights"];
   array["rows"] = array["rows"].get<int>() + 1;

@@ -125,8 +125,8 @@ TEST(StudyOptions, ValidateNamesTheField) {
               o.methods = {drift::Method::kElm, drift::Method::kPoly, drift::Method::kElm};
             }),
             "methods");
-  // Ranges the library owns keep the library's names (OptionErrorMessage maps them to flags).
-  EXPECT_EQ(refused([](StudyOptions& o) { o.causal_window = 4; }), "causal window");
+  // Ranges the library owns name the study's field that set them.
+  EXPECT_EQ(refused([](StudyOptions& o) { o.causal_window = 4; }), "causal_window");
   EXPECT_EQ(refused([](StudyOptions& o) { o.realisations = 3; }), "realisations");
   EXPECT_EQ(refused([](StudyOptions& o) { o.threads = -1; }), "threads");
 }
