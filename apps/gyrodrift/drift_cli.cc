@@ -51,68 +51,64 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
           "degC (for a bias calibrated separately); default: keep the fitted intercept, the "
           "unit's repeatable bias"),
       {"reference_temperature"});
-  BindSetting(cmd->add_flag("--nonlinear", a->nonlinear,
+  BindSetting(cmd->add_flag("--nonlinear", a->settings.nonlinear,
                             "compensate mode, identified methods: each thermal model may add a "
                             "sigmoid ELM of its regressors, kept only where the blocked "
                             "cross-validation says it helps"),
               {"nonlinear"});
-  BindSetting(cmd->add_option("--hysteresis", a->hysteresis,
+  BindSetting(cmd->add_option("--hysteresis", a->settings.hysteresis,
                               "compensate mode, identified methods: the thermal models' "
                               "hysteresis term (a bias that differs between heating and "
                               "cooling), auto (tried on calibrations of 12 h or more) | on | off; "
                               "docs/drift.md 4.7")
                   ->capture_default_str(),
               {"hysteresis"});
-  BindSetting(cmd->add_option("--mode", a->mode,
+  BindSetting(cmd->add_option("--mode", a->settings.mode,
                               "predict (one-step-ahead from past samples) | compensate (drift "
                               "from temperature)")
                   ->required(),
               {"mode"});
-  BindSetting(cmd->add_option("--decomposition", a->decomposition,
+  BindSetting(cmd->add_option("--decomposition", a->settings.decomposition,
                               "beemdan|iceemdan|ceemdan|eemd|emd")
                   ->capture_default_str(),
               {"decomposition"});
-  a->lags_option = BindSetting(
-      cmd->add_option("--lags,-p", a->lags,
-                      "own lags per sub-model: auto (chosen on the last 20% of the training "
-                      "record among 1,2,4,8,16) or p in [1,256] (predict mode)")
-          ->capture_default_str(),
-      {"lags"});
-  a->hidden_option = BindSetting(
-      cmd->add_option("--hidden", a->hidden,
-                      "ELM hidden units: auto (leave-one-out choice of L <= 50 and C) or a fixed "
-                      "L")
-          ->capture_default_str(),
-      {"hidden"});
-  a->rate_option = BindSetting(cmd->add_option("--rate-hz", a->rate_hz,
+  BindSetting(cmd->add_option("--lags,-p", a->settings.lags,
+                              "own lags per sub-model: auto (chosen on the last 20% of the "
+                              "training record among 1,2,4,8,16) or p in [1,256] (predict mode; "
+                              "default 4)"),
+              {"lags"});
+  BindSetting(cmd->add_option("--hidden", a->settings.hidden,
+                              "ELM hidden units: auto (leave-one-out choice of L <= 50 and C; "
+                              "the default) or a fixed L"),
+              {"hidden"});
+  a->rate_option = BindSetting(cmd->add_option("--rate-hz", a->settings.rate_hz,
                                                "sample rate, Hz (default: from the median step "
                                                "of a time_s column, else 1)"),
                                {"rate_hz"});
-  BindSetting(cmd->add_option("--thermal-features", a->thermal_features,
+  BindSetting(cmd->add_option("--thermal-features", a->settings.thermal_features,
                               "temperature inputs: auto (classic for poly, ladder otherwise) | "
                               "ladder (rungs between first-order lags of T, the slowest lag, "
                               "(T - 20)^2) | classic (T and its smoothed rate) | lag-bank (T, "
                               "each lag and its rate); docs/drift.md 1.1")
                   ->capture_default_str(),
               {"thermal_features"});
-  BindSetting(cmd->add_option("--time-constants", a->time_constants_s,
+  BindSetting(cmd->add_option("--time-constants", a->settings.time_constants,
                               "time constants of the thermal lags, seconds, comma-separated "
                               "(default 60,300,900,1800,3600)")
                   ->delimiter(','),
               {"time_constants"});
-  BindSetting(
-      cmd->add_option("--ensemble,-I", a->ensemble, "decomposition ensemble size")
-          ->capture_default_str(),
-      {"ensemble"});
-  BindSetting(cmd->add_option("--realisations", a->realisations,
+  BindSetting(cmd->add_option("--ensemble,-I", a->settings.ensemble, "decomposition ensemble size")
+                  ->capture_default_str(),
+              {"ensemble"});
+  BindSetting(cmd->add_option("--realisations", a->settings.realisations,
                               "white-noise realisations of the ms-elm grouping's Monte-Carlo "
                               "level, >= 20")
                   ->capture_default_str(),
               {"realisations"});
-  cmd->add_option("--seed", a->seed, "seed of the decomposition and the learners")
+  cmd->add_option("--seed", a->settings.seed, "seed of the decomposition and the learners")
       ->check(kSeed)
       ->capture_default_str();
-  BindSetting(cmd->add_option("--threads,-j", a->threads,
+  BindSetting(cmd->add_option("--threads,-j", a->settings.threads,
                               "worker threads (0 = all cores); results do not depend on it")
                   ->capture_default_str(),
               {"threads"});
@@ -121,31 +117,18 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
 }
 
 drift::FitSettings Settings(const DriftArgs& a, const std::string& method) {
-  drift::FitSettings s;
-  s.mode = a.mode;
+  drift::FitSettings s = a.settings;
   s.method = method;
-  s.decomposition = a.decomposition;
-  if (a.lags_option != nullptr && a.lags_option->count() > 0) s.lags = a.lags;
-  if (a.hidden_option != nullptr && a.hidden_option->count() > 0) s.hidden = a.hidden;
-  if (a.rate_option != nullptr && a.rate_option->count() > 0) s.rate_hz = a.rate_hz;
-  s.thermal_features = a.thermal_features;
-  s.time_constants = a.time_constants_s;
-  s.ensemble = a.ensemble;
-  s.realisations = a.realisations;
-  s.seed = a.seed;
-  s.threads = a.threads;
-  s.nonlinear = a.nonlinear;
   if (a.reference_option != nullptr && a.reference_option->count() > 0) {
     s.reference_temperature = a.reference_c;
   }
-  s.hysteresis = a.hysteresis;
   s.has_temperature = !a.temperature.empty();
   return s;
 }
 
 double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string* how) {
   const bool given = a.rate_option != nullptr && a.rate_option->count() > 0;
-  return ResolveSampleRate(table, given ? a.rate_hz : 0.0, how);
+  return ResolveSampleRate(table, given ? a.settings.rate_hz : 0.0, how);
 }
 
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table) {

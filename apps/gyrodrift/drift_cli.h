@@ -18,29 +18,17 @@
 
 namespace gyrodrift::cli {
 
-// Options fit and evaluate share. Defaults are those of drift::DriftOptions.
+// Options fit and evaluate share.
 struct DriftArgs {
   std::vector<std::string> inputs;  // fit takes several calibration logs, evaluate one
   std::string target;
   std::string temperature;  // "" = none; several columns comma-separated
+  // The model settings the flags set (drift::MakeDriftOptions maps them); the method, the
+  // reference temperature and whether there is a temperature are settled by Settings().
+  drift::FitSettings settings;
   double reference_c = 0.0;
-  bool nonlinear = false;  // --nonlinear: identified sub-models may add a nonlinear correction
-  std::string hysteresis = "auto";  // --hysteresis: drift::HysteresisTerm name
-  CLI::Option* reference_option = nullptr;  // "--reference-temperature given"
-  std::string mode;
-  std::string decomposition = "beemdan";
-  std::string lags = "4";       // "auto" or p
-  std::string hidden = "auto";  // "auto" or L
-  double rate_hz = 1.0;
-  CLI::Option* rate_option = nullptr;  // to tell "--rate-hz given" from the default
-  CLI::Option* lags_option = nullptr;    // ... "--lags given"
-  CLI::Option* hidden_option = nullptr;  // ... "--hidden given"
-  int ensemble = 100;
-  int realisations = 100;  // white-noise realisations of the selection's Monte-Carlo level
-  std::string thermal_features = "auto";  // drift::ThermalSet name
-  std::vector<double> time_constants_s;   // empty = the library default
-  std::uint64_t seed = 1;
-  int threads = 0;
+  CLI::Option* reference_option = nullptr;  // to tell "--reference-temperature given"
+  CLI::Option* rate_option = nullptr;       // ... "--rate-hz given" from the default
   LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };

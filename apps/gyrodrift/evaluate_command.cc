@@ -59,7 +59,7 @@ void Run(const EvaluateArgs& a) {
   e.methods = ParseMethods(a.methods, base.mode);
   e.protocols = ParseProtocols(a.protocol);
   e.causal.window = a.window;
-  e.causal.threads = a.threads;
+  e.causal.threads = a.settings.threads;
   e.horizon = a.horizon;
   e.Validate();  // option errors before any file is read
   if (a.target.find(',') != std::string::npos) {
