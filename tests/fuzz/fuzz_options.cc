@@ -1,6 +1,7 @@
 // libFuzzer harness: the CLI's option parsers on any text: durations, tau lists, method lists,
-// temperature column lists, gap policies and delimiters. Each accepts or throws a gyrodrift::Error (a usage error naming the
-// option); nothing else may happen.
+// temperature column lists, gap policies and delimiters, and the drift settings' one mapping
+// (drift::MakeDriftOptions) with the text split at '|' into its string settings. Each accepts or
+// throws a gyrodrift::Error (a usage error naming the option); nothing else may happen.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -8,6 +9,7 @@
 #include "cli_util.h"
 #include "drift_cli.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/gyro_log.h"
 
@@ -41,6 +43,27 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     (void)gyrodrift::io::DelimiterFromString(text);
+  } catch (const gyrodrift::Error&) {
+  }
+  try {
+    // "mode|method|decomposition|lags|hidden|thermal_features|hysteresis", missing parts empty.
+    std::string part[7];
+    for (size_t i = 0, k = 0; i < text.size() && k < 7; ++i) {
+      if (text[i] == '|') {
+        ++k;
+      } else {
+        part[k] += text[i];
+      }
+    }
+    gyrodrift::drift::FitSettings s{.mode = part[0],
+                                    .method = part[1],
+                                    .decomposition = part[2],
+                                    .lags = part[3],
+                                    .hidden = part[4],
+                                    .thermal_features = part[5],
+                                    .hysteresis = part[6],
+                                    .has_temperature = !part[6].empty()};
+    (void)gyrodrift::drift::MakeDriftOptions(s);
   } catch (const gyrodrift::Error&) {
   }
   return 0;
