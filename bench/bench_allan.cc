@@ -8,6 +8,7 @@
 
 #include "bench_util.h"
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/common/random.h"
 
 namespace {

@@ -9,6 +9,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"

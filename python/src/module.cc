@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/edf.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 

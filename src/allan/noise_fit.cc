@@ -11,6 +11,8 @@
 
 #include "allan/avar_correlation.h"
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/allan/edf.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 

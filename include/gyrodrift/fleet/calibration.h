@@ -26,7 +26,7 @@
 #include <utility>
 #include <vector>
 
-#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/fleet/manifest.h"
 #include "gyrodrift/io/report.h"
 

@@ -33,7 +33,7 @@
 #include <utility>
 #include <vector>
 
-#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/drift/evaluation.h"

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 
 namespace gyrodrift::simulation {

@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/io/csv.h"
 #include "support/test_support.h"
 

@@ -11,6 +11,7 @@
 
 #include "allan_fixtures.h"
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/edf.h"
 #include "support/test_support.h"
 
 namespace gyrodrift::allan {

@@ -1,4 +1,5 @@
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/edf.h"
 
 #include <gtest/gtest.h>
 

@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/allan/edf.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
 

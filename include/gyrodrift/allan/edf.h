@@ -1,0 +1,31 @@
+// Equivalent degrees of freedom of the Allan-variance family and their chi-square confidence
+// intervals, as Compute() (allan.h) attaches them to every point.
+//
+// References
+//   C. A. Greenhall, W. J. Riley, "Uncertainty of stability variances based on finite
+//     differences", 35th PTTI (2003): EDF of ADEV/OADEV/MDEV/TDEV/HDEV/OHDEV.
+//   W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065 (2008): EDF of TOTDEV
+//     (table 7), the simple formulas of table 5, chi-square intervals (eq. 45).
+// Cost: O(1) per point: at most 100 terms of Greenhall & Riley's basic sum (their J_max).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "gyrodrift/allan/allan.h"
+
+namespace gyrodrift::allan {
+
+// Equivalent degrees of freedom of deviation `d` at factor m for n_phase points and noise alpha:
+// Greenhall & Riley 2003 for ADEV/OADEV/MDEV/TDEV/HDEV/OHDEV, NIST SP 1065 table 7 for TOTDEV
+// (alpha = 0, -1, -2; SP 1065 table 5 simple formulas for alpha = 2, 1, as Stable32).
+double EquivalentDof(Deviation d, int alpha, std::int64_t m, Eigen::Index n_phase);
+// Quantile of the chi-square distribution with `dof` (> 0, real) degrees of freedom.
+double ChiSquareQuantile(double p, double dof);
+// Regularized lower incomplete gamma P(a, x).
+double RegularizedGammaP(double a, double x);
+// [lo, hi] of a deviation with `edf` degrees of freedom at two-sided confidence `confidence`
+// (NIST SP 1065 eq. 45).
+void ConfidenceInterval(double dev, double edf, double confidence, double* lo, double* hi);
+
+}  // namespace gyrodrift::allan
