@@ -155,12 +155,5 @@ std::int64_t TermCount(Deviation d, Eigen::Index n_phase, std::int64_t m);
 // Averaging factors of a grid (sorted, unique, each <= MaxAveragingFactor).
 std::vector<std::int64_t> AveragingFactors(const AllanOptions& options, Eigen::Index n_phase);
 
-// Lag-1 autocorrelation noise identification (Riley & Greenhall 2004) at averaging factor m.
-// `phase` is the internal phase (angle) series; for rate data the m-averaged rates are analysed,
-// for angle data the m-decimated phase. dmax = 2 for Allan-type, 3 for Hadamard-type estimators.
-// Returns nullopt when fewer than 30 points remain. Cost O(N / m), no copy of the series unless
-// differencing is needed (rho >= 0.25 at d = 0).
-std::optional<int> IdentifyAlpha(const Eigen::Ref<const Eigen::VectorXd>& phase, std::int64_t m,
-                                 DataType type, int dmax);
 
 }  // namespace gyrodrift::allan

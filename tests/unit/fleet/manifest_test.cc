@@ -1,0 +1,92 @@
+// The calibration manifest (fleet/manifest.h): its fit keys map onto the model options as fit's
+// flags do (drift::MakeDriftOptions), a refusal names the manifest's line and key, and a unit's
+// fingerprint changes with every setting that shapes its results, the hysteresis term included.
+#include "gyrodrift/fleet/manifest.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
+#include "support/test_support.h"
+
+namespace gyrodrift::fleet {
+namespace {
+
+class ManifestTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::TempDir("manifest");
+    for (const char* log : {"cal.csv", "ver.csv"}) {
+      io::WriteFileAtomically(dir_ + "/" + log, "time_s,gyro,temp\n0,1,20\n1,2,21\n");
+    }
+  }
+  // The manifest `top` (its first lines) followed by one axis and one unit.
+  Manifest Parse(const std::string& top) const {
+    return ParseManifest(top +
+                             "[[axis]]\ntarget = \"gyro\"\ntemperature = \"temp\"\n"
+                             "[[unit]]\nserial = \"SN1\"\ncalibration = \"cal.csv\"\n"
+                             "verification = \"ver.csv\"\n",
+                         dir_ + "/fleet.toml");
+  }
+  // The one-line refusal of the manifest `top`.
+  std::string Refusal(const std::string& top) const {
+    try {
+      Parse(top);
+    } catch (const UsageError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+      return e.what();
+    }
+    return "";
+  }
+  std::string dir_;
+};
+
+TEST_F(ManifestTest, FitKeysMapOntoTheOptionsAsFitsFlagsDo) {
+  const drift::DriftOptions defaults = Parse("").FitOptions();
+  EXPECT_EQ(defaults.mode, drift::Mode::kCompensate);
+  EXPECT_EQ(defaults.method, drift::Method::kThermal);
+  EXPECT_EQ(defaults.thermal.hysteresis, drift::HysteresisTerm::kAuto);
+  EXPECT_TRUE(std::isnan(defaults.reference_c));
+  EXPECT_TRUE(defaults.linear_compensation);
+
+  const drift::DriftOptions o =
+      Parse("method = \"ms-elm\"\nseed = 5\nnonlinear = true\nhysteresis = \"off\"\n"
+            "reference_temperature_c = 20\n")
+          .FitOptions();
+  EXPECT_EQ(o.method, drift::Method::kMsElm);
+  EXPECT_EQ(o.seed, 5u);
+  EXPECT_FALSE(o.linear_compensation);
+  EXPECT_EQ(o.thermal.hysteresis, drift::HysteresisTerm::kOff);
+  EXPECT_EQ(o.reference_c, 20.0);
+}
+
+TEST_F(ManifestTest, RefusalsNameTheLineAndTheKey) {
+  const std::string file = dir_ + "/fleet.toml:";
+  EXPECT_EQ(Refusal(""), "");
+  EXPECT_EQ(Refusal("seed = 1\nhysteresis = \"sometimes\"\n"),
+            file + "2: hysteresis = 'sometimes': must be one of auto, on, off");
+  EXPECT_EQ(Refusal("rate_unit = \"mph\"\n"),
+            file + "1: rate_unit = 'mph': must be one of dph, dps, rads");
+  EXPECT_EQ(Refusal("method = \"poly\"\nhysteresis = \"on\"\n"),
+            file + "2: hysteresis = 'on': must be auto unless mode is 'compensate' with method "
+                   "thermal, ms-elm or emd-elm");
+  EXPECT_EQ(Refusal("method = \"poly\"\nnonlinear = true\n"),
+            file + "2: nonlinear = true: must be false unless mode is 'compensate' with method "
+                   "thermal, ms-elm or emd-elm");
+  EXPECT_EQ(Refusal("reference_temperature_c = 500\n"),
+            file + "1: reference_temperature_c = 500: must be in [-100, 200]");
+}
+
+TEST_F(ManifestTest, TheFingerprintFollowsTheHysteresisSetting) {
+  const Manifest a = Parse("");
+  const Manifest off = Parse("hysteresis = \"off\"\n");
+  ASSERT_EQ(a.units.size(), 1u);
+  EXPECT_EQ(UnitFingerprint(a, a.units[0]), UnitFingerprint(Parse(""), a.units[0]));
+  EXPECT_NE(UnitFingerprint(a, a.units[0]), UnitFingerprint(off, off.units[0]));
+}
+
+}  // namespace
+}  // namespace gyrodrift::fleet
