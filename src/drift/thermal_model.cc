@@ -83,12 +83,13 @@ void HysteresisColumns(const Eigen::Ref<const Eigen::VectorXd>& level,
 // Columns of one state: its standardised level to the powers 1..max_power (the powers >= 2
 // continued along their tangent beyond [s.level_min, s.level_max]), its rate (K/s), then H_w of
 // its level for each of widths_k. With `learn_range` the range is first set to the level's own
-// (the calibration run).
+// (the calibration run). `level` receives the state's level (degC).
 void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
                   int max_power, double dt_s, double centre, double scale, bool learn_range,
                   const std::vector<Eigen::Index>& record_starts,
-                  const std::vector<double>& widths_k, Eigen::Ref<Eigen::MatrixXd> out) {
-  Eigen::VectorXd previous, state;
+                  const std::vector<double>& widths_k, Eigen::Ref<Eigen::MatrixXd> out,
+                  Eigen::VectorXd& state) {
+  Eigen::VectorXd previous;
   StateOf(t, s.tau_s, order, dt_s, record_starts, previous, state);
   const Eigen::ArrayXd z = (state.array() - centre) / scale;
   if (learn_range) {
@@ -239,6 +240,7 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
   const Eigen::Index first_state = 1 + channels;
   Eigen::MatrixXd x(temperatures_c.rows(),
                     first_state + static_cast<Eigen::Index>(candidates.size()) * per_state);
+  Eigen::VectorXd level;
   x.col(0).setOnes();
   for (int c = 0; c < channels; ++c) {
     x.col(1 + c) = (temperatures_c.col(c).array() - model.centre_c[static_cast<size_t>(c)]) /
@@ -249,7 +251,8 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
     StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
                  model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
                  /*learn_range=*/true, record_starts, widths_k,
-                 x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state));
+                 x.middleCols(first_state + static_cast<Eigen::Index>(j) * per_state, per_state),
+                 level);
   }
   return x;
 }
@@ -659,19 +662,18 @@ Eigen::MatrixXd ThermalRegression::Regressors(
     x.col(col++) = (temperatures_c.col(c).array() - centre_c[static_cast<size_t>(c)]) /
                    scale_k[static_cast<size_t>(c)];
   }
-  for (ThermalState s : states) {
+  Eigen::VectorXd level, hysteresis_level;
+  for (size_t j = 0; j < states.size(); ++j) {
+    ThermalState s = states[j];
     const auto c = static_cast<size_t>(s.channel);
     StateColumns(temperatures_c.col(s.channel), s, order, max_power, 1.0 / rate_hz, centre_c[c],
                  scale_k[c], /*learn_range=*/false, record_starts, {},
-                 x.middleCols(col, max_power + 1));
+                 x.middleCols(col, max_power + 1), level);
+    if (static_cast<int>(j) == hysteresis_state) hysteresis_level.swap(level);
     col += max_power + 1;
   }
   if (has_hysteresis()) {
-    const ThermalState& s = states[static_cast<size_t>(hysteresis_state)];
-    Eigen::VectorXd previous, level;
-    StateOf(temperatures_c.col(s.channel), s.tau_s, order, 1.0 / rate_hz, record_starts, previous,
-            level);
-    HysteresisColumns(level, {hysteresis_width_k}, record_starts, x.middleCols(col, 1));
+    HysteresisColumns(hysteresis_level, {hysteresis_width_k}, record_starts, x.middleCols(col, 1));
   }
   return x;
 }
