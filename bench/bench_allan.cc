@@ -31,14 +31,11 @@ const Eigen::VectorXd& Record(Eigen::Index n) {
 
 void Run(benchmark::State& state, TauGrid grid, Deviation dev, int threads, bool intervals) {
   const Eigen::VectorXd& y = Record(state.range(0));
-  AllanOptions o{.rate_hz = 100.0,
-                 .deviation = dev,
-                 .grid = grid,
-                 .confidence_intervals = intervals,
-                 .threads = threads};
+  AllanOptions o{
+      .rate_hz = 100.0, .deviation = dev, .grid = grid, .confidence_intervals = intervals};
   std::size_t taus = 0;
   for (auto _ : state) {
-    const auto r = Compute(y, o);
+    const auto r = Compute(y, o, {.threads = threads});
     taus = r.points.size();
     benchmark::DoNotOptimize(r.points.data());
   }

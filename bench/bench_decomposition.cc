@@ -30,7 +30,7 @@ Eigen::VectorXd Signal(Eigen::Index n) {
   return x;
 }
 
-DecompositionOptions LibeemdLike(Method method, int threads) {
+DecompositionOptions LibeemdLike(Method method) {
   DecompositionOptions o;
   o.method = method;
   o.sifting.stop_rule = StopRule::kSNumber;
@@ -38,15 +38,17 @@ DecompositionOptions LibeemdLike(Method method, int threads) {
   o.sifting.max_sifts = 50;
   o.ensemble_size = 100;
   o.noise_strength = 0.2;
-  o.threads = threads;
   return o;
 }
 
-void Run(benchmark::State& state, const DecompositionOptions& o) {
+// Decomposes the signal of state.range(0) samples on `threads` workers.
+void Run(benchmark::State& state, const DecompositionOptions& o, int threads) {
   const Eigen::VectorXd x = Signal(state.range(0));
+  gyrodrift::decomposition::DecompositionContext context;
+  context.execution.threads = threads;
   int imfs = 0;
   for (auto _ : state) {
-    const auto d = gyrodrift::decomposition::Decompose(x, o);
+    const auto d = gyrodrift::decomposition::Decompose(x, o, context);
     imfs = d.num_imfs();
     benchmark::DoNotOptimize(d.imfs.data());
   }
@@ -54,28 +56,28 @@ void Run(benchmark::State& state, const DecompositionOptions& o) {
   state.counters["samples"] = static_cast<double>(state.range(0));
 }
 
-void BM_Emd_SNumber(benchmark::State& state) { Run(state, LibeemdLike(Method::kEmd, 1)); }
+int Threads(const benchmark::State& state) { return static_cast<int>(state.range(1)); }
+
+void BM_Emd_SNumber(benchmark::State& state) { Run(state, LibeemdLike(Method::kEmd), 1); }
 void BM_Emd_Rilling(benchmark::State& state) {
   DecompositionOptions o;
   o.method = Method::kEmd;
-  Run(state, o);
+  Run(state, o, 0);
 }
 void BM_Eemd_SNumber(benchmark::State& state) {
-  Run(state, LibeemdLike(Method::kEemd, static_cast<int>(state.range(1))));
+  Run(state, LibeemdLike(Method::kEemd), Threads(state));
 }
 void BM_Ceemdan_SNumber(benchmark::State& state) {
-  Run(state, LibeemdLike(Method::kCeemdan, static_cast<int>(state.range(1))));
+  Run(state, LibeemdLike(Method::kCeemdan), Threads(state));
 }
 void BM_Iceemdan_Rilling(benchmark::State& state) {
   DecompositionOptions o;
   o.method = Method::kIceemdan;
-  o.threads = static_cast<int>(state.range(1));
-  Run(state, o);
+  Run(state, o, Threads(state));
 }
 void BM_Beemdan_Defaults(benchmark::State& state) {
   DecompositionOptions o;  // every default: Rilling stop, I = 100, eps 0.2, 99 % band
-  o.threads = static_cast<int>(state.range(1));
-  Run(state, o);
+  Run(state, o, Threads(state));
 }
 
 const bool kSmoke = gyrodrift::bench::SmokeMode();

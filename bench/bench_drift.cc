@@ -40,22 +40,22 @@ const simulation::SimulationResult& Record() {
   return record;
 }
 
-drift::DriftOptions Options(drift::Mode mode, int threads) {
+drift::DriftOptions Options(drift::Mode mode) {
   drift::DriftOptions o;
   o.mode = mode;
-  o.threads = threads;
   if (gyrodrift::bench::SmokeMode()) o.decomposition.ensemble_size = 10;
   return o;
 }
 
 void BM_MsElmFit(benchmark::State& state) {
   const auto& r = Record();
-  const drift::DriftOptions o =
-      Options(static_cast<drift::Mode>(state.range(0)), static_cast<int>(state.range(1)));
+  const drift::DriftOptions o = Options(static_cast<drift::Mode>(state.range(0)));
+  const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(1))};
   double cpu = 0.0;
   for (auto _ : state) {
     const double start = ProcessCpuSeconds();
-    const drift::DriftModel model = drift::FitDriftModel(r.rate_dph, r.temperature_c, o);
+    const drift::DriftModel model =
+        drift::FitDriftModel(r.rate_dph, r.temperature_c, o, {}, execution);
     cpu += ProcessCpuSeconds() - start;
     benchmark::DoNotOptimize(model.sub_models.data());
   }
@@ -73,13 +73,13 @@ void BM_ThermalFit(benchmark::State& state) {
     return simulation::Simulate(simulation::BuiltinProgramme("chamber"),
                                 simulation::PresetParameters(simulation::Preset::kNavigation), o);
   }();
-  drift::DriftOptions o = Options(drift::Mode::kCompensate, 2);
+  drift::DriftOptions o = Options(drift::Mode::kCompensate);
   o.method = drift::Method::kThermal;
   double cpu = 0.0;
   for (auto _ : state) {
     const double start = ProcessCpuSeconds();
     const drift::DriftModel model =
-        drift::FitDriftModel(record.rate_dph, record.temperature_c, o);
+        drift::FitDriftModel(record.rate_dph, record.temperature_c, o, {}, {.threads = 2});
     cpu += ProcessCpuSeconds() - start;
     benchmark::DoNotOptimize(model.sub_models.data());
   }
@@ -90,18 +90,18 @@ void BM_ThermalFit(benchmark::State& state) {
 
 void BM_CausalEvaluation(benchmark::State& state) {
   const auto& r = Record();
-  const drift::DriftOptions o = Options(drift::Mode::kPredict, static_cast<int>(state.range(0)));
+  const drift::DriftOptions o = Options(drift::Mode::kPredict);
+  const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(0))};
   drift::EvaluationOptions eo;
   eo.methods = {drift::Method::kMsElm};
   eo.protocols = {drift::Protocol::kCausal};
-  eo.causal.threads = static_cast<int>(state.range(0));
   if (gyrodrift::bench::SmokeMode()) eo.causal.window = 64;
   double cpu = 0.0;
   double rmse = 0.0;
   for (auto _ : state) {
     const double start = ProcessCpuSeconds();
     const drift::EvaluationResult result =
-        drift::Evaluate(r.rate_dph, Eigen::VectorXd(), r.drift_dph, o, eo);
+        drift::Evaluate(r.rate_dph, Eigen::VectorXd(), r.drift_dph, o, eo, execution);
     cpu += ProcessCpuSeconds() - start;
     rmse = result.rows.front().rmse;
   }

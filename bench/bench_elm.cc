@@ -55,10 +55,10 @@ Eigen::Index Rows() { return gyrodrift::bench::SmokeMode() ? 2000 : 70000; }
 void Run(benchmark::State& state, ElmOptions o) {
   const LagData& d = Lags(Rows());
   o.hidden_units = static_cast<int>(state.range(0));
-  o.threads = static_cast<int>(state.range(1));
+  const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(1))};
   gyrodrift::elm::ElmFit fit;
   for (auto _ : state) {
-    fit = gyrodrift::elm::Fit(d.x, d.t, o);
+    fit = gyrodrift::elm::Fit(d.x, d.t, o, execution);
     benchmark::DoNotOptimize(fit.model.output_weights.data());
   }
   state.counters["rows"] = static_cast<double>(d.x.rows());
@@ -75,11 +75,11 @@ void BM_ElmAutoLoo(benchmark::State& state) { Run(state, {.selection = Selection
 
 void BM_ElmPredict(benchmark::State& state) {
   const LagData& d = Lags(Rows());
-  ElmOptions o{.hidden_units = static_cast<int>(state.range(0)),
-               .threads = static_cast<int>(state.range(1))};
-  const auto model = gyrodrift::elm::Fit(d.x, d.t, o).model;
+  const ElmOptions o{.hidden_units = static_cast<int>(state.range(0))};
+  const int threads = static_cast<int>(state.range(1));
+  const auto model = gyrodrift::elm::Fit(d.x, d.t, o, {.threads = threads}).model;
   for (auto _ : state) {
-    Eigen::MatrixXd y = gyrodrift::elm::Predict(model, d.x, o.threads);
+    Eigen::MatrixXd y = gyrodrift::elm::Predict(model, d.x, threads);
     benchmark::DoNotOptimize(y.data());
   }
   state.SetLabel(std::string(gyrodrift::elm::KernelName()));

@@ -47,7 +47,6 @@ LagData MakeLags(Eigen::Index rows) {
 LearnerOptions Options(int kind) {
   LearnerOptions o;
   o.kind = static_cast<LearnerKind>(kind);
-  o.threads = 1;
   return o;
 }
 
@@ -55,7 +54,7 @@ void BM_Fit(benchmark::State& state) {
   const LagData data = MakeLags(state.range(1));
   const LearnerOptions o = Options(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    auto learner = gyrodrift::drift::FitLearner(data.x, data.y, o);
+    auto learner = gyrodrift::drift::FitLearner(data.x, data.y, o, {.threads = 1});
     benchmark::DoNotOptimize(learner.get());
   }
   state.SetLabel(std::string(gyrodrift::drift::ToString(o.kind)));

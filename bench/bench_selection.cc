@@ -53,12 +53,12 @@ void BM_SelectModesCachedLevel(benchmark::State& state) {
   const Eigen::VectorXd x = Signal(state.range(0));
   const auto d = gyrodrift::decomposition::Emd(x);
   sel::SelectionOptions options;
-  options.threads = static_cast<int>(state.range(1));
+  const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(1))};
   options.monte_carlo.realisations = 20;  // only primes the cache; not timed
-  sel::SelectModes(x, d, options);
+  sel::SelectModes(x, d, options, execution);
   int grid = 0;
   for (auto _ : state) {
-    const auto r = sel::SelectModes(x, d, options);
+    const auto r = sel::SelectModes(x, d, options, execution);
     benchmark::DoNotOptimize(r.groups.data());
     grid = r.grid_points;
   }
@@ -69,10 +69,10 @@ void BM_SelectModesCachedLevel(benchmark::State& state) {
 void BM_NoiseLevelMonteCarlo(benchmark::State& state) {
   sel::MonteCarloOptions mc;
   mc.realisations = 20;
-  mc.threads = static_cast<int>(state.range(1));
+  const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(1))};
   for (auto _ : state) {
-    const auto level =
-        sel::ComputeNoiseLevel(static_cast<int>(state.range(0)), mc, {}, sel::PdfDistance::kL2);
+    const auto level = sel::ComputeNoiseLevel(static_cast<int>(state.range(0)), mc, {},
+                                              sel::PdfDistance::kL2, execution);
     benchmark::DoNotOptimize(level.level.data());
   }
   state.counters["realisations"] = mc.realisations;

@@ -94,7 +94,6 @@ void Run(const AllanArgs& a) {
   o.deviation = al::DeviationFromString(a.dev);
   o.units = al::RateUnitFromString(a.units);
   o.confidence = a.confidence;
-  o.threads = a.threads;
   ParseTaus(a.taus, &o);
   for (double tau : o.tau_list_s) {
     // Averages span whole samples: a tau between two is not silently moved to the nearer one.
@@ -108,6 +107,8 @@ void Run(const AllanArgs& a) {
     }
   }
   o.Validate();
+  const Execution execution{.threads = a.threads};
+  execution.Validate();
   const al::NoiseFitOptions fit_options{.tau_min_s = a.fit_tau_min_s, .tau_max_s = a.fit_tau_max_s};
   fit_options.Validate();  // every option error before any file is read
 
@@ -124,7 +125,7 @@ void Run(const AllanArgs& a) {
                          "its Allan deviation is zero at every tau (a logging fault?)");
     return column;
   }();
-  const al::AllanResult r = al::Compute(data, o);
+  const al::AllanResult r = al::Compute(data, o, execution);
 
   // Noise terms need an Allan-variance curve; for the other estimators fit an OADEV on the same
   // grid.
@@ -141,7 +142,7 @@ void Run(const AllanArgs& a) {
       al::AllanOptions oa = o;
       oa.deviation = al::Deviation::kOadev;
       fit_source = "oadev";
-      terms = al::IdentifyNoise(al::Compute(data, oa), fit_options);
+      terms = al::IdentifyNoise(al::Compute(data, oa, execution), fit_options);
     }
   } catch (const DataError& e) {
     fit_error = e.what();  // too few points to fit: the deviations are still the result
@@ -186,7 +187,7 @@ void Run(const AllanArgs& a) {
       {"tau_list_s", o.tau_list_s},
       {"units", al::ToString(o.units)},
       {"confidence", o.confidence},
-      {"threads", o.threads},
+      {"threads", a.threads},
       {"fit_tau_min_s", fit_options.tau_min_s},
       {"fit_tau_max_s", std::isfinite(fit_options.tau_max_s) ? nlohmann::json(fit_options.tau_max_s)
                                                              : nlohmann::json("inf")},

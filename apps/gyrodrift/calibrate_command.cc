@@ -38,14 +38,15 @@ void Run(const CalibrateArgs& a) {
   fleet::FleetOptions o;
   o.output_dir = a.output;
   o.force = a.force;
-  o.threads = a.threads;
+  fleet::FleetContext context;
+  context.threads = a.threads;
   ProgressBar progress({1.0}, IsTerminal() && !a.quiet);
   progress.BeginStage(0, "calibrate");
-  o.progress = [&](int done, int total, const std::string& serial, const std::string& what) {
+  context.progress = [&](int done, int total, const std::string& serial, const std::string& what) {
     progress.Update(static_cast<double>(done) / total, fmt::format("{}/{} units", done, total));
     if (!a.quiet) progress.Print(fmt::format("{:<16} {}\n", serial, what));
   };
-  const fleet::FleetResult result = fleet::RunFleet(manifest, o);
+  const fleet::FleetResult result = fleet::RunFleet(manifest, o, context);
   progress.Finish();
   if (!a.quiet) {
     for (const fleet::FleetRow& row : result.rows) {

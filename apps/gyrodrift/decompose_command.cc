@@ -60,7 +60,7 @@ nlohmann::json OptionsJson(const DecomposeArgs& a, const dec::DecompositionOptio
       {"ensemble_size", o.ensemble_size},
       {"noise_strength", o.noise_strength},
       {"seed", o.seed},
-      {"threads", o.threads},
+      {"threads", a.threads},
       {"noise_scaling", dec::ToString(o.noise_scaling)},
       {"beemdan_bound", dec::ToString(o.beemdan_bound)},
       {"band_confidence", o.band_confidence},
@@ -96,12 +96,14 @@ void Run(const DecomposeArgs& a) {
   o.ensemble_size = a.ensemble;
   o.noise_strength = a.noise;
   o.seed = a.seed;
-  o.threads = a.threads;
   o.noise_scaling = dec::NoiseScalingFromString(a.scaling);
   o.beemdan_bound = dec::BeemdanBoundFromString(a.bound);
   o.band_confidence = a.band;
   o.noise_stages = a.noise_stages;
   o.Validate();  // option errors before any file is read
+  dec::DecompositionContext context;
+  context.execution.threads = a.threads;
+  context.execution.Validate();
 
   // Only the column (and time_s) is read, and the table is dropped once the column is out.
   std::string notes;
@@ -113,23 +115,26 @@ void Run(const DecomposeArgs& a) {
     RequireDecomposableSize(name, column.size());
     return column;
   }();
+  Eigen::MatrixXd noise;  // --noise-file: one realisation per column
   if (!a.noise_file.empty()) {
     if (o.method == dec::Method::kEmd) {
       throw UsageError("--noise-file = " + a.noise_file + ": must not be given with --method emd");
     }
-    const io::CsvTable noise = io::CsvTable::Read(a.noise_file);
-    auto w = std::make_shared<Eigen::MatrixXd>(noise.rows(),
-                                               static_cast<Eigen::Index>(noise.header().size()));
-    for (int c = 0; c < static_cast<int>(noise.header().size()); ++c) w->col(c) = noise.Column(c);
-    o.supplied_noise = w;
-    o.ensemble_size = static_cast<int>(w->cols());
+    const io::CsvTable table = io::CsvTable::Read(a.noise_file);
+    noise.resize(table.rows(), static_cast<Eigen::Index>(table.header().size()));
+    for (int c = 0; c < static_cast<int>(table.header().size()); ++c)
+      noise.col(c) = table.Column(c);
+    o.ensemble_size = static_cast<int>(noise.cols());
   }
   dec::Decomposition d;
   {
     ProgressBar progress({1.0}, IsTerminal() && !a.quiet && o.method != dec::Method::kEmd);
     progress.BeginStage(0, std::string(dec::ToString(o.method)));
-    o.progress = [&progress](double fraction) { progress.Update(fraction); };
-    d = dec::Decompose(x, o);
+    context.execution.progress = [&progress](double fraction, std::string_view) {
+      progress.Update(fraction);
+    };
+    d = a.noise_file.empty() ? dec::Decompose(x, o, context)
+                             : dec::DecomposeWithNoise(x, noise, o, context);
   }
 
   // Streamed from the decomposition itself: the text of 1e7 samples is gigabytes.

@@ -70,9 +70,9 @@ study::StudyOptions MakeStudyOptions(const DemoArgs& a) {
   o.realisations = a.realisations;
   o.causal_window = a.window;
   o.seed = a.seed;
-  o.threads = a.threads;
   try {
     o.Validate();
+    ValidateThreads(a.threads);
   } catch (const OptionError& e) {
     // The duration as typed ("90min"), not the seconds it became.
     if (e.option() == "duration_s") ThrowOption("--duration", a.duration, e.rule());
@@ -153,24 +153,25 @@ void Run(const DemoArgs& a) {
                        : std::vector<double>{0.2, 5, 68, 22, 0.1, 3},
                   !a.quiet);
   std::atomic<int> bar_stage{-1};
-  study::StudyObserver observer;
-  observer.progress = [&](int stage, double fraction, const std::string& what) {
+  study::StudyContext context;
+  context.threads = a.threads;
+  context.progress = [&](int stage, double fraction, const std::string& what) {
     if (bar_stage.exchange(stage) != stage) {
       bar.BeginStage(stage, what);
     } else {
       bar.Update(fraction, what);
     }
   };
-  observer.stage_done = [&](int, const std::string& summary) {
+  context.stage_done = [&](int, const std::string& summary) {
     if (!a.quiet) bar.Print(summary);
   };
   study::StudyResult result;
   if (user) {
     bar_stage = 0;
     bar.BeginStage(0, "reading " + a.input);
-    result = study::RunStudy(options, ReadStudyLog(a), observer);
+    result = study::RunStudy(options, ReadStudyLog(a), context);
   } else {
-    result = study::RunStudy(options, observer);
+    result = study::RunStudy(options, context);
   }
 
   bar.BeginStage(study::kStudyStages, "writing " + a.output);

@@ -52,14 +52,15 @@ std::string TableCsv(const drift::EvaluationResult& result) {
 
 void Run(const EvaluateArgs& a) {
   RequireOutputsAreNotInputs(a.inputs, {a.output, SidecarPath(a.output)});
-  drift::DriftOptions base = drift::MakeDriftOptions(Settings(a, "ms-elm"));
+  const drift::FitSettings settings = Settings(a, "ms-elm");
+  drift::DriftOptions base = drift::MakeDriftOptions(settings);
+  Execution execution = drift::MakeExecution(settings);
   drift::EvaluationOptions e;
   e.split = a.split;
   e.repeats = a.repeats;
   e.methods = ParseMethods(a.methods, base.mode);
   e.protocols = ParseProtocols(a.protocol);
   e.causal.window = a.window;
-  e.causal.threads = a.settings.threads;
   e.horizon = a.horizon;
   e.Validate();  // option errors before any file is read
   if (a.target.find(',') != std::string::npos) {
@@ -92,10 +93,10 @@ void Run(const EvaluateArgs& a) {
   {
     ProgressBar progress({1.0}, IsTerminal() && !a.quiet);  // Finish() on every exit path
     progress.BeginStage(0, "evaluate");
-    e.progress = [&progress](double fraction, const std::string& label) {
-      progress.Update(fraction, label);
+    execution.progress = [&progress](double fraction, std::string_view label) {
+      progress.Update(fraction, std::string(label));
     };
-    result = drift::Evaluate(y, temperature, truth, base, e);
+    result = drift::Evaluate(y, temperature, truth, base, e, execution);
   }
 
   nlohmann::json methods = nlohmann::json::array(), protocols = nlohmann::json::array();
@@ -113,6 +114,7 @@ void Run(const EvaluateArgs& a) {
                         {"window", e.causal.window},
                         {"horizon", e.horizon},
                         {"rate_hz_from", rate_how},
+                        {"threads", execution.threads},
                         {"drift", io::DriftOptionsToJson(base)}};
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& r : result.rows) {

@@ -70,7 +70,9 @@ struct FitArgs : DriftArgs {
 
 void Run(const FitArgs& a) {
   RequireOutputsAreNotInputs(a.inputs, {a.output});
-  drift::DriftOptions o = drift::MakeDriftOptions(Settings(a, a.method));
+  const drift::FitSettings settings = Settings(a, a.method);
+  drift::DriftOptions o = drift::MakeDriftOptions(settings);
+  Execution execution = drift::MakeExecution(settings);
   const drift::Method method = o.method;
 
   // Several calibration logs (or one split at its gaps) become one run of several records: the
@@ -129,13 +131,11 @@ void Run(const FitArgs& a) {
       const std::string label = axes > 1 ? axis.info.target_column + ": " + std::string(drift::ToString(method))
                                          : std::string(drift::ToString(method));
       progress.BeginStage(i, label);
-      drift::DriftOptions axis_options = o;
-      axis_options.progress = [&progress, &label](double fraction, const std::string& step) {
-        progress.Update(fraction, label + ": " + step);
+      execution.progress = [&progress, &label](double fraction, std::string_view step) {
+        progress.Update(fraction, label + ": " + std::string(step));
       };
-      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, axis_options,
-                                        record_starts);
-      axis.model.options.progress = nullptr;
+      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, o, record_starts,
+                                        execution);
       fitted.push_back(std::move(axis));
     }
   }

@@ -41,14 +41,13 @@ void Run(const PredictArgs& a) {
   if (a.threads < 0 || a.threads > 1024) {
     ThrowOption("--threads", std::to_string(a.threads), "an integer in [0, 1024] (0 = all cores)");
   }
-  io::LoadedModel loaded = io::ReadModelFile(a.model);
-  drift::DriftModel& model = loaded.model;
+  const io::LoadedModel loaded = io::ReadModelFile(a.model);
+  const drift::DriftModel& model = loaded.model;
   if (model.options.mode != drift::Mode::kPredict) {
     throw UsageError(a.model +
                      " is a compensate-mode model: use 'gyrodrift compensate' (predict "
                      "needs a model fitted with --mode predict)");
   }
-  model.options.threads = a.threads;  // the thread count never changes the result
 
   std::string notes;
   const io::CsvTable table = ReadLog(a.input, a.log, &notes);
@@ -65,15 +64,18 @@ void Run(const PredictArgs& a) {
   }
   drift::CausalOptions causal;
   causal.window = a.window;
-  causal.threads = a.threads;
+  Execution execution{.threads = a.threads};  // it never changes the result
   Eigen::VectorXd prediction;
   {
     // Causal prediction decomposes one trailing window per sample: minutes on a long log.
     const bool windows = protocol == drift::Protocol::kCausal && decomposes;
     ProgressBar progress({1.0}, windows && IsTerminal() && !a.quiet);  // Finish() on every path
     progress.BeginStage(0, "causal windows");
-    causal.progress = [&progress](double fraction) { progress.Update(fraction, ""); };
-    prediction = drift::PredictAhead(model, y, temperature, first, a.horizon, protocol, causal);
+    execution.progress = [&progress](double fraction, std::string_view) {
+      progress.Update(fraction, "");
+    };
+    prediction =
+        drift::PredictAhead(model, y, temperature, first, a.horizon, protocol, causal, execution);
   }
 
   const Eigen::Index count = y.size() - first;

@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   o.method = dec::MethodFromString(argv[2]);
   o.ensemble_size = std::atoi(argv[3]);
   o.seed = std::strtoull(argv[4], nullptr, 10);
-  o.threads = std::atoi(argv[5]);
+  dec::DecompositionContext context;
+  context.execution.threads = std::atoi(argv[5]);
   const int repeats = std::atoi(argv[6]);
   if (argc == 9) {
     o.sifting.stop_rule = dec::StopRuleFromString(argv[7]);
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
   int imfs = 0;
   for (int i = 0; i < repeats; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    const dec::Decomposition d = dec::Decompose(x, o);
+    const dec::Decomposition d = dec::Decompose(x, o, context);
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     imfs = d.num_imfs();
   }

@@ -29,9 +29,9 @@ int main() {
   options.ensemble_size = 4;
   options.causal_window = 32;
   options.methods = {gyrodrift::drift::Method::kMsElm, gyrodrift::drift::Method::kPoly};
-  study::StudyObserver observer;
-  observer.stage_done = [](int, const std::string& summary) { std::fputs(summary.c_str(), stdout); };
-  const study::StudyResult result = study::RunStudy(options, log, observer);
+  study::StudyContext context;
+  context.stage_done = [](int, const std::string& summary) { std::fputs(summary.c_str(), stdout); };
+  const study::StudyResult result = study::RunStudy(options, log, context);
   bool finite = !result.compensate.empty();
   for (const auto& row : result.compensate) finite = finite && std::isfinite(row.metrics.rmse);
   // The output's white noise hides the drift in the RMS scores; the Allan deviation's floor shows

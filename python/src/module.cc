@@ -33,6 +33,7 @@
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"
@@ -173,9 +174,9 @@ class LongCall {
     }
   }
 
-  // The library's progress hook.
-  std::function<void(double)> Hook() {
-    return [this](double fraction) { Report(fraction); };
+  // The library's progress hook (Execution::progress); the step is not passed on.
+  std::function<void(double, std::string_view)> Hook() {
+    return [this](double fraction, std::string_view) { Report(fraction); };
   }
 
   // Runs work (library code only: it must not touch Python objects) to its end or its
@@ -255,25 +256,30 @@ py::tuple Decompose(const Array& x_in, const std::string& method, const std::str
   o.ensemble_size = ensemble;
   o.noise_strength = noise;
   o.seed = seed;
-  o.threads = threads;
   o.noise_scaling = dec::NoiseScalingFromString(noise_scaling);
   o.beemdan_bound = dec::BeemdanBoundFromString(bound);
   o.band_confidence = band;
   o.noise_stages = noise_stages;
   o.Validate();
+  dec::DecompositionContext context;
+  context.execution.threads = threads;
+  context.execution.Validate();
   const Eigen::VectorXd x = ToVector(x_in, "x");
+  Eigen::MatrixXd supplied;  // noise_realisations, one per column
   if (noise_realisations) {
     if (o.method == dec::Method::kEmd) {
       throw UsageError("noise_realisations: must not be given with method='emd'");
     }
-    auto w = std::make_shared<Eigen::MatrixXd>(ToMatrix(*noise_realisations, "noise_realisations"));
-    o.supplied_noise = w;
-    o.ensemble_size = static_cast<int>(w->cols());
+    supplied = ToMatrix(*noise_realisations, "noise_realisations");
+    o.ensemble_size = static_cast<int>(supplied.cols());
   }
   LongCall call(progress);
-  o.progress = call.Hook();
+  context.execution.progress = call.Hook();
   dec::Decomposition d;
-  call.Run([&] { d = dec::Decompose(x, o); });
+  call.Run([&] {
+    d = noise_realisations ? dec::DecomposeWithNoise(x, supplied, o, context)
+                           : dec::Decompose(x, o, context);
+  });
   const dec::DecompositionReport& r = d.report;
   py::dict report;
   report["summary"] = r.Summary();
@@ -352,9 +358,10 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
   o.deviation = al::DeviationFromString(dev);
   o.units = al::RateUnitFromString(units);
   o.confidence = confidence;
-  o.threads = threads;
   SetTaus(taus, &o);
   o.Validate();
+  const Execution execution{.threads = threads};
+  execution.Validate();
   const al::NoiseFitOptions fit_options{.tau_min_s = fit_tau_min, .tau_max_s = fit_tau_max};
   fit_options.Validate();
   const Eigen::VectorXd data = ToVector(x_in, "x");
@@ -364,7 +371,7 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
   std::string fit_error, fit_source = al::ToString(o.deviation);
   {
     py::gil_scoped_release release;
-    r = al::Compute(data, o);
+    r = al::Compute(data, o, execution);
     // As `gyrodrift allan`: the noise terms need an Allan-variance curve; for the other
     // estimators an OADEV on the same grid is fitted.
     const bool allan_curve = o.deviation == al::Deviation::kAdev ||
@@ -377,7 +384,7 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
         al::AllanOptions oa = o;
         oa.deviation = al::Deviation::kOadev;
         fit_source = "oadev";
-        terms = al::IdentifyNoise(al::Compute(data, oa), fit_options);
+        terms = al::IdentifyNoise(al::Compute(data, oa, execution), fit_options);
       }
     } catch (const DataError& e) {
       fit_error = e.what();  // too few points to fit: the deviations are still the result
@@ -566,6 +573,14 @@ drift::DriftOptions MakeDriftOptions(const ModelArgs& a) {
   return drift::MakeDriftOptions(s);
 }
 
+// The Execution of a long call's `threads` keyword (as drift::MakeExecution maps it), reporting
+// to the call's progress callable; checked before any work (OptionError naming `threads`).
+Execution ExecutionOf(int threads, LongCall& call) {
+  const Execution execution{.threads = threads, .progress = call.Hook()};
+  execution.Validate();
+  return execution;
+}
+
 // One axis of a model file: the fitted model and the column names it was fitted on.
 class PyDriftModel {
  public:
@@ -584,10 +599,11 @@ class PyDriftModel {
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
            const py::object& progress) {
     LongCall call(progress);
-    drift::DriftOptions o = MakeDriftOptions(
-        {mode, method, decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
-         ensemble, realisations, seed, threads, nonlinear, reference_temperature, hysteresis,
-         temperature_in.has_value()});
+    const drift::DriftOptions o =
+        MakeDriftOptions({mode, method, decomposition, lags, hidden, rate_hz, thermal_features,
+                          time_constants, ensemble, realisations, seed, threads, nonlinear,
+                          reference_temperature, hysteresis, temperature_in.has_value()});
+    const Execution execution = ExecutionOf(threads, call);
 
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::MatrixXd temperature;
@@ -612,9 +628,8 @@ class PyDriftModel {
       for (size_t c = 0; c < names.size(); ++c)
         loaded.info.temperature_column += (c ? "," : "") + names[c];
     }
-    const std::function<void(double)> report = call.Hook();
-    o.progress = [&report](double fraction, const std::string&) { report(fraction); };
-    call.Run([&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts); });
+    call.Run(
+        [&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution); });
     loaded_ = std::move(loaded);
     fitted_ = true;
   }
@@ -673,8 +688,8 @@ class PyDriftModel {
     if (window < 16 || window > 1000000) {
       throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
     }
-    drift::DriftModel model = Loaded().model;
-    model.options.threads = threads;  // the thread count never changes the result
+    const drift::DriftModel& model = Loaded().model;
+    const Execution execution = ExecutionOf(threads, call);  // it never changes the result
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
     if (model.uses_temperature()) {
@@ -688,11 +703,10 @@ class PyDriftModel {
     }
     drift::CausalOptions causal;
     causal.window = window;
-    causal.threads = threads;
-    causal.progress = call.Hook();
     Eigen::VectorXd prediction;
     call.Run([&] {
-      prediction = drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal);
+      prediction =
+          drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal, execution);
     });
     return py::make_tuple(first, ToArray(prediction));
   }
@@ -774,17 +788,17 @@ py::dict SelectModesPy(const Array& x_in, const py::array_t<double, py::array::f
   o.monte_carlo.realisations = realisations;
   o.monte_carlo.confidence = confidence;
   o.monte_carlo.seed = seed;
-  o.monte_carlo.threads = threads;
   o.band_confidence = band;
-  o.threads = threads;
   o.Validate();
+  const Execution execution{.threads = threads};
+  execution.Validate();
   const Eigen::VectorXd x = ToVector(x_in, "x");
   if (imfs_in.ndim() != 2) throw UsageError("imfs: must be an (N, K) array, one IMF per column");
   const Eigen::MatrixXd imfs = Eigen::Map<const Eigen::MatrixXd>(imfs_in.data(), imfs_in.shape(0),
                                                                  imfs_in.shape(1));
   const Eigen::VectorXd residue = ToVector(residue_in, "residue");
   selection::SelectionResult r;
-  call.Run([&] { r = selection::SelectModes(x, imfs, residue, o); });
+  call.Run([&] { r = selection::SelectModes(x, imfs, residue, o, execution); });
   py::list groups;
   for (const selection::ModeGroup& g : r.groups) {
     py::dict d;
@@ -855,6 +869,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
       {mode, "ms-elm", decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
        ensemble, realisations, seed, threads, nonlinear, reference_temperature, hysteresis,
        temperature_in.has_value()});
+  const Execution execution = ExecutionOf(threads, call);
   drift::EvaluationOptions e;
   e.split = split;
   e.repeats = repeats;
@@ -867,7 +882,6 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
     throw OptionError("protocol", "'" + protocol + "'", "paper, causal or both");
   }
   e.causal.window = window;
-  e.causal.threads = threads;
   e.horizon = horizon;
   e.Validate();
   const Eigen::VectorXd y = ToVector(y_in, "y");
@@ -875,10 +889,8 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
   if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
   Eigen::VectorXd truth;
   if (truth_in) truth = ToVector(*truth_in, "truth");
-  const std::function<void(double)> report = call.Hook();
-  e.progress = [&report](double fraction, const std::string&) { report(fraction); };
   drift::EvaluationResult result;
-  call.Run([&] { result = drift::Evaluate(y, temperature, truth, base, e); });
+  call.Run([&] { result = drift::Evaluate(y, temperature, truth, base, e, execution); });
 
   py::list rows;
   for (const drift::EvaluationRow& r : result.rows) {
@@ -944,9 +956,7 @@ fleet::Manifest LoadManifest(const std::string& path) {
 
 py::dict Calibrate(const std::string& manifest_path, const std::string& output_dir, bool force,
                    int threads) {
-  if (threads < 0 || threads > 1024) {
-    throw OptionError("threads", std::to_string(threads), "in [0, 1024] (0: every core)");
-  }
+  ValidateThreads(threads);
   fleet::FleetResult r;
   {
     py::gil_scoped_release release;
@@ -954,8 +964,9 @@ py::dict Calibrate(const std::string& manifest_path, const std::string& output_d
     fleet::FleetOptions o;
     o.output_dir = output_dir;
     o.force = force;
-    o.threads = threads;
-    r = fleet::RunFleet(m, o);
+    fleet::FleetContext context;
+    context.threads = threads;
+    r = fleet::RunFleet(m, o, context);
   }
   return FleetDict(r);
 }

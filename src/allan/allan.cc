@@ -130,7 +130,6 @@ void AllanOptions::Validate() const {
   RequirePositive("rate_hz", rate_hz);
   if (!(confidence > 0.0 && confidence < 1.0))
     ThrowOption("confidence", FormatValue(confidence), "in (0, 1)");
-  if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = all cores)");
   if (forced_alpha && (*forced_alpha < -4 || *forced_alpha > 2))
     ThrowOption("forced_alpha", std::to_string(*forced_alpha), "an integer in -4..2");
   if (forced_alpha && *forced_alpha + 2 * DifferenceOrder(deviation) <= 1)
@@ -240,8 +239,10 @@ std::string AllanResult::Summary() const {
   return s.str();
 }
 
-AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options) {
+AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options,
+                    const Execution& execution) {
   options.Validate();
+  execution.Validate();
   const Eigen::Index min_samples = options.data_type == DataType::kRate ? 2 : 3;
   RequireFiniteSignal("input", data, min_samples);
   AllanResult result;
@@ -278,7 +279,7 @@ AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options) {
   task_begin.push_back(count);
   const int dmax = DifferenceOrder(dev);
   const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
-  ParallelFor(static_cast<int>(task_begin.size()) - 1, options.threads, [&](int task, int) {
+  ParallelFor(static_cast<int>(task_begin.size()) - 1, execution.threads, [&](int task, int) {
     const int begin = task_begin[static_cast<size_t>(task)];
     const int end = task_begin[static_cast<size_t>(task) + 1];
     if (dev == Deviation::kOadev) {

@@ -59,17 +59,17 @@ NoiseStagePolicy EnergyBandExit(const DecompositionOptions& o) {
 
 }  // namespace
 
-Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
-                         const DecompositionOptions& o) {
+Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job) {
+  const DecompositionOptions& o = job.options;
   switch (o.beemdan_bound) {
     case BeemdanBound::kEnergyBand:
-      return RunIceemdanStages(x, o, EnergyBandExit(o));
+      return RunIceemdanStages(x, job, EnergyBandExit(o));
     case BeemdanBound::kFixedStages:
-      return RunIceemdanStages(x, o, FixedStages(o));
+      return RunIceemdanStages(x, job, FixedStages(o));
     case BeemdanBound::kFull:
       break;
   }
-  return RunIceemdanStages(x, o, {});
+  return RunIceemdanStages(x, job, {});
 }
 
 }  // namespace gyrodrift::decomposition::internal

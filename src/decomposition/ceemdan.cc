@@ -11,16 +11,16 @@
 
 namespace gyrodrift::decomposition::internal {
 
-Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
-                         const DecompositionOptions& o) {
+Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job) {
+  const DecompositionOptions& o = job.options;
   const Eigen::Index n = x.size();
-  const int ensemble = EnsembleSize(o);
+  const int ensemble = EnsembleSize(job);
   const double eps = o.noise_strength;
   const double sx = SampleStd(x.data(), n);
   const Eigen::VectorXd xn = x / sx;
-  auto workers = MakeWorkers(ensemble, o, n);
+  auto workers = MakeWorkers(ensemble, job, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report = EnsembleReport(Method::kCeemdan, o, workers);
+  DecompositionReport report = EnsembleReport(Method::kCeemdan, job, workers);
   const double inv = 1.0 / ensemble;
 
   std::vector<Eigen::VectorXd> modes;
@@ -32,15 +32,15 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
     Eigen::VectorXd mode = Eigen::VectorXd::Zero(n);
     StageStats stats;
     ParallelOrderedReduce(
-        ensemble, o.threads,
+        ensemble, job.threads(),
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
           if (stage == 0) {
             // Stage 1 adds the realisation itself; its EMD then feeds the later stages.
-            modes_i.emplace(o, i, n);
+            modes_i.emplace(job, i, n);
             wk.input = xn + eps * modes_i->white();
-          } else if (NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data())) {
+          } else if (NextNoiseRow(job, i, *modes_i, wk.sifter, wk.noise.data())) {
             // Torres et al. 2011, stage k: r_k + eps_k E_k(w); here eps_k keeps the added noise
             // at eps * std(r_k), a constant SNR per stage.
             const double sn = SampleStd(wk.noise.data(), n);
@@ -57,7 +57,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, StageTerm term) {
           for (Eigen::Index j = 0; j < n; ++j) mode[j] = mode[j] + term.value[j] * inv;
           stats.Add(term.outcome);
-          ReportProgress(o, stage, i, ensemble, n, reported);
+          ReportProgress(job, stage, i, ensemble, n, reported);
         });
     stats.Report(report, ensemble);
     r -= mode;

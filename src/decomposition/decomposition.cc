@@ -9,6 +9,7 @@
 
 #include "common/enum_names.h"
 #include "decomposition/drivers.h"
+#include "decomposition/noise_ensemble.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/decomposition/energy_band.h"
@@ -108,14 +109,11 @@ void DecompositionOptions::Validate() const {
     ThrowOption("max_imfs", std::to_string(max_imfs), "an integer in [0, 1000] (0 = no cap)");
   }
   // Every field is checked whatever the method, so a mistyped option is never silently ignored.
-  if (!supplied_noise && (ensemble_size < 1 || ensemble_size > 100000)) {
+  if (ensemble_size < 1 || ensemble_size > 100000) {
     ThrowOption("ensemble_size", std::to_string(ensemble_size), "an integer in [1, 100000]");
   }
   if (!(noise_strength > 0 && noise_strength <= 10)) {
     ThrowOption("noise_strength", FormatValue(noise_strength), "in (0, 10]");
-  }
-  if (threads < 0 || threads > 1024) {
-    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
   }
   ValidateBandConfidence(band_confidence);
   if (noise_stages < 1 || noise_stages > 1000) {
@@ -161,13 +159,21 @@ void RequireNoiseStateFits(double ensemble, Eigen::Index n, double vectors_per_r
 
 }  // namespace internal
 
-Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
-                        const DecompositionOptions& options) {
+namespace {
+
+// Decompose and DecomposeWithNoise: checks the inputs against each other, then runs the method.
+Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Job& job) {
+  const DecompositionOptions& options = job.options;
+  const DecompositionContext& context = job.context;
   options.Validate();
+  context.execution.Validate();
   RequireFiniteSignal("input signal", x, 4);
   const Eigen::Index n = x.size();
-  if (options.method != Method::kEmd && options.supplied_noise) {
-    const auto& w = *options.supplied_noise;
+  if (job.noise) {
+    const auto& w = *job.noise;
+    if (options.method == Method::kEmd) {
+      throw UsageError("supplied noise: method emd adds no noise (decompose with Decompose)");
+    }
     if (w.rows() != n || w.cols() < 1) {
       throw DataError("supplied noise is " + std::to_string(w.rows()) + " x " +
                       std::to_string(w.cols()) + ": it must have one row per sample (" +
@@ -176,9 +182,10 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
     if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
   }
   const bool ceemdan_family = UsesNoiseEmds(options.method);
-  if (options.noise_emds && !(ceemdan_family && options.noise_emds->Matches(n, options))) {
-    throw UsageError("noise_emds (" + std::to_string(options.noise_emds->length()) +
-                     " samples, ensemble " + std::to_string(options.noise_emds->ensemble_size()) +
+  if (context.noise_emds &&
+      !(ceemdan_family && !job.noise && context.noise_emds->Matches(n, options))) {
+    throw UsageError("noise_emds (" + std::to_string(context.noise_emds->length()) +
+                     " samples, ensemble " + std::to_string(context.noise_emds->ensemble_size()) +
                      ") do not match this decomposition (" + std::string(ToString(options.method)) +
                      ", " + std::to_string(n) +
                      " samples): they serve the CEEMDAN family with the same length, seed, "
@@ -186,10 +193,7 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
   if (ceemdan_family) {
     // Each realisation keeps the running residue of its noise EMD (N doubles).
-    const double ensemble = options.supplied_noise
-                                ? static_cast<double>(options.supplied_noise->cols())
-                                : static_cast<double>(options.ensemble_size);
-    internal::RequireNoiseStateFits(ensemble, n, 1.0);
+    internal::RequireNoiseStateFits(internal::EnsembleSize(job), n, 1.0);
   }
   // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.
   if (internal::CountExtrema(x.data(), n).extrema() < 3) {
@@ -205,15 +209,29 @@ Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
     case Method::kEmd:
       return internal::RunEmd(x, options);
     case Method::kEemd:
-      return internal::RunEemd(x, options);
+      return internal::RunEemd(x, job);
     case Method::kCeemdan:
-      return internal::RunCeemdan(x, options);
+      return internal::RunCeemdan(x, job);
     case Method::kIceemdan:
-      return internal::RunIceemdan(x, options);
+      return internal::RunIceemdan(x, job);
     case Method::kBeemdan:
-      return internal::RunBeemdan(x, options);
+      return internal::RunBeemdan(x, job);
   }
   throw UsageError("unknown decomposition method");
+}
+
+}  // namespace
+
+Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
+                        const DecompositionOptions& options, const DecompositionContext& context) {
+  return Run(x, internal::Job{options, context});
+}
+
+Decomposition DecomposeWithNoise(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& noise,
+                                 const DecompositionOptions& options,
+                                 const DecompositionContext& context) {
+  return Run(x, internal::Job{options, context, &noise});
 }
 
 Decomposition Emd(const Eigen::Ref<const Eigen::VectorXd>& x, const SiftingOptions& sifting,

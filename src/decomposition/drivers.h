@@ -11,6 +11,16 @@
 
 namespace gyrodrift::decomposition::internal {
 
+// What a driver reads: the options, the caller's context and, for DecomposeWithNoise, the
+// supplied noise (N x I; null: realisation i is drawn from stream (seed, i)). Decompose has
+// checked all three against each other and against the signal.
+struct Job {
+  const DecompositionOptions& options;
+  const DecompositionContext& context;
+  const Eigen::Ref<const Eigen::MatrixXd>* noise = nullptr;
+  int threads() const { return context.execution.threads; }
+};
+
 // The EMD of one white-noise realisation, extracted one mode at a time on demand, so the
 // CEEMDAN family never computes a noise mode it does not use nor recomputes one from the start.
 // Rows follow emd.m: IMF 1, IMF 2, ..., then the residue (if not identically zero).
@@ -48,10 +58,10 @@ Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd 
                              DecompositionReport report);
 
 Decomposition RunEmd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
-Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
-Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
-Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
-Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o);
+Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
+Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
+Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
 
 // What ends the noise assistance of the ICEEMDAN stages, asked before every stage k >= 1 with
 // the modes so far (normalised input), the residue r, a free sifter and N-vector: true goes on
@@ -61,7 +71,7 @@ using NoiseStagePolicy =
     std::function<bool(int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r,
                        Sifter& sifter, Eigen::VectorXd& scratch, DecompositionReport& report)>;
 // ICEEMDAN's stages under a policy (empty: noise assistance to the end, ICEEMDAN itself).
-Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                const DecompositionOptions& o, const NoiseStagePolicy& go_on);
+Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job,
+                                const NoiseStagePolicy& go_on);
 
 }  // namespace gyrodrift::decomposition::internal

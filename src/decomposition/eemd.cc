@@ -12,15 +12,16 @@
 
 namespace gyrodrift::decomposition::internal {
 
-Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const DecompositionOptions& o) {
+Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job) {
+  const DecompositionOptions& o = job.options;
   const Eigen::Index n = x.size();
-  const int ensemble = EnsembleSize(o);
+  const int ensemble = EnsembleSize(job);
   const int max_imfs =
       o.max_imfs > 0
           ? o.max_imfs
           : std::max(1, static_cast<int>(std::floor(std::log2(static_cast<double>(n)))) - 1);
   const double amplitude = o.noise_strength * SampleStd(x.data(), n);
-  auto workers = MakeWorkers(ensemble, o, n);
+  auto workers = MakeWorkers(ensemble, job, n);
 
   Eigen::MatrixXd mean_imfs = Eigen::MatrixXd::Zero(n, max_imfs);
   Eigen::VectorXd mean_residue = Eigen::VectorXd::Zero(n);
@@ -32,15 +33,15 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
   };
   const double inv = 1.0 / ensemble;
   ParallelOrderedReduce(
-      ensemble, o.threads,
+      ensemble, job.threads(),
       [&](int i, int w) {
         Member m;
-        m.residue = x + amplitude * DrawNoise(o, i, n);
+        m.residue = x + amplitude * DrawNoise(job, i, n);
         EmdLoop(workers[static_cast<size_t>(w)].sifter, m.residue, max_imfs, m.imfs, m.report);
         return m;
       },
       [&](int i, Member m) {
-        if (o.progress) o.progress(static_cast<double>(i + 1) / ensemble);
+        job.context.execution.Report(static_cast<double>(i + 1) / ensemble, ToString(o.method));
         for (size_t k = 0; k < m.imfs.size(); ++k) {
           mean_imfs.col(static_cast<Eigen::Index>(k)) += m.imfs[k] * inv;
           SiftOutcome s;
@@ -51,7 +52,7 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Decompos
         mean_residue += m.residue * inv;
       });
 
-  DecompositionReport report = EnsembleReport(Method::kEemd, o, workers);
+  DecompositionReport report = EnsembleReport(Method::kEemd, job, workers);
   for (const auto& s : stats) s.Report(report, ensemble);
   report.stop_reason =
       "fixed IMF count " + std::to_string(max_imfs) + " (EEMD aligns every member's modes)";

@@ -13,17 +13,18 @@
 
 namespace gyrodrift::decomposition::internal {
 
-Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                const DecompositionOptions& o, const NoiseStagePolicy& go_on) {
+Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job,
+                                const NoiseStagePolicy& go_on) {
+  const DecompositionOptions& o = job.options;
   const Eigen::Index n = x.size();
-  const int ensemble = EnsembleSize(o);
+  const int ensemble = EnsembleSize(job);
   const double eps = o.noise_strength;
   const bool constant_snr = o.noise_scaling == NoiseScaling::kConstantSnr;
   const double sx = SampleStd(x.data(), n);
   const Eigen::VectorXd xn = x / sx;
-  auto workers = MakeWorkers(ensemble, o, n);
+  auto workers = MakeWorkers(ensemble, job, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
-  DecompositionReport report = EnsembleReport(o.method, o, workers);
+  DecompositionReport report = EnsembleReport(o.method, job, workers);
   const double nr = static_cast<double>(ensemble);
 
   std::vector<Eigen::VectorXd> modes;
@@ -47,13 +48,13 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
     Eigen::VectorXd next = Eigen::VectorXd::Zero(n);
     StageStats stats;
     ParallelOrderedReduce(
-        ensemble, o.threads,
+        ensemble, job.threads(),
         [&](int i, int w) {
           Worker& wk = workers[static_cast<size_t>(w)];
           auto& modes_i = noise[static_cast<size_t>(i)];
-          if (stage == 0) modes_i.emplace(o, i, n);
+          if (stage == 0) modes_i.emplace(job, i, n);
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
-          const bool has_noise = NextNoiseRow(o, i, *modes_i, wk.sifter, wk.noise.data());
+          const bool has_noise = NextNoiseRow(job, i, *modes_i, wk.sifter, wk.noise.data());
           if (stage == 0) {
             const double se = SampleStd(wk.noise.data(), n);
             for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = xn[j] + (eps * wk.noise[j]) / se;
@@ -84,7 +85,7 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
         [&](int i, StageTerm term) {
           for (Eigen::Index j = 0; j < n; ++j) next[j] = next[j] + term.value[j] / nr;
           stats.Add(term.outcome);
-          ReportProgress(o, stage, i, ensemble, n, reported);
+          ReportProgress(job, stage, i, ensemble, n, reported);
         });
     stats.Report(report, ensemble);
     Eigen::VectorXd mode = r - next;
@@ -98,9 +99,8 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x,
   return AssembleResult(std::move(modes), std::move(r), std::move(report));
 }
 
-Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x,
-                          const DecompositionOptions& o) {
-  return RunIceemdanStages(x, o, {});
+Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job) {
+  return RunIceemdanStages(x, job, {});
 }
 
 }  // namespace gyrodrift::decomposition::internal

@@ -20,20 +20,23 @@
 namespace gyrodrift::decomposition::internal {
 
 // I: the supplied noise's columns, or ensemble_size.
-int EnsembleSize(const DecompositionOptions& o);
+int EnsembleSize(const Job& job);
 
-// White noise of realisation i, unit variance (before any method-specific scaling).
-Eigen::VectorXd DrawNoise(const DecompositionOptions& o, int i, Eigen::Index n);
+// White noise of realisation i, unit variance (before any method-specific scaling): the supplied
+// noise's column i, or drawn from stream (seed, i).
+Eigen::VectorXd DrawNoise(const Job& job, int i, Eigen::Index n);
 
 // Realisation i's white noise and its EMD, row by row: read from the shared NoiseEmds when the
-// options carry one, else drawn and sifted on demand.
+// context carries one, else drawn and sifted on demand.
 class NoiseRows {
  public:
-  NoiseRows(const DecompositionOptions& o, int i, Eigen::Index n) {
-    if (o.noise_emds) {
-      cached_ = &o.noise_emds->realisation(i);
+  NoiseRows(const Job& job, int i, Eigen::Index n) {
+    if (job.context.noise_emds) {
+      // Decompose checked the set against the options; supplied noise never shares one.
+      assert(job.noise == nullptr && job.context.noise_emds->length() == n);
+      cached_ = &job.context.noise_emds->realisation(i);
     } else {
-      modes_.emplace(DrawNoise(o, i, n));
+      modes_.emplace(DrawNoise(job, i, n));
     }
   }
   // The realisation itself (valid before the first Next).
@@ -65,8 +68,7 @@ class NoiseRows {
 
 // The next row of realisation i's noise EMD into out (false: none), shown to the observer when
 // it is an IMF.
-bool NextNoiseRow(const DecompositionOptions& o, int i, NoiseRows& modes, Sifter& sifter,
-                  double* out);
+bool NextNoiseRow(const Job& job, int i, NoiseRows& modes, Sifter& sifter, double* out);
 
 // Per-worker state: a sifter and scratch vectors sized once.
 struct Worker {
@@ -77,7 +79,7 @@ struct Worker {
 
 // A report of `method` with the ensemble's size, seed, whether its noise was supplied and the
 // worker threads used.
-DecompositionReport EnsembleReport(Method method, const DecompositionOptions& o,
+DecompositionReport EnsembleReport(Method method, const Job& job,
                                    const std::vector<Worker>& workers);
 
 // The stage-wise methods' end before a stage: the IMF cap reached, or (when check_extrema) a
@@ -86,7 +88,7 @@ bool StagesEnd(const DecompositionOptions& o, size_t modes, const Eigen::VectorX
                bool check_extrema, DecompositionReport& report);
 
 // One worker per thread the ensemble can use.
-std::vector<Worker> MakeWorkers(int ensemble, const DecompositionOptions& o, Eigen::Index n);
+std::vector<Worker> MakeWorkers(int ensemble, const Job& job, Eigen::Index n);
 
 // Sift statistics of one stage across realisations.
 struct StageStats {
@@ -117,7 +119,7 @@ void Scale(std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& residue, double
 // Stage-wise methods do not know their stage count in advance: EMD of noise gives about
 // log2(N) modes, so that is the estimate (never reaching 1 before the end).
 // `reported` keeps the display monotone when the estimate grows.
-void ReportProgress(const DecompositionOptions& o, int stage, int realisation, int ensemble,
-                    Eigen::Index n, double& reported);
+void ReportProgress(const Job& job, int stage, int realisation, int ensemble, Eigen::Index n,
+                    double& reported);
 
 }  // namespace gyrodrift::decomposition::internal

@@ -4,6 +4,7 @@
 // window is too short to feed (CausalWindowNote). PredictAhead (prediction.cc) runs it.
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -32,21 +33,22 @@ namespace internal {
 decomposition::DecompositionOptions DecompositionFor(const DriftModel& model) {
   decomposition::DecompositionOptions dopt = model.options.decomposition;
   dopt.seed = model.options.seed;
-  dopt.noise_emds = nullptr;
   return dopt;
 }
 
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                                         const Eigen::Ref<const Eigen::VectorXd>& y,
                                         Eigen::Index origin, Eigen::Index count,
-                                        const CausalOptions& causal) {
+                                        const CausalOptions& causal, const Execution& execution) {
   decomposition::DecompositionOptions dopt = DecompositionFor(model);
-  dopt.threads = 1;
   if (causal.ensemble_size > 0) dopt.ensemble_size = causal.ensemble_size;
+  // The windows run in parallel, each decomposition on its worker's thread.
+  decomposition::DecompositionContext one_thread;
+  one_thread.execution.threads = 1;
   // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
   // computed once here instead of once per window (the same bits; about half of each window's
   // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
-  decomposition::DecompositionOptions dopt_full = dopt;
+  decomposition::DecompositionContext full_window = one_thread;
   const Eigen::Index last_origin = origin + count - 1;
   const Eigen::Index full_windows = last_origin - std::max<Eigen::Index>(origin, causal.window) + 1;
   const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
@@ -55,9 +57,9 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   // Shared, the noise EMDs are computed to the end; a window computes only the rows it uses
   // (few, when BEEMDAN's bound stops early): sharing pays from a few windows on.
   if (decomposition::UsesNoiseEmds(dopt.method) && full_windows >= 16 && cache_bytes <= 256e6) {
-    decomposition::DecompositionOptions build = dopt;
-    build.threads = causal.threads;
-    dopt_full.noise_emds = std::make_shared<const decomposition::NoiseEmds>(causal.window, build);
+    full_window.noise_emds = std::make_shared<const decomposition::NoiseEmds>(
+        causal.window, dopt, execution);  // its progress is not called
+    assert(full_window.noise_emds->Matches(causal.window, dopt));
   }
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
@@ -66,25 +68,25 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   std::mutex progress_mutex;
   double reported = 0.0;
   const Eigen::Index report_every = std::max<Eigen::Index>(1, count / 200);
-  ParallelFor(static_cast<int>(count), causal.threads, [&](int r, int) {
+  ParallelFor(static_cast<int>(count), execution.threads, [&](int r, int) {
     const Eigen::Index end = origin + r;  // the window ends just before the origin
     const Eigen::Index start = std::max<Eigen::Index>(0, end - causal.window);
     const Eigen::Index length = end - start;
-    const Eigen::MatrixXd series =
-        GroupSeries(model, decomposition::Decompose(y.segment(start, length),
-                                                    length == causal.window ? dopt_full : dopt));
+    const Eigen::MatrixXd series = GroupSeries(
+        model, decomposition::Decompose(y.segment(start, length), dopt,
+                                        length == causal.window ? full_window : one_thread));
     for (size_t g = 0; g < groups; ++g) {
       for (int k = 0; k < p; ++k) {
         lags[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));
       }
     }
     const Eigen::Index done = ++windows_done;
-    if (causal.progress && (done % report_every == 0 || done == count)) {
+    if (execution.progress && (done % report_every == 0 || done == count)) {
       std::lock_guard<std::mutex> lock(progress_mutex);
       const double fraction = static_cast<double>(done) / static_cast<double>(count);
       if (fraction > reported) {
         reported = fraction;
-        causal.progress(fraction);
+        execution.progress(fraction, "causal windows");
       }
     }
   });

@@ -41,9 +41,9 @@ Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
                     " given");
   }
   // Equilibrium at the reference: a one-sample record starts (and stays) in equilibrium.
-  const bool referenced = !std::isnan(model.options.reference_c);
+  const bool referenced = model.options.reference_c.has_value();
   const Eigen::MatrixXd t_ref =
-      Eigen::MatrixXd::Constant(1, temperature_c.cols(), model.options.reference_c);
+      Eigen::MatrixXd::Constant(1, temperature_c.cols(), model.options.reference_c.value_or(0.0));
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, 2);
   bool every_band = true;
   Eigen::MatrixXd f;

@@ -2,6 +2,7 @@
 // the decomposition and grouping into sub-series (PrepareSubSeries), and one learner or
 // identified thermal model per sub-series (FitLearners), with the automatic choice of lags.
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -37,7 +38,6 @@ LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
   LearnerOptions l = o.learner;
   l.kind = internal::KindOf(o.method);
   l.seed = SubModelSeed(o, g);
-  l.threads = o.threads;
   return l;
 }
 
@@ -88,16 +88,9 @@ Eigen::MatrixXd ThermalOrEmpty(const DriftModel& model,
 }
 
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
-                           bool report) {
-  report = report && static_cast<bool>(o.progress);
+                           const Execution& execution) {
   SubSeries out;
   out.model.options = o;
-  // A model keeps no caller callbacks (it may run later, from other threads, after they are
-  // gone) and no shared noise EMDs (they serve one record length; a model predicts on any).
-  out.model.options.progress = nullptr;
-  out.model.options.decomposition.progress = nullptr;
-  out.model.options.decomposition.noise_imf_observer = nullptr;
-  out.model.options.decomposition.noise_emds = nullptr;
   if (!UsesDecomposition(o.method)) {
     out.model.sub_models.push_back({"signal", {}, true, nullptr});
     out.series = y;
@@ -105,22 +98,24 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
   }
   decomposition::DecompositionOptions dopt = o.decomposition;
   dopt.seed = o.seed;
-  dopt.threads = o.threads;
-  if (report) {
-    o.progress(0.0, "decompose");
-    dopt.progress = [&o](double fraction) { o.progress(kDecomposeShare * fraction, "decompose"); };
+  decomposition::DecompositionContext context;
+  context.execution.threads = execution.threads;
+  if (execution.progress) {
+    execution.progress(0.0, "decompose");
+    context.execution.progress = [&execution](double fraction, std::string_view) {
+      execution.progress(kDecomposeShare * fraction, "decompose");
+    };
   }
   decomposition::Decomposition d;
   std::optional<selection::SelectionResult> sel;
   if (o.method == Method::kEmdElm) {
-    d = decomposition::Decompose(y, dopt);
+    d = decomposition::Decompose(y, dopt, context);
   } else {
     selection::SelectionOptions sopt = o.selection;
-    sopt.threads = o.threads;
     // The white-noise level, when it cannot reuse the decomposition's noise, draws the same
     // realisations itself: the user's seed, not the Monte-Carlo's default.
     sopt.monte_carlo.seed = o.seed;
-    selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt);
+    selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt, context);
     d = std::move(grouped.decomposition);
     sel = std::move(grouped.selection);
   }
@@ -148,8 +143,9 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
                  const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                 const std::vector<Eigen::Index>& record_starts) {
+                 const std::vector<Eigen::Index>& record_starts, int threads) {
   const DriftOptions& o = model.options;
+  const Execution learners{.threads = threads};
   model.training_samples = fit_end;
   const size_t groups = model.sub_models.size();
   if (IdentifiesThermalModel(o)) {
@@ -165,9 +161,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
     return;
   }
   if (o.mode == Mode::kCompensate) {  // a single learner on the thermal features
-    model.sub_models.front().learner =
-        FitLearner(thermal.topRows(fit_end), series.col(0).head(fit_end),
-                   SubModelLearner(o, 0));
+    model.sub_models.front().learner = FitLearner(
+        thermal.topRows(fit_end), series.col(0).head(fit_end), SubModelLearner(o, 0), learners);
     return;
   }
   auto fit_with_lags = [&](int p, Eigen::Index end) {
@@ -180,7 +175,7 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       const auto s = series.col(static_cast<Eigen::Index>(g));
       model.sub_models[g].learner =
           FitLearner(PredictRows(model, s, thermal, p, end - p), s.segment(p, end - p),
-                     SubModelLearner(o, g));
+                     SubModelLearner(o, g), learners);
     }
   };
   if (!o.auto_lags) {
@@ -212,8 +207,10 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options,
-                         const std::vector<Eigen::Index>& record_starts) {
+                         const std::vector<Eigen::Index>& record_starts,
+                         const Execution& execution) {
   options.Validate();
+  execution.Validate();
   if (!record_starts.empty() &&
       !(options.mode == Mode::kCompensate && options.method == Method::kThermal)) {
     throw UsageError(
@@ -236,18 +233,20 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   }
   DriftOptions o = options;
   o.features = ForTrainingRecord(o.features, y.size());
-  internal::SubSeries prepared = internal::PrepareSubSeries(y, o, /*report=*/true);
+  internal::SubSeries prepared = internal::PrepareSubSeries(y, o, execution);
   const Eigen::MatrixXd thermal = internal::ThermalOrEmpty(prepared.model, temperature_c, y.size());
   const bool decomposed = UsesDecomposition(options.method);
-  if (options.progress)
-    options.progress(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
+  execution.Report(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
   internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c,
-                        record_starts);
+                        record_starts, execution.threads);
   if (prepared.model.uses_temperature()) {
     prepared.model.temperature_min_c = temperature_c.col(0).minCoeff();
     prepared.model.temperature_max_c = temperature_c.col(0).maxCoeff();
   }
-  if (options.progress) options.progress(1.0, "fit sub-models");
+  execution.Report(1.0, "fit sub-models");
+  // A model holds the options it was fitted with, as given: plain values, nothing of how the fit
+  // ran (its threads and callbacks are the execution's, which a model never sees).
+  assert(prepared.model.options == o);
   return std::move(prepared.model);
 }
 

@@ -89,7 +89,7 @@ void DriftOptions::Validate() const {
   ValidateNested("decomposition", [&] { decomposition.Validate(); });
   ValidateNested("selection", [&] { selection.Validate(); });
   ValidateNested("features", [&] { EffectiveFeatures(*this).Validate(); });
-  if (!std::isnan(reference_c)) RequireInRange("reference_c", reference_c, -100.0, 200.0);
+  if (reference_c) RequireInRange("reference_c", *reference_c, -100.0, 200.0);
   if (!SupportsMode(method, mode)) {
     ThrowOption("method", std::string(ToString(method)),
                 "a method of " + std::string(ToString(mode)) +
@@ -106,9 +106,6 @@ void DriftOptions::Validate() const {
     ThrowOption("lag_candidates", "(empty)", "at least one candidate when lags are 'auto'");
   }
   RequireInRange("validation_fraction", validation_fraction, 0.05, 0.5);
-  if (threads < 0 || threads > 1024) {
-    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
-  }
 }
 
 bool DriftOptions::uses_temperature() const {

@@ -33,7 +33,9 @@ struct Trial {
 // Fits and scores one (method, protocol, seed) on the split record.
 Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
                const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, const DriftOptions& given,
-               Protocol protocol, Eigen::Index split, int horizon, const CausalOptions& causal) {
+               Protocol protocol, Eigen::Index split, int horizon, const CausalOptions& causal,
+               const Execution& windows) {
+  const Execution fit{.threads = windows.threads};  // a trial's fit reports nothing
   DriftOptions o = given;
   o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
   const Eigen::Index n = y.size();
@@ -52,15 +54,17 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
     thermal_all.resize(n, 0);
   }
   if (decompose_all) {
-    internal::SubSeries prepared = internal::PrepareSubSeries(y, o);
+    internal::SubSeries prepared = internal::PrepareSubSeries(y, o, fit);
     series_all = std::move(prepared.series);
     model = std::move(prepared.model);
     internal::FitLearners(model, series_all, y, thermal_all, split,
-                          thermal_needed ? Eigen::MatrixXd(temperature_c) : Eigen::MatrixXd(n, 0));
+                          thermal_needed ? Eigen::MatrixXd(temperature_c) : Eigen::MatrixXd(n, 0),
+                          {}, fit.threads);
   } else {
     model = FitDriftModel(
         y.head(split),
-        thermal_needed ? Eigen::MatrixXd(temperature_c.topRows(split)) : Eigen::MatrixXd(), o);
+        thermal_needed ? Eigen::MatrixXd(temperature_c.topRows(split)) : Eigen::MatrixXd(), o, {},
+        fit);
   }
   trial.train_s = Seconds(start);
   trial.summary = model.Summary();
@@ -74,10 +78,9 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
     trial.estimate = PredictFromSeries(
         model, series_all, thermal_all, split, test, horizon);
   } else {
-    trial.estimate =
-        PredictAhead(model, y,
-                     thermal_needed ? Eigen::VectorXd(temperature_c.col(0)) : Eigen::VectorXd(),
-                     split, horizon, Protocol::kCausal, causal);
+    trial.estimate = PredictAhead(
+        model, y, thermal_needed ? Eigen::VectorXd(temperature_c.col(0)) : Eigen::VectorXd(), split,
+        horizon, Protocol::kCausal, causal, windows);
   }
   trial.predict_s = Seconds(start);
   if (protocol == Protocol::kCausal) trial.note = CausalWindowNote(model, causal.window);
@@ -108,9 +111,10 @@ void EvaluationOptions::Validate() const {
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                           const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                           const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
-                          const EvaluationOptions& options) {
+                          const EvaluationOptions& options, const Execution& execution) {
   base.Validate();
   options.Validate();
+  execution.Validate();
   if (base.mode == Mode::kCompensate && options.horizon != 1) {
     ThrowOption("horizon", std::to_string(options.horizon),
                 "1 in compensate mode (the estimate at t is read from the temperature, not "
@@ -193,25 +197,22 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
       std::vector<double> rmse;
       for (int r = 0; r < options.repeats; ++r) {
         DriftOptions o = base;
-        o.progress = nullptr;  // Evaluate reports through EvaluationOptions::progress
         o.method = method;
         o.seed = RepeatSeed(base.seed, r);
-        if (options.progress) {
-          options.progress(done / total, std::string(ToString(method)) + " / " +
-                                             std::string(ToString(protocol)) + " / seed " +
-                                             std::to_string(o.seed));
-        }
-        CausalOptions causal = options.causal;
-        if (options.progress) {
+        const std::string label = std::string(ToString(method)) + " / " +
+                                  std::string(ToString(protocol)) + " / seed " +
+                                  std::to_string(o.seed);
+        execution.Report(done / total, label);
+        Execution windows{.threads = execution.threads};
+        if (execution.progress) {
           // The causal trial's windows are most of an evaluation's time: report within it too.
-          const std::string label = std::string(ToString(method)) + " / " +
-                                    std::string(ToString(protocol)) + " / seed " +
-                                    std::to_string(o.seed) + " / windows";
-          causal.progress = [&options, done, total, label](double fraction) {
-            options.progress((done + fraction) / total, label);
+          windows.progress = [&execution, done, total, label = label + " / windows"](
+                                 double fraction, std::string_view) {
+            execution.progress((done + fraction) / total, label);
           };
         }
-        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.horizon, causal);
+        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.horizon,
+                                     options.causal, windows);
         const Metrics m = ComputeMetrics(trial.estimate - result.reference);
         rmse.push_back(m.rmse);
         row.mae += m.mae / options.repeats;
@@ -235,7 +236,7 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
       result.rows.push_back(row);
     }
   }
-  if (options.progress) options.progress(1.0, "done");
+  execution.Report(1.0, "done");
   return result;
 }
 

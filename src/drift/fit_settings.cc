@@ -38,6 +38,12 @@ bool ElmBased(Method method) {
 
 }  // namespace
 
+Execution MakeExecution(const FitSettings& s) {
+  const Execution execution{.threads = s.threads};
+  execution.Validate();
+  return execution;
+}
+
 Method ResolveMethod(std::string_view method, Mode mode) {
   if (method != "auto") return MethodFromString(method);
   return mode == Mode::kCompensate ? Method::kThermal : Method::kMsElm;
@@ -52,7 +58,7 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
   o.decomposition.ensemble_size = s.ensemble;
   o.selection.monte_carlo.realisations = s.realisations;
   o.seed = s.seed;
-  o.threads = s.threads;
+  MakeExecution(s);  // the threads are the fit's execution, checked here with the rest
   o.features.rate_hz = s.rate_hz;
   o.features.thermal_set = Named("thermal_features", s.thermal_features, ThermalSetFromString);
   if (!s.time_constants.empty()) {

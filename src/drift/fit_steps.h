@@ -32,19 +32,20 @@ struct SubSeries {
   Eigen::MatrixXd series;  // N x G sub-series of the decomposed record
 };
 
-// Decomposes y (if the method needs it), groups the IMFs and defines the sub-models.
-// Reports "decompose" (fractions up to kDecomposeShare) through o.progress when `report` is set.
+// Decomposes y (if the method needs it) on execution.threads, groups the IMFs and defines the
+// sub-models. Reports "decompose" (fractions up to kDecomposeShare) through execution.progress.
 constexpr double kDecomposeShare = 0.7;
 constexpr double kGroupsDoneShare = 0.85;  // the decomposition and the grouping done
 SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const DriftOptions& o,
-                           bool report = false);
+                           const Execution& execution);
 
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
 // identified sub-models read the temperature channels, N x C, instead, as records: features.h).
+// Learners run on `threads` workers (Execution::threads).
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
                  const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                 const std::vector<Eigen::Index>& record_starts = {});
+                 const std::vector<Eigen::Index>& record_starts, int threads);
 
 }  // namespace gyrodrift::drift::internal

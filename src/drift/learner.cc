@@ -50,12 +50,8 @@ LearnerKind LearnerKindFromString(std::string_view name) {
 }
 
 void LearnerOptions::Validate() const {
-  if (threads < 0 || threads > 1024) {
-    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
-  }
   elm::ElmOptions elm_options = elm;
   elm_options.seed = seed;
-  elm_options.threads = threads;
   ValidateNested("elm", [&] { elm_options.Validate(); });
   if (poly_degree < 1 || poly_degree > 4) {
     ThrowOption("poly_degree", std::to_string(poly_degree), "an integer in [1, 4]");
@@ -89,16 +85,17 @@ void LearnerOptions::Validate() const {
 
 std::unique_ptr<Learner> FitLearner(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                     const Eigen::Ref<const Eigen::VectorXd>& y,
-                                    const LearnerOptions& options) {
+                                    const LearnerOptions& options, const Execution& execution) {
   options.Validate();
+  execution.Validate();
   CheckTrainingData(x, y);
   switch (options.kind) {
     case LearnerKind::kElm:
-      return internal::FitElm(x, y, options);
+      return internal::FitElm(x, y, options, execution.threads);
     case LearnerKind::kPoly:
       return internal::FitPoly(x, y, options);
     case LearnerKind::kSvr:
-      return internal::FitSvr(x, y, options);
+      return internal::FitSvr(x, y, options, execution.threads);
     case LearnerKind::kBp:
       return internal::FitBp(x, y, options);
   }
@@ -203,6 +200,10 @@ const std::string& ParameterReader::Text(const std::string& name) const {
   const auto it = parameters_.texts.find(name);
   if (it == parameters_.texts.end()) Fail("text '" + name + "' is missing");
   return it->second;
+}
+
+void ParameterReader::DropLegacyThreads() const {
+  if (parameters_.scalars.count("threads") != 0) Integer("threads", 0, 1024);
 }
 
 std::uint64_t ParameterReader::Seed() const {

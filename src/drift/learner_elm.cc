@@ -37,7 +37,6 @@ class ElmLearner final : public Learner {
     p.scalars["hidden_units"] = model_.num_hidden();
     // May be +inf (QR solver without regularisation); it is informational for prediction.
     p.scalars["ridge_c"] = model_.options.ridge_c;
-    p.scalars["threads"] = model_.options.threads;
     return p;
   }
 
@@ -61,11 +60,10 @@ class ElmLearner final : public Learner {
 
 std::unique_ptr<Learner> FitElm(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const Eigen::Ref<const Eigen::VectorXd>& y,
-                                const LearnerOptions& options) {
+                                const LearnerOptions& options, int threads) {
   elm::ElmOptions elm_options = options.elm;
   elm_options.seed = options.seed;
-  elm_options.threads = options.threads;
-  elm::ElmFit fit = elm::Fit(x, y, elm_options);
+  elm::ElmFit fit = elm::Fit(x, y, elm_options, Execution{.threads = threads});
   return std::make_unique<ElmLearner>(std::move(fit.model), static_cast<int>(x.rows()),
                                       fit.report.train_rmse);
 }
@@ -96,7 +94,7 @@ std::unique_ptr<Learner> LoadElm(const ParameterReader& reader) {
   const double ridge_c = reader.Scalar("ridge_c");
   if (!(ridge_c > 0.0)) reader.Fail("ridge_c = " + FormatShort(ridge_c) + " is not > 0");
   model.options.ridge_c = ridge_c;
-  model.options.threads = static_cast<int>(reader.Integer("threads", 0, 1024));
+  reader.DropLegacyThreads();
   model.options.seed = reader.Seed();
   model.Validate();
   const int rows = static_cast<int>(reader.Integer("train_rows", 0, 2147483647L));

@@ -41,6 +41,9 @@ class ParameterReader {
   long Integer(const std::string& name, long lo, long hi) const;
   const std::string& Text(const std::string& name) const;
   std::uint64_t Seed() const;  // texts["seed"], decimal
+  // Learners saved before model format 6 kept the fit's thread count as the scalar "threads":
+  // checked (an integer in [0, 1024]) if present, and dropped, since it changes no result.
+  void DropLegacyThreads() const;
   [[noreturn]] void Fail(const std::string& what) const;
 
  private:
@@ -56,9 +59,10 @@ elm::Standardizer GetScaler(const ParameterReader& reader, const std::string& pr
 // Fields every learner saves: kind, seed (text, exact for 64 bits), training rows and RMSE.
 void PutCommon(LearnerKind kind, std::uint64_t seed, int rows, double train_rmse, Parameters* out);
 
+// `threads` as Execution::threads (FitLearner has checked it).
 std::unique_ptr<Learner> FitElm(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const Eigen::Ref<const Eigen::VectorXd>& y,
-                                const LearnerOptions& options);
+                                const LearnerOptions& options, int threads);
 std::unique_ptr<Learner> LoadElm(const ParameterReader& reader);
 
 std::unique_ptr<Learner> FitPoly(const Eigen::Ref<const Eigen::MatrixXd>& x,
@@ -68,7 +72,7 @@ std::unique_ptr<Learner> LoadPoly(const ParameterReader& reader);
 
 std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const Eigen::Ref<const Eigen::VectorXd>& y,
-                                const LearnerOptions& options);
+                                const LearnerOptions& options, int threads);
 std::unique_ptr<Learner> LoadSvr(const ParameterReader& reader);
 
 std::unique_ptr<Learner> FitBp(const Eigen::Ref<const Eigen::MatrixXd>& x,

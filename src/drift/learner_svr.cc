@@ -94,7 +94,6 @@ class SvrLearner final : public Learner {
     p.scalars["c"] = c_;
     p.scalars["epsilon"] = epsilon_;
     p.scalars["rows_used"] = rows_used_;
-    p.scalars["threads"] = threads_;
     return p;
   }
 
@@ -128,7 +127,7 @@ class SvrLearner final : public Learner {
   double c_ = 0.0;
   double epsilon_ = 0.0;
   int rows_used_ = 0;
-  int threads_ = 0;
+  int threads_ = 0;  // of Predict: the fit's (Execution::threads), 0 = every core when loaded
   std::uint64_t seed_ = 0;  // libsvm draws nothing; kept for uniform metadata
   int rows_ = 0;
   double train_rmse_ = 0.0;
@@ -142,7 +141,7 @@ struct ModelDeleter {
 
 std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const Eigen::Ref<const Eigen::VectorXd>& y,
-                                const LearnerOptions& options) {
+                                const LearnerOptions& options, int threads) {
   const Eigen::Index n = x.rows();
   const Eigen::Index d = x.cols();
   elm::Standardizer input_scaler = elm::FitStandardizer(x, true);
@@ -212,7 +211,7 @@ std::unique_ptr<Learner> FitSvr(const Eigen::Ref<const Eigen::MatrixXd>& x,
   auto learner =
       std::make_unique<SvrLearner>(std::move(support_t), std::move(coefficients), rho, param.gamma,
                                    std::move(input_scaler), std::move(target_scaler));
-  learner->SetInfo(options.svr_c, options.svr_epsilon, static_cast<int>(used), options.threads,
+  learner->SetInfo(options.svr_c, options.svr_epsilon, static_cast<int>(used), threads,
                    options.seed);
   learner->SetTraining(static_cast<int>(n), Rmse(learner->Predict(x), y));
   return learner;
@@ -239,9 +238,9 @@ std::unique_ptr<Learner> LoadSvr(const ParameterReader& reader) {
   auto learner =
       std::make_unique<SvrLearner>(support.transpose(), std::move(coefficients), rho, gamma,
                                    std::move(input_scaler), std::move(target_scaler));
+  reader.DropLegacyThreads();
   learner->SetInfo(reader.Scalar("c"), reader.Scalar("epsilon"),
-                   static_cast<int>(reader.Integer("rows_used", 1, 2147483647L)),
-                   static_cast<int>(reader.Integer("threads", 0, 1024)), reader.Seed());
+                   static_cast<int>(reader.Integer("rows_used", 1, 2147483647L)), 0, reader.Seed());
   learner->SetTraining(static_cast<int>(reader.Integer("train_rows", 0, 2147483647L)),
                        reader.Scalar("train_rmse"));
   return learner;

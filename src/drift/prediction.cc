@@ -95,7 +95,7 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
 Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                              Eigen::Index first, int horizon, Protocol protocol,
-                             const CausalOptions& causal) {
+                             const CausalOptions& causal, const Execution& execution) {
   if (model.options.mode != Mode::kPredict) {
     throw UsageError(
         "model mode = compensate: prediction needs a model fitted in mode predict");
@@ -103,6 +103,7 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
   RequireFiniteSignal("target", y, 2);
   const Eigen::Index n = y.size();
   causal.Validate();
+  execution.Validate();
   const Eigen::Index min_first = FirstPredictable(model, protocol, horizon);
   if (first < min_first || first >= n) {
     throw DataError(
@@ -118,19 +119,22 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
     return PredictFromSeries(model, y, thermal, first, count, horizon);
   }
   if (protocol == Protocol::kPaper) {
-    decomposition::DecompositionOptions dopt = internal::DecompositionFor(model);
-    dopt.threads = model.options.threads;
-    const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(y, dopt));
+    // The paper protocol reports no progress (it never did): only its threads are passed on.
+    decomposition::DecompositionContext context;
+    context.execution.threads = execution.threads;
+    const Eigen::MatrixXd series =
+        GroupSeries(model, decomposition::Decompose(y, internal::DecompositionFor(model), context));
     return PredictFromSeries(model, series, thermal, first, count, horizon);
   }
-  return PredictRecursively(model, internal::CausalLags(model, y, origin, count, causal), thermal,
-                            origin, horizon);
+  return PredictRecursively(model, internal::CausalLags(model, y, origin, count, causal, execution),
+                            thermal, origin, horizon);
 }
 
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                                const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
-                               Eigen::Index first, Protocol protocol, const CausalOptions& causal) {
-  return PredictAhead(model, y, temperature_c, first, 1, protocol, causal);
+                               Eigen::Index first, Protocol protocol, const CausalOptions& causal,
+                               const Execution& execution) {
+  return PredictAhead(model, y, temperature_c, first, 1, protocol, causal, execution);
 }
 
 }  // namespace gyrodrift::drift

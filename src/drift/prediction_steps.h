@@ -18,17 +18,16 @@ void RequireHorizon(int horizon);
 // `windowed` (the causal protocol's decompositions), the shortest causal window (16 samples).
 Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 
-// The decomposition a fitted model applies to new data: its options with its seed, and no noise
-// EMDs a caller may have left in them (they serve one record length; the causal windows build
-// their own).
+// The decomposition a fitted model applies to new data: its options with its seed.
 decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
 
 // Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
 // trailing window y[o-W .. o-1] alone: lags[g](r, k) = s_g[o - 1 - k] of that window's groups
-// (count x lags per sub-model g). Windows run in parallel on causal.threads.
+// (count x lags per sub-model g). Windows run in parallel on execution.threads, which reports
+// the fraction of windows done ("causal windows").
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                                         const Eigen::Ref<const Eigen::VectorXd>& y,
                                         Eigen::Index origin, Eigen::Index count,
-                                        const CausalOptions& causal);
+                                        const CausalOptions& causal, const Execution& execution);
 
 }  // namespace gyrodrift::drift::internal

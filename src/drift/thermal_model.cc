@@ -422,8 +422,8 @@ std::shared_ptr<const Learner> FitCorrection(const CrossValidation& cv, const Ei
   eo.hidden_units = kCorrectionUnits.back();
   eo.ridge_c = 1.0;
   eo.seed = SeedFor(seed, "thermal-correction");
-  eo.threads = 1;
-  const elm::ElmFit widest = elm::Fit(z, yc, eo);
+  const Execution one_thread{.threads = 1};
+  const elm::ElmFit widest = elm::Fit(z, yc, eo, one_thread);
   const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);
   const Eigen::MatrixXd hth = h.transpose() * h;
   std::vector<double> error(kCorrectionUnits.size() * kCorrectionRidge.size(), 0.0);
@@ -465,10 +465,9 @@ std::shared_ptr<const Learner> FitCorrection(const CrossValidation& cv, const Ei
   lo.elm.hidden_units = kCorrectionUnits[chosen / kCorrectionRidge.size()];
   lo.elm.ridge_c = kCorrectionRidge[chosen % kCorrectionRidge.size()];
   lo.seed = eo.seed;
-  lo.threads = 1;
   report.nonlinear_units = lo.elm.hidden_units;
   report.nonlinear_ridge_c = lo.elm.ridge_c;
-  return FitLearner(z, residual, lo);
+  return FitLearner(z, residual, lo, one_thread);
 }
 
 // What the run cannot identify (docs/drift.md 4.5, "Calibration sufficiency").

@@ -46,12 +46,6 @@ std::string FormatShort(double value) {
   return buffer;
 }
 
-void CheckThreads(int threads) {
-  if (threads < 0 || threads > 1024) {
-    ThrowOption("threads", std::to_string(threads), "an integer in [0, 1024] (0 = all cores)");
-  }
-}
-
 void RequireFiniteMatrix(std::string_view what, const Eigen::Ref<const Eigen::MatrixXd>& m) {
   for (Eigen::Index j = 0; j < m.cols(); ++j) {
     for (Eigen::Index i = 0; i < m.rows(); ++i) {
@@ -195,7 +189,6 @@ void ElmOptions::Validate() const {
   if (!(max_condition >= 1e3 && max_condition <= 1e15)) {
     ThrowOption("max_condition", FormatValue(max_condition), "in [1e3, 1e15]");
   }
-  CheckThreads(threads);
 }
 
 std::vector<int> ElmOptions::HiddenUnitGrid() const {
@@ -298,8 +291,10 @@ std::string ElmReport::Summary() const {
 }
 
 ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::MatrixXd>& t,
-           const ElmOptions& options) {
+           const ElmOptions& options, const Execution& execution) {
   options.Validate();
+  execution.Validate();
+  const int threads = execution.threads;
   CheckTrainingData(x, t);
   const Eigen::Index n = x.rows();
 
@@ -308,8 +303,6 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   ElmReport& report = fit.report;
   model.activation = options.activation;
   model.options = options;
-  // The thread count is how this run was executed, not part of the model (it changes no bit).
-  model.options.threads = 0;
   model.input_scaler = FitStandardizer(x, options.standardize_inputs);
   model.target_scaler = FitStandardizer(t, options.standardize_targets);
   const Eigen::MatrixXd xs = model.input_scaler.Apply(x);
@@ -319,7 +312,7 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   report.solver = options.solver;
   report.rows = static_cast<int>(n);
   report.seed = options.seed;
-  report.threads = std::min(ResolveThreads(options.threads), internal::NumBlocks(n));
+  report.threads = std::min(ResolveThreads(threads), internal::NumBlocks(n));
 
   int hidden = options.hidden_units;
   double ridge_c = options.ridge_c;
@@ -331,11 +324,11 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
     internal::DrawUnits(static_cast<int>(x.cols()), hidden_grid.back(), options.seed,
                         &model.input_weights, &model.biases);
     gram = internal::ComputeGram(options.activation, xs, ts, model.input_weights, model.biases,
-                                 options.threads);
+                                 threads);
     have_gram = true;
     internal::LooGrid(options.activation, xs, ts, model.input_weights, model.biases, gram,
                       hidden_grid, ridge_grid, options.max_condition, model.target_scaler.scale,
-                      options.threads, &report.candidates);
+                      threads, &report.candidates);
     const LooCandidate* best = nullptr;
     for (const auto& c : report.candidates) {
       // Ties (to the bit) go to the smaller network, then the stronger regularisation.
@@ -367,12 +360,12 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   report.numerical_rank = hidden;
 
   if (options.solver == Solver::kQr) {
-    SolveQr(&model, xs, ts, options.threads, &report);
+    SolveQr(&model, xs, ts, threads, &report);
     return fit;
   }
   if (!have_gram) {
     gram = internal::ComputeGram(options.activation, xs, ts, model.input_weights, model.biases,
-                                 options.threads);
+                                 threads);
   }
   internal::RidgeSolution solution =
       internal::SolveRidgeCholesky(gram.hth, gram.htt, hidden, ridge_c);
@@ -404,7 +397,7 @@ std::string_view KernelName() { return internal::ActiveKernels().name; }
 
 Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
                             int threads) {
-  CheckThreads(threads);
+  ValidateThreads(threads);
   const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd h(x.rows(), model.num_hidden());
   ForEachHiddenBlock(model, xs, threads,
@@ -416,7 +409,7 @@ Eigen::MatrixXd HiddenLayer(const ElmModel& model, const Eigen::Ref<const Eigen:
 
 Eigen::MatrixXd Predict(const ElmModel& model, const Eigen::Ref<const Eigen::MatrixXd>& x,
                         int threads) {
-  CheckThreads(threads);
+  ValidateThreads(threads);
   const Eigen::MatrixXd xs = CheckedScaledInputs(model, x);
   Eigen::MatrixXd y(x.rows(), model.num_outputs());
   const internal::Kernels& kernels = internal::ActiveKernels();

@@ -65,8 +65,7 @@ allan::NoiseTerms NoiseOf(const Eigen::Ref<const Eigen::VectorXd>& rate, double 
   o.units = unit;
   o.deviation = allan::Deviation::kOadev;
   o.grid = allan::TauGrid::kOctave;
-  o.threads = 1;
-  const allan::AllanResult r = allan::Compute(rate, o);
+  const allan::AllanResult r = allan::Compute(rate, o, Execution{.threads = 1});
   *tau = r.tau_s();
   *adev = r.dev();
   return allan::IdentifyNoise(r);
@@ -140,8 +139,8 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   // Units run in parallel (RunFleet's threads, or one Dask task per worker thread), so a unit
   // runs on one thread: a decomposing method (ms-elm, emd-elm) would otherwise take every core
   // per unit, T units x every core on the machine, and a one-thread Dask worker would use them
-  // all. The results do not depend on it; the model records threads = 1, as `fit --threads 1`.
-  options.threads = 1;
+  // all. The results do not depend on it: the model is the one `fit` writes with any --threads.
+  const Execution one_thread{.threads = 1};
   std::vector<io::LoadedModel> models;
   for (const AxisSpec& axis : m.axes) {
     // The calibration logs one after the other: the target, then the temperatures.
@@ -157,7 +156,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
     model.info.source = Joined(unit.calibration);
     model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
     model.model = drift::FitDriftModel(run.rows.col(0), run.rows.rightCols(run.rows.cols() - 1),
-                                       options, run.record_starts);
+                                       options, run.record_starts, one_thread);
     AxisResult a;
     a.target = axis.target;
     a.temperature = model.info.temperature_column;
@@ -534,7 +533,8 @@ FleetResult FinishFleet(const Manifest& m, const std::string& output_dir,
   return fleet;
 }
 
-FleetResult RunFleet(const Manifest& m, const FleetOptions& o) {
+FleetResult RunFleet(const Manifest& m, const FleetOptions& o, const FleetContext& context) {
+  ValidateThreads(context.threads);
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   fs::create_directories(o.output_dir, ec);
@@ -546,14 +546,14 @@ FleetResult RunFleet(const Manifest& m, const FleetOptions& o) {
   std::vector<UnitRun> runs(static_cast<size_t>(n));
   std::mutex mutex;
   int done = 0;
-  ParallelFor(n, ResolveThreads(o.threads), [&](int task, int /*worker*/) {
+  ParallelFor(n, ResolveThreads(context.threads), [&](int task, int /*worker*/) {
     const UnitSpec& unit = m.units[static_cast<size_t>(task)];
     UnitRun run = RunUnit(m, unit, o.output_dir, o.force, assets);
     std::lock_guard<std::mutex> lock(mutex);
     const std::string what = run.what;
     runs[static_cast<size_t>(task)] = std::move(run);
     ++done;
-    if (o.progress) o.progress(done, n, unit.serial, what);
+    if (context.progress) context.progress(done, n, unit.serial, what);
   });
   // The time of the whole run, fleet.csv and fleet.html being the last bit of it.
   return FinishFleet(m, o.output_dir, runs, Seconds(start), assets);

@@ -124,7 +124,7 @@ Plan MakePlan(const std::vector<LoadedModel>& axes) {
     axis.summary = model.Summary();
     axis.source = loaded.info.source;
     axis.method = drift::ToString(model.options.method);
-    axis.reference_c = model.options.reference_c;
+    axis.reference_c = model.options.reference_c.value_or(std::numeric_limits<double>::quiet_NaN());
     const bool referenced = !std::isnan(axis.reference_c);
     for (const drift::SubModel& sub : model.sub_models) {
       Sub s;

@@ -19,6 +19,9 @@ using nlohmann::json;
 namespace dec = gyrodrift::decomposition;
 namespace sel = gyrodrift::selection;
 
+// The last format that stored thread counts (model_file.h, version 6).
+constexpr int kLastModelFormatVersionWithThreads = 5;
+
 // ---------------------------------------------------------------------------------------------
 // Writing
 
@@ -59,7 +62,6 @@ json DecompositionJson(const dec::DecompositionOptions& o) {
           {"ensemble_size", o.ensemble_size},
           {"noise_strength", Number(o.noise_strength)},
           {"seed", o.seed},
-          {"threads", o.threads},
           {"noise_scaling", dec::ToString(o.noise_scaling)},
           {"beemdan_bound", dec::ToString(o.beemdan_bound)},
           {"band_confidence", Number(o.band_confidence)},
@@ -83,13 +85,11 @@ json SelectionJson(const sel::SelectionOptions& o) {
            {{"realisations", m.realisations},
             {"confidence", Number(m.confidence)},
             {"seed", m.seed},
-            {"threads", m.threads},
             {"sifting", SiftingJson(m.sifting)},
             {"max_imfs", m.max_imfs}}},
           // A precomputed level only shortens the fit; the model does not need it afterwards.
           {"precomputed_noise_level", o.noise_level != nullptr},
-          {"band_confidence", Number(o.band_confidence)},
-          {"threads", o.threads}};
+          {"band_confidence", Number(o.band_confidence)}};
 }
 
 json LearnerOptionsJson(const drift::LearnerOptions& l) {
@@ -106,7 +106,7 @@ json LearnerOptionsJson(const drift::LearnerOptions& l) {
             {"max_condition", Number(e.max_condition)},
             {"standardize_inputs", e.standardize_inputs},
             {"standardize_targets", e.standardize_targets},
-            {"seed", e.seed}}},  // no "threads": a run-time choice, not part of the model
+            {"seed", e.seed}}},
           {"poly_degree", l.poly_degree},
           {"poly_ridge", Number(l.poly_ridge)},
           {"svr_c", Number(l.svr_c)},
@@ -116,8 +116,7 @@ json LearnerOptionsJson(const drift::LearnerOptions& l) {
           {"bp_hidden", l.bp_hidden},
           {"bp_epochs", l.bp_epochs},
           {"bp_desired_mse", Number(l.bp_desired_mse)},
-          {"seed", l.seed},
-          {"threads", l.threads}};
+          {"seed", l.seed}};
 }
 
 json LearnerJson(const drift::Learner& learner) {
@@ -256,6 +255,15 @@ class Node {
   bool IsNull() const { return j_.is_null(); }
   const json& raw() const { return j_; }
 
+  // Files of format 5 and older hold thread counts beside the options, the fit's execution rather
+  // than the model: "threads" is read (a non-negative integer) and dropped if present.
+  // ParseModelFileAxes refuses the field in newer files.
+  void DropLegacyThreads() const {
+    if (j_.is_object() && j_.contains("threads")) {
+      (*this)["threads"].Int(0, std::numeric_limits<int>::max());
+    }
+  }
+
   double Double() const {
     if (j_.is_number()) return j_.get<double>();
     if (j_.is_string()) {
@@ -377,7 +385,7 @@ dec::DecompositionOptions ReadDecomposition(const Node& n) {
   o.ensemble_size = n["ensemble_size"].Int();
   o.noise_strength = n["noise_strength"].Double();
   o.seed = n["seed"].U64();
-  o.threads = n["threads"].Int();
+  n.DropLegacyThreads();
   o.noise_scaling = n["noise_scaling"].Enum(dec::NoiseScalingFromString);
   o.beemdan_bound = n["beemdan_bound"].Enum(dec::BeemdanBoundFromString);
   o.band_confidence = n["band_confidence"].Double();
@@ -401,12 +409,12 @@ sel::SelectionOptions ReadSelection(const Node& n) {
   o.monte_carlo.realisations = m["realisations"].Int();
   o.monte_carlo.confidence = m["confidence"].Double();
   o.monte_carlo.seed = m["seed"].U64();
-  o.monte_carlo.threads = m["threads"].Int();
+  m.DropLegacyThreads();
   o.monte_carlo.sifting = ReadSifting(m["sifting"]);
   o.monte_carlo.max_imfs = m["max_imfs"].Int();
   n["precomputed_noise_level"].Bool();  // provenance only; the level is not stored
   o.band_confidence = n["band_confidence"].Double();
-  o.threads = n["threads"].Int();
+  n.DropLegacyThreads();
   return o;
 }
 
@@ -425,9 +433,7 @@ drift::LearnerOptions ReadLearnerOptions(const Node& n) {
   l.elm.standardize_inputs = e["standardize_inputs"].Bool();
   l.elm.standardize_targets = e["standardize_targets"].Bool();
   l.elm.seed = e["seed"].U64();
-  // Files written before the ELM thread count left the model still carry it: read, checked and
-  // dropped, since the count never changes a result.
-  if (e.raw().contains("threads")) e["threads"].Int(0, 1024);
+  e.DropLegacyThreads();
   l.poly_degree = n["poly_degree"].Int();
   l.poly_ridge = n["poly_ridge"].Double();
   l.svr_c = n["svr_c"].Double();
@@ -438,7 +444,7 @@ drift::LearnerOptions ReadLearnerOptions(const Node& n) {
   l.bp_epochs = n["bp_epochs"].Int();
   l.bp_desired_mse = n["bp_desired_mse"].Double();
   l.seed = n["seed"].U64();
-  l.threads = n["threads"].Int();
+  n.DropLegacyThreads();
   return l;
 }
 
@@ -565,11 +571,14 @@ drift::DriftOptions ReadOptions(const Node& n) {
   o.lag_candidates = n["lag_candidates"].Ints();
   o.validation_fraction = n["validation_fraction"].Double();
   o.linear_compensation = n["linear_compensation"].Bool();
-  o.reference_c = n["reference_c"].Double();  // NaN is allowed: keep the fitted intercept
+  // "nan": unset, keep the fitted intercept.
+  if (const double reference_c = n["reference_c"].Double(); !std::isnan(reference_c)) {
+    o.reference_c = reference_c;
+  }
   // Files written before identification (format 2) have the defaults.
   if (n.raw().contains("thermal")) o.thermal = ReadThermalOptions(n["thermal"]);
   o.seed = n["seed"].U64();
-  o.threads = n["threads"].Int();
+  n.DropLegacyThreads();
   try {
     o.Validate();
   } catch (const UsageError& e) {
@@ -661,10 +670,10 @@ nlohmann::json DriftOptionsToJson(const drift::DriftOptions& o) {
           {"lag_candidates", o.lag_candidates},
           {"validation_fraction", Number(o.validation_fraction)},
           {"linear_compensation", o.linear_compensation},
-          {"reference_c", Number(o.reference_c)},
+          // Unset: "nan", as format 5 and older wrote the NaN that meant it.
+          {"reference_c", o.reference_c ? Number(*o.reference_c) : json("nan")},
           {"thermal", ThermalOptionsJson(o.thermal)},
-          {"seed", o.seed},
-          {"threads", o.threads}};
+          {"seed", o.seed}};
 }
 
 drift::DriftOptions DriftOptionsFromJson(const nlohmann::json& json, const std::string& source) {
@@ -676,11 +685,6 @@ namespace {
 // One axis: what it was trained on, its options and its parameters.
 json AxisJson(const LoadedModel& axis) {
   const drift::DriftModel& model = axis.model;
-  if (model.options.decomposition.supplied_noise) {
-    throw UsageError(
-        "model options hold supplied decomposition noise, which a model file cannot store; fit "
-        "with drawn noise (a seed) to save the model");
-  }
   return {{"training",
            {{"target_column", axis.info.target_column},
             {"temperature_column", axis.info.temperature_column},
@@ -842,11 +846,23 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
   }
   json known = ModelFileJson(axes);
   known["checksum"] = stored;
-  // Older files' field, checked on reading above.
-  if (known.contains("axes")) {
-    for (json& axis : known["axes"]) axis["options"]["learner"]["elm"]["threads"] = 0;
-  } else {
-    known["options"]["learner"]["elm"]["threads"] = 0;
+  if (version <= kLastModelFormatVersionWithThreads) {
+    // Their thread counts, checked and dropped on reading above.
+    auto add_threads = [](json& axis) {
+      json& o = axis["options"];
+      for (json* at : {&o, &o["decomposition"], &o["selection"], &o["selection"]["monte_carlo"],
+                       &o["learner"], &o["learner"]["elm"]}) {
+        (*at)["threads"] = 0;
+      }
+      for (json& sub : axis["model"]["sub_models"]) {
+        if (!sub["learner"].is_null()) sub["learner"]["scalars"]["threads"] = 0;
+      }
+    };
+    if (known.contains("axes")) {
+      for (json& axis : known["axes"]) add_threads(axis);
+    } else {
+      add_threads(known);
+    }
   }
   const std::string unknown = FirstUnknownField(j, known, "");
   if (!unknown.empty()) {

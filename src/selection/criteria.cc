@@ -52,12 +52,14 @@ void EnergyCurve(const Eigen::Ref<const Eigen::MatrixXd>& imfs, double band_conf
   }
 }
 
-void PdfSimilarityBoundaries(int length, const SelectionOptions& options, SelectionResult* result) {
+void PdfSimilarityBoundaries(int length, const SelectionOptions& options,
+                             const Execution& execution, SelectionResult* result) {
   const int k_count = result->num_imfs;
   std::shared_ptr<const NoiseLevel> level = options.noise_level;
   if (!level) {
-    level = NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde,
-                                          options.distance, &result->noise_level_computed);
+    level =
+        NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde, options.distance,
+                                      &result->noise_level_computed, execution);
   }
   int k_noise = 0;
   for (int k = 1; k <= k_count; ++k) {
@@ -68,8 +70,9 @@ void PdfSimilarityBoundaries(int length, const SelectionOptions& options, Select
                                     " from the decomposition's noise (seed " +
                                     std::to_string(level->seed) +
                                     "), later modes from the Monte-Carlo");
-      level = NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde,
-                                            options.distance, &result->noise_level_computed);
+      level =
+          NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde, options.distance,
+                                        &result->noise_level_computed, execution);
     }
     const double lk = level->LevelFor(k);
     result->noise_level.push_back(lk);

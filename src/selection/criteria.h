@@ -29,8 +29,10 @@ void EnergyCurve(const Eigen::Ref<const Eigen::MatrixXd>& imfs, double band_conf
 // kPdfSimilarity: k_N = the leading run of IMFs with G_k under the white-noise level of
 // `length`-sample records (options.noise_level, or NoiseLevelCache::Global(), which also completes
 // a partial level the run outlasts); mixed_end = max(k_N, k*). Also sets noise_level,
-// noise_level_realisations, noise_level_seed and noise_level_computed.
-void PdfSimilarityBoundaries(int length, const SelectionOptions& options, SelectionResult* result);
+// noise_level_realisations, noise_level_seed and noise_level_computed. A Monte-Carlo runs on the
+// execution's threads.
+void PdfSimilarityBoundaries(int length, const SelectionOptions& options,
+                             const Execution& execution, SelectionResult* result);
 
 // kKomaty: noise up to k*, no mixed group.
 void KomatyBoundaries(SelectionResult* result);

@@ -128,7 +128,6 @@ void MonteCarloOptions::Validate() const {
   if (!(confidence >= 0.5 && confidence < 1.0)) {
     ThrowOption("confidence", FormatValue(confidence), "in [0.5, 1)");
   }
-  if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
   if (max_imfs < 0) ThrowOption("max_imfs", std::to_string(max_imfs), ">= 0 (0 = no cap)");
   ValidateNested("sifting", [&] { sifting.Validate(); });
 }
@@ -151,12 +150,14 @@ std::string NoiseLevel::Summary() const {
 }
 
 NoiseLevel ComputeNoiseLevel(int length, const MonteCarloOptions& monte_carlo,
-                             const KdeOptions& kde, PdfDistance distance) {
+                             const KdeOptions& kde, PdfDistance distance,
+                             const Execution& execution) {
   monte_carlo.Validate();
   kde.Validate();
+  execution.Validate();
   if (length < 16) ThrowOption("length", std::to_string(length), ">= 16 samples");
   const int r = monte_carlo.realisations;
-  const int workers = std::min(ResolveThreads(monte_carlo.threads), r);
+  const int workers = std::min(ResolveThreads(execution.threads), r);
   std::vector<internal::Scratch> scratch(static_cast<size_t>(workers));
   std::vector<Eigen::VectorXd> noise(static_cast<size_t>(workers), Eigen::VectorXd(length));
   std::vector<std::vector<double>> g(static_cast<size_t>(r));
@@ -184,9 +185,9 @@ NoiseLevelCollector::NoiseLevelCollector(int length, const MonteCarloOptions& mo
   kde_.Validate();
 }
 
-bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposition) {
-  const auto& d = *decomposition;
-  if (!decomposition::UsesNoiseEmds(d.method) || d.supplied_noise || d.noise_imf_observer ||
+bool NoiseLevelCollector::Attach(const decomposition::DecompositionOptions& d,
+                                 decomposition::DecompositionContext* context) {
+  if (!decomposition::UsesNoiseEmds(d.method) || context->noise_imf_observer ||
       d.ensemble_size < monte_carlo_.realisations || !(d.sifting == monte_carlo_.sifting) ||
       monte_carlo_.max_imfs != 0 || length_ < 16) {
     return false;
@@ -194,8 +195,8 @@ bool NoiseLevelCollector::Attach(decomposition::DecompositionOptions* decomposit
   attached_ = true;
   seed_ = d.seed;
   g_.assign(static_cast<size_t>(monte_carlo_.realisations), {});
-  decomposition->noise_imf_observer = [this](int realisation, [[maybe_unused]] int mode,
-                                             const double* imf) {
+  context->noise_imf_observer = [this](int realisation, [[maybe_unused]] int mode,
+                                       const double* imf) {
     if (realisation >= monte_carlo_.realisations) return;
     // One realisation's modes arrive in order and never concurrently (the decomposition's
     // contract), so its slot needs no lock; the scratch is per thread.
@@ -227,9 +228,10 @@ NoiseLevelCache::~NoiseLevelCache() = default;
 std::shared_ptr<const NoiseLevel> NoiseLevelCache::Get(int length,
                                                        const MonteCarloOptions& monte_carlo,
                                                        const KdeOptions& kde, PdfDistance distance,
-                                                       bool* computed) {
+                                                       bool* computed, const Execution& execution) {
   monte_carlo.Validate();
   kde.Validate();
+  execution.Validate();
   const std::string key = CacheKey(length, monte_carlo, kde, distance);
   std::promise<std::shared_ptr<const NoiseLevel>> promise;
   std::shared_future<std::shared_ptr<const NoiseLevel>> existing;
@@ -248,8 +250,8 @@ std::shared_ptr<const NoiseLevel> NoiseLevelCache::Get(int length,
     return existing.get();
   }
   try {
-    auto level =
-        std::make_shared<const NoiseLevel>(ComputeNoiseLevel(length, monte_carlo, kde, distance));
+    auto level = std::make_shared<const NoiseLevel>(
+        ComputeNoiseLevel(length, monte_carlo, kde, distance, execution));
     promise.set_value(level);
     if (computed != nullptr) *computed = true;
     return level;

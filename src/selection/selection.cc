@@ -64,7 +64,6 @@ void SelectionOptions::Validate() const {
   ValidateNested("kde", [&] { kde.Validate(); });
   ValidateNested("monte_carlo", [&] { monte_carlo.Validate(); });
   decomposition::ValidateBandConfidence(band_confidence);
-  if (threads < 0) ThrowOption("threads", std::to_string(threads), ">= 0 (0 = every core)");
 }
 
 const ModeGroup* SelectionResult::Group(GroupKind kind) const {
@@ -98,31 +97,33 @@ std::string SelectionResult::Summary() const {
 
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const decomposition::Decomposition& decomposition,
-                            const SelectionOptions& options) {
-  return SelectModes(x, decomposition.imfs, decomposition.residue, options);
+                            const SelectionOptions& options, const Execution& execution) {
+  return SelectModes(x, decomposition.imfs, decomposition.residue, options, execution);
 }
 
-GroupedDecomposition DecomposeAndSelect(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                        decomposition::DecompositionOptions decomposition_options,
-                                        SelectionOptions options) {
+GroupedDecomposition DecomposeAndSelect(
+    const Eigen::Ref<const Eigen::VectorXd>& x,
+    const decomposition::DecompositionOptions& decomposition_options, SelectionOptions options,
+    decomposition::DecompositionContext context) {
   NoiseLevelCollector white_noise(static_cast<int>(x.size()), options.monte_carlo, options.kde,
                                   options.distance);
   if (options.criterion == Criterion::kPdfSimilarity && !options.noise_level) {
-    white_noise.Attach(&decomposition_options);
+    white_noise.Attach(decomposition_options, &context);
   }
   GroupedDecomposition out;
-  out.decomposition = decomposition::Decompose(x, decomposition_options);
+  out.decomposition = decomposition::Decompose(x, decomposition_options, context);
   if (out.decomposition.num_imfs() == 0) return out;
   if (!options.noise_level) options.noise_level = white_noise.Level();
-  out.selection = SelectModes(x, out.decomposition, options);
+  out.selection = SelectModes(x, out.decomposition, options, context.execution);
   return out;
 }
 
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const Eigen::Ref<const Eigen::MatrixXd>& imfs,
                             const Eigen::Ref<const Eigen::VectorXd>& residue,
-                            const SelectionOptions& options) {
+                            const SelectionOptions& options, const Execution& execution) {
   options.Validate();
+  execution.Validate();
   RequireFiniteSignal("x", x, 16);
   const Eigen::Index n = x.size();
   const int k_count = static_cast<int>(imfs.cols());
@@ -160,7 +161,7 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
   }
 
   // Bandwidths: x (centred or not, the same), then each IMF.
-  const int workers = std::min(ResolveThreads(options.threads), k_count + 1);
+  const int workers = std::min(ResolveThreads(execution.threads), k_count + 1);
   std::vector<internal::Scratch> scratch(static_cast<size_t>(workers));
   const double h_x = kde.bandwidth_scale * SilvermanBandwidth(x, &scratch[0].kde);
   if (!(h_x > 0.0)) throw DataError("x: constant signal, nothing to select");
@@ -215,7 +216,7 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
   // Boundaries per criterion.
   switch (options.criterion) {
     case Criterion::kPdfSimilarity:
-      internal::PdfSimilarityBoundaries(static_cast<int>(n), options, &result);
+      internal::PdfSimilarityBoundaries(static_cast<int>(n), options, execution, &result);
       break;
     case Criterion::kKomaty:
       internal::KomatyBoundaries(&result);

@@ -132,6 +132,7 @@ std::vector<StudyFile> RenderStudyFiles(const StudyResult& s, const io::Dygraphs
 nlohmann::json StudyRecord(const StudyResult& s) {
   nlohmann::json record;
   record["drift_options"] = io::DriftOptionsToJson(s.drift_options);
+  record["threads"] = s.threads;  // how it ran (0 = every core); no result depends on it
   record["decomposition"] = s.decomposition.report.Summary();
   record["selection"] = s.selection.Summary();
   record["stages_s"] = nlohmann::json::object();

@@ -50,21 +50,21 @@ std::string UnitText(allan::RateUnit unit) {
   return "deg/h";
 }
 
-// The observer's calls, each of which may be empty.
+// The context's calls, each of which may be empty.
 struct Notifier {
-  const StudyObserver& observer;
+  const StudyContext& context;
   void Progress(int stage, double fraction, const std::string& what) const {
-    if (observer.progress) observer.progress(stage, fraction, what);
+    if (context.progress) context.progress(stage, fraction, what);
   }
   void StageDone(int stage, const std::string& summary) const {
-    if (observer.stage_done) observer.stage_done(stage, summary);
+    if (context.stage_done) context.stage_done(stage, summary);
   }
 };
 
 // Evaluate reports the share of its trials done; the trials differ in cost by orders of magnitude
 // (a causal MS-ELM trial decomposes one window per test sample), so the trial index is mapped to
 // a share of the expected cost instead. Weights: measured shares of the default demo.
-std::function<void(double, const std::string&)> TrialProgress(
+std::function<void(double, std::string_view)> TrialProgress(
     const Notifier& notify, int stage, const std::vector<drift::Method>& methods, drift::Mode mode,
     const std::string& prefix) {
   const std::vector<drift::Protocol> protocols{drift::Protocol::kPaper, drift::Protocol::kCausal};
@@ -80,11 +80,11 @@ std::function<void(double, const std::string&)> TrialProgress(
       cumulative.push_back(cumulative.back() + w);
     }
   }
-  return [notify, stage, cumulative, prefix](double fraction, const std::string& label) {
+  return [notify, stage, cumulative, prefix](double fraction, std::string_view label) {
     const double trials = static_cast<double>(cumulative.size() - 1);
     const size_t i =
         std::min(cumulative.size() - 1, static_cast<size_t>(std::lround(fraction * trials)));
-    notify.Progress(stage, cumulative[i] / cumulative.back(), prefix + label);
+    notify.Progress(stage, cumulative[i] / cumulative.back(), prefix + std::string(label));
   };
 }
 
@@ -92,7 +92,6 @@ drift::EvaluationOptions EvaluationFor(const StudyOptions& a, std::vector<drift:
   drift::EvaluationOptions e;
   e.methods = std::move(methods);
   e.causal.window = a.causal_window;
-  e.causal.threads = a.threads;
   e.causal.ensemble_size = a.ensemble_size;
   return e;
 }
@@ -137,10 +136,10 @@ void DecomposeStep(StudyResult& s) {
   const StudyOptions& a = s.options;
   dec::DecompositionOptions dopt = s.drift_options.decomposition;
   dopt.seed = a.seed;
-  dopt.threads = a.threads;
-  sel::SelectionOptions sopt = s.drift_options.selection;
-  sopt.threads = a.threads;
-  sel::GroupedDecomposition grouped = sel::DecomposeAndSelect(s.output, dopt, sopt);
+  dec::DecompositionContext context;
+  context.execution.threads = s.threads;
+  sel::GroupedDecomposition grouped =
+      sel::DecomposeAndSelect(s.output, dopt, s.drift_options.selection, context);
   if (!grouped.selection) {
     throw DataError(s.target_name +
                     " has fewer than 3 extrema: there is nothing to decompose or to model");
@@ -156,9 +155,11 @@ void PredictStep(StudyResult& s, const Notifier& notify) {
   for (drift::Method m : s.options.methods) {
     if (drift::SupportsMode(m, drift::Mode::kPredict)) methods.push_back(m);
   }
-  drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  e.progress = TrialProgress(notify, 2, e.methods, drift::Mode::kPredict, "predict: ");
-  s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e);
+  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
+  const Execution execution{
+      .threads = s.threads,
+      .progress = TrialProgress(notify, 2, e.methods, drift::Mode::kPredict, "predict: ")};
+  s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e, execution);
 }
 
 void CompensateSimulated(StudyResult& s, const Notifier& notify) {
@@ -176,8 +177,8 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
     o.method = methods[i];
     StudyResult::CompensateRow row{methods[i], "train A test B", {}, 0.0, 0.0, 0.0, {}, {}};
     auto start = Clock::now();
-    const drift::DriftModel model =
-        drift::FitDriftModel(s.run_a.rate_dph, s.run_a.temperature_c, o);
+    const drift::DriftModel model = drift::FitDriftModel(s.run_a.rate_dph, s.run_a.temperature_c, o,
+                                                         {}, Execution{.threads = s.threads});
     row.train_s = Seconds(start);
     start = Clock::now();
     row.estimate = drift::EstimateDrift(model, s.run_b.temperature_c);
@@ -197,9 +198,12 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
   const std::vector<drift::Method>& methods = s.options.methods;
   drift::DriftOptions base = s.drift_options;
   base.mode = drift::Mode::kCompensate;
-  drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  e.progress = TrialProgress(notify, 3, methods, drift::Mode::kCompensate, "compensate: ");
-  s.compensate_split = drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e);
+  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
+  const Execution execution{
+      .threads = s.threads,
+      .progress = TrialProgress(notify, 3, methods, drift::Mode::kCompensate, "compensate: ")};
+  s.compensate_split =
+      drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e, execution);
   const Eigen::Index split = s.compensate_split.split_index;
   s.compensate_reference = s.compensate_split.reference;
   s.compensate_output = s.output.tail(s.output.size() - split);
@@ -221,7 +225,8 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
   for (drift::Method m : methods) {
     drift::DriftOptions o = base;
     o.method = m;
-    const drift::DriftModel model = drift::FitDriftModel(s.output, s.temperature, o);
+    const drift::DriftModel model =
+        drift::FitDriftModel(s.output, s.temperature, o, {}, Execution{.threads = s.threads});
     // gyrodrift compensate reads the temperature from the column named here.
     io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, "",
                            std::string(allan::ToString(s.options.units))};
@@ -252,15 +257,17 @@ void AllanStep(StudyResult& s) {
   allan::AllanOptions o;
   o.rate_hz = s.rate_hz;
   o.units = s.options.units;
-  o.threads = s.options.threads;
-  s.allan_raw = allan::Compute(s.compensate_output, o);
+  const Execution execution{.threads = s.threads};
+  s.allan_raw = allan::Compute(s.compensate_output, o, execution);
   if (best) {
     s.allan_compensated =
-        allan::Compute(Eigen::VectorXd(s.compensate_output - best->estimate), o);
+        allan::Compute(Eigen::VectorXd(s.compensate_output - best->estimate), o, execution);
   }
-  if (lowest)
-    s.allan_best = allan::Compute(Eigen::VectorXd(s.compensate_output - lowest->estimate), o);
-  if (s.simulated) s.allan_noise = allan::Compute(s.run_b.noise_dph, o);
+  if (lowest) {
+    s.allan_best =
+        allan::Compute(Eigen::VectorXd(s.compensate_output - lowest->estimate), o, execution);
+  }
+  if (s.simulated) s.allan_noise = allan::Compute(s.run_b.noise_dph, o, execution);
   // The noise terms are in deg/h; a curve too short to fit is reported, not fatal.
   auto fit = [&](const allan::AllanResult& r, std::optional<allan::NoiseTerms>& out) {
     if (r.points.empty()) return;
@@ -284,8 +291,9 @@ void AllanStep(StudyResult& s) {
   if (s.simulated) fit(s.allan_noise, s.terms_noise);
 }
 
-StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyObserver& observer) {
+StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyContext& context) {
   options.Validate();
+  ValidateThreads(context.threads);
   const bool simulated = log == nullptr;
   if (log) {
     ValidateAsSettings({{"features.rate_hz", "rate_hz"}}, [&] {
@@ -304,9 +312,10 @@ StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyObs
   }
   const auto start = Clock::now();
   const double read_s = log ? log->read_s : 0.0;
-  const Notifier notify{observer};
+  const Notifier notify{context};
   StudyResult s;
   s.options = options;
+  s.threads = context.threads;
   s.simulated = simulated;
   auto time_stage = [&](const std::string& name, Clock::time_point t0, double extra_s = 0.0) {
     s.stage_s.push_back({name, extra_s + Seconds(t0)});
@@ -379,7 +388,6 @@ drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_h
   o.selection.monte_carlo.realisations = options.realisations;
   o.features.rate_hz = rate_hz;
   o.seed = options.seed;
-  o.threads = options.threads;
   if (simulated) o.reference_c = 20.0;
   return o;
 }
@@ -418,13 +426,13 @@ void StudyOptions::Validate() const {
   }
 }
 
-StudyResult RunStudy(const StudyOptions& options, const StudyObserver& observer) {
-  return Run(options, nullptr, observer);
+StudyResult RunStudy(const StudyOptions& options, const StudyContext& context) {
+  return Run(options, nullptr, context);
 }
 
 StudyResult RunStudy(const StudyOptions& options, const StudyLog& log,
-                     const StudyObserver& observer) {
-  return Run(options, &log, observer);
+                     const StudyContext& context) {
+  return Run(options, &log, context);
 }
 
 }  // namespace gyrodrift::study

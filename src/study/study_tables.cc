@@ -153,10 +153,9 @@ void FillSettingsTable(StudyResult& s) {
       {"compensate mode",
        std::string("thermal models identified from the calibration run") +
            ", estimate referenced to " +
-           (std::isnan(base.reference_c) ? std::string("the fitted intercept (user log)")
-                                         : "equilibrium at " + RoundedText(base.reference_c) +
-                                               " degC")});
-  settings.Add({"threads", a.threads == 0 ? "all cores" : std::to_string(a.threads)});
+           (!base.reference_c ? std::string("the fitted intercept (user log)")
+                              : "equilibrium at " + RoundedText(*base.reference_c) + " degC")});
+  settings.Add({"threads", s.threads == 0 ? "all cores" : std::to_string(s.threads)});
 }
 
 void FillTimingTable(StudyResult& s, double total_s) {

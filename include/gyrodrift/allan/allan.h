@@ -28,7 +28,7 @@
 // Cost
 //   O(N) to integrate, then O(N) per averaging time for every estimator (running sums; the
 //   overlapping ADEV kernel is blocked over consecutive taus and vectorised), spread over
-//   `threads` workers with ParallelFor; results are bit-identical for any thread count.
+//   the execution's threads with ParallelFor; results are bit-identical for any thread count.
 //   Octave grid: O(N log N); every averaging factor: O(N^2). Memory: about 3 N doubles.
 #pragma once
 
@@ -39,6 +39,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "gyrodrift/common/execution.h"
 
 namespace gyrodrift::allan {
 
@@ -107,12 +109,11 @@ struct AllanOptions {
   // Force the noise type used for the EDF instead of identifying it per tau (alpha in -4..2, see
   // NoiseTypeName); empty = identify (default).
   std::optional<int> forced_alpha = {};
-  // Worker threads; 0 = every hardware core (default). Results do not depend on it.
-  int threads = 0;
 
   double tau0_s() const { return 1.0 / rate_hz; }
   // Throws UsageError "<field> = <value>: must be <rule>".
   void Validate() const;
+  bool operator==(const AllanOptions&) const = default;
 };
 
 struct AllanPoint {
@@ -140,10 +141,12 @@ struct AllanResult {
   std::string Summary() const;
 };
 
-// Runs the estimator on `data` (rate or angle samples, see options). Throws UsageError for bad
-// options and DataError for non-finite samples or a record too short for the requested taus
-// (at least one tau must be computable; list taus beyond the estimator's limit are an error).
-AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options);
+// Runs the estimator on `data` (rate or angle samples, see options) on execution.threads workers
+// (its progress is not called). Throws UsageError for bad options or threads and DataError for
+// non-finite samples or a record too short for the requested taus (at least one tau must be
+// computable; list taus beyond the estimator's limit are an error).
+AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options,
+                    const Execution& execution = {});
 
 // ---- Building blocks (exposed for tests and other modules) --------------------------------------
 

@@ -11,9 +11,12 @@
 //            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11
 //            (2004).
 // Cost: one sift is O(N); EMD is O(N * total sifts); the ensemble methods multiply the per-mode
-// cost by the ensemble size I and spread realisations over `threads` workers. Results are the
+// cost by the ensemble size I and spread realisations over the context's threads. Results are the
 // same bits for any thread count (realisation i draws from stream (seed, i), sums run in i order).
 // Units: the IMFs have the units of the input.
+// DecompositionOptions are the plain values that decide the result (comparable with ==); how a
+// decomposition runs (threads, progress, observers, shared noise EMDs) is its DecompositionContext,
+// none of which changes a bit of the result.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,12 +28,14 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/common/execution.h"
+
 namespace gyrodrift::decomposition {
 
 enum class Method { kEmd, kEemd, kCeemdan, kIceemdan, kBeemdan };
 std::string_view ToString(Method method);
 // CEEMDAN, ICEEMDAN and BEEMDAN: the methods built on their realisations' white-noise EMDs
-// (DecompositionOptions::noise_imf_observer and noise_emds apply to them only).
+// (DecompositionContext::noise_imf_observer and noise_emds apply to them only).
 bool UsesNoiseEmds(Method method);
 Method MethodFromString(std::string_view name);  // "emd", "eemd", ...; throws UsageError
 
@@ -87,37 +92,39 @@ struct DecompositionOptions {
   int max_imfs = 0;  // cap on the IMF count (residue not counted), 0 = until the residue is
                      // monotone; EEMD with 0 uses floor(log2 N) - 1 so all members align
   // Noise-assisted methods.
-  int ensemble_size = 100;      // I, >= 1
+  int ensemble_size = 100;      // I, in [1, 100000] (DecomposeWithNoise: the noise's columns)
   double noise_strength = 0.2;  // eps (EEMD: noise std / signal std; CEEMDAN family: eps_0)
   std::uint64_t seed = 1;       // realisation i draws from stream (seed, i)
-  int threads = 0;              // workers, 0 = every core
   NoiseScaling noise_scaling = NoiseScaling::kColominas2014;
-  // Supplied white noise (N x I, one realisation per column) used instead of drawing; for the
-  // CEEMDAN family in the normalised domain x / std(x), for EEMD scaled by eps * std(x).
-  std::shared_ptr<const Eigen::MatrixXd> supplied_noise;
   // BEEMDAN.
   BeemdanBound beemdan_bound = BeemdanBound::kEnergyBand;
   double band_confidence = 0.99;  // 0.95 or 0.99 (the two bands Flandrin et al. 2004 fitted)
   int noise_stages = 3;           // for kFixedStages, >= 1
 
-  // Noise-assisted methods: called with the estimated fraction done, in order and never
-  // concurrently (from the thread that accumulates the ensemble); may be empty. For progress
-  // displays only: it does not change the result.
-  std::function<void(double fraction)> progress;
+  void Validate() const;  // throws UsageError naming the field, value and allowed range
+  bool operator==(const DecompositionOptions&) const = default;
+};
+
+// How one decomposition runs. Nothing here changes the result: the same options give the same
+// bits with any context.
+struct DecompositionContext {
+  // threads: workers over the noise-assisted methods' realisations (an ensemble uses no more than
+  // its realisations; plain EMD runs on the calling thread). progress: the noise-assisted methods
+  // report the estimated fraction done, with the method's name as the step, from the thread that
+  // accumulates the ensemble; plain EMD reports nothing.
+  Execution execution = {};
   // CEEMDAN, ICEEMDAN, BEEMDAN: called with IMF `mode` (1-based) of white-noise realisation
   // `realisation`'s own EMD (unit variance, before any scaling; N samples) each time the method
   // extracts one, in increasing mode order per realisation, from the worker threads (calls for
   // different realisations may run concurrently; those for one realisation never do). Lets a
   // caller reuse these EMDs instead of computing its own (selection's white-noise level, see
-  // selection::NoiseLevelCollector). May be empty; it does not change the result.
-  std::function<void(int realisation, int mode, const double* imf)> noise_imf_observer;
+  // selection::NoiseLevelCollector). May be empty (default).
+  std::function<void(int realisation, int mode, const double* imf)> noise_imf_observer = {};
   // CEEMDAN, ICEEMDAN, BEEMDAN: the realisations' white-noise EMDs, computed beforehand for
-  // signals of this length with this seed, ensemble size and sifting (see NoiseEmds); Decompose
-  // refuses a set that does not match. Empty: each decomposition computes its own. The result
-  // is the same bits either way.
-  std::shared_ptr<const NoiseEmds> noise_emds;
-
-  void Validate() const;  // throws UsageError naming the field, value and allowed range
+  // signals of this length with this seed, ensemble size and sifting (see NoiseEmds) and shared
+  // by many decompositions; Decompose refuses a set that does not match (or supplied noise).
+  // Empty (default): each decomposition computes its own.
+  std::shared_ptr<const NoiseEmds> noise_emds = {};
 };
 
 struct DecompositionReport {
@@ -127,10 +134,11 @@ struct DecompositionReport {
   int sift_cap_hits = 0;           // total number of one-mode extractions that hit the cap
   int ensemble_size = 0;           // 0 for plain EMD
   std::uint64_t seed = 0;
-  // Worker threads used (options.threads is the number asked for, 0 = every core; an ensemble
-  // uses no more than its realisations). Not in Summary(): it never changes a result.
+  // Worker threads used (the context's execution.threads is the number asked for, 0 = every
+  // core; an ensemble uses no more than its realisations). Not in Summary(): it never changes a
+  // result.
   int threads = 1;
-  bool supplied_noise = false;
+  bool supplied_noise = false;    // DecomposeWithNoise
   int noise_assisted_stages = 0;  // CEEMDAN family: stages run with noise
   std::string stop_reason;        // why the decomposition (or BEEMDAN's noise assistance) ended
   std::vector<double> mode_log2_energy;       // BEEMDAN: log2 energy of each tested mode
@@ -148,16 +156,17 @@ struct Decomposition {
 // The white-noise EMDs of an ensemble (realisation i drawn from stream (seed, i), unit variance)
 // for signals of one length, each computed to the end once and then shared by every CEEMDAN,
 // ICEEMDAN or BEEMDAN decomposition of that length with the same seed, ensemble size and sifting
-// (DecompositionOptions::noise_emds). The causal protocol decomposes thousands of windows of
+// (DecompositionContext::noise_emds). The causal protocol decomposes thousands of windows of
 // one length, and the noise EMDs are about half of each one's cost. Immutable once built, so
 // one set may serve many threads; it holds ensemble x (IMFs + 2) x length doubles (the
 // realisation, its IMFs and its residue).
 class NoiseEmds {
  public:
-  // Computes the EMDs with options' seed, ensemble_size, sifting and threads. Throws UsageError
-  // for invalid options or supplied noise (whose EMDs a caller computes itself), DataError for a
-  // length under 4 samples.
-  NoiseEmds(Eigen::Index length, const DecompositionOptions& options);
+  // Computes the EMDs with options' seed, ensemble_size and sifting on execution.threads workers
+  // (its progress is not called). Throws UsageError for invalid options or threads, DataError for
+  // a length under 4 samples.
+  NoiseEmds(Eigen::Index length, const DecompositionOptions& options,
+            const Execution& execution = {});
 
   struct Realisation {
     Eigen::VectorXd white;              // the realisation itself
@@ -183,10 +192,23 @@ class NoiseEmds {
   std::vector<Realisation> realisations_;
 };
 
-// Decomposes x with options.method. Throws UsageError (bad options) or DataError (fewer than 4
-// samples, a non-finite sample, supplied noise of the wrong shape).
+// Decomposes x with options.method. Throws UsageError (bad options or context) or DataError
+// (fewer than 4 samples, a non-finite sample).
 Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
-                        const DecompositionOptions& options);
+                        const DecompositionOptions& options,
+                        const DecompositionContext& context = {});
+
+// Decompose with supplied white noise instead of drawn: `noise` is N x I, one realisation per
+// column (I = the ensemble size; options.ensemble_size is checked, not used), for the CEEMDAN
+// family in the normalised domain x / std(x), for EEMD scaled by eps * std(x); e.g. the reference
+// noise that reproduces the authors' MATLAB code. An input like x, not a context: it decides the
+// result.
+// Throws as Decompose, UsageError for method kEmd (which draws no noise) or with
+// context.noise_emds, DataError for noise of the wrong shape or with a non-finite value.
+Decomposition DecomposeWithNoise(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& noise,
+                                 const DecompositionOptions& options,
+                                 const DecompositionContext& context = {});
 
 // Plain EMD (the same as Decompose with Method::kEmd, without the ensemble fields).
 Decomposition Emd(const Eigen::Ref<const Eigen::VectorXd>& x, const SiftingOptions& sifting = {},

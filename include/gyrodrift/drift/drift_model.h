@@ -17,16 +17,20 @@
 // the calibration run (thermal_model.h: states, time constants and terms chosen by blocked
 // cross-validation); the fitted intercept keeps the unit's repeatable bias (docs/drift.md 1.2).
 // Cost: one decomposition of the training record plus one learner fit per sub-series.
+// DriftOptions and CausalOptions are plain values (comparable with ==; a model file stores every
+// field of DriftOptions); worker threads and progress are the Execution the fit and the
+// prediction take as their last argument, which changes no result.
 #pragma once
 
 #include <Eigen/Core>
-#include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/drift/learner.h"
@@ -69,23 +73,20 @@ struct DriftOptions {
   // cross-validation says it helps (thermal_model.h; docs/drift.md 4.5).
   bool linear_compensation = true;
   ThermalModelOptions thermal;  // the identification of those sub-models
-  // Compensate mode: NaN (default) keeps the fitted intercept, the unit's repeatable bias, which a
-  // calibration is expected to remove. A temperature (degC, in [-100, 200]) references the
+  // Compensate mode: unset (default) keeps the fitted intercept, the unit's repeatable bias, which
+  // a calibration is expected to remove. A temperature (degC, in [-100, 200]) references the
   // estimate to thermal equilibrium there instead: the model's output for a record that sits at
-  // that temperature is subtracted, for users who calibrate the bias separately.
-  double reference_c = std::numeric_limits<double>::quiet_NaN();
+  // that temperature is subtracted, for users who calibrate the bias separately. (An optional, not
+  // a NaN, so that == compares options as values.)
+  std::optional<double> reference_c;
   // The fit's one seed: the decomposition's noise draws streams (seed, i), sub-model g's learner
   // (or thermal correction) SeedFor(seed, "sub-model", g), the white-noise level the
   // decomposition's streams (common/random.h); decomposition.seed, learner.seed and
   // selection.monte_carlo.seed are overwritten with these.
   std::uint64_t seed = 1;
-  int threads = 0;         // 0 = every core
-  // FitDriftModel reports its progress here (fraction of the whole fit in [0, 1], and the step:
-  // "decompose" (the grouping included), "fit sub-models"), from the calling thread or the thread
-  // that accumulates the ensemble; may be empty. Not part of the model; Evaluate does not call it.
-  std::function<void(double fraction, const std::string& step)> progress;
   DriftOptions();         // sets the learner defaults described above
   void Validate() const;  // throws UsageError naming the field
+  bool operator==(const DriftOptions&) const = default;
   // Compensate mode, or predict mode with features.use_temperature: needs the temperature channel.
   bool uses_temperature() const;
 };
@@ -140,11 +141,14 @@ bool IdentifiesThermalModel(const DriftOptions& options);
 // runs, or a log split at its gaps; features.h CheckRecordStarts) are given one after the other
 // with the first sample of each after the first in record_starts: compensate mode with
 // Method::kThermal only (IdentifyThermalModel restarts its lag states there), UsageError
-// otherwise. Throws UsageError / DataError.
+// otherwise. Runs on execution.threads workers and reports its progress there: the fraction of
+// the whole fit and the step, "decompose" (the grouping included) then "fit sub-models". The model
+// is the same bits for any execution. Throws UsageError / DataError.
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options,
-                         const std::vector<Eigen::Index>& record_starts = {});
+                         const std::vector<Eigen::Index>& record_starts = {},
+                         const Execution& execution = {});
 
 // Share of temperature samples outside [min_c, max_c] (0 when the range is NaN: no temperature),
 // e.g. a model's training range: where a thermal model extrapolates.
@@ -152,7 +156,7 @@ double ShareOutsideRange(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                          double max_c);
 
 // Compensate mode: the drift estimate at every sample of a temperature record (N x channels;
-// relative to equilibrium at options.reference_c unless that is NaN). With record_starts, every
+// relative to equilibrium at options.reference_c if set). With record_starts, every
 // record is estimated on its own, its lags starting in equilibrium at its first temperature.
 Eigen::VectorXd EstimateDrift(const DriftModel& model,
                               const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
@@ -183,18 +187,15 @@ Protocol ProtocolFromString(std::string_view name);  // "paper", "causal"
 
 struct CausalOptions {
   int window = 512;  // W, samples of the trailing window, in [16, 1e6]
-  int threads = 0;   // windows in parallel (each decomposition then runs on one thread)
   // Realisations of each window's decomposition (noise-assisted methods), in [0, 100000]; 0 = the
   // model's own decomposition.ensemble_size. Default 20 [choice]: one decomposition per test
   // sample is the whole cost of the causal protocol (W = 512: 9 ms CPU with 20 realisations,
   // 46 ms with 100; 8,640 test samples of an 8-h record), and docs/drift.md shows what 20
   // instead of 100 costs in accuracy.
   int ensemble_size = 20;
-  // Called with the fraction of windows decomposed, increasing, never concurrently (from whichever
-  // worker finished one); may be empty. For progress displays: it does not change the result.
-  std::function<void(double fraction)> progress;
 
   void Validate() const;  // throws OptionError for a window or ensemble size out of range
+  bool operator==(const CausalOptions&) const = default;
 };
 
 // Largest prediction horizon, steps.
@@ -212,10 +213,13 @@ Eigen::Index FirstPredictable(const DriftModel& model, Protocol protocol, int ho
 // step, as for a temperature programme known in advance. first >= FirstPredictable(model,
 // protocol, horizon). horizon = 1 is PredictOneStep.
 // Single models need no decomposition and are causal under both protocols.
+// The paper protocol's decomposition runs on execution.threads workers; the causal protocol's
+// windows run in parallel on them (each window's decomposition on one thread) and report the
+// fraction of windows decomposed, with the step "causal windows". Nothing else is reported.
 Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                              const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                              Eigen::Index first, int horizon, Protocol protocol,
-                             const CausalOptions& causal = {});
+                             const CausalOptions& causal = {}, const Execution& execution = {});
 
 // "" unless, under the causal protocol with `window`-sample windows, some sub-model other than
 // the residue's and MS-ELM's noise group sums IMFs a window cannot resolve (a window of W samples
@@ -229,6 +233,6 @@ std::string CausalWindowNote(const DriftModel& model, int window);
 Eigen::VectorXd PredictOneStep(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& y,
                                const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                Eigen::Index first, Protocol protocol,
-                               const CausalOptions& causal = {});
+                               const CausalOptions& causal = {}, const Execution& execution = {});
 
 }  // namespace gyrodrift::drift

@@ -11,7 +11,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -39,9 +38,8 @@ struct EvaluationOptions {
   // Predict mode: score horizon-step-ahead predictions (PredictAhead), in [1, 100000].
   int horizon = 1;
   CausalOptions causal;
-  // Called with the fraction done and a label; may be empty.
-  std::function<void(double fraction, const std::string& label)> progress;
   void Validate() const;
+  bool operator==(const EvaluationOptions&) const = default;
 };
 
 struct EvaluationRow {
@@ -71,9 +69,13 @@ struct EvaluationResult {
 // Evaluates options.methods on (y, temperature_c, truth); temperature (N x channels; several only
 // for identified compensate-mode models, else a UsageError before any fit) and truth may be
 // empty. The training temperature range and the share outside it are of the first channel.
+// Fits, decompositions and causal windows run on execution.threads; its progress gets the share
+// of the trials done (the causal windows counted within their trial) and a label naming the
+// trial, "ms-elm / causal / seed 1" (" / windows" within), then "done". The fits themselves do
+// not report. No result depends on the execution but the timings.
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                           const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                           const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
-                          const EvaluationOptions& options);
+                          const EvaluationOptions& options, const Execution& execution = {});
 
 }  // namespace gyrodrift::drift

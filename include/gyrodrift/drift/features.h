@@ -51,6 +51,7 @@ struct FeatureOptions {
   // one time constant.
   ThermalSet thermal_set = ThermalSet::kAuto;
   void Validate() const;  // throws UsageError naming the field
+  bool operator==(const FeatureOptions&) const = default;
   // Columns of ThermalFeatures for thermal_set (kAuto counted as kLadder).
   int NumThermalFeatures() const;
 };

@@ -36,7 +36,9 @@ struct FitSettings {
   int ensemble = 100;                   // decomposition ensemble size
   int realisations = 100;               // white-noise realisations of the grouping's level
   std::uint64_t seed = 1;
-  int threads = 0;                      // 0 = every core
+  // Worker threads of the fit, in [0, 1024], 0 = every core: how it runs, not a setting of the
+  // model (MakeExecution, not MakeDriftOptions, maps it; both check it).
+  int threads = 0;
   // Compensate mode, identified methods: each thermal model may add a nonlinear correction.
   bool nonlinear = false;
   // Compensate mode: reference the estimate to equilibrium at this temperature, degC, in
@@ -54,5 +56,9 @@ Method ResolveMethod(std::string_view method, Mode mode);
 // DriftOptions of these settings, validated. Throws OptionError naming the setting (value out of
 // range, or a setting that does not apply to the mode or method) or UsageError.
 DriftOptions MakeDriftOptions(const FitSettings& settings);
+
+// The Execution of the settings' threads (no progress: the front end adds its own), checked:
+// OptionError naming `threads`.
+Execution MakeExecution(const FitSettings& settings);
 
 }  // namespace gyrodrift::drift

@@ -11,7 +11,8 @@
 // scalers. A fitted learner exports itself as Parameters (named arrays, scalars and texts), so
 // the io module writes any kind to a model file without knowing it, and LoadLearner rebuilds it
 // with predictions identical to the bit.
-// Single output: y is a vector. Units: predictions in the units of y.
+// Single output: y is a vector. Units: predictions in the units of y. Fits run on the execution's
+// threads (kElm, kSvr); no result depends on them, so a learner's Parameters do not hold them.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +23,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/elm/elm.h"
 
 namespace gyrodrift::drift {
@@ -32,7 +34,7 @@ LearnerKind LearnerKindFromString(std::string_view name);  // "elm", "poly", "sv
 
 struct LearnerOptions {
   LearnerKind kind = LearnerKind::kElm;
-  elm::ElmOptions elm;  // kElm (seed and threads below override elm.seed / elm.threads)
+  elm::ElmOptions elm;  // kElm (seed below overrides elm.seed)
   // kPoly: total degree in [1, 4]; ridge in [0, 1] on the standardised problem.
   int poly_degree = 2;
   double poly_ridge = 1e-10;
@@ -48,8 +50,8 @@ struct LearnerOptions {
   int bp_epochs = 300;
   double bp_desired_mse = 1e-4;
   std::uint64_t seed = 1;
-  int threads = 0;  // 0 = every core (where the learner can use threads)
   void Validate() const;  // throws UsageError "<field> = <value>: must be <rule>"
+  bool operator==(const LearnerOptions&) const = default;
 };
 
 // A fitted learner's state, for model files.
@@ -71,11 +73,13 @@ class Learner {
   virtual std::string Summary() const = 0;  // one line: kind, size, training error
 };
 
-// Fits a learner of options.kind on rows x (N x d) and targets y (N). Throws UsageError (bad
-// options) or DataError (mismatched rows, too few rows, non-finite values).
+// Fits a learner of options.kind on rows x (N x d) and targets y (N) on execution.threads workers
+// (its progress is not called; an SVR also predicts on them, a loaded one on every core). Throws
+// UsageError (bad options or threads) or DataError (mismatched rows, too few rows, non-finite
+// values).
 std::unique_ptr<Learner> FitLearner(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                     const Eigen::Ref<const Eigen::VectorXd>& y,
-                                    const LearnerOptions& options);
+                                    const LearnerOptions& options, const Execution& execution = {});
 
 // Rebuilds a learner from Save()'s output. Throws DataError naming what is missing or malformed.
 std::unique_ptr<Learner> LoadLearner(LearnerKind kind, const Parameters& parameters);

@@ -23,8 +23,9 @@
 // Cost (N rows, d inputs, m outputs, L units): fit O(N d L + N L^2 + L^3) with the Cholesky
 // solver, O(N L^2) memory-free streaming over row blocks (H is never stored); QR stores H and
 // costs 2 N L^2. Leave-one-out selection over candidates L_k <= L_max: O(N L_max^2) for H^T H
-// plus O(N L_k^2 + L_k^3) per candidate. Row blocks run on `threads` workers; results are the same
-// bits for any thread count (blocks are fixed by N alone and sums run in block order).
+// plus O(N L_k^2 + L_k^3) per candidate. Row blocks run on the execution's (or Predict's) threads;
+// results are the same bits for any thread count (blocks are fixed by N alone and sums run in
+// block order), so a fitted model does not depend on how many threads fitted it.
 // Instruction set: the row kernels are built for baseline x86-64 and for AVX2 + FMA and chosen
 // at run time by the CPU. The FMA kernels round differently, so fitted weights, predictions and
 // leave-one-out errors can differ in the last bits (about 1e-13 relative) between a CPU with
@@ -38,6 +39,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "gyrodrift/common/execution.h"
 
 namespace gyrodrift::elm {
 
@@ -89,9 +92,9 @@ struct ElmOptions {
   bool standardize_inputs = true;
   bool standardize_targets = true;
   std::uint64_t seed = 1;  // hidden unit j draws from Rng(seed, j)
-  int threads = 0;         // workers for the row blocks, in [0, 1024], 0 = every core
 
   void Validate() const;  // throws UsageError "<field> = <value>: must be <rule>"
+  bool operator==(const ElmOptions&) const = default;
   // The hidden-unit and C grids kAuto searches (the defaults above if the fields are empty).
   std::vector<int> HiddenUnitGrid() const;
   std::vector<double> RidgeGrid() const;
@@ -116,9 +119,7 @@ struct ElmModel {
   Eigen::MatrixXd output_weights;  // L x m: beta, in standardised target units
   Standardizer input_scaler;       // d columns
   Standardizer target_scaler;      // m columns
-  // As fitted: hidden_units = L, ridge_c = C actually used. options.threads is always 0 in a
-  // fitted model and is ignored by Predict: the thread count is a run-time choice (Predict's
-  // argument), not part of the model, so a model does not depend on how many threads fitted it.
+  // As fitted: hidden_units = L, ridge_c = C actually used.
   ElmOptions options;
 
   int num_inputs() const { return static_cast<int>(input_weights.rows()); }
@@ -168,10 +169,11 @@ struct ElmFit {
   ElmReport report;
 };
 
-// Fits an ELM to inputs X (N x d) and targets T (N x m). Throws UsageError for bad options and
-// DataError for mismatched rows, fewer than 2 rows, no columns, or a non-finite value.
+// Fits an ELM to inputs X (N x d) and targets T (N x m) on execution.threads workers (its progress
+// is not called). Throws UsageError for bad options or threads and DataError for mismatched rows,
+// fewer than 2 rows, no columns, or a non-finite value.
 ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::MatrixXd>& t,
-           const ElmOptions& options);
+           const ElmOptions& options, const Execution& execution = {});
 
 // Predictions in target units, N x m, on `threads` workers (0 = every core, in [0, 1024]; the
 // result is the same bits for any count). Each row's prediction is the same bits whether it is

@@ -10,13 +10,13 @@
 //     RMS(truth), as `compensate --truth` reports it;
 // then pass/fail against the manifest's limits (every verification log must pass).
 //
-// Units run in parallel (ParallelFor over units, each unit single-threaded inside, so results do
-// not depend on the thread count). Each unit's files are written together, atomically, into
-// OUT/<serial>/ with summary.json last in the set; a rerun skips a unit whose summary.json holds
-// the same fingerprint (manifest settings and the logs' bytes: UnitFingerprint) unless `force`.
-// A unit that fails (unreadable log, a fit that cannot run) is reported with its one-line error
-// and the others go on. OUT/fleet.csv (one row per unit, axis and verification log) and
-// OUT/fleet.html (distributions across the fleet, outliers flagged, links to each unit's page)
+// Units run in parallel (ParallelFor over the FleetContext's threads, each unit single-threaded
+// inside, so results do not depend on the thread count). Each unit's files are written together,
+// atomically, into OUT/<serial>/ with summary.json last in the set; a rerun skips a unit whose
+// summary.json holds the same fingerprint (manifest settings and the logs' bytes: UnitFingerprint)
+// unless `force`. A unit that fails (unreadable log, a fit that cannot run) is reported with its
+// one-line error and the others go on. OUT/fleet.csv (one row per unit, axis and verification log)
+// and OUT/fleet.html (distributions across the fleet, outliers flagged, links to each unit's page)
 // are written at the end.
 #pragma once
 
@@ -91,11 +91,17 @@ std::vector<FleetRow> Rows(const UnitResult& unit);
 struct FleetOptions {
   std::string output_dir;  // created if missing
   bool force = false;      // redo units whose summary.json matches
-  int threads = 0;         // units at once; 0 = every core
-  // Called (serialised) after each unit: units done, total, serial, "calibrated" / "skipped" /
-  // "error".
+  bool operator==(const FleetOptions&) const = default;
+};
+
+// How RunFleet runs; nothing here changes a file it writes (but the timings).
+struct FleetContext {
+  int threads = 0;  // units at once, in [0, 1024]; 0 (default) = every core
+  // Called after each unit, never concurrently (from the worker that finished it): units done,
+  // total, serial, "calibrated" / "skipped" / "error". May be empty (default); throw from it to
+  // stop the fleet (the units already written stay).
   std::function<void(int done, int total, const std::string& serial, const std::string& what)>
-      progress;
+      progress = {};
 };
 
 struct FleetResult {
@@ -127,9 +133,10 @@ FleetResult FinishFleet(const Manifest& manifest, const std::string& output_dir,
                         const io::DygraphsAssets& assets);
 
 // Calibrates every unit of the manifest into options.output_dir (see the header comment).
-// Throws UsageError / IoError for the fleet as a whole (no output folder, no dygraphs); a unit's
-// own failure is a row, not an exception.
-FleetResult RunFleet(const Manifest& manifest, const FleetOptions& options);
+// Throws UsageError / IoError for the fleet as a whole (no output folder, no dygraphs, threads
+// out of range); a unit's own failure is a row, not an exception.
+FleetResult RunFleet(const Manifest& manifest, const FleetOptions& options,
+                     const FleetContext& context = {});
 
 // The fleet report from fleet.csv's rows: a summary, the distributions of the residual drift, the
 // share removed, the bias and the noise terms across units, the rows with outliers flagged and a

@@ -9,7 +9,7 @@
 //              source (informative)
 //   options    every field of drift::DriftOptions (mode, method, decomposition with its sifting
 //              rule, selection with its KDE and Monte-Carlo settings, features with the thermal
-//              time constants and rate_hz, learner, lag candidates, seed, threads); enums as the
+//              time constants and rate_hz, learner, lag candidates, seed); enums as the
 //              strings their ToString() gives
 //   model      lags, training_imfs, training_samples, the training reports, lag validation RMSE,
 //              and sub_models: name, imfs, has_residue, learner (null for the zero sub-model of
@@ -49,7 +49,12 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // the target's rate unit (training.rate_unit).
 // Version 5 adds the thermal models' hysteresis term and the options that choose it (older files
 // read as identified without it).
-inline constexpr int kModelFormatVersion = 5;
+// Version 6 drops the thread counts (options.threads, options.decomposition.threads,
+// options.selection.threads and its monte_carlo.threads, options.learner.threads, and the
+// "threads" scalar of ELM and SVR learners): they are how a fit ran (common/execution.h), never
+// part of the model, whose every bit is the same for any count. Older files still load, the
+// counts read and dropped; a version-6 file that holds one is refused as an unknown field.
+inline constexpr int kModelFormatVersion = 6;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 
@@ -72,9 +77,9 @@ struct LoadedModel {
 };
 
 // Renders / writes a model file of one or several axes (distinct target columns, in order).
-// Throws UsageError when the model cannot be stored (options that hold supplied decomposition
-// noise, a predict-mode sub-model without a learner, no axis, repeated targets), IoError when the
-// file cannot be written (atomically: nothing partial is left).
+// Throws UsageError when the model cannot be stored (a predict-mode sub-model without a learner,
+// no axis, repeated targets), IoError when the file cannot be written (atomically: nothing partial
+// is left).
 std::string RenderModelFile(const std::vector<LoadedModel>& axes);
 std::string RenderModelFile(const drift::DriftModel& model, const ModelFileInfo& info);
 void WriteModelFile(const std::string& path, const std::vector<LoadedModel>& axes);

@@ -51,6 +51,7 @@ struct KdeOptions {
   KdeMethod method = KdeMethod::kBinnedFft;
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range
+  bool operator==(const KdeOptions&) const = default;
 };
 
 // A uniform grid g_j = lo + j * step, j = 0..points-1.

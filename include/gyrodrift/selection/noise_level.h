@@ -10,8 +10,8 @@
 // realisations of seeded white noise of length N (realisation i draws from Rng(seed, i)) are
 // decomposed by plain EMD; the level of mode k is the `confidence` quantile (type 7) of G_k over
 // the realisations that have a mode k (at least kMinRealisationsPerMode of them, else NaN: no
-// level, the mode cannot be called noise). Realisations run on `threads` workers (ParallelFor);
-// each fills its own slot, so the level is the same bits for any thread count.
+// level, the mode cannot be called noise). Realisations run on the execution's threads
+// (ParallelFor); each fills its own slot, so the level is the same bits for any thread count.
 // Cost: R plain EMDs of length N plus R * K KDEs, dominated by the EMDs: for N = 28,800 about
 // 0.1 s of CPU per realisation, so R = 100 costs about 10 s of CPU (bench_selection).
 // NoiseLevelCache keeps one level per (N, options) so a process pays this once.
@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/selection/distance.h"
 #include "gyrodrift/selection/kde.h"
@@ -43,10 +44,10 @@ struct MonteCarloOptions {
   int realisations = 100;    // white-noise realisations R, [20, 100000]
   double confidence = 0.99;  // quantile of G_k taken as the level, [0.5, 1)
   std::uint64_t seed = 1;    // realisation i draws from stream (seed, i)
-  int threads = 0;           // workers, >= 0 (0 = every core); does not change the result
   decomposition::SiftingOptions sifting;  // EMD of the noise realisations
   int max_imfs = 0;                       // EMD IMF cap, >= 0 (0 = until the residue is monotone)
   void Validate() const;                  // throws UsageError naming the field
+  bool operator==(const MonteCarloOptions&) const = default;
 };
 
 constexpr int kMinRealisationsPerMode = 20;
@@ -68,14 +69,16 @@ struct NoiseLevel {
   std::string Summary() const;  // one line
 };
 
-// Runs the Monte-Carlo (no cache). length >= 16. Throws UsageError for bad options.
+// Runs the Monte-Carlo (no cache) on execution.threads workers (its progress is not called).
+// length >= 16. Throws UsageError for bad options or threads.
 NoiseLevel ComputeNoiseLevel(int length, const MonteCarloOptions& monte_carlo,
-                             const KdeOptions& kde, PdfDistance distance);
+                             const KdeOptions& kde, PdfDistance distance,
+                             const Execution& execution = {});
 
 // The level of the white-noise IMFs a CEEMDAN-family decomposition computes anyway:
 //   NoiseLevelCollector collector(n, selection.monte_carlo, selection.kde, selection.distance);
-//   collector.Attach(&decomposition_options);   // before Decompose
-//   selection.noise_level = collector.Level();  // after it (nullptr if not attached)
+//   collector.Attach(decomposition_options, &context);  // before Decompose(x, options, context)
+//   selection.noise_level = collector.Level();          // after it (nullptr if not attached)
 // Realisations 0..R-1 of the decomposition play the Monte-Carlo's; their G_k are computed in the
 // decomposition's worker threads as each noise IMF appears. The result equals ComputeNoiseLevel
 // with the decomposition's seed (bit for bit) for the modes the decomposition reached, and is
@@ -84,11 +87,13 @@ class NoiseLevelCollector {
  public:
   NoiseLevelCollector(int length, const MonteCarloOptions& monte_carlo, const KdeOptions& kde,
                       PdfDistance distance);
-  // Installs the observer when the decomposition's noise is what the Monte-Carlo would use: a
-  // CEEMDAN-family method with drawn (not supplied) noise, at least R realisations, the
+  // Installs the observer in the context of a decomposition with these options when its noise is
+  // what the Monte-Carlo would use: a CEEMDAN-family method, at least R realisations, the
   // Monte-Carlo's sifting options and no IMF cap on its side, and no observer is installed yet.
-  // Returns whether it did.
-  bool Attach(decomposition::DecompositionOptions* decomposition);
+  // Returns whether it did. For Decompose only: the noise DecomposeWithNoise is given is not the
+  // Monte-Carlo's (drawn from (seed, i)), so its EMDs give no level of the seed.
+  bool Attach(const decomposition::DecompositionOptions& decomposition,
+              decomposition::DecompositionContext* context);
   // After the decomposition: the level of the modes it reached, or nullptr when not attached or
   // when no noise IMF was seen.
   std::shared_ptr<const NoiseLevel> Level() const;
@@ -103,14 +108,15 @@ class NoiseLevelCollector {
   std::vector<std::vector<double>> g_;  // G_k of realisation i's noise IMFs, in mode order
 };
 
-// Thread-safe cache of levels keyed by (length, every option except threads). Concurrent callers
-// asking for the same key wait for one computation. A failed computation is not cached.
+// Thread-safe cache of levels keyed by (length, every option). Concurrent callers asking for the
+// same key wait for one computation. A failed computation is not cached.
 class NoiseLevelCache {
  public:
-  // The level for the key; *computed (if given) tells whether this call ran the Monte-Carlo.
+  // The level for the key; *computed (if given) tells whether this call ran the Monte-Carlo (on
+  // execution.threads workers).
   std::shared_ptr<const NoiseLevel> Get(int length, const MonteCarloOptions& monte_carlo,
                                         const KdeOptions& kde, PdfDistance distance,
-                                        bool* computed = nullptr);
+                                        bool* computed = nullptr, const Execution& execution = {});
   void Clear();
   std::size_t Size() const;
   // The process-wide cache SelectModes uses.

@@ -17,7 +17,8 @@
 // sum of its IMF columns in increasing k, then the residue, so noise + mixed + drift equals
 // sum_k imf_k + residue to round-off.
 // Cost: K + 1 binned-FFT KDEs (milliseconds for N = 28,800) plus, for kPdfSimilarity, the
-// Monte-Carlo level once per (N, options) per process (seconds; see noise_level.h).
+// Monte-Carlo level once per (N, options) per process (seconds; see noise_level.h). The densities
+// and the Monte-Carlo run on the execution's threads; the result does not depend on them.
 // Units: the group series have the units of x; D_k and G_k those of the chosen distance.
 #pragma once
 
@@ -29,6 +30,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/selection/distance.h"
 #include "gyrodrift/selection/kde.h"
@@ -57,14 +59,16 @@ struct SelectionOptions {
   bool center_signal = true;
   MonteCarloOptions monte_carlo;  // the white-noise level (kPdfSimilarity only)
   // A precomputed level (length must equal N), e.g. NoiseLevelCollector's; skips
-  // NoiseLevelCache::Global() unless it is partial and the noise run outlasts it.
+  // NoiseLevelCache::Global() unless it is partial and the noise run outlasts it. It decides the
+  // grouping like any option (== compares the pointer); a model file records only whether it was
+  // given.
   std::shared_ptr<const NoiseLevel> noise_level;
   // kEnergyModel band: 0.99 (a = 0.46, b = -1.919) or 0.95 (a = 0.474, b = -2.449), the two
   // bands Flandrin et al. fitted; other values are rejected.
   double band_confidence = 0.99;
-  int threads = 0;  // workers for the per-IMF densities, >= 0 (0 = every core)
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range
+  bool operator==(const SelectionOptions&) const = default;
 };
 
 struct ModeGroup {
@@ -109,27 +113,31 @@ struct SelectionResult {
   std::string Summary() const;                   // one line
 };
 
-// Groups the IMFs (N x K, K >= 1) and residue (N) of x (N >= 16 samples). Throws UsageError (bad
-// options, a supplied level of another length) or DataError (a non-finite sample, no IMF,
-// mismatched sizes, a constant signal).
+// Groups the IMFs (N x K, K >= 1) and residue (N) of x (N >= 16 samples) on execution.threads
+// workers (its progress is not called). Throws UsageError (bad options or threads, a supplied
+// level of another length) or DataError (a non-finite sample, no IMF, mismatched sizes, a
+// constant signal).
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const Eigen::Ref<const Eigen::MatrixXd>& imfs,
                             const Eigen::Ref<const Eigen::VectorXd>& residue,
-                            const SelectionOptions& options = {});
+                            const SelectionOptions& options = {}, const Execution& execution = {});
 SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
                             const decomposition::Decomposition& decomposition,
-                            const SelectionOptions& options = {});
+                            const SelectionOptions& options = {}, const Execution& execution = {});
 
 // Decompose then SelectModes, with the pdf criterion's white-noise level taken from the
 // decomposition's own noise EMDs where they are the Monte-Carlo's (NoiseLevelCollector): the way
 // to group a signal's IMFs without paying for the Monte-Carlo a second time. A decomposition
-// without IMF has no selection. Throws as Decompose and SelectModes do.
+// without IMF has no selection. The context serves both (its execution's progress reports the
+// decomposition only); the collector adds its observer to it. Throws as Decompose and SelectModes
+// do.
 struct GroupedDecomposition {
   decomposition::Decomposition decomposition;
   std::optional<SelectionResult> selection;  // nullopt when the decomposition has no IMF
 };
-GroupedDecomposition DecomposeAndSelect(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                        decomposition::DecompositionOptions decomposition_options,
-                                        SelectionOptions options);
+GroupedDecomposition DecomposeAndSelect(
+    const Eigen::Ref<const Eigen::VectorXd>& x,
+    const decomposition::DecompositionOptions& decomposition_options, SelectionOptions options,
+    decomposition::DecompositionContext context = {});
 
 }  // namespace gyrodrift::selection

@@ -22,7 +22,8 @@
 // (a log's in whatever unit it has); times in s (hours on the time axes of the result).
 // Cost: dominated by the causal protocol, one BEEMDAN of `causal_window` samples per test sample
 // for each decomposing method (ms-elm, emd-elm): the defaults take about 25 s on 2 cores.
-// Nothing here reads files or prints: RunStudy reports through a StudyObserver.
+// Nothing here reads files or prints: RunStudy reports through its StudyContext, which also holds
+// the worker threads; StudyOptions are plain values (comparable with ==) that decide the result.
 #pragma once
 
 #include <Eigen/Core>
@@ -74,12 +75,11 @@ struct StudyOptions {
   // Seed of the simulation (run B uses RunBSeed(seed)), the decompositions and the learners.
   // Default 1.
   std::uint64_t seed = 1;
-  // Worker threads, 0 = all cores; DriftOptions' range [0, 1024]. Default 0.
-  int threads = 0;
 
   // Throws OptionError naming the field (duration_s, ensemble_size, methods) or, for a range the
-  // library owns, the library's name for it (realisations, causal window, threads).
+  // library owns, the library's name for it (realisations, causal window).
   void Validate() const;
+  bool operator==(const StudyOptions&) const = default;
 };
 
 // A user's log for the study: one gyro output and one temperature channel, uniformly sampled.
@@ -99,14 +99,21 @@ struct StudyLog {
 // 3 compensate mode, 4 Allan deviation.
 inline constexpr int kStudyStages = 5;
 
-struct StudyObserver {
+// How RunStudy runs and what it reports as it goes; nothing here changes a result (but the
+// timings). The study's own Execution: its progress names the stage, and a stage's results are
+// reported when it ends.
+struct StudyContext {
+  // Worker threads of every step (decompositions, causal windows, fits, Allan deviations), in
+  // [0, 1024]; 0 (default) = every core. Recorded in the settings table.
+  int threads = 0;
   // Progress: the stage (in [0, kStudyStages)), the fraction of it done in [0, 1] and what is
-  // being done. Called with fraction 0 when a stage begins; may be called from worker threads.
-  // The fraction weighs each evaluation trial by its expected cost, not by its count.
-  std::function<void(int stage, double fraction, const std::string& what)> progress;
+  // being done. Called with fraction 0 when a stage begins; never concurrently, from the calling
+  // thread or a worker. The fraction weighs each evaluation trial by its expected cost, not by its
+  // count. May be empty (default); throw from it to cancel the study.
+  std::function<void(int stage, double fraction, const std::string& what)> progress = {};
   // A finished stage's results as the text `gyrodrift demo` prints: "1. simulated run A: ...",
-  // the tables of stages 2-4 (Table::Text), each ending in a newline.
-  std::function<void(int stage, const std::string& summary)> stage_done;
+  // the tables of stages 2-4 (Table::Text), each ending in a newline. May be empty (default).
+  std::function<void(int stage, const std::string& summary)> stage_done = {};
 };
 
 // A file the study writes: its name under the output folder ("/"-separated) and its contents.
@@ -118,6 +125,7 @@ struct StudyFile {
 // Everything the study produced: the files, the report and a caller's own analysis read it.
 struct StudyResult {
   StudyOptions options;
+  int threads = 0;                    // StudyContext::threads, as asked (0 = every core)
   drift::DriftOptions drift_options;  // the models' options (method and mode set per model)
   bool simulated = false;
   std::string source;            // "simulation" or StudyLog::source
@@ -163,11 +171,12 @@ struct StudyResult {
   std::vector<std::pair<std::string, double>> stage_s;  // wall seconds per stage
 };
 
-// The simulated study. Throws what StudyOptions::Validate throws, before any work.
-StudyResult RunStudy(const StudyOptions& options, const StudyObserver& observer = {});
+// The simulated study. Throws what StudyOptions::Validate throws, and OptionError naming
+// `threads` for a context's thread count out of range, before any work.
+StudyResult RunStudy(const StudyOptions& options, const StudyContext& context = {});
 // The study of a user's log. Also throws DataError for fewer than 64 samples or a temperature
 // of another length, and what DriftOptions::Validate throws for the rate.
 StudyResult RunStudy(const StudyOptions& options, const StudyLog& log,
-                     const StudyObserver& observer = {});
+                     const StudyContext& context = {});
 
 }  // namespace gyrodrift::study

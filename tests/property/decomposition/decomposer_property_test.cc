@@ -33,16 +33,18 @@ DecompositionOptions Options(Method method) {
   o.method = method;
   o.ensemble_size = 16;  // small ensembles keep the suite fast; properties do not depend on I
   o.seed = 7;
-  o.threads = 1;
   return o;
 }
+
+const DecompositionContext kOneThread{.execution = {.threads = 1}};
+DecompositionContext Threads(int threads) { return {.execution = {.threads = threads}}; }
 
 class Decomposer : public ::testing::TestWithParam<Method> {};
 
 TEST_P(Decomposer, CompletenessAndShape) {
   const Eigen::VectorXd x = Noisy(1024, 1);
   const Eigen::VectorXd copy = x;
-  const Decomposition d = Decompose(x, Options(GetParam()));
+  const Decomposition d = Decompose(x, Options(GetParam()), kOneThread);
   EXPECT_EQ(x, copy) << "input modified";
   ASSERT_EQ(d.imfs.rows(), x.size());
   ASSERT_EQ(d.residue.size(), x.size());
@@ -69,7 +71,7 @@ TEST_P(Decomposer, EemdErrorShrinksLikeOneOverSqrtI) {
   for (int k = 0; k < 2; ++k) {
     DecompositionOptions o = Options(Method::kEemd);
     o.ensemble_size = sizes[k];
-    const Decomposition d = Decompose(x, o);
+    const Decomposition d = Decompose(x, o, kOneThread);
     rms[k] = std::sqrt((d.imfs.rowwise().sum() + d.residue - x).squaredNorm() / x.size());
   }
   // 16x the members: 4x smaller error (within sampling scatter).
@@ -79,7 +81,7 @@ TEST_P(Decomposer, EemdErrorShrinksLikeOneOverSqrtI) {
 TEST_P(Decomposer, ImfCapIsRespected) {
   DecompositionOptions o = Options(GetParam());
   o.max_imfs = 2;
-  const Decomposition d = Decompose(Noisy(512, 3), o);
+  const Decomposition d = Decompose(Noisy(512, 3), o, kOneThread);
   EXPECT_EQ(d.num_imfs(), 2);
   if (GetParam() != Method::kEemd) {
     const Eigen::VectorXd x = Noisy(512, 3);
@@ -91,19 +93,17 @@ TEST_P(Decomposer, ImfCapIsRespected) {
 TEST_P(Decomposer, SameSeedSameBitsAndThreadCountDoesNotMatter) {
   const Eigen::VectorXd x = Noisy(777, 4);
   DecompositionOptions o = Options(GetParam());
-  const Decomposition a = Decompose(x, o);
-  const Decomposition b = Decompose(x, o);
-  o.threads = 2;
-  const Decomposition c = Decompose(x, o);
-  o.threads = 3;
-  const Decomposition e = Decompose(x, o);
+  const Decomposition a = Decompose(x, o, kOneThread);
+  const Decomposition b = Decompose(x, o, kOneThread);
+  const Decomposition c = Decompose(x, o, Threads(2));
+  const Decomposition e = Decompose(x, o, Threads(3));
   EXPECT_EQ(a.imfs, b.imfs);
   EXPECT_EQ(a.imfs, c.imfs);
   EXPECT_EQ(a.residue, c.residue);
   EXPECT_EQ(a.imfs, e.imfs);
   if (GetParam() != Method::kEmd) {
     o.seed = 8;
-    const Decomposition other = Decompose(x, o);
+    const Decomposition other = Decompose(x, o, kOneThread);
     EXPECT_FALSE(a.imfs.cols() == other.imfs.cols() && a.imfs == other.imfs) << "seed ignored";
   }
 }
@@ -112,7 +112,7 @@ TEST_P(Decomposer, ConstantAndLinearInputsHaveNoOscillatingImf) {
   for (const double slope : {0.0, 0.37}) {
     Eigen::VectorXd x(300);
     for (int i = 0; i < 300; ++i) x[i] = 2.5 + slope * i;
-    const Decomposition d = Decompose(x, Options(GetParam()));
+    const Decomposition d = Decompose(x, Options(GetParam()), kOneThread);
     EXPECT_EQ(d.num_imfs(), 0) << "slope " << slope;
     EXPECT_EQ(d.residue, x);
   }
@@ -126,7 +126,7 @@ TEST_P(Decomposer, WellSeparatedTonesLandInSeparateImfs) {
     slow[i] = 2.0 * std::sin(2 * std::numbers::pi * i / 400.0);
   }
   const Eigen::VectorXd x = fast + slow;
-  const Decomposition d = Decompose(x, Options(GetParam()));
+  const Decomposition d = Decompose(x, Options(GetParam()), kOneThread);
   ASSERT_GE(d.num_imfs(), 2);
   // The IMF most correlated with each tone carries it almost entirely, and they differ.
   auto best = [&](const Eigen::VectorXd& tone, double* corr) {
@@ -156,11 +156,11 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
   const DecompositionOptions o = Options(GetParam());
   Eigen::VectorXd tiny(3);
   tiny << 1, 2, 1;
-  EXPECT_THROW(Decompose(tiny, o), DataError);
+  EXPECT_THROW(Decompose(tiny, o, kOneThread), DataError);
   Eigen::VectorXd with_nan = Noisy(64, 5);
   with_nan[10] = std::nan("");
   try {
-    Decompose(with_nan, o);
+    Decompose(with_nan, o, kOneThread);
     FAIL();
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("sample 11"), std::string::npos) << e.what();
@@ -177,7 +177,7 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
   for (const auto& [field, spoil] : bad_options) {
     bad = o;
     spoil(bad);
-    EXPECT_THROW(Decompose(Noisy(64, 5), bad), UsageError) << field;
+    EXPECT_THROW(Decompose(Noisy(64, 5), bad, kOneThread), UsageError) << field;
   }
   if (UsesNoiseEmds(GetParam())) {
     // 1e5 realisations of 1e7 samples would hold 8 TB of noise state: refused before any work.
@@ -185,7 +185,7 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
     bad.ensemble_size = 100000;
     const Eigen::VectorXd long_signal = Eigen::VectorXd::LinSpaced(10000000, 0.0, 1.0);
     try {
-      Decompose(long_signal, bad);
+      Decompose(long_signal, bad, kOneThread);
       FAIL();
     } catch (const UsageError& e) {
       EXPECT_NE(std::string(e.what()).find("fits in half the memory"), std::string::npos)
@@ -193,21 +193,28 @@ TEST_P(Decomposer, BadInputIsRejectedWithAClearError) {
     }
   }
   if (GetParam() != Method::kEmd) {
-    bad = o;
-    bad.supplied_noise = std::make_shared<Eigen::MatrixXd>(Eigen::MatrixXd::Zero(63, 4));
-    EXPECT_THROW(Decompose(Noisy(64, 5), bad), DataError);
+    EXPECT_THROW(DecomposeWithNoise(Noisy(64, 5), Eigen::MatrixXd::Zero(63, 4), o, kOneThread),
+                 DataError);
+  } else {
+    EXPECT_THROW(DecomposeWithNoise(Noisy(64, 5), Eigen::MatrixXd::Zero(64, 4), o, kOneThread),
+                 UsageError);  // EMD adds no noise
   }
+  EXPECT_THROW(Decompose(Noisy(64, 5), o, Threads(-1)), UsageError);
+  EXPECT_THROW(Decompose(Noisy(64, 5), o, Threads(1025)), UsageError);
 }
 
 TEST_P(Decomposer, ProgressIsMonotoneAndDoesNotChangeTheResult) {
   if (GetParam() == Method::kEmd) GTEST_SKIP() << "plain EMD reports no progress";
   const Eigen::VectorXd x = Noisy(512, 7);
-  DecompositionOptions o = Options(GetParam());
-  o.threads = 2;
-  const Decomposition plain = Decompose(x, o);
+  const DecompositionOptions o = Options(GetParam());
+  DecompositionContext context = Threads(2);
+  const Decomposition plain = Decompose(x, o, context);
   std::vector<double> seen;
-  o.progress = [&seen](double f) { seen.push_back(f); };
-  const Decomposition with_progress = Decompose(x, o);
+  context.execution.progress = [&seen, &o](double f, std::string_view step) {
+    EXPECT_EQ(step, ToString(o.method));
+    seen.push_back(f);
+  };
+  const Decomposition with_progress = Decompose(x, o, context);
   EXPECT_EQ(plain.imfs, with_progress.imfs);
   ASSERT_GE(seen.size(), static_cast<size_t>(o.ensemble_size));
   EXPECT_GT(seen.front(), 0.0);
@@ -219,17 +226,17 @@ TEST_P(Decomposer, ProgressIsMonotoneAndDoesNotChangeTheResult) {
 // in mode order, and watching does not change the result.
 TEST_P(Decomposer, NoiseImfObserverSeesTheNoiseEmdAndDoesNotChangeTheResult) {
   const Eigen::VectorXd x = Noisy(512, 8);
-  DecompositionOptions o = Options(GetParam());
-  o.threads = 2;
-  const Decomposition plain = Decompose(x, o);
+  const DecompositionOptions o = Options(GetParam());
+  DecompositionContext context = Threads(2);
+  const Decomposition plain = Decompose(x, o, context);
   std::vector<std::vector<Eigen::VectorXd>> seen(static_cast<size_t>(o.ensemble_size));
   std::vector<int> out_of_order(static_cast<size_t>(o.ensemble_size), 0);
-  o.noise_imf_observer = [&](int i, int mode, const double* imf) {
+  context.noise_imf_observer = [&](int i, int mode, const double* imf) {
     auto& modes = seen[static_cast<size_t>(i)];
     out_of_order[static_cast<size_t>(i)] += static_cast<int>(modes.size()) != mode - 1;
     modes.push_back(Eigen::Map<const Eigen::VectorXd>(imf, x.size()));
   };
-  const Decomposition watched = Decompose(x, o);
+  const Decomposition watched = Decompose(x, o, context);
   EXPECT_EQ(plain.imfs, watched.imfs);
   EXPECT_EQ(plain.residue, watched.residue);
   const bool family = UsesNoiseEmds(GetParam());
@@ -258,11 +265,11 @@ TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
   const Eigen::VectorXd x = Noisy(700, 8);
   DecompositionOptions o = Options(GetParam());
   const bool family = UsesNoiseEmds(GetParam());
-  o.threads = 2;
-  auto shared = std::make_shared<const NoiseEmds>(x.size(), o);
+  DecompositionContext context = Threads(2);
+  auto shared = std::make_shared<const NoiseEmds>(x.size(), o, context.execution);
   if (!family) {
-    o.noise_emds = shared;
-    EXPECT_THROW(Decompose(x, o), UsageError);
+    context.noise_emds = shared;
+    EXPECT_THROW(Decompose(x, o, context), UsageError);
     return;
   }
   std::vector<BeemdanBound> bounds = {BeemdanBound::kEnergyBand};
@@ -281,12 +288,12 @@ TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
       };
     };
     Calls own_calls, shared_calls;
-    o.noise_emds = nullptr;
-    o.noise_imf_observer = watch(own_calls);
-    const Decomposition own = Decompose(x, o);
-    o.noise_emds = shared;
-    o.noise_imf_observer = watch(shared_calls);
-    const Decomposition reused = Decompose(x, o);
+    context.noise_emds = nullptr;
+    context.noise_imf_observer = watch(own_calls);
+    const Decomposition own = Decompose(x, o, context);
+    context.noise_emds = shared;
+    context.noise_imf_observer = watch(shared_calls);
+    const Decomposition reused = Decompose(x, o, context);
     const std::string label(ToString(bound));
     EXPECT_EQ(own.imfs, reused.imfs) << label;
     EXPECT_EQ(own.residue, reused.residue) << label;
@@ -300,9 +307,8 @@ TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
 TEST(NoiseEmds, AreEachRealisationsEmdWhateverTheThreadCount) {
   DecompositionOptions o = Options(Method::kIceemdan);
   o.ensemble_size = 5;
-  const NoiseEmds one(300, o);
-  o.threads = 2;
-  const NoiseEmds two(300, o);
+  const NoiseEmds one(300, o, {.threads = 1});
+  const NoiseEmds two(300, o, {.threads = 2});
   ASSERT_EQ(one.ensemble_size(), 5);
   for (int i = 0; i < 5; ++i) {
     const NoiseEmds::Realisation& r = one.realisation(i);
@@ -322,9 +328,10 @@ TEST(NoiseEmds, AMismatchIsRefused) {
   const Eigen::VectorXd x = Noisy(400, 3);
   DecompositionOptions o = Options(Method::kBeemdan);
   auto shared = std::make_shared<const NoiseEmds>(x.size(), o);
-  auto refused = [&](DecompositionOptions changed, const Eigen::VectorXd& signal) {
-    changed.noise_emds = shared;
-    EXPECT_THROW(Decompose(signal, changed), UsageError);
+  DecompositionContext with_shared;
+  with_shared.noise_emds = shared;
+  auto refused = [&](const DecompositionOptions& changed, const Eigen::VectorXd& signal) {
+    EXPECT_THROW(Decompose(signal, changed, with_shared), UsageError);
   };
   refused(o, x.head(399));
   DecompositionOptions c = o;
@@ -336,15 +343,11 @@ TEST(NoiseEmds, AMismatchIsRefused) {
   c = o;
   c.sifting.stop_rule = StopRule::kSNumber;
   refused(c, x);
-  c = o;
-  c.supplied_noise = std::make_shared<const Eigen::MatrixXd>(Eigen::MatrixXd::Ones(400, 16));
-  refused(c, x);
-  c = o;
-  c.noise_emds = shared;
-  EXPECT_NO_THROW(Decompose(x, c));
+  EXPECT_THROW(DecomposeWithNoise(x, Eigen::MatrixXd::Ones(400, 16), o, with_shared), UsageError)
+      << "supplied noise";
+  EXPECT_NO_THROW(Decompose(x, o, with_shared));
   EXPECT_THROW(NoiseEmds(3, o), DataError);
-  c.supplied_noise = std::make_shared<const Eigen::MatrixXd>(Eigen::MatrixXd::Ones(400, 16));
-  EXPECT_THROW(NoiseEmds(400, c), UsageError) << "supplied noise";
+  EXPECT_THROW(NoiseEmds(400, o, {.threads = -1}), UsageError);
   c = o;
   c.ensemble_size = 0;
   EXPECT_THROW(NoiseEmds(400, c), UsageError);
@@ -355,7 +358,7 @@ TEST_P(Decomposer, EveryStopRuleTerminatesWithinItsCap) {
        {StopRule::kRilling, StopRule::kSNumber, StopRule::kFixed, StopRule::kCauchySd}) {
     DecompositionOptions o = Options(GetParam());
     o.sifting.stop_rule = rule;
-    const Decomposition d = Decompose(Noisy(600, 6), o);
+    const Decomposition d = Decompose(Noisy(600, 6), o, kOneThread);
     ASSERT_GE(d.num_imfs(), 1) << ToString(rule);
     for (int s : d.report.sifts_per_imf) EXPECT_LE(s, o.sifting.EffectiveMaxSifts());
     if (rule == StopRule::kFixed && GetParam() == Method::kEmd) {

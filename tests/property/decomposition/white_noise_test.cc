@@ -37,8 +37,7 @@ TEST(WhiteNoise, EnergyRatioOfConsecutiveImfsIsAboutTwo) {
 TEST(WhiteNoise, BeemdanKeepsNoiseAssistanceThroughNoiseModes) {
   DecompositionOptions o;  // BEEMDAN defaults
   o.ensemble_size = 20;
-  o.threads = 2;
-  const Decomposition d = Decompose(WhiteNoise(4096, 100), o);
+  const Decomposition d = Decompose(WhiteNoise(4096, 100), o, {.execution = {.threads = 2}});
   // Pure noise: every tested mode stays in the 99 % band until the residue runs out of extrema
   // or only a few modes with too few samples per oscillation remain.
   EXPECT_GE(d.report.noise_assisted_stages, 6) << d.report.Summary();
@@ -50,8 +49,7 @@ TEST(WhiteNoise, BeemdanStopsBeforeASlowSinusoidsMode) {
   for (int i = 0; i < n; ++i) x[i] += 3.0 * std::sin(2 * std::numbers::pi * i / 512.0);
   DecompositionOptions o;
   o.ensemble_size = 20;
-  o.threads = 2;
-  const Decomposition d = Decompose(x, o);
+  const Decomposition d = Decompose(x, o, {.execution = {.threads = 2}});
   // The sine (period 512 samples) sits near mode 8 of the dyadic bank; noise assistance must
   // end before it, and the plain-EMD mode that follows carries the sine.
   ASSERT_GT(d.report.noise_assisted_stages, 0);

@@ -98,11 +98,8 @@ TEST_P(ElmFamily, ThreadCountDoesNotChangeBits) {
   ElmOptions o = Options();
   o.hidden_units = 30;
   o.selection = Selection::kAuto;
-  o.threads = 1;
-  ElmOptions o3 = o;
-  o3.threads = 3;
-  const ElmFit a = Fit(p.x, p.t, o);
-  const ElmFit b = Fit(p.x, p.t, o3);
+  const ElmFit a = Fit(p.x, p.t, o, {.threads = 1});
+  const ElmFit b = Fit(p.x, p.t, o, {.threads = 3});
   ASSERT_EQ(a.model.output_weights.size(), b.model.output_weights.size());
   EXPECT_EQ(std::memcmp(a.model.output_weights.data(), b.model.output_weights.data(),
                         sizeof(double) * a.model.output_weights.size()),

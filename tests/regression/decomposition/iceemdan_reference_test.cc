@@ -76,9 +76,8 @@ TEST_P(IceemdanReference, EveryModeMatches) {
   o.noise_strength = 0.2;
   o.noise_scaling = c.scaling;
   o.sifting.max_sifts = 5000;
-  o.supplied_noise = FixtureNoise();
-  o.threads = 2;
-  const Decomposition d = Decompose(c.octsines ? OctSines() : FixtureSignal(), o);
+  const Decomposition d = DecomposeWithNoise(c.octsines ? OctSines() : FixtureSignal(),
+                                             *FixtureNoise(), o, {.execution = {.threads = 2}});
   const Eigen::MatrixXd ref =
       test::ReadCsvMatrix(test::TestDataPath(std::string("iceemdan_colominas/") + c.modes_file));
   ASSERT_EQ(d.num_imfs() + 1, ref.cols()) << d.report.Summary();

@@ -40,13 +40,13 @@ TEST(Compensation, ThermalModelRemovesNinetyPercentOfAnUnseenProgrammesDriftAndB
   o.mode = Mode::kCompensate;
   o.method = Method::kThermal;
   o.reference_c = 20.0;
-  o.threads = 2;
-  const DriftModel thermal = FitDriftModel(train.rate_dph, train.temperature_c, o);
+  const DriftModel thermal =
+      FitDriftModel(train.rate_dph, train.temperature_c, o, {}, {.threads = 2});
   const double thermal_removed =
       ShareRemovedPercent(EstimateDrift(thermal, test.temperature_c), test.drift_dph);
 
   o.method = Method::kPoly;
-  const DriftModel poly = FitDriftModel(train.rate_dph, train.temperature_c, o);
+  const DriftModel poly = FitDriftModel(train.rate_dph, train.temperature_c, o, {}, {.threads = 2});
   ASSERT_EQ(poly.num_inputs(), 2) << "the classic baseline sees T and dT/dt only";
   const double poly_removed =
       ShareRemovedPercent(EstimateDrift(poly, test.temperature_c), test.drift_dph);

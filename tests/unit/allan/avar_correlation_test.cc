@@ -22,7 +22,7 @@ struct MonteCarlo {
 };
 
 MonteCarlo Simulate(Noise noise, int records, Eigen::Index length) {
-  AllanOptions o{.grid = TauGrid::kOctave, .confidence_intervals = false, .threads = 1};
+  AllanOptions o{.grid = TauGrid::kOctave, .confidence_intervals = false};
   Eigen::MatrixXd avar;
   MonteCarlo mc;
   Eigen::VectorXd white(length + 1), y(length);
@@ -43,7 +43,7 @@ MonteCarlo Simulate(Noise noise, int records, Eigen::Index length) {
           break;
       }
     }
-    const AllanResult result = Compute(y, o);
+    const AllanResult result = Compute(y, o, {.threads = 1});
     const auto t = static_cast<Eigen::Index>(result.points.size());
     if (r == 0) {
       avar.resize(records, t);

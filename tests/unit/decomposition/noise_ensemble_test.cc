@@ -26,17 +26,14 @@ TEST(NoiseEnsemble, ReportsTheThreadsUsedAndNeverMoreThanTheRealisations) {
   DecompositionOptions o;
   o.method = Method::kCeemdan;
   o.ensemble_size = 3;
-  o.threads = 8;
-  const Decomposition many = Decompose(x, o);
+  const Decomposition many = Decompose(x, o, {.execution = {.threads = 8}});
   EXPECT_EQ(many.report.threads, 3);  // 3 realisations keep at most 3 workers busy
-  o.threads = 1;
-  const Decomposition one = Decompose(x, o);
+  const Decomposition one = Decompose(x, o, {.execution = {.threads = 1}});
   EXPECT_EQ(one.report.threads, 1);
   EXPECT_EQ(one.imfs, many.imfs);  // and the count never changes a result
   EXPECT_EQ(one.report.Summary(), many.report.Summary());
   o.method = Method::kEmd;
-  o.threads = 8;
-  EXPECT_EQ(Decompose(x, o).report.threads, 1);
+  EXPECT_EQ(Decompose(x, o, {.execution = {.threads = 8}}).report.threads, 1);
 }
 
 TEST(NoiseEnsemble, StagesEndAtTheImfCapOrAResidueWithoutThreeExtrema) {
@@ -61,12 +58,13 @@ TEST(NoiseEnsemble, RowsAreTheSameDrawnOnDemandOrReadFromSharedNoiseEmds) {
   o.method = Method::kIceemdan;
   o.ensemble_size = 4;
   o.seed = 11;
-  DecompositionOptions shared = o;
+  const DecompositionContext own;
+  DecompositionContext shared;
   shared.noise_emds = std::make_shared<const NoiseEmds>(n, o);
   Sifter sifter(n, o.sifting);
   Eigen::VectorXd a(n), b(n);
   for (int i = 0; i < o.ensemble_size; ++i) {
-    NoiseRows drawn(o, i, n), read(shared, i, n);
+    NoiseRows drawn(Job{o, own}, i, n), read(Job{o, shared}, i, n);
     EXPECT_EQ(drawn.white(), read.white()) << i;
     Rng rng(o.seed, static_cast<std::uint64_t>(i));  // realisation i is stream (seed, i)
     Eigen::VectorXd expected(n);

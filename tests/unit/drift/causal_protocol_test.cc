@@ -19,7 +19,7 @@ using fixtures::Log;
 using fixtures::MakeLog;
 
 // An MS-ELM predict model fitted on the first 500 samples of a 700-sample log, and causal options
-// with 64-sample windows on 2 threads.
+// with 64-sample windows (run on 2 threads).
 struct CausalCase {
   Log log;
   DriftModel model;
@@ -31,18 +31,21 @@ CausalCase MakeCausalCase(std::uint64_t seed) {
   c.model =
       FitDriftModel(c.log.rate.head(500), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
   c.causal.window = 64;
-  c.causal.threads = 2;
   return c;
 }
 
 TEST(DriftModel, CausalWindowProgressIsMonotoneAndDoesNotChangeTheResult) {
   auto [log, model, causal] = MakeCausalCase(5);
+  Execution execution{.threads = 2};
   const Eigen::VectorXd quiet =
-      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal, execution);
   std::vector<double> seen;
-  causal.progress = [&seen](double f) { seen.push_back(f); };
+  execution.progress = [&seen](double f, std::string_view step) {
+    EXPECT_EQ(step, "causal windows");
+    seen.push_back(f);
+  };
   const Eigen::VectorXd reported =
-      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal);
+      PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kCausal, causal, execution);
   EXPECT_EQ(quiet, reported);
   ASSERT_GE(seen.size(), 10u);
   EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));

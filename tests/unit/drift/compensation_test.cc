@@ -42,7 +42,7 @@ TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThrea
     EXPECT_FALSE(sub.learner) << sub.name;
   }
   // The fitted intercept is kept by default: the estimate in equilibrium is the unit's bias.
-  EXPECT_TRUE(std::isnan(o.reference_c));
+  EXPECT_FALSE(o.reference_c);
   const Eigen::VectorXd estimate = EstimateDrift(model, train.temperature);
   // Referenced: a record in equilibrium at 20 degC has no thermal drift, and referencing only
   // shifts the estimate by a constant.
@@ -54,9 +54,12 @@ TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThrea
   const Eigen::VectorXd shifted = EstimateDrift(referenced, train.temperature);
   EXPECT_LE(((shifted - estimate).array() - (shifted - estimate).mean()).abs().maxCoeff(), 1e-10);
   // One thread or two: the same bits.
-  o.reference_c = std::nan("");
-  o.threads = 1;
-  EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o), train.temperature),
+  o.reference_c.reset();
+  EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o, {}, {.threads = 1}),
+                          train.temperature),
+            estimate);
+  EXPECT_EQ(EstimateDrift(FitDriftModel(train.rate, train.temperature, o, {}, {.threads = 2}),
+                          train.temperature),
             estimate);
   // The nonlinear option: each group is still identified, and the blocked cross-validation
   // decides whether it keeps a correction (one only where it lowered the error).
@@ -71,6 +74,8 @@ TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThrea
     if (sub.thermal->correction) EXPECT_LT(r.cv_rmse_nonlinear, r.cv_rmse) << sub.name;
   }
   o.reference_c = 300.0;
+  EXPECT_THROW(o.Validate(), UsageError);
+  o.reference_c = std::nan("");  // set, so a temperature: NaN is none
   EXPECT_THROW(o.Validate(), UsageError);
 }
 

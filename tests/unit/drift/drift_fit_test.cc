@@ -94,15 +94,15 @@ TEST(DriftModel, FitReportsItsProgressInOrderAndUnchanged) {
   const DriftModel quiet = FitDriftModel(log.rate, Eigen::VectorXd(), o);
   std::mutex mutex;
   std::vector<std::pair<double, std::string>> seen;
-  o.progress = [&](double fraction, const std::string& step) {
+  const Execution execution{.progress = [&](double fraction, std::string_view step) {
     std::lock_guard<std::mutex> lock(mutex);
     seen.emplace_back(fraction, step);
-  };
-  const DriftModel reported = FitDriftModel(log.rate, Eigen::VectorXd(), o);
+  }};
+  const DriftModel reported = FitDriftModel(log.rate, Eigen::VectorXd(), o, {}, execution);
   EXPECT_EQ(reported.Summary(), quiet.Summary());
   EXPECT_EQ(PredictOneStep(reported, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper),
             PredictOneStep(quiet, log.rate, Eigen::VectorXd(), 4, Protocol::kPaper));
-  EXPECT_FALSE(reported.options.progress);  // a model keeps no callback
+  EXPECT_EQ(reported.options, quiet.options);
   ASSERT_GE(seen.size(), 3u);
   EXPECT_EQ(seen.front(), std::make_pair(0.0, std::string("decompose")));
   EXPECT_EQ(seen.back(), std::make_pair(1.0, std::string("fit sub-models")));
@@ -143,20 +143,29 @@ TEST(DriftModel, SeveralRecordsAreFittedByTheThermalMethodOnly) {
       UsageError);
 }
 
-// Shared white-noise EMDs serve one record length: a model fitted with a set in its options does
-// not keep it, and predicts on records of any length.
-TEST(DriftModel, AModelKeepsNoSharedNoiseEmds) {
+// Options are plain values: a model holds the options it was fitted with (the thermal time
+// constants limited to the record, as FitDriftModel does), whatever execution ran the fit, and
+// the same options compare equal (reference_c unset included).
+TEST(DriftModel, AModelHoldsTheOptionsItWasFittedWith) {
   const Log log = MakeLog(600, 4);
-  DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
-  decomposition::DecompositionOptions d = o.decomposition;
-  d.seed = o.seed;
-  o.decomposition.noise_emds = std::make_shared<const decomposition::NoiseEmds>(500, d);
-  const DriftModel model = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
-  EXPECT_EQ(model.options.decomposition.noise_emds, nullptr);
-  o.decomposition.noise_emds = nullptr;
-  const DriftModel plain = FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o);
-  EXPECT_EQ(PredictOneStep(model, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper),
-            PredictOneStep(plain, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper));
+  const DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
+  EXPECT_EQ(DriftOptions(), DriftOptions());
+  EXPECT_EQ(o, Fast(Mode::kPredict, Method::kMsElm));
+  EXPECT_NE(o, Fast(Mode::kPredict, Method::kElm));
+  int calls = 0;
+  const DriftModel one =
+      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o, {},
+                    {.threads = 1, .progress = [&calls](double, std::string_view) { ++calls; }});
+  const DriftModel two =
+      FitDriftModel(log.rate.head(500), Eigen::VectorXd(), o, {}, {.threads = 2});
+  EXPECT_GT(calls, 0);
+  DriftOptions expected = o;
+  expected.features = ForTrainingRecord(o.features, 500);
+  EXPECT_EQ(one.options, expected);
+  EXPECT_EQ(two.options, expected);
+  EXPECT_EQ(PredictOneStep(one, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper),
+            PredictOneStep(two, log.rate, Eigen::VectorXd(), 500, Protocol::kPaper));
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), o, {}, {.threads = -1}), UsageError);
 }
 
 TEST(DriftModel, BadInputIsRejected) {

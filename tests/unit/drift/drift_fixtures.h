@@ -39,7 +39,6 @@ inline DriftOptions Fast(Mode mode, Method method) {
   o.method = method;
   o.decomposition.ensemble_size = 10;
   o.selection.monte_carlo.realisations = 20;
-  o.threads = 2;
   return o;
 }
 

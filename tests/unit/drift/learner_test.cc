@@ -57,7 +57,6 @@ LearnerOptions Options(LearnerKind kind) {
   LearnerOptions o;
   o.kind = kind;
   o.poly_degree = 3;
-  o.threads = 2;
   return o;
 }
 
@@ -97,6 +96,12 @@ TEST_P(EveryKind, SaveLoadRoundTripGivesIdenticalBits) {
   EXPECT_TRUE(SameBits(learner->Predict(test.x), loaded->Predict(test.x)));
   EXPECT_TRUE(SameBits(learner->Predict(train.x), loaded->Predict(train.x)));
   EXPECT_EQ(learner->Summary(), loaded->Summary());
+  // How many threads fitted it is not a parameter; those saved before model format 6 kept it (ELM,
+  // SVR), and still load.
+  EXPECT_EQ(saved.scalars.count("threads"), 0u);
+  Parameters legacy = saved;
+  legacy.scalars["threads"] = 2;
+  EXPECT_TRUE(SameBits(learner->Predict(test.x), LoadLearner(GetParam(), legacy)->Predict(test.x)));
   // Saving the loaded learner gives the same parameters again.
   const Parameters again = loaded->Save();
   EXPECT_EQ(again.texts, saved.texts);
@@ -225,9 +230,9 @@ TEST(Learner, SeedReproducesAndDifferentSeedsDiffer) {
   for (LearnerKind kind : {LearnerKind::kElm, LearnerKind::kBp}) {
     LearnerOptions o = Options(kind);
     o.seed = 5;
-    const Eigen::VectorXd a = FitLearner(train.x, train.y, o)->Predict(test.x);
-    o.threads = 1;  // the thread count must not matter
-    const Eigen::VectorXd b = FitLearner(train.x, train.y, o)->Predict(test.x);
+    const Eigen::VectorXd a = FitLearner(train.x, train.y, o, {.threads = 2})->Predict(test.x);
+    // The thread count must not matter.
+    const Eigen::VectorXd b = FitLearner(train.x, train.y, o, {.threads = 1})->Predict(test.x);
     o.seed = 6;
     const Eigen::VectorXd c = FitLearner(train.x, train.y, o)->Predict(test.x);
     EXPECT_TRUE(SameBits(a, b)) << ToString(kind);
@@ -417,9 +422,8 @@ TEST(Learner, ConcurrentFitsMatchSequentialFits) {
   auto fit = [&](int task) {
     LearnerOptions o = Options(kinds[static_cast<size_t>(task)]);
     o.seed = static_cast<std::uint64_t>(task);
-    o.threads = 1;
     o.bp_epochs = 100;
-    return FitLearner(train.x, train.y, o)->Predict(test.x);
+    return FitLearner(train.x, train.y, o, {.threads = 1})->Predict(test.x);
   };
   const int n = static_cast<int>(kinds.size());
   std::vector<Eigen::VectorXd> sequential(kinds.size());
@@ -461,7 +465,6 @@ TEST(Learner, ValidateRejectsBadOptions) {
       {[](LearnerOptions& o) { o.bp_epochs = 0; }, "bp_epochs"},
       {[](LearnerOptions& o) { o.bp_epochs = 100001; }, "bp_epochs"},
       {[](LearnerOptions& o) { o.bp_desired_mse = -1.0; }, "bp_desired_mse"},
-      {[](LearnerOptions& o) { o.threads = -1; }, "threads"},
       {[](LearnerOptions& o) { o.elm.hidden_units = 0; }, "elm.hidden_units"},
       {[](LearnerOptions& o) { o.elm.ridge_c = -1.0; }, "elm.ridge_c"},
   };
@@ -482,6 +485,10 @@ TEST(Learner, ValidateRejectsBadOptions) {
     EXPECT_THROW(FitLearner(Eigen::MatrixXd::Ones(4, 1), Eigen::VectorXd::Ones(4), o), UsageError)
         << c.field;
   }
+  // And the execution's thread count.
+  EXPECT_THROW(FitLearner(Eigen::MatrixXd::Ones(4, 1), Eigen::VectorXd::Ones(4), LearnerOptions{},
+                          {.threads = -1}),
+               UsageError);
 }
 
 }  // namespace

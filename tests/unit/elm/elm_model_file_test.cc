@@ -1,6 +1,6 @@
 // The ELM inside a model file: the thread count a model was fitted with is not part of it (the
-// saved model is the same text for 1 and 2 threads), files that still carry the old ELM
-// "threads" option load, and a loaded ELM predicts the same bits as the fitted one.
+// saved model is the same text for 1 and 2 threads), files of format 5 and older that still carry
+// thread counts load, and a loaded ELM predicts the same bits as the fitted one.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,13 +32,12 @@ Log MakeLog(Eigen::Index n, std::uint64_t seed) {
   return log;
 }
 
-drift::DriftOptions ElmOptionsWithThreads(int threads) {
+drift::DriftOptions ElmDriftOptions() {
   drift::DriftOptions o;
   o.mode = drift::Mode::kPredict;
   o.method = drift::Method::kElm;
   o.learner.elm.hidden_units = 30;
   o.seed = 5;
-  o.threads = threads;
   return o;
 }
 
@@ -57,24 +56,23 @@ std::string Reseal(json j) {
 TEST(ElmModelFile, SavedElmDoesNotDependOnTheThreadCount) {
   const Log log = MakeLog(5000, 1);  // two row blocks, so two threads really split the work
   const drift::DriftModel m1 =
-      drift::FitDriftModel(log.rate, log.temperature, ElmOptionsWithThreads(1));
+      drift::FitDriftModel(log.rate, log.temperature, ElmDriftOptions(), {}, {.threads = 1});
   const drift::DriftModel m2 =
-      drift::FitDriftModel(log.rate, log.temperature, ElmOptionsWithThreads(2));
-  const json j1 = json::parse(io::RenderModelFile(m1, kInfo));
-  const json j2 = json::parse(io::RenderModelFile(m2, kInfo));
-  // The fitted model, learner parameters included, is the same text.
-  EXPECT_EQ(j1["model"], j2["model"]);
-  EXPECT_FALSE(j1["options"]["learner"]["elm"].contains("threads"));
-  const json& learner = j1["model"]["sub_models"][0]["learner"];
-  ASSERT_EQ(learner["kind"], "elm");
-  EXPECT_EQ(learner["scalars"]["threads"], 0);
+      drift::FitDriftModel(log.rate, log.temperature, ElmDriftOptions(), {}, {.threads = 2});
+  // The whole file, learner parameters included, is the same text.
+  const std::string text = io::RenderModelFile(m1, kInfo);
+  EXPECT_EQ(text, io::RenderModelFile(m2, kInfo));
+  EXPECT_EQ(text.find("threads"), std::string::npos);
+  const json j = json::parse(text);
+  EXPECT_EQ(j["model"]["sub_models"][0]["learner"]["kind"], "elm");
 }
 
 TEST(ElmModelFile, RoundTripPredictsTheSameBits) {
   const Log log = MakeLog(800, 2);
   const drift::DriftModel model =
-      drift::FitDriftModel(log.rate, log.temperature, ElmOptionsWithThreads(0));
+      drift::FitDriftModel(log.rate, log.temperature, ElmDriftOptions());
   const io::LoadedModel loaded = io::ParseModelFile(io::RenderModelFile(model, kInfo), "m.json");
+  EXPECT_EQ(loaded.model.options, model.options);
   const Log test = MakeLog(300, 3);
   const Eigen::VectorXd a =
       drift::PredictOneStep(model, test.rate, Eigen::VectorXd(), 20, drift::Protocol::kPaper);
@@ -84,14 +82,26 @@ TEST(ElmModelFile, RoundTripPredictsTheSameBits) {
   EXPECT_EQ(a, b);  // bit for bit
 }
 
-TEST(ElmModelFile, OlderFilesWithTheElmThreadCountStillLoad) {
+// Format 5 and older stored thread counts (model_file.h): such a file loads, the counts checked
+// and dropped; from format 6 on a thread count is an unknown field.
+TEST(ElmModelFile, Format5FilesWithThreadCountsStillLoad) {
   const Log log = MakeLog(400, 4);
   const drift::DriftModel model =
-      drift::FitDriftModel(log.rate, log.temperature, ElmOptionsWithThreads(0));
+      drift::FitDriftModel(log.rate, log.temperature, ElmDriftOptions());
   json j = json::parse(io::RenderModelFile(model, kInfo));
-  j["options"]["learner"]["elm"]["threads"] = 2;
+  json& o = j["options"];
+  for (json* at : {&o, &o["decomposition"], &o["selection"], &o["selection"]["monte_carlo"],
+                   &o["learner"], &o["learner"]["elm"]}) {
+    (*at)["threads"] = 2;
+  }
+  j["model"]["sub_models"][0]["learner"]["scalars"]["threads"] = 2;
+  j["format_version"] = 5;
   const io::LoadedModel loaded = io::ParseModelFile(Reseal(j), "m.json");
-  EXPECT_EQ(loaded.model.options.learner.elm.threads, 0);
+  EXPECT_EQ(loaded.model.options, model.options);
+  const Log test = MakeLog(300, 5);
+  EXPECT_EQ(drift::PredictOneStep(model, test.rate, Eigen::VectorXd(), 20, drift::Protocol::kPaper),
+            drift::PredictOneStep(loaded.model, test.rate, Eigen::VectorXd(), 20,
+                                  drift::Protocol::kPaper));
   j["options"]["learner"]["elm"]["threads"] = -3;
   try {
     io::ParseModelFile(Reseal(j), "m.json");
@@ -99,6 +109,14 @@ TEST(ElmModelFile, OlderFilesWithTheElmThreadCountStillLoad) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("options.learner.elm.threads"), std::string::npos)
         << e.what();
+  }
+  j["options"]["learner"]["elm"]["threads"] = 2;
+  j["format_version"] = io::kModelFormatVersion;
+  try {
+    io::ParseModelFile(Reseal(j), "m.json");
+    ADD_FAILURE() << "a format-6 file with a thread count was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("threads' is not part of"), std::string::npos) << e.what();
   }
 }
 

@@ -342,11 +342,9 @@ TEST(Elm, OneAndTwoThreadsGiveTheSameBits) {
   const Data d = NoisySine(10000, 0.1, 101);
   for (Selection selection : {Selection::kFixed, Selection::kAuto}) {
     for (Solver solver : {Solver::kCholesky, Solver::kQr}) {
-      ElmOptions one{.hidden_units = 40, .solver = solver, .selection = selection, .threads = 1};
-      ElmOptions two = one;
-      two.threads = 2;
-      const ElmFit f1 = Fit(d.x, d.t, one);
-      const ElmFit f2 = Fit(d.x, d.t, two);
+      const ElmOptions o{.hidden_units = 40, .solver = solver, .selection = selection};
+      const ElmFit f1 = Fit(d.x, d.t, o, {.threads = 1});
+      const ElmFit f2 = Fit(d.x, d.t, o, {.threads = 2});
       EXPECT_EQ(f2.report.threads, 2);
       EXPECT_TRUE(SameBits(f1.model.output_weights, f2.model.output_weights))
           << ToString(selection) << " " << ToString(solver);
@@ -366,15 +364,15 @@ TEST(Elm, OneAndTwoThreadsGiveTheSameBits) {
   }
 }
 
-// The thread count is how a run executes, not part of the model: a model fitted on 1 or 3
-// threads is the same struct (so a saved model file is the same text).
+// The thread count is how a run executes (the Execution), not part of the model: a model fitted
+// on 1 or 3 threads has the same options (so a saved model file is the same text).
 TEST(Elm, ModelDoesNotRecordTheThreadCount) {
   const Data d = NoisySine(9000, 0.1, 105);
   for (Selection selection : {Selection::kFixed, Selection::kAuto}) {
-    const ElmFit f1 = Fit(d.x, d.t, {.hidden_units = 20, .selection = selection, .threads = 1});
-    const ElmFit f3 = Fit(d.x, d.t, {.hidden_units = 20, .selection = selection, .threads = 3});
-    EXPECT_EQ(f1.model.options.threads, 0);
-    EXPECT_EQ(f3.model.options.threads, 0);
+    const ElmOptions o{.hidden_units = 20, .selection = selection};
+    const ElmFit f1 = Fit(d.x, d.t, o, {.threads = 1});
+    const ElmFit f3 = Fit(d.x, d.t, o, {.threads = 3});
+    EXPECT_EQ(f1.model.options, f3.model.options);
     EXPECT_EQ(f3.report.threads, 3);  // the report says how the run executed
     EXPECT_TRUE(SameBits(f1.model.output_weights, f3.model.output_weights));
     EXPECT_EQ(f1.model.options.hidden_units, f3.model.options.hidden_units);
@@ -385,6 +383,8 @@ TEST(Elm, ModelDoesNotRecordTheThreadCount) {
             "threads = -1: must be an integer in [0, 1024] (0 = all cores)");
   EXPECT_EQ(ErrorOf<UsageError>([&] { HiddenLayer(model, d.x, 1025); }),
             "threads = 1025: must be an integer in [0, 1024] (0 = all cores)");
+  EXPECT_EQ(ErrorOf<UsageError>([&] { Fit(d.x, d.t, {}, {.threads = -1}); }),
+            "threads = -1: must be an integer in [0, 1024] (0 = all cores)");
 }
 
 // A row predicted alone, in a short batch or inside a long one (across row blocks and at every
@@ -449,7 +449,6 @@ TEST(Elm, BadOptionsAndDataThrowClearErrors) {
   EXPECT_NE(ErrorOf<UsageError>(fit_with({.ridge_c_candidates = {1.0, -2.0}}))
                 .find("ridge_c_candidates = -2"),
             std::string::npos);
-  EXPECT_NE(ErrorOf<UsageError>(fit_with({.threads = -1})).find("threads = -1"), std::string::npos);
   EXPECT_EQ(ErrorOf<UsageError>([] { ActivationFromString("relu"); }),
             "activation = 'relu': must be one of sigmoid, tanh, sine, rbf, linear");
   EXPECT_EQ(ActivationFromString(ToString(Activation::kRbf)), Activation::kRbf);

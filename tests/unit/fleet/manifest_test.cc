@@ -49,7 +49,7 @@ TEST_F(ManifestTest, FitKeysMapOntoTheOptionsAsFitsFlagsDo) {
   EXPECT_EQ(defaults.mode, drift::Mode::kCompensate);
   EXPECT_EQ(defaults.method, drift::Method::kThermal);
   EXPECT_EQ(defaults.thermal.hysteresis, drift::HysteresisTerm::kAuto);
-  EXPECT_TRUE(std::isnan(defaults.reference_c));
+  EXPECT_FALSE(defaults.reference_c.has_value());
   EXPECT_TRUE(defaults.linear_compensation);
 
   const drift::DriftOptions o =

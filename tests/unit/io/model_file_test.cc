@@ -97,6 +97,7 @@ TEST_P(EveryMethod, RoundTripGivesIdenticalPredictions) {
   EXPECT_EQ(loaded.info.temperature_column, "temperature_c");
   EXPECT_EQ(loaded.info.source, "train.csv");
   EXPECT_FALSE(loaded.info.tool_version.empty());
+  EXPECT_EQ(loaded.model.options, model.options);
   ASSERT_EQ(loaded.model.sub_models.size(), model.sub_models.size());
   for (size_t g = 0; g < model.sub_models.size(); ++g) {
     EXPECT_EQ(loaded.model.sub_models[g].name, model.sub_models[g].name);
@@ -128,7 +129,6 @@ TEST_P(EveryMethod, RoundTripGivesIdenticalPredictions) {
     EXPECT_EQ(a, b);
     drift::CausalOptions causal;
     causal.window = 64;
-    causal.threads = 0;
     const Eigen::VectorXd c =
         drift::PredictOneStep(model, test.rate, t, 190, drift::Protocol::kCausal, causal);
     const Eigen::VectorXd d =
@@ -276,7 +276,7 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.lag_candidates = {2, 3};
   o.validation_fraction = 0.25;
   o.linear_compensation = false;
-  o.reference_c = std::numeric_limits<double>::quiet_NaN();  // keep the fitted intercept
+  o.reference_c.reset();  // keep the fitted intercept
   o.thermal.shortest_tau_s = 17.0;
   o.thermal.taus_per_octave = 3;
   o.thermal.longest_tau_share = 0.1 + 0.2;
@@ -285,11 +285,16 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   o.thermal.hysteresis = drift::HysteresisTerm::kOn;
   o.thermal.hysteresis_widths_k = {0.1 + 0.2, 3.0};
   o.seed = 123456789012345ULL;
-  o.threads = 3;
   const json j = DriftOptionsToJson(o);
   const json reparsed = json::parse(j.dump());
   const drift::DriftOptions r = DriftOptionsFromJson(reparsed, "x");
   EXPECT_EQ(DriftOptionsToJson(r), j);
+  EXPECT_EQ(r, o);                     // every field, as values
+  EXPECT_EQ(j["reference_c"], "nan");  // unset, as older files wrote it
+  drift::DriftOptions referenced = o;
+  referenced.reference_c = 25.5;
+  EXPECT_EQ(DriftOptionsFromJson(json::parse(DriftOptionsToJson(referenced).dump()), "x"),
+            referenced);
   EXPECT_EQ(r.decomposition.sifting.rilling_threshold1, 0.1 + 0.2);
   EXPECT_EQ(r.decomposition.noise_strength, 1.0 / 3.0);
   EXPECT_EQ(r.decomposition.seed, std::numeric_limits<std::uint64_t>::max());
@@ -310,7 +315,7 @@ TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   EXPECT_EQ(r.lag_candidates, o.lag_candidates);
   EXPECT_EQ(r.seed, o.seed);
   EXPECT_FALSE(r.linear_compensation);
-  EXPECT_TRUE(std::isnan(r.reference_c));
+  EXPECT_FALSE(r.reference_c);
   EXPECT_EQ(r.thermal, o.thermal);
   EXPECT_EQ(j["learner"]["elm"]["ridge_c"], "inf");
 }
@@ -376,9 +381,9 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 6;
+  j["format_version"] = 7;
   ExpectRefused(Reseal(j),
-                "format_version 6 is not supported (this gyrodrift reads versions 1 to 5)");
+                "format_version 7 is not supported (this gyrodrift reads versions 1 to 6)");
   j["format_version"] = 0;
   ExpectRefused(Reseal(j), "format_version 0 is not supported");
   // A version-1 file (before the feature set, the limit flag and the range were stored) loads,
@@ -528,9 +533,6 @@ TEST(ModelFile, RefusesToStoreWhatItCannotRebuild) {
   const Log log = MakeLog(200, 41);
   drift::DriftModel model =
       drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kPoly));
-  drift::DriftModel with_noise = model;
-  with_noise.options.decomposition.supplied_noise = std::make_shared<Eigen::MatrixXd>(200, 2);
-  EXPECT_THROW(RenderModelFile(with_noise, Info()), UsageError);
   model.sub_models[0].learner = nullptr;  // predict mode cannot run a zero sub-model
   EXPECT_THROW(RenderModelFile(model, Info()), UsageError);
 }

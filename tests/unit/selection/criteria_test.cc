@@ -50,7 +50,7 @@ TEST(Criteria, KStarIsTheFirstMaximumOfTheDistance) {
 TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   const SelectionOptions o = WithLevel({0.5, 0.5, 0.5, 0.5, 0.5});
   SelectionResult r = Curves({0.1, 0.5, 0.9, 0.1, 0.1}, 4);
-  PdfSimilarityBoundaries(100, o, &r);
+  PdfSimilarityBoundaries(100, o, {}, &r);
   EXPECT_EQ(r.k_noise, 2);
   EXPECT_EQ(r.mixed_end, 4);
   EXPECT_EQ(r.noise_level, (std::vector<double>{0.5, 0.5, 0.5, 0.5, 0.5}));
@@ -60,18 +60,18 @@ TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   EXPECT_EQ(r.note, "");
 
   r = Curves({0.1, 0.5, 0.9, 0.1, 0.1}, 1);
-  PdfSimilarityBoundaries(100, o, &r);
+  PdfSimilarityBoundaries(100, o, {}, &r);
   EXPECT_EQ(r.mixed_end, 2);
   EXPECT_EQ(r.note, "k* <= k_N: no mixed group, drift starts after k_N");
 
   r = Curves({0.9, 0.1, 0.1, 0.1, 0.1}, 3);
-  PdfSimilarityBoundaries(100, o, &r);
+  PdfSimilarityBoundaries(100, o, {}, &r);
   EXPECT_EQ(r.k_noise, 0);
   EXPECT_EQ(r.mixed_end, 3);
   EXPECT_EQ(r.note, "no IMF passes the white-noise test: no noise group");
 
   r = Curves({0.1, 0.1, 0.1, 0.1, 0.1}, 5);
-  PdfSimilarityBoundaries(100, WithLevel({0.5, kNan, 0.5, 0.5, 0.5}), &r);
+  PdfSimilarityBoundaries(100, WithLevel({0.5, kNan, 0.5, 0.5, 0.5}), {}, &r);
   EXPECT_EQ(r.k_noise, 1);
 }
 

@@ -20,13 +20,14 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kLength = 2048;
 
-MonteCarloOptions SmallRun(int threads = 0, std::uint64_t seed = 1) {
+MonteCarloOptions SmallRun(std::uint64_t seed = 1) {
   MonteCarloOptions o;
   o.realisations = 40;
   o.seed = seed;
-  o.threads = threads;
   return o;
 }
+
+Execution Threads(int threads) { return {.threads = threads}; }
 
 // Bitwise equality of two level vectors (NaN entries included).
 bool SameBits(const std::vector<double>& a, const std::vector<double>& b) {
@@ -48,13 +49,14 @@ TEST(SelfSimilarity, AffineInvariantAndSmallForGaussianSamples) {
 }
 
 TEST(NoiseLevel, SeededAndThreadCountIndependent) {
-  const NoiseLevel one = ComputeNoiseLevel(kLength, SmallRun(1), {}, PdfDistance::kL2);
-  const NoiseLevel two = ComputeNoiseLevel(kLength, SmallRun(2), {}, PdfDistance::kL2);
-  const NoiseLevel again = ComputeNoiseLevel(kLength, SmallRun(2), {}, PdfDistance::kL2);
+  const NoiseLevel one = ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2, Threads(1));
+  const NoiseLevel two = ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2, Threads(2));
+  const NoiseLevel again = ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2, Threads(2));
   EXPECT_TRUE(SameBits(one.level, two.level));
   EXPECT_TRUE(SameBits(two.level, again.level));
   EXPECT_EQ(one.realisations_with_mode, two.realisations_with_mode);
-  const NoiseLevel other = ComputeNoiseLevel(kLength, SmallRun(2, 2), {}, PdfDistance::kL2);
+  const NoiseLevel other =
+      ComputeNoiseLevel(kLength, SmallRun(2), {}, PdfDistance::kL2, Threads(2));
   EXPECT_FALSE(SameBits(one.level, other.level));
   ASSERT_GE(one.level.size(), 5u);
   for (int k = 1; k <= 5; ++k) {
@@ -94,7 +96,7 @@ TEST(NoiseLevelCache, SecondCallIsCachedAndIdentical) {
   const auto first = cache.Get(kLength, SmallRun(), {}, PdfDistance::kL2, &computed);
   const auto t1 = std::chrono::steady_clock::now();
   EXPECT_TRUE(computed);
-  const auto second = cache.Get(kLength, SmallRun(2), {}, PdfDistance::kL2, &computed);
+  const auto second = cache.Get(kLength, SmallRun(), {}, PdfDistance::kL2, &computed, Threads(2));
   const auto t2 = std::chrono::steady_clock::now();
   EXPECT_FALSE(computed);  // the thread count is not part of the key
   EXPECT_EQ(first.get(), second.get());
@@ -102,7 +104,7 @@ TEST(NoiseLevelCache, SecondCallIsCachedAndIdentical) {
   EXPECT_TRUE(
       SameBits(first->level, ComputeNoiseLevel(kLength, SmallRun(), {}, PdfDistance::kL2).level));
   // Another seed, distance or grid is another entry.
-  cache.Get(kLength, SmallRun(0, 3), {}, PdfDistance::kL2, &computed);
+  cache.Get(kLength, SmallRun(3), {}, PdfDistance::kL2, &computed);
   EXPECT_TRUE(computed);
   cache.Get(kLength, SmallRun(), {}, PdfDistance::kHellinger, &computed);
   EXPECT_TRUE(computed);
@@ -117,9 +119,9 @@ TEST(NoiseLevelCache, ConcurrentCallersShareOneComputation) {
   NoiseLevelCache cache;
   std::shared_ptr<const NoiseLevel> a, b, c;
   bool ca = false, cb = false, cc = false;
-  std::thread ta([&] { a = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &ca); });
-  std::thread tb([&] { b = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &cb); });
-  std::thread tc([&] { c = cache.Get(1024, SmallRun(1), {}, PdfDistance::kL2, &cc); });
+  std::thread ta([&] { a = cache.Get(1024, SmallRun(), {}, PdfDistance::kL2, &ca, Threads(1)); });
+  std::thread tb([&] { b = cache.Get(1024, SmallRun(), {}, PdfDistance::kL2, &cb, Threads(1)); });
+  std::thread tc([&] { c = cache.Get(1024, SmallRun(), {}, PdfDistance::kL2, &cc, Threads(1)); });
   ta.join();
   tb.join();
   tc.join();
@@ -136,35 +138,36 @@ struct Decomposed {
   std::shared_ptr<const NoiseLevel> level;
   bool attached = false;
 };
-Decomposed DecomposeWithCollector(decomposition::DecompositionOptions o,
-                                  const MonteCarloOptions& mc) {
+Decomposed DecomposeWithCollector(const decomposition::DecompositionOptions& o,
+                                  const MonteCarloOptions& mc, int threads,
+                                  decomposition::DecompositionContext context = {}) {
   Decomposed out;
   out.x.resize(kLength);
   Rng(11, 0).FillNormal(out.x);
   for (int t = 0; t < kLength; ++t) out.x[t] += 3.0 * std::sin(2 * kPi * t / 700.0);
   NoiseLevelCollector collector(kLength, mc, {}, PdfDistance::kL2);
-  out.attached = collector.Attach(&o);
-  out.d = decomposition::Decompose(out.x, o);
+  context.execution.threads = threads;
+  out.attached = collector.Attach(o, &context);
+  out.d = decomposition::Decompose(out.x, o, context);
   out.level = collector.Level();
   return out;
 }
 
-decomposition::DecompositionOptions FamilyRun(decomposition::Method method, int threads) {
+decomposition::DecompositionOptions FamilyRun(decomposition::Method method) {
   decomposition::DecompositionOptions o;
   o.method = method;
   o.ensemble_size = 40;
   o.seed = 5;
-  o.threads = threads;
   return o;
 }
 
 TEST(NoiseLevelCollector, EqualsTheMonteCarloForTheModesTheDecompositionReached) {
-  const NoiseLevel mc = ComputeNoiseLevel(kLength, SmallRun(0, 5), {}, PdfDistance::kL2);
+  const NoiseLevel mc = ComputeNoiseLevel(kLength, SmallRun(5), {}, PdfDistance::kL2);
   for (auto method : {decomposition::Method::kCeemdan, decomposition::Method::kIceemdan,
                       decomposition::Method::kBeemdan}) {
     const std::string name(decomposition::ToString(method));
     for (int threads : {1, 2}) {
-      const Decomposed run = DecomposeWithCollector(FamilyRun(method, threads), SmallRun(0, 1));
+      const Decomposed run = DecomposeWithCollector(FamilyRun(method), SmallRun(1), threads);
       ASSERT_TRUE(run.attached) << name;
       ASSERT_TRUE(run.level) << name;
       const NoiseLevel& level = *run.level;
@@ -183,40 +186,36 @@ TEST(NoiseLevelCollector, EqualsTheMonteCarloForTheModesTheDecompositionReached)
     }
   }
   // BEEMDAN with 2 noise-assisted stages reaches noise mode 2 only.
-  decomposition::DecompositionOptions bounded = FamilyRun(decomposition::Method::kBeemdan, 2);
+  decomposition::DecompositionOptions bounded = FamilyRun(decomposition::Method::kBeemdan);
   bounded.beemdan_bound = decomposition::BeemdanBound::kFixedStages;
   bounded.noise_stages = 2;
-  const Decomposed run = DecomposeWithCollector(bounded, SmallRun());
+  const Decomposed run = DecomposeWithCollector(bounded, SmallRun(), 2);
   ASSERT_TRUE(run.level);
   EXPECT_EQ(run.level->level.size(), 2u);
 }
 
 TEST(NoiseLevelCollector, StaysOutWhenTheNoiseIsNotTheMonteCarlos) {
   using decomposition::Method;
-  auto refused = [](decomposition::DecompositionOptions o, const MonteCarloOptions& mc) {
-    const Decomposed run = DecomposeWithCollector(o, mc);
+  auto refused = [](const decomposition::DecompositionOptions& o, const MonteCarloOptions& mc,
+                    decomposition::DecompositionContext context = {}) {
+    const Decomposed run = DecomposeWithCollector(o, mc, 2, std::move(context));
     return !run.attached && !run.level;
   };
-  EXPECT_TRUE(refused(FamilyRun(Method::kEemd, 2), SmallRun()));
-  EXPECT_TRUE(refused(FamilyRun(Method::kEmd, 2), SmallRun()));
-  decomposition::DecompositionOptions few = FamilyRun(Method::kIceemdan, 2);
+  EXPECT_TRUE(refused(FamilyRun(Method::kEemd), SmallRun()));
+  EXPECT_TRUE(refused(FamilyRun(Method::kEmd), SmallRun()));
+  decomposition::DecompositionOptions few = FamilyRun(Method::kIceemdan);
   few.ensemble_size = 39;
   EXPECT_TRUE(refused(few, SmallRun()));
-  decomposition::DecompositionOptions snumber = FamilyRun(Method::kIceemdan, 2);
+  decomposition::DecompositionOptions snumber = FamilyRun(Method::kIceemdan);
   snumber.sifting.stop_rule = decomposition::StopRule::kSNumber;
   EXPECT_TRUE(refused(snumber, SmallRun()));
   MonteCarloOptions capped = SmallRun();
   capped.max_imfs = 3;
-  EXPECT_TRUE(refused(FamilyRun(Method::kIceemdan, 2), capped));
-  decomposition::DecompositionOptions supplied = FamilyRun(Method::kIceemdan, 2);
-  Eigen::MatrixXd noise(kLength, 40);
-  for (int i = 0; i < 40; ++i) {
-    Eigen::VectorXd w(kLength);
-    Rng(5, static_cast<std::uint64_t>(i)).FillNormal(w);
-    noise.col(i) = w;
-  }
-  supplied.supplied_noise = std::make_shared<const Eigen::MatrixXd>(noise);
-  EXPECT_TRUE(refused(supplied, SmallRun()));
+  EXPECT_TRUE(refused(FamilyRun(Method::kIceemdan), capped));
+  // Another observer holds the context's place.
+  decomposition::DecompositionContext observed;
+  observed.noise_imf_observer = [](int, int, const double*) {};
+  EXPECT_TRUE(refused(FamilyRun(Method::kIceemdan), SmallRun(), observed));
 }
 
 TEST(NoiseLevel, RejectsBadOptions) {
@@ -231,7 +230,8 @@ TEST(NoiseLevel, RejectsBadOptions) {
       ComputeNoiseLevel(kLength, SmallRun(), KdeOptions{.grid_points = 10}, PdfDistance::kL2),
       UsageError);
   NoiseLevelCache cache;
-  EXPECT_THROW(cache.Get(kLength, SmallRun(-1), {}, PdfDistance::kL2), UsageError);
+  EXPECT_THROW(cache.Get(kLength, SmallRun(), {}, PdfDistance::kL2, nullptr, Threads(-1)),
+               UsageError);
   EXPECT_EQ(cache.Size(), 0u);
 }
 

@@ -298,10 +298,8 @@ TEST(SelectModes, ThreadCountDoesNotChangeTheResult) {
   const Synthetic s = ThreeGroupCase();
   SelectionOptions options;
   options.noise_level = FlatLevel(7);
-  options.threads = 1;
-  const SelectionResult one = SelectModes(s.x, s.imfs, s.residue, options);
-  options.threads = 2;
-  const SelectionResult two = SelectModes(s.x, s.imfs, s.residue, options);
+  const SelectionResult one = SelectModes(s.x, s.imfs, s.residue, options, {.threads = 1});
+  const SelectionResult two = SelectModes(s.x, s.imfs, s.residue, options, {.threads = 2});
   EXPECT_EQ(one.pdf_distance, two.pdf_distance);
   EXPECT_EQ(one.self_distance, two.self_distance);
   EXPECT_EQ(one.Summary(), two.Summary());
@@ -336,6 +334,7 @@ TEST(SelectModes, RejectsBadInput) {
   bad = options;
   bad.monte_carlo.realisations = 1;
   EXPECT_THROW(SelectModes(s.x, s.imfs, s.residue, bad), UsageError);
+  EXPECT_THROW(SelectModes(s.x, s.imfs, s.residue, options, {.threads = -1}), UsageError);
 }
 
 TEST(SelectModes, NamesRoundTrip) {

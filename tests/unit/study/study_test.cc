@@ -50,7 +50,6 @@ StudyOptions Quick(std::vector<drift::Method> methods) {
   o.causal_window = 32;
   o.duration_s = 2 * 3600.0;
   o.methods = std::move(methods);
-  o.threads = 2;
   return o;
 }
 
@@ -128,7 +127,6 @@ TEST(StudyOptions, ValidateNamesTheField) {
   // Ranges the library owns name the study's field that set them.
   EXPECT_EQ(refused([](StudyOptions& o) { o.causal_window = 4; }), "causal_window");
   EXPECT_EQ(refused([](StudyOptions& o) { o.realisations = 3; }), "realisations");
-  EXPECT_EQ(refused([](StudyOptions& o) { o.threads = -1; }), "threads");
 }
 
 TEST(StudyLog, RefusesWhatTheStudyCannotUse) {
@@ -147,6 +145,8 @@ TEST(StudyLog, RefusesWhatTheStudyCannotUse) {
   StudyOptions bad = options;
   bad.ensemble_size = 0;
   EXPECT_EQ(RefusedOption([&] { RunStudy(bad, log); }), "ensemble_size");
+  // And so is the context's thread count.
+  EXPECT_EQ(RefusedOption([&] { RunStudy(options, ChamberLog(), {.threads = -1}); }), "threads");
 }
 
 TEST(Study, LogStudyGivesTablesFilesAndReport) {
@@ -155,18 +155,18 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
   std::vector<int> begun, done;
   int last_stage = -1;
   bool fractions_in_range = true;
-  StudyObserver observer;
-  observer.progress = [&](int stage, double fraction, const std::string&) {
+  StudyContext context{.threads = 2};
+  context.progress = [&](int stage, double fraction, const std::string&) {
     if (stage != last_stage) begun.push_back(stage);
     last_stage = stage;
     fractions_in_range = fractions_in_range && fraction >= 0.0 && fraction <= 1.0;
   };
   std::string summaries;
-  observer.stage_done = [&](int stage, const std::string& summary) {
+  context.stage_done = [&](int stage, const std::string& summary) {
     done.push_back(stage);
     summaries += summary;
   };
-  const StudyResult s = RunStudy(options, log, observer);
+  const StudyResult s = RunStudy(options, log, context);
 
   EXPECT_EQ(begun, (std::vector<int>{0, 1, 2, 3, 4}));
   EXPECT_EQ(done, (std::vector<int>{0, 1, 2, 3, 4}));
@@ -179,7 +179,8 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
 
   EXPECT_FALSE(s.simulated);
   EXPECT_EQ(s.unit, "deg/h");
-  EXPECT_TRUE(std::isnan(s.drift_options.reference_c));  // a log keeps the fitted intercept
+  EXPECT_FALSE(s.drift_options.reference_c);  // a log keeps the fitted intercept
+  EXPECT_EQ(s.threads, 2);
   EXPECT_GE(s.decomposition.num_imfs(), 3);
   const std::set<std::string> both{"ms-elm/paper", "ms-elm/causal", "poly/paper", "poly/causal"};
   EXPECT_EQ(Pairs(s.predict_table), both);
@@ -220,8 +221,8 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
   EXPECT_EQ(check.tables, 5);  // predict, compensate, noise terms, settings, timing
 
   const nlohmann::json record = StudyRecord(s);
-  for (const char* key : {"drift_options", "decomposition", "selection", "stages_s",
-                          "compensated_by"}) {
+  for (const char* key :
+       {"drift_options", "threads", "decomposition", "selection", "stages_s", "compensated_by"}) {
     EXPECT_TRUE(record.contains(key)) << key;
   }
   EXPECT_EQ(record["stages_s"].size(), 5u);
@@ -229,7 +230,8 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
 
 TEST(Study, ShortSimulationComparesRunsAAndB) {
   // thermal is compensate-only: predict mode runs poly alone.
-  const StudyResult s = RunStudy(Quick({drift::Method::kPoly, drift::Method::kThermal}));
+  const StudyResult s =
+      RunStudy(Quick({drift::Method::kPoly, drift::Method::kThermal}), {.threads = 2});
   EXPECT_TRUE(s.simulated);
   EXPECT_EQ(s.output.size(), 7200);
   EXPECT_EQ(s.run_b.samples, 7200);
