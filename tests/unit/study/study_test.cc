@@ -1,13 +1,12 @@
-// The study module: tables render the same numbers three ways; StudyOptions and StudyLog
-// refuse bad values naming the field; small studies (a log, a short simulation) produce the
-// expected tables, observer calls, files and report sections; the files are written as a set.
+// The study module: StudyOptions and StudyLog refuse bad values naming the field; small studies
+// (a log, a short simulation) produce the expected tables, observer calls, files and report
+// sections; the files are written as a set. The Table itself is table_test.cc's.
 #include "gyrodrift/study/study.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
-#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -81,30 +80,6 @@ std::set<std::string> Names(const std::vector<StudyFile>& files) {
   std::set<std::string> names;
   for (const auto& f : files) names.insert(f.name);
   return names;
-}
-
-TEST(StudyTable, KeepsFullPrecisionForCsvAndRoundsForDisplay) {
-  Table t;
-  t.title = "Scores";
-  t.header = {"method", "protocol", "rmse", "train_s"};
-  t.Add({"ms-elm", "paper", 0.123456789, {1.5, 3}});
-  t.Add({"poly", "causal", std::numeric_limits<double>::quiet_NaN(), {12.345, 3}});
-  EXPECT_EQ(t.Csv(),
-            "method,protocol,rmse,train_s\n"
-            "ms-elm,paper," + io::FormatDouble(0.123456789) + ",1.5\n"
-            "poly,causal," + io::FormatDouble(std::nan("")) + ",12.345\n");
-  // Names left-aligned, numbers right-aligned, each column as wide as its widest cell.
-  EXPECT_EQ(t.Text(),
-            "Scores\n"
-            "  method protocol   rmse train_s\n"
-            "  ms-elm paper    0.1235     1.5\n"
-            "  poly   causal        -    12.3\n");
-  const io::ReportTable r = t.Report();
-  EXPECT_EQ(r.title, "Scores");
-  EXPECT_EQ(r.header, t.header);
-  EXPECT_EQ(r.rows, t.shown);
-  EXPECT_EQ(RoundedText(std::nan("")), "-");
-  EXPECT_EQ(RoundedText(2.0 / 3.0, 3), "0.667");
 }
 
 TEST(StudyOptions, DefaultsAreValid) { EXPECT_NO_THROW(StudyOptions().Validate()); }
