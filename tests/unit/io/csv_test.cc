@@ -1,8 +1,6 @@
 #include "gyrodrift/io/csv.h"
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -258,27 +256,6 @@ TEST(Csv, WriteReadRoundTripIsExact) {
   EXPECT_EQ(t.Column("b"), b);
 }
 
-TEST(Files, FailedSetLeavesNothingBehind) {
-  const std::string dir = test::TempDir("atomic_set");
-  EXPECT_THROW(WriteFilesAtomically({{dir + "/ok.txt", "x"}, {dir + "/missing/dir/f.txt", "y"}}),
-               IoError);
-  EXPECT_FALSE(test::FileExists(dir + "/ok.txt"));
-  // A directory among the targets or a target named twice: refused before anything is written,
-  // and existing files keep their contents.
-  WriteFileAtomically(dir + "/old.txt", "old");
-  std::filesystem::create_directory(dir + "/sub");
-  EXPECT_THROW(WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/sub", "z"}}), IoError);
-  EXPECT_THROW(WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/./old.txt", "z"}}),
-               IoError);
-  EXPECT_EQ(ReadTextFile(dir + "/old.txt"), "old");
-  // A set that succeeds replaces existing files and leaves no temporary or backup behind.
-  WriteFilesAtomically({{dir + "/old.txt", "new"}, {dir + "/other.txt", "o"}});
-  EXPECT_EQ(ReadTextFile(dir + "/old.txt"), "new");
-  int entries = 0;
-  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
-  EXPECT_EQ(entries, 3);  // old.txt, other.txt, sub
-}
-
 TEST(Csv, StreamedTextEqualsRenderedText) {
   const std::string dir = test::TempDir("csv_streamed");
   // Enough rows for several 1-MiB blocks.
@@ -308,29 +285,6 @@ TEST(Csv, StreamedTextEqualsRenderedText) {
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 1);
-}
-
-TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
-  const std::string dir = test::TempDir("atomic_stale");
-  // A pid that no longer runs: a child that has exited and been reaped.
-  const pid_t child = ::fork();
-  if (child == 0) ::_exit(0);
-  ASSERT_GT(child, 0);
-  ::waitpid(child, nullptr, 0);
-  const std::string dead = std::to_string(child);
-  const std::string alive = std::to_string(::getppid());
-  const std::vector<std::string> stale = {"x.csv.tmp." + dead, "x.csv.bak." + dead};
-  const std::vector<std::string> kept = {
-      "x.csv.tmp." + alive,  // a writer that still runs
-      "y.csv.tmp." + dead,   // another target's: that write cleans it
-      "x.csv.tmp.12ab",      // not our naming pattern
-      "x.csv.old"};
-  for (const auto& name : stale) WriteFileAtomically(dir + "/" + name, "partial");
-  for (const auto& name : kept) WriteFileAtomically(dir + "/" + name, "other");
-  WriteFileAtomically(dir + "/x.csv", "complete");
-  EXPECT_EQ(ReadTextFile(dir + "/x.csv"), "complete");
-  for (const auto& name : stale) EXPECT_FALSE(test::FileExists(dir + "/" + name)) << name;
-  for (const auto& name : kept) EXPECT_EQ(ReadTextFile(dir + "/" + name), "other") << name;
 }
 
 }  // namespace
