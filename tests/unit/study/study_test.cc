@@ -1,24 +1,21 @@
 // The study module: StudyOptions and StudyLog refuse bad values naming the field; small studies
 // (a log, a short simulation) produce the expected tables, observer calls, files and report
-// sections; the files are written as a set. The Table itself is table_test.cc's.
+// sections. The Table itself is table_test.cc's, the files' rendering and writing
+// study_files_test.cc's.
 #include "gyrodrift/study/study.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "gyrodrift/common/error.h"
-#include "gyrodrift/io/csv.h"
-#include "gyrodrift/io/files.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/study/files.h"
 #include "gyrodrift/study/table.h"
-#include "support/test_support.h"
 
 namespace gyrodrift::study {
 namespace {
@@ -225,17 +222,6 @@ TEST(Study, ShortSimulationComparesRunsAAndB) {
   const std::set<std::string> names = Names(RenderStudyFiles(s, FakeAssets()));
   EXPECT_TRUE(names.count("run_a.csv") && names.count("run_b.csv"));
   EXPECT_TRUE(names.count("models/thermal_compensate.json"));
-}
-
-TEST(StudyFiles, WritesTheSetWithItsSubfolders) {
-  const std::string dir = test::TempDir("study_files") + "/out/deeper";
-  EXPECT_NO_THROW(RequireUsableOutputFolder(dir));
-  WriteStudyFiles(dir, {{"a.csv", "x\n1\n"}, {"models/m.json", "{}\n"}});
-  EXPECT_EQ(io::ReadTextFile(dir + "/a.csv"), "x\n1\n");
-  EXPECT_EQ(io::ReadTextFile(dir + "/models/m.json"), "{}\n");
-  // A file where a folder should be: refused up front, and by the writer.
-  EXPECT_THROW(RequireUsableOutputFolder(dir + "/a.csv/sub"), IoError);
-  EXPECT_THROW(WriteStudyFiles(dir + "/a.csv/sub", {{"b.csv", "y\n"}}), IoError);
 }
 
 }  // namespace
