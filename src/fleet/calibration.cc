@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <utility>
 
 #include "gyrodrift/common/error.h"
@@ -316,7 +317,10 @@ void FlagOutliers(std::vector<FleetRow>& rows) {
         const double v = std::strtod(text.c_str(), nullptr);
         if (std::isfinite(v)) values.push_back({i, v});
       }
-      if (values.size() < 5) continue;  // too few units to call one unusual
+      // Too few units to call one unusual. Units, not rows: a unit has a row per verification log.
+      std::set<std::string> units;
+      for (const auto& [i, v] : values) units.insert(rows[i].cells[0]);
+      if (units.size() < 5) continue;
       std::vector<double> x;
       for (const auto& [i, v] : values) x.push_back(v);
       const double median = Median(x);

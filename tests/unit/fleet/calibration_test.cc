@@ -482,6 +482,33 @@ TEST(FinishFleet, CountsFlagsOutliersAndWritesTheTable) {
   EXPECT_THROW(FinishFleet(m, dir, five, 1.0, FakeAssets()), UsageError);
 }
 
+TEST(FinishFleet, OutliersNeedFiveUnitsNotFiveRows) {
+  // Regression: the threshold counted rows, so four units with two verification logs each (eight
+  // rows) had a unit flagged although docs/calibration.md asks for at least 5 units.
+  const std::string dir = test::TempDir("fleet_outlier_units");
+  Manifest m;
+  m.axes = {AxisSpec{.target = "gyro", .temperature = {"temp"}}};
+  const std::vector<double> drift = {1.0, 1.1, 0.9, 10.0};
+  std::vector<UnitRun> runs;
+  for (size_t u = 0; u < drift.size(); ++u) {
+    UnitRun run = HandMadeRun(std::string(1, static_cast<char>('A' + u)), "pass", drift[u], 1.0);
+    run.rows.push_back(run.rows[0]);
+    run.rows[1].cells[2] = "second_ver.csv";
+    runs.push_back(run);
+  }
+  m.units.resize(runs.size());
+  for (const FleetRow& row : FinishFleet(m, dir, runs, 1.0, FakeAssets()).rows) {
+    EXPECT_EQ(Cell(row, "outliers"), "") << row.cells[0];
+  }
+  // A fifth unit: now the odd one is flagged, on both of its rows.
+  runs.push_back(HandMadeRun("E", "pass", 0.95, 1.0));
+  m.units.resize(runs.size());
+  const FleetResult five = FinishFleet(m, dir, runs, 1.0, FakeAssets());
+  for (const FleetRow& row : five.rows) {
+    EXPECT_EQ(Cell(row, "outliers"), row.cells[0] == "D" ? "drift_rms_after" : "") << row.cells[0];
+  }
+}
+
 TEST_F(FleetCalibration, ResultsDoNotDependOnTheThreadCount) {
   if (!HaveDygraphs()) GTEST_SKIP() << "libjs-dygraphs not installed";
   const Manifest m = Fleet();
