@@ -115,8 +115,7 @@ TEST(Ceemdan, StagesWithoutNoiseRowsArePlainEmdOfTheResidue) {
   const Eigen::VectorXd xn = x / sx;
   const Eigen::VectorXd mode1 = FirstImf(xn + eps * alternating);
   const Eigen::VectorXd r1 = xn - mode1;
-  const Eigen::VectorXd mode2 =
-      FirstImf(r1 + Std(r1) * (eps * (alternating / Std(alternating))));
+  const Eigen::VectorXd mode2 = FirstImf(r1 + Std(r1) * (eps * (alternating / Std(alternating))));
   const Eigen::VectorXd r2 = r1 - mode2;
   const Decomposition rest = Emd(r2);
 
