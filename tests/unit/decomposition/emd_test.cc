@@ -254,8 +254,8 @@ TEST(Emd, FirstImfOfTwoSeparatedTonesIsTheFastTone) {
   const Eigen::Index edge = 100;
   const Eigen::VectorXd error =
       d.imfs.col(0).segment(edge, n - 2 * edge) - fast.segment(edge, n - 2 * edge);
-  // Residual leakage of the slow tone, relative to the fast tone's unit amplitude.
-  EXPECT_LT(error.cwiseAbs().maxCoeff(), 0.05);
+  // Leakage of the slow tone into IMF 1, against the fast tone's unit amplitude.
+  EXPECT_LT(error.cwiseAbs().maxCoeff(), 1e-4);  // measured 3.4e-6
 }
 
 }  // namespace
