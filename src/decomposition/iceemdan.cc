@@ -2,7 +2,6 @@
 // of the local means of r_k + beta_k E_k(w_i), E_k the k-th EMD mode of realisation i, as the
 // reference iceemdan.m computes it. BEEMDAN (beemdan.cc) runs these stages under a policy that
 // ends the noise assistance.
-#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,11 +34,9 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
     if (stage > 0 && go_on && !go_on(stage, modes, r, workers[0].sifter, workers[0].imf, report)) {
       // The policy ended the noise assistance: plain EMD finishes the decomposition.
       const std::string reason = report.stop_reason;
-      const int remaining =
-          o.max_imfs > 0 ? std::max(0, o.max_imfs - static_cast<int>(modes.size())) : 0;
-      if (o.max_imfs == 0 || remaining > 0) {
-        EmdLoop(workers[0].sifter, r, o.max_imfs > 0 ? remaining : 0, modes, report);
-      }
+      // EmdLoop's cap counts every mode in `modes`, the noise-assisted ones included: the
+      // caller's max_imfs as it is (at or past it, EmdLoop only says so).
+      EmdLoop(workers[0].sifter, r, o.max_imfs, modes, report);
       report.stop_reason = reason + "; then " + report.stop_reason;
       break;
     }
@@ -55,10 +52,15 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
           if (stage == 0) modes_i.emplace(job, i, n);
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
           const bool has_noise = NextNoiseRow(job, i, *modes_i, wk.sifter, wk.noise.data());
-          if (stage == 0) {
+          if (!has_noise) {
+            // Fewer noise modes than stages (supplied all-zero noise has none, so this holds at
+            // stage 0 too, where r_k is x): the local mean of r_k without noise. wk.noise is
+            // then another realisation's row, not this one's.
+            wk.input = r;
+          } else if (stage == 0) {
             const double se = SampleStd(wk.noise.data(), n);
             for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = xn[j] + (eps * wk.noise[j]) / se;
-          } else if (has_noise) {
+          } else {
             if (constant_snr) {
               const double se = SampleStd(wk.noise.data(), n);
               for (Eigen::Index j = 0; j < n; ++j)
@@ -66,8 +68,6 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
             } else {
               for (Eigen::Index j = 0; j < n; ++j) wk.input[j] = r[j] + sr * (eps * wk.noise[j]);
             }
-          } else {
-            wk.input = r;  // fewer noise modes than stages: the local mean of r_k without noise
           }
           StageTerm term;
           term.outcome = wk.sifter.ExtractImf(wk.input.data(), wk.imf.data());
