@@ -180,6 +180,16 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
                       std::to_string(n) + ") and at least one realisation column");
     }
     if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
+    for (Eigen::Index j = 0; UsesNoiseEmds(options.method) && j < w.cols(); ++j) {
+      // The CEEMDAN family scales each realisation's EMD modes to unit variance: a constant one
+      // has no spread, and its stages would divide by a standard deviation of rounding error
+      // and never end. (EEMD adds the noise as given: a constant column only shifts x.)
+      const double spread = w.col(j).maxCoeff() - w.col(j).minCoeff();
+      if (!(spread > 1e-9 * w.col(j).cwiseAbs().maxCoeff()) || spread == 0.0) {
+        throw DataError("supplied noise column " + std::to_string(j + 1) +
+                        " is constant: a noise realisation must vary");
+      }
+    }
   }
   const bool ceemdan_family = UsesNoiseEmds(options.method);
   if (context.noise_emds &&

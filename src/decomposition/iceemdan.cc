@@ -53,9 +53,9 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
           // Row stage+1 of the realisation's EMD (the residue row counts, as in ceemdan.m).
           const bool has_noise = NextNoiseRow(job, i, *modes_i, wk.sifter, wk.noise.data());
           if (!has_noise) {
-            // Fewer noise modes than stages (supplied all-zero noise has none, so this holds at
-            // stage 0 too, where r_k is x): the local mean of r_k without noise. wk.noise is
-            // then another realisation's row, not this one's.
+            // Fewer noise modes than stages: the local mean of r_k without noise. wk.noise is
+            // then another realisation's row, not this one's. (Never at stage 0: every noise
+            // realisation varies, Run refuses a constant one, so its EMD has a first row.)
             wk.input = r;
           } else if (stage == 0) {
             const double se = SampleStd(wk.noise.data(), n);

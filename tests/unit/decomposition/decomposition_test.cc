@@ -279,6 +279,22 @@ TEST(Decomposition, SuppliedNoiseIsCheckedAndItsColumnsAreTheEnsemble) {
   Eigen::MatrixXd bad = w;
   bad(5, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(DecomposeWithNoise(x, bad, o), DataError);
+  // A constant realisation (zero or not) cannot be scaled to unit variance: refused by column,
+  // for every method of the CEEMDAN family, before any work (it used to run without end). EEMD
+  // adds the noise unscaled and takes it (eemd_test: a zero member is plain EMD).
+  for (const double level : {0.0, 0.3}) {
+    Eigen::MatrixXd flat = w;
+    flat.col(2).setConstant(level);
+    for (const Method m : {Method::kCeemdan, Method::kIceemdan, Method::kBeemdan}) {
+      o.method = m;
+      try {
+        DecomposeWithNoise(x, flat, o);
+        ADD_FAILURE() << ToString(m) << " accepted a constant noise column " << level;
+      } catch (const DataError& e) {
+        EXPECT_STREQ(e.what(), "supplied noise column 3 is constant: a noise realisation must vary");
+      }
+    }
+  }
 }
 
 // Supplying stream (seed, i) as column i reproduces the drawn decomposition bit for bit: the

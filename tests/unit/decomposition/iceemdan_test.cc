@@ -159,31 +159,6 @@ TEST(Iceemdan, TheNoiseResidueIsItsLastModeAndThenStagesGoWithoutNoise) {
   EXPECT_EQ(d.report.noise_assisted_stages, d.num_imfs());
 }
 
-// A realisation without any noise mode (an all-zero supplied column has no IMF and a zero
-// residue) contributes M(r_k) without noise from the first stage on. Regression: stage 1 used
-// the worker's noise buffer regardless, i.e. whatever realisation the worker had sifted before.
-TEST(Iceemdan, AnAllZeroNoiseColumnContributesTheNoiseFreeLocalMean) {
-  const Eigen::Index n = 500;
-  const Eigen::VectorXd x = Noisy(n);
-  Eigen::MatrixXd w = Gaussian(n, 2, 94);
-  w.col(1).setZero();
-  DecompositionOptions o = Iceemdan(NoiseScaling::kColominas2014);
-  o.max_imfs = 1;
-  const double sx = Std(x);
-  const Eigen::VectorXd xn = x / sx;
-  const Eigen::VectorXd e1 = Emd(w.col(0)).imfs.col(0);
-  Eigen::VectorXd r1 = Eigen::VectorXd::Zero(n);
-  r1 += LocalMean(xn + (o.noise_strength * e1) / Std(e1)) / 2.0;
-  r1 += LocalMean(xn) / 2.0;
-  for (const int threads : {1, 2}) {
-    const Decomposition d = DecomposeWithNoise(x, w, o, {.execution = {.threads = threads}});
-    ASSERT_EQ(d.num_imfs(), 1);
-    EXPECT_LE((d.imfs.col(0) - sx * (xn - r1)).cwiseAbs().maxCoeff(),
-              1e-12 * x.cwiseAbs().maxCoeff())
-        << threads << " threads";
-  }
-}
-
 // beta_k = eps std(r_k): the noise follows the residue's scale, so scaling x by a power of two
 // (exact in floating point) scales every mode by it, bit for bit.
 TEST(Iceemdan, IsScaleEquivariant) {

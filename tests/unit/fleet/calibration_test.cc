@@ -50,8 +50,9 @@ bool HaveDygraphs() {
   }
 }
 
+// With `zero_truth` the truth column is all zeros (a gyro without thermal drift to remove).
 void WriteLog(const std::string& path, const char* programme, double duration_s,
-              std::uint64_t seed) {
+              std::uint64_t seed, bool zero_truth = false) {
   sim::SimulationOptions so;
   so.duration_s = duration_s;
   so.seed = seed;
@@ -60,7 +61,8 @@ void WriteLog(const std::string& path, const char* programme, double duration_s,
   io::WriteCsv(path, {{"time_s", r.time_s},
                       {"gyro", r.rate_dph},
                       {"temp", r.temperature_c},
-                      {"drift", r.drift_dph}});
+                      {"drift", zero_truth ? Eigen::VectorXd::Zero(r.drift_dph.size()).eval()
+                                           : r.drift_dph}});
 }
 
 double RmsAboutMean(const Eigen::VectorXd& v) {
@@ -90,6 +92,7 @@ class FleetCalibration : public ::testing::Test {
       // model's quality is drift_fit_test's subject, not this file's.
       WriteLog(Dir() + "/" + sn + "_ver.csv", "chamber", kVerSamples, 20 + i);
     }
+    WriteLog(Dir() + "/SNZ_ver.csv", "chamber", kVerSamples, 24, /*zero_truth=*/true);
     // SN1's verification log with a NaN gyro reading on its second data row.
     std::string text = io::ReadTextFile(Dir() + "/SN1_ver.csv");
     const size_t row = text.find('\n', text.find('\n') + 1) + 1;
@@ -238,6 +241,41 @@ TEST_F(FleetCalibration, LimitsFailStrictlyBeyondTheirValue) {
   EXPECT_EQ(Cell(rows[0], "failures"), failures[0] + "; " + failures[1]);
   // The figures do not depend on the limits.
   EXPECT_EQ(fail.axes[0].verification[0].drift_rms_after, v.drift_rms_after);
+}
+
+TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
+  const Manifest none = Fleet();
+  const VerificationResult v =
+      CalibrateUnit(none, none.units[1], FakeAssets()).result.axes.at(0).verification.at(0);
+  // Bias instability: the fitted B when identified, else its bound, the flat bottom / 0.664 (the
+  // 0 reported for an unidentified term must not pass any limit below that bound).
+  const allan::NoiseTerm& b = v.noise_after.b_dph;
+  const double figure = b.identified ? b.value : b.slope_reading;
+  ASSERT_TRUE(std::isfinite(figure));
+  ASSERT_GT(figure, 0.0);
+  const Manifest m_at = Fleet("bias_instability_dph = " + io::FormatDouble(figure) + "\n");
+  EXPECT_TRUE(CalibrateUnit(m_at, m_at.units[1], FakeAssets()).result.pass());
+  const Manifest m_below =
+      Fleet("bias_instability_dph = " + io::FormatDouble(std::nextafter(figure, 0.0)) + "\n");
+  const UnitResult below = CalibrateUnit(m_below, m_below.units[1], FakeAssets()).result;
+  ASSERT_EQ(below.error, "");
+  ASSERT_EQ(below.axes[0].verification[0].failures.size(), 1u);
+  const std::string& phrase = below.axes[0].verification[0].failures[0];
+  EXPECT_EQ(phrase.rfind("bias instability ", 0), 0u) << phrase;
+  EXPECT_EQ(phrase.find("not identified") != std::string::npos, !b.identified) << phrase;
+
+  // A truth column of zeros leaves the removed share undefined: a set limit is broken, named so.
+  const Manifest zero = Make("removed_share_min = 0\n", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
+  const UnitResult z = CalibrateUnit(zero, zero.units[0], FakeAssets()).result;
+  ASSERT_EQ(z.error, "");
+  EXPECT_TRUE(std::isnan(z.axes[0].verification[0].truth_removed));
+  ASSERT_EQ(z.axes[0].verification[0].failures.size(), 1u);
+  EXPECT_EQ(z.axes[0].verification[0].failures[0],
+            "removed share undefined (the true drift is zero)");
+  EXPECT_FALSE(z.pass());
+  // Without the limit the same log passes: only a set limit needs its figure.
+  const Manifest zero_free = Make("", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
+  EXPECT_TRUE(CalibrateUnit(zero_free, zero_free.units[0], FakeAssets()).result.pass());
 }
 
 TEST_F(FleetCalibration, AUnitsOwnErrorIsItsResultNotAnException) {
