@@ -59,7 +59,7 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& 
           stats.Add(term.outcome);
           ReportProgress(job, stage, i, ensemble, n, reported);
         });
-    stats.Report(report, ensemble);
+    stats.Report(report);
     r -= mode;
     modes.push_back(std::move(mode));
     ++report.noise_assisted_stages;

@@ -53,7 +53,7 @@ Decomposition RunEemd(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job
       });
 
   DecompositionReport report = EnsembleReport(Method::kEemd, job, workers);
-  for (const auto& s : stats) s.Report(report, ensemble);
+  for (const auto& s : stats) s.Report(report);
   report.stop_reason =
       "fixed IMF count " + std::to_string(max_imfs) + " (EEMD aligns every member's modes)";
   Decomposition result;

@@ -87,7 +87,7 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
           stats.Add(term.outcome);
           ReportProgress(job, stage, i, ensemble, n, reported);
         });
-    stats.Report(report, ensemble);
+    stats.Report(report);
     Eigen::VectorXd mode = r - next;
     modes.push_back(std::move(mode));
     r = std::move(next);

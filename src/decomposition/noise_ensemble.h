@@ -90,19 +90,23 @@ bool StagesEnd(const DecompositionOptions& o, size_t modes, const Eigen::VectorX
 // One worker per thread the ensemble can use.
 std::vector<Worker> MakeWorkers(int ensemble, const Job& job, Eigen::Index n);
 
-// Sift statistics of one stage across realisations.
+// Sift statistics of one stage across the realisations that sifted it (an EEMD member may end
+// before the aligned mode count: it sifted nothing there, which is not a sift count of 0).
 struct StageStats {
   long total_sifts = 0;
+  int members = 0;
   bool cap_hit = false;
   int cap_hits = 0;
   void Add(const SiftOutcome& s) {
     total_sifts += s.sifts;
+    ++members;
     cap_hit |= s.cap_hit;
     cap_hits += s.cap_hit;
   }
-  void Report(DecompositionReport& report, int ensemble) const {
+  void Report(DecompositionReport& report) const {
     report.sifts_per_imf.push_back(
-        static_cast<int>(std::lround(static_cast<double>(total_sifts) / ensemble)));
+        members == 0 ? 0
+                     : static_cast<int>(std::lround(static_cast<double>(total_sifts) / members)));
     report.sift_cap_hit.push_back(cap_hit);
     report.sift_cap_hits += cap_hits;
   }

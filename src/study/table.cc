@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "gyrodrift/io/csv.h"
 
@@ -15,6 +17,11 @@ std::string RoundedText(double value, int digits) {
 }
 
 void Table::Add(const std::vector<Cell>& cells) {
+  // A caller's bug, not the user's: a row of another width would be drawn past its columns.
+  if (cells.size() != header.size()) {
+    throw std::logic_error("table '" + title + "': a row of " + std::to_string(cells.size()) +
+                           " cells under a header of " + std::to_string(header.size()));
+  }
   std::vector<std::string> c, s;
   for (const auto& cell : cells) {
     c.push_back(cell.numeric ? io::FormatDouble(cell.value) : cell.text);

@@ -129,7 +129,8 @@ struct DecompositionContext {
 
 struct DecompositionReport {
   Method method = Method::kEmd;
-  std::vector<int> sifts_per_imf;  // EMD: sifts of IMF k; ensembles: mean over realisations
+  // EMD: sifts of IMF k; ensembles: mean over the realisations that sifted mode k.
+  std::vector<int> sifts_per_imf;
   std::vector<bool> sift_cap_hit;  // IMF k hit the sift cap (any realisation)
   int sift_cap_hits = 0;           // total number of one-mode extractions that hit the cap
   int ensemble_size = 0;           // 0 for plain EMD

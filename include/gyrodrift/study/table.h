@@ -31,7 +31,7 @@ struct Table {
     Cell(const char* t) : text(t) {}             // NOLINT
     Cell(double v, int d = 4) : value(v), numeric(true), digits(d) {}  // NOLINT
   };
-  // Appends a row (as many cells as the header).
+  // Appends a row of as many cells as the header (std::logic_error otherwise).
   void Add(const std::vector<Cell>& cells);
 
   // Header and rows, comma-separated, one line each (cells hold no commas).

@@ -343,8 +343,10 @@ TEST(NoiseEmds, AMismatchIsRefused) {
   c = o;
   c.sifting.stop_rule = StopRule::kSNumber;
   refused(c, x);
-  EXPECT_THROW(DecomposeWithNoise(x, Eigen::MatrixXd::Ones(400, 16), o, with_shared), UsageError)
-      << "supplied noise";
+  // Any valid noise (it varies: a constant column is refused as data first).
+  const Eigen::MatrixXd ramps =
+      Eigen::VectorXd::LinSpaced(400, -1.0, 1.0).replicate(1, 16).array().sin().matrix();
+  EXPECT_THROW(DecomposeWithNoise(x, ramps, o, with_shared), UsageError) << "supplied noise";
   EXPECT_NO_THROW(Decompose(x, o, with_shared));
   EXPECT_THROW(NoiseEmds(3, o), DataError);
   EXPECT_THROW(NoiseEmds(400, o, {.threads = -1}), UsageError);

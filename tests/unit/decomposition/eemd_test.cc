@@ -120,13 +120,48 @@ TEST(Eemd, ModesAreTheMembersMeans) {
   const double scale = x.cwiseAbs().maxCoeff();
   EXPECT_LE((d.imfs - 0.5 * (Padded(a, k) + Padded(b, k))).cwiseAbs().maxCoeff(), 1e-14 * scale);
   EXPECT_LE((d.residue - 0.5 * (a.residue + b.residue)).cwiseAbs().maxCoeff(), 1e-14 * scale);
-  // Sift counts are the members' means, rounded (over the modes both members reached).
-  for (int m = 0; m < std::min(a.num_imfs(), b.num_imfs()); ++m) {
+  // Sift counts are the means over the members that sifted the mode, rounded: a member that
+  // ended before mode m is not a member that took 0 sifts for it.
+  for (int m = 0; m < k; ++m) {
     const size_t s = static_cast<size_t>(m);
-    EXPECT_EQ(d.report.sifts_per_imf[s],
-              std::lround((a.report.sifts_per_imf[s] + b.report.sifts_per_imf[s]) / 2.0))
+    double total = 0.0;
+    int members = 0;
+    for (const Decomposition* e : {&a, &b}) {
+      if (m < e->num_imfs()) {
+        total += e->report.sifts_per_imf[s];
+        ++members;
+      }
+    }
+    EXPECT_EQ(d.report.sifts_per_imf[s], members == 0 ? 0 : std::lround(total / members)) << m;
+  }
+}
+
+// Modes only some members reach: their sift count is those members' mean (regression: the mean
+// was over the whole ensemble, so a mode one member in four reached showed a quarter of its sifts).
+TEST(Eemd, SiftCountsOfModesSomeMembersMissAreTheirSiftersMean) {
+  const Eigen::VectorXd x = Noisy(64);
+  DecompositionOptions o = Eemd(4);
+  o.max_imfs = 8;
+  const Eigen::MatrixXd w = Gaussian(64, 4, 79);
+  const double amplitude = o.noise_strength * internal::SampleStd(x.data(), x.size());
+  const Decomposition d = DecomposeWithNoise(x, w, o);
+  bool some_mode_partly_reached = false;
+  for (int m = 0; m < o.max_imfs; ++m) {
+    long total = 0;
+    int members = 0;
+    for (int i = 0; i < 4; ++i) {
+      const Decomposition e = Emd(x + amplitude * w.col(i), {}, o.max_imfs);
+      if (m < e.num_imfs()) {
+        total += e.report.sifts_per_imf[static_cast<size_t>(m)];
+        ++members;
+      }
+    }
+    some_mode_partly_reached |= members > 0 && members < 4;
+    EXPECT_EQ(d.report.sifts_per_imf[static_cast<size_t>(m)],
+              members == 0 ? 0 : std::lround(static_cast<double>(total) / members))
         << m;
   }
+  EXPECT_TRUE(some_mode_partly_reached);  // the case under test happened
 }
 
 // EEMD is not complete, and what it misses is exactly the mean of the noise it added: each

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,18 @@ TEST(StudyTable, TextAlignsTheFirstTwoColumnsLeftAndTheRestRight) {
             "  a         b         c         d\n"
             "  long name x      text         1\n"
             "  n         longer    t 1.234e+04\n");
+}
+
+// A row of another width is the caller's bug: refused, not drawn past the header's columns.
+TEST(StudyTable, ARowMustHaveAsManyCellsAsTheHeader) {
+  Table t;
+  t.title = "Scores";
+  t.header = {"method", "rmse"};
+  EXPECT_THROW(t.Add({"ms-elm", 0.1, 0.2}), std::logic_error);
+  EXPECT_THROW(t.Add({"ms-elm"}), std::logic_error);
+  EXPECT_TRUE(t.csv.empty());
+  t.Add({"ms-elm", 0.1});
+  EXPECT_EQ(t.csv.size(), 1u);
 }
 
 TEST(StudyTable, AHeaderWithoutRowsRendersItsHeader) {
