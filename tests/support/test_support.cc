@@ -134,4 +134,8 @@ std::string ThermalLogCsv(int n, std::uint64_t seed, double step_s) {
   return csv;
 }
 
+io::DygraphsAssets FakeDygraphs() {
+  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
+}
+
 }  // namespace gyrodrift::test

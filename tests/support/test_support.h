@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "gyrodrift/io/report.h"
+
 namespace gyrodrift::test {
 
 // ../shared/testdata/<relative>
@@ -56,5 +58,9 @@ std::string Substitute(std::string text,
 // behind. `label` names the case in failure messages.
 void ExpectCleanFailure(const CommandResult& result, int exit_code, const std::string& message,
                         const std::string& output, const std::string& label);
+
+// Stand-in for dygraphs (the size of the real script, no function): for tests of a page's
+// composition, not of the package.
+io::DygraphsAssets FakeDygraphs();
 
 }  // namespace gyrodrift::test

@@ -12,7 +12,6 @@
 namespace gyrodrift::allan {
 namespace {
 
-
 TEST(AllanEnums, RoundTripAndReject) {
   for (auto d : {Deviation::kAdev, Deviation::kOadev, Deviation::kMdev, Deviation::kHdev,
                  Deviation::kOhdev, Deviation::kTdev, Deviation::kTotdev})

@@ -11,9 +11,14 @@
 #include "decomposition/drivers.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/decomposition/decomposition.h"
+#include "unit/decomposition/hand_made.h"
 
 namespace gyrodrift::decomposition {
 namespace {
+
+using hand_made::Drawn;
+using hand_made::FirstImf;
+using hand_made::Std;
 
 Eigen::VectorXd Noisy(Eigen::Index n) {
   Eigen::VectorXd x(n);
@@ -23,21 +28,6 @@ Eigen::VectorXd Noisy(Eigen::Index n) {
   }
   return x;
 }
-
-Eigen::VectorXd Drawn(std::uint64_t seed, int i, Eigen::Index n) {
-  Eigen::VectorXd w(n);
-  Rng(seed, static_cast<std::uint64_t>(i)).FillNormal(w);
-  return w;
-}
-
-// E_1(y): the first IMF of plain EMD.
-Eigen::VectorXd FirstImf(const Eigen::VectorXd& y) {
-  const Decomposition d = Emd(y, {}, 1);
-  EXPECT_EQ(d.num_imfs(), 1);
-  return d.imfs.col(0);
-}
-
-double Std(const Eigen::VectorXd& v) { return internal::SampleStd(v.data(), v.size()); }
 
 DecompositionOptions Ceemdan(int ensemble) {
   DecompositionOptions o;

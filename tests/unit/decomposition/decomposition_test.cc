@@ -3,6 +3,7 @@
 // checks on the signal and on supplied noise, and the report's summary line. The methods
 // themselves have their own files (emd_test.cc, eemd_test.cc, ...).
 #include "gyrodrift/decomposition/decomposition.h"
+#include "unit/decomposition/hand_made.h"
 
 #include <gtest/gtest.h>
 
@@ -261,12 +262,7 @@ TEST(Decomposition, SuppliedNoiseIsCheckedAndItsColumnsAreTheEnsemble) {
   DecompositionOptions o;
   o.method = Method::kIceemdan;
   o.ensemble_size = 100;  // checked, not used: the noise's columns are the ensemble
-  Eigen::MatrixXd w(128, 3);
-  for (int i = 0; i < 3; ++i) {
-    Eigen::VectorXd c(128);
-    Rng(5, static_cast<std::uint64_t>(i)).FillNormal(c);
-    w.col(i) = c;
-  }
+  const Eigen::MatrixXd w = hand_made::DrawnColumns(5, 3, 128);
   const Decomposition d = DecomposeWithNoise(x, w, o);
   EXPECT_EQ(d.report.ensemble_size, 3);
   EXPECT_TRUE(d.report.supplied_noise);
@@ -306,12 +302,7 @@ TEST(Decomposition, SuppliedNoiseEqualToTheDrawnStreamsGivesTheSameBits) {
     o.method = m;
     o.ensemble_size = 4;
     o.seed = 23;
-    Eigen::MatrixXd w(512, 4);
-    for (int i = 0; i < 4; ++i) {
-      Eigen::VectorXd c(512);
-      Rng(o.seed, static_cast<std::uint64_t>(i)).FillNormal(c);
-      w.col(i) = c;
-    }
+    const Eigen::MatrixXd w = hand_made::DrawnColumns(o.seed, 4, 512);
     const Decomposition drawn = Decompose(x, o);
     const Decomposition supplied = DecomposeWithNoise(x, w, o);
     EXPECT_EQ(drawn.imfs, supplied.imfs) << ToString(m);

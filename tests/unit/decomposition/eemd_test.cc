@@ -10,9 +10,12 @@
 #include "decomposition/drivers.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/decomposition/decomposition.h"
+#include "unit/decomposition/hand_made.h"
 
 namespace gyrodrift::decomposition {
 namespace {
+
+using hand_made::DrawnColumns;
 
 Eigen::VectorXd Noisy(Eigen::Index n) {
   Eigen::VectorXd x(n);
@@ -29,16 +32,6 @@ DecompositionOptions Eemd(int ensemble) {
   o.ensemble_size = ensemble;
   o.seed = 5;
   return o;
-}
-
-Eigen::MatrixXd Gaussian(Eigen::Index n, int columns, std::uint64_t seed) {
-  Eigen::MatrixXd w(n, columns);
-  for (int i = 0; i < columns; ++i) {
-    Eigen::VectorXd c(n);
-    Rng(seed, static_cast<std::uint64_t>(i)).FillNormal(c);
-    w.col(i) = c;
-  }
-  return w;
 }
 
 // d's modes as an N x k matrix, zero beyond the ones it has (as EEMD pads a short member).
@@ -109,7 +102,7 @@ TEST(Eemd, OneMemberIsTheEmdOfXPlusScaledNoise) {
 // The mean is taken mode by mode: with two members, each mode is the average of the members'.
 TEST(Eemd, ModesAreTheMembersMeans) {
   const Eigen::VectorXd x = Noisy(512);
-  const Eigen::MatrixXd w = Gaussian(512, 2, 77);
+  const Eigen::MatrixXd w = DrawnColumns(77, 2, 512);
   const DecompositionOptions o = Eemd(2);
   const double amplitude = o.noise_strength * internal::SampleStd(x.data(), x.size());
   const int k = DefaultImfCount(512);
@@ -142,7 +135,7 @@ TEST(Eemd, SiftCountsOfModesSomeMembersMissAreTheirSiftersMean) {
   const Eigen::VectorXd x = Noisy(64);
   DecompositionOptions o = Eemd(4);
   o.max_imfs = 8;
-  const Eigen::MatrixXd w = Gaussian(64, 4, 79);
+  const Eigen::MatrixXd w = DrawnColumns(79, 4, 64);
   const double amplitude = o.noise_strength * internal::SampleStd(x.data(), x.size());
   const Decomposition d = DecomposeWithNoise(x, w, o);
   bool some_mode_partly_reached = false;
@@ -172,7 +165,7 @@ TEST(Eemd, ReconstructionErrorIsTheMeanAddedNoise) {
   const DecompositionOptions o = Eemd(4);
   const double amplitude = o.noise_strength * internal::SampleStd(x.data(), x.size());
   const double scale = x.cwiseAbs().maxCoeff();
-  const Eigen::MatrixXd w = Gaussian(1024, 4, 78);
+  const Eigen::MatrixXd w = DrawnColumns(78, 4, 1024);
   const Decomposition d = DecomposeWithNoise(x, w, o);
   const Eigen::VectorXd error = d.imfs.rowwise().sum() + d.residue - x;
   const Eigen::VectorXd mean_noise = amplitude * w.rowwise().mean();

@@ -11,9 +11,14 @@
 #include "decomposition/drivers.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/decomposition/decomposition.h"
+#include "unit/decomposition/hand_made.h"
 
 namespace gyrodrift::decomposition {
 namespace {
+
+using hand_made::DrawnColumns;
+using hand_made::LocalMean;
+using hand_made::Std;
 
 Eigen::VectorXd Noisy(Eigen::Index n) {
   Eigen::VectorXd x(n);
@@ -23,25 +28,6 @@ Eigen::VectorXd Noisy(Eigen::Index n) {
            1.5 * std::sin(2 * std::numbers::pi * i / 200.0);
   }
   return x;
-}
-
-Eigen::MatrixXd Gaussian(Eigen::Index n, int columns, std::uint64_t seed) {
-  Eigen::MatrixXd w(n, columns);
-  for (int i = 0; i < columns; ++i) {
-    Eigen::VectorXd c(n);
-    Rng(seed, static_cast<std::uint64_t>(i)).FillNormal(c);
-    w.col(i) = c;
-  }
-  return w;
-}
-
-double Std(const Eigen::VectorXd& v) { return internal::SampleStd(v.data(), v.size()); }
-
-// M(y) = y - E_1(y) (plain EMD's first IMF).
-Eigen::VectorXd LocalMean(const Eigen::VectorXd& y) {
-  const Decomposition d = Emd(y, {}, 1);
-  EXPECT_EQ(d.num_imfs(), 1);
-  return y - d.imfs.col(0);
 }
 
 DecompositionOptions Iceemdan(NoiseScaling scaling) {
@@ -87,7 +73,7 @@ class IceemdanByHand : public ::testing::TestWithParam<NoiseScaling> {};
 TEST_P(IceemdanByHand, FirstTwoStagesAreMeansOfLocalMeans) {
   const Eigen::Index n = 800;
   const Eigen::VectorXd x = Noisy(n);
-  const Eigen::MatrixXd w = Gaussian(n, 2, 93);
+  const Eigen::MatrixXd w = DrawnColumns(93, 2, n);
   const DecompositionOptions o = Iceemdan(GetParam());
   const double sx = Std(x);
   const TwoStages s = ByHand(x / sx, w, o.noise_strength, GetParam());

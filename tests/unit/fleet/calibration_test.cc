@@ -36,11 +36,6 @@ constexpr Eigen::Index kCalSamples = 7200;
 constexpr Eigen::Index kVerSamples = 7250;
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-// Stand-in for dygraphs: the pages' composition, not the package, is under test here.
-io::DygraphsAssets FakeAssets() {
-  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
-}
-
 bool HaveDygraphs() {
   try {
     io::LoadDygraphs();
@@ -135,7 +130,7 @@ std::string* FleetCalibration::dir_ = nullptr;
 
 TEST_F(FleetCalibration, AVerificationIsMeasuredAsDocumented) {
   const Manifest m = Fleet();
-  const UnitOutputs out = CalibrateUnit(m, m.units[0], FakeAssets());
+  const UnitOutputs out = CalibrateUnit(m, m.units[0], test::FakeDygraphs());
   const UnitResult& r = out.result;
   ASSERT_EQ(r.error, "");
   EXPECT_EQ(r.serial, "SN1");
@@ -213,12 +208,12 @@ TEST_F(FleetCalibration, AVerificationIsMeasuredAsDocumented) {
 TEST_F(FleetCalibration, LimitsFailStrictlyBeyondTheirValue) {
   const Manifest none = Fleet();
   const VerificationResult v =
-      CalibrateUnit(none, none.units[1], FakeAssets()).result.axes.at(0).verification.at(0);
+      CalibrateUnit(none, none.units[1], test::FakeDygraphs()).result.axes.at(0).verification.at(0);
   // At the limit: pass (the limits are bounds the output may reach).
   const std::string at = "residual_drift_rms = " + io::FormatDouble(v.drift_rms_after) +
                          "\nremoved_share_min = " + io::FormatDouble(v.truth_removed) + "\n";
   const Manifest m_at = Fleet(at);
-  const UnitResult pass = CalibrateUnit(m_at, m_at.units[1], FakeAssets()).result;
+  const UnitResult pass = CalibrateUnit(m_at, m_at.units[1], test::FakeDygraphs()).result;
   ASSERT_EQ(pass.error, "");
   EXPECT_TRUE(pass.axes[0].verification[0].failures.empty());
   EXPECT_TRUE(pass.pass());
@@ -227,7 +222,7 @@ TEST_F(FleetCalibration, LimitsFailStrictlyBeyondTheirValue) {
       "residual_drift_rms = " + io::FormatDouble(std::nextafter(v.drift_rms_after, 0.0)) +
       "\nremoved_share_min = " + io::FormatDouble(std::nextafter(v.truth_removed, 1.0)) + "\n";
   const Manifest m_beyond = Fleet(beyond);
-  const UnitResult fail = CalibrateUnit(m_beyond, m_beyond.units[1], FakeAssets()).result;
+  const UnitResult fail = CalibrateUnit(m_beyond, m_beyond.units[1], test::FakeDygraphs()).result;
   ASSERT_EQ(fail.error, "");
   const std::vector<std::string>& failures = fail.axes[0].verification[0].failures;
   ASSERT_EQ(failures.size(), 2u);
@@ -246,7 +241,7 @@ TEST_F(FleetCalibration, LimitsFailStrictlyBeyondTheirValue) {
 TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
   const Manifest none = Fleet();
   const VerificationResult v =
-      CalibrateUnit(none, none.units[1], FakeAssets()).result.axes.at(0).verification.at(0);
+      CalibrateUnit(none, none.units[1], test::FakeDygraphs()).result.axes.at(0).verification.at(0);
   // Bias instability: the fitted B when identified, else its bound, the flat bottom / 0.664 (the
   // 0 reported for an unidentified term must not pass any limit below that bound).
   const allan::NoiseTerm& b = v.noise_after.b_dph;
@@ -254,10 +249,10 @@ TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
   ASSERT_TRUE(std::isfinite(figure));
   ASSERT_GT(figure, 0.0);
   const Manifest m_at = Fleet("bias_instability_dph = " + io::FormatDouble(figure) + "\n");
-  EXPECT_TRUE(CalibrateUnit(m_at, m_at.units[1], FakeAssets()).result.pass());
+  EXPECT_TRUE(CalibrateUnit(m_at, m_at.units[1], test::FakeDygraphs()).result.pass());
   const Manifest m_below =
       Fleet("bias_instability_dph = " + io::FormatDouble(std::nextafter(figure, 0.0)) + "\n");
-  const UnitResult below = CalibrateUnit(m_below, m_below.units[1], FakeAssets()).result;
+  const UnitResult below = CalibrateUnit(m_below, m_below.units[1], test::FakeDygraphs()).result;
   ASSERT_EQ(below.error, "");
   ASSERT_EQ(below.axes[0].verification[0].failures.size(), 1u);
   const std::string& phrase = below.axes[0].verification[0].failures[0];
@@ -266,7 +261,7 @@ TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
 
   // A truth column of zeros leaves the removed share undefined: a set limit is broken, named so.
   const Manifest zero = Make("removed_share_min = 0\n", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
-  const UnitResult z = CalibrateUnit(zero, zero.units[0], FakeAssets()).result;
+  const UnitResult z = CalibrateUnit(zero, zero.units[0], test::FakeDygraphs()).result;
   ASSERT_EQ(z.error, "");
   EXPECT_TRUE(std::isnan(z.axes[0].verification[0].truth_removed));
   ASSERT_EQ(z.axes[0].verification[0].failures.size(), 1u);
@@ -275,13 +270,13 @@ TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
   EXPECT_FALSE(z.pass());
   // Without the limit the same log passes: only a set limit needs its figure.
   const Manifest zero_free = Make("", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
-  EXPECT_TRUE(CalibrateUnit(zero_free, zero_free.units[0], FakeAssets()).result.pass());
+  EXPECT_TRUE(CalibrateUnit(zero_free, zero_free.units[0], test::FakeDygraphs()).result.pass());
 }
 
 TEST_F(FleetCalibration, AUnitsOwnErrorIsItsResultNotAnException) {
   const Manifest m = Make("", {{"SNX", "SN1_cal.csv", "SNX_ver.csv"}});
   UnitOutputs out;
-  ASSERT_NO_THROW(out = CalibrateUnit(m, m.units[0], FakeAssets()));
+  ASSERT_NO_THROW(out = CalibrateUnit(m, m.units[0], test::FakeDygraphs()));
   EXPECT_EQ(out.result.serial, "SNX");
   EXPECT_NE(out.result.error.find("SNX_ver.csv"), std::string::npos) << out.result.error;
   EXPECT_EQ(out.result.error.find('\n'), std::string::npos) << out.result.error;
@@ -385,7 +380,7 @@ TEST_F(FleetCalibration, AFailingUnitIsReportedAndTheOthersGoOn) {
   const Manifest m = Make("", {Good("SN2"), {"SNX", "SN1_cal.csv", "SNX_ver.csv"}, Good("SN3")});
   std::vector<UnitRun> runs;
   for (const UnitSpec& unit : m.units) {
-    runs.push_back(RunUnit(m, unit, out, /*force=*/false, FakeAssets()));
+    runs.push_back(RunUnit(m, unit, out, /*force=*/false, test::FakeDygraphs()));
   }
   EXPECT_EQ(runs[0].what, "calibrated");
   EXPECT_EQ(runs[1].what, "error");
@@ -396,7 +391,7 @@ TEST_F(FleetCalibration, AFailingUnitIsReportedAndTheOthersGoOn) {
   EXPECT_TRUE(test::FileExists(out + "/SN3/summary.json"));
   EXPECT_FALSE(test::FileExists(out + "/SNX"));  // nothing of a failed unit
 
-  const FleetResult fleet = FinishFleet(m, out, runs, 1.5, FakeAssets());
+  const FleetResult fleet = FinishFleet(m, out, runs, 1.5, test::FakeDygraphs());
   EXPECT_EQ(fleet.units, 3);
   EXPECT_EQ(fleet.calibrated, 2);
   EXPECT_EQ(fleet.skipped, 0);
@@ -421,25 +416,25 @@ TEST_F(FleetCalibration, AFailingUnitIsReportedAndTheOthersGoOn) {
 TEST_F(FleetCalibration, AFinishedUnitIsSkippedAndADamagedOneRedone) {
   const std::string out = Dir() + "/out_rerun";
   const Manifest m = Make("", {Good("SN3")});
-  const UnitRun first = RunUnit(m, m.units[0], out, false, FakeAssets());
+  const UnitRun first = RunUnit(m, m.units[0], out, false, test::FakeDygraphs());
   ASSERT_EQ(first.what, "calibrated");
   const std::string model = io::ReadTextFile(out + "/SN3/model.json");
   // Skipped: the rows come back from summary.json as they were written, timing included.
-  const UnitRun again = RunUnit(m, m.units[0], out, false, FakeAssets());
+  const UnitRun again = RunUnit(m, m.units[0], out, false, test::FakeDygraphs());
   EXPECT_EQ(again.what, "skipped");
   EXPECT_LT(again.seconds, 0.0);
   ASSERT_EQ(again.rows.size(), first.rows.size());
   EXPECT_EQ(again.rows[0].cells, first.rows[0].cells);
   // Another limit changes the fingerprint: redone.
   const Manifest limited = Make("residual_drift_rms = 1\n", {Good("SN3")});
-  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, FakeAssets()).what, "calibrated");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what, "calibrated");
   // A damaged summary is not trusted.
   const std::string summary = io::ReadTextFile(out + "/SN3/summary.json");
   io::WriteFileAtomically(out + "/SN3/summary.json", summary.substr(0, summary.size() / 2));
-  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, FakeAssets()).what, "calibrated");
-  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, FakeAssets()).what, "skipped");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what, "calibrated");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what, "skipped");
   // Forced: redone, to the same model.
-  EXPECT_EQ(RunUnit(limited, limited.units[0], out, true, FakeAssets()).what, "calibrated");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, true, test::FakeDygraphs()).what, "calibrated");
   EXPECT_EQ(io::ReadTextFile(out + "/SN3/model.json"), model);
 }
 
@@ -477,7 +472,7 @@ TEST(FinishFleet, CountsFlagsOutliersAndWritesTheTable) {
       HandMadeRun("C", "fail", 0.9, 4.0),          HandMadeRun("D", "pass", 1.05, 0.0, "skipped"),
       HandMadeRun("E", "pass", 0.95, 5.0),         HandMadeRun("F", "fail", 10.0, 6.0),
       HandMadeRun("G", "error", 0.0, 0.0, "error")};
-  const FleetResult fleet = FinishFleet(m, dir, runs, 9.0, FakeAssets());
+  const FleetResult fleet = FinishFleet(m, dir, runs, 9.0, test::FakeDygraphs());
   EXPECT_EQ(fleet.units, 7);
   EXPECT_EQ(fleet.calibrated, 5);
   EXPECT_EQ(fleet.skipped, 1);
@@ -509,15 +504,15 @@ TEST(FinishFleet, CountsFlagsOutliersAndWritesTheTable) {
   // Five units: still enough to flag; four: too few to call one unusual.
   std::vector<UnitRun> five(runs.begin() + 1, runs.begin() + 6);
   m.units.resize(5);
-  EXPECT_EQ(Cell(FinishFleet(m, dir, five, 1.0, FakeAssets()).rows[4], "outliers"),
+  EXPECT_EQ(Cell(FinishFleet(m, dir, five, 1.0, test::FakeDygraphs()).rows[4], "outliers"),
             "drift_rms_after");
   std::vector<UnitRun> four(runs.begin() + 2, runs.begin() + 6);
   m.units.resize(4);
-  for (const FleetRow& row : FinishFleet(m, dir, four, 1.0, FakeAssets()).rows) {
+  for (const FleetRow& row : FinishFleet(m, dir, four, 1.0, test::FakeDygraphs()).rows) {
     EXPECT_EQ(Cell(row, "outliers"), "");
   }
   // One run per unit of the manifest, or a UsageError.
-  EXPECT_THROW(FinishFleet(m, dir, five, 1.0, FakeAssets()), UsageError);
+  EXPECT_THROW(FinishFleet(m, dir, five, 1.0, test::FakeDygraphs()), UsageError);
 }
 
 TEST(FinishFleet, OutliersNeedFiveUnitsNotFiveRows) {
@@ -535,13 +530,13 @@ TEST(FinishFleet, OutliersNeedFiveUnitsNotFiveRows) {
     runs.push_back(run);
   }
   m.units.resize(runs.size());
-  for (const FleetRow& row : FinishFleet(m, dir, runs, 1.0, FakeAssets()).rows) {
+  for (const FleetRow& row : FinishFleet(m, dir, runs, 1.0, test::FakeDygraphs()).rows) {
     EXPECT_EQ(Cell(row, "outliers"), "") << row.cells[0];
   }
   // A fifth unit: now the odd one is flagged, on both of its rows.
   runs.push_back(HandMadeRun("E", "pass", 0.95, 1.0));
   m.units.resize(runs.size());
-  const FleetResult five = FinishFleet(m, dir, runs, 1.0, FakeAssets());
+  const FleetResult five = FinishFleet(m, dir, runs, 1.0, test::FakeDygraphs());
   for (const FleetRow& row : five.rows) {
     EXPECT_EQ(Cell(row, "outliers"), row.cells[0] == "D" ? "drift_rms_after" : "") << row.cells[0];
   }

@@ -17,15 +17,12 @@
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/report.h"
+#include "support/test_support.h"
 
 namespace gyrodrift::fleet {
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-
-io::DygraphsAssets FakeAssets() {
-  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
-}
 
 std::string Unescape(std::string s) {
   const std::vector<std::pair<std::string, std::string>> entities = {
@@ -166,7 +163,7 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   y.verification[1].failures.clear();
   unit.axes = {x, y};
 
-  const std::string html = RenderUnitReport(m, spec, unit, FakeAssets());
+  const std::string html = RenderUnitReport(m, spec, unit, test::FakeDygraphs());
   const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.tables, 2);
@@ -228,7 +225,7 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   open.limits = Limits{};
   unit.axes[0].verification[1].failures.clear();
   EXPECT_NE(
-      RenderUnitReport(open, spec, unit, FakeAssets()).find("Limits: no limits set. Result: PASS."),
+      RenderUnitReport(open, spec, unit, test::FakeDygraphs()).find("Limits: no limits set. Result: PASS."),
       std::string::npos);
 }
 
@@ -273,7 +270,7 @@ TEST(FleetReport, PlotsEachUnitsWorstLogAndLinksTheCalibratedUnits) {
   fleet.rows[4].cells[5] = "drift_rms_after bias";  // flagged by FinishFleet
   fleet.rows[3].cells[4] = "log.csv: data row 2 is 'nan'";
 
-  const std::string html = RenderFleetReport(m, fleet, FakeAssets());
+  const std::string html = RenderFleetReport(m, fleet, test::FakeDygraphs());
   const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_NE(Unescape(html).find(fleet.Summary() + ". Limits: residual drift <= 0.05; true drift "
@@ -331,7 +328,7 @@ TEST(FleetReport, AFleetWithoutFiguresStillRenders) {
   fleet.units = 1;
   fleet.errors = 1;
   fleet.rows = {Row("SN1", "", "", "error", kNan, kNan)};
-  const std::string html = RenderFleetReport(m, fleet, FakeAssets());
+  const std::string html = RenderFleetReport(m, fleet, test::FakeDygraphs());
   const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.figures, 0);

@@ -19,12 +19,6 @@ bool HaveDygraphs() {
   return std::filesystem::exists(std::string(kDygraphsDir) + "/dygraph.min.js");
 }
 
-// Stand-in assets for the checks that must not depend on the package: a large script that
-// mentions Dygraph (the check only needs "inlined and big").
-DygraphsAssets FakeAssets() {
-  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
-}
-
 ReportSeries S(std::string name, Eigen::VectorXd values, bool dashed = false) {
   ReportSeries s;
   s.name = std::move(name);
@@ -66,7 +60,7 @@ HtmlReport SmallReport() {
 }
 
 TEST(Report, SmallReportRendersAndPassesTheCheck) {
-  const std::string html = SmallReport().Render(FakeAssets());
+  const std::string html = SmallReport().Render(test::FakeDygraphs());
   const ReportCheck check = CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.figures, 2);
@@ -102,7 +96,7 @@ TEST(Report, MissingDygraphsNamesThePackage) {
 }
 
 TEST(Report, CheckCatchesBrokenReports) {
-  const std::string good = SmallReport().Render(FakeAssets());
+  const std::string good = SmallReport().Render(test::FakeDygraphs());
   ASSERT_TRUE(CheckReportHtml(good).ok());
   auto broken = [&](std::string from, std::string to) {
     std::string html = good;

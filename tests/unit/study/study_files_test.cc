@@ -16,10 +16,9 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/simulation/fog_simulator.h"
-#include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/study/files.h"
 #include "gyrodrift/study/study.h"
+#include "unit/study/chamber_log.h"
 #include "study/study_steps.h"  // GroupOf, private to src/study
 #include "support/test_support.h"
 
@@ -27,34 +26,16 @@ namespace gyrodrift::study {
 namespace {
 
 namespace fs = std::filesystem;
-namespace sim = gyrodrift::simulation;
-
-// Stand-in for dygraphs: the files, not the package, are under test here.
-io::DygraphsAssets FakeAssets() {
-  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
-}
 
 // A 40-minute chamber log studied with the cheapest settings that run every step: poly only
 // (no causal decompositions), a 4-member ensemble.
 const StudyResult& LogStudy() {
   static const StudyResult* const result = [] {
-    sim::SimulationOptions so;
-    so.duration_s = 2400.0;
-    so.seed = 5;
-    const sim::SimulationResult run = sim::Simulate(
-        sim::BuiltinProgramme("chamber"), sim::PresetParameters(sim::Preset::kNavigation), so);
-    StudyLog log;
-    log.source = "chamber.csv";
-    log.target_name = "rate_dph";
-    log.temperature_name = "temperature_c";
-    log.output = run.rate_dph;
-    log.temperature = run.temperature_c;
-    log.rate_source = "given";
     StudyOptions o;
     o.ensemble_size = 4;
     o.causal_window = 32;
     o.methods = {drift::Method::kPoly};
-    return new StudyResult(RunStudy(o, log, {.threads = 2}));
+    return new StudyResult(RunStudy(o, ChamberLog(), {.threads = 2}));
   }();
   return *result;
 }
@@ -110,7 +91,7 @@ std::vector<std::string> Exactly(const Eigen::Ref<const Eigen::VectorXd>& values
 
 TEST(RenderStudyFiles, ALogStudyHasEveryFileButTheRunsAndTheReportLast) {
   const StudyResult& s = LogStudy();
-  const std::vector<StudyFile> files = RenderStudyFiles(s, FakeAssets());
+  const std::vector<StudyFile> files = RenderStudyFiles(s, test::FakeDygraphs());
   std::vector<std::string> names;
   for (const StudyFile& f : files) names.push_back(f.name);
   EXPECT_EQ(names, (std::vector<std::string>{
@@ -123,12 +104,12 @@ TEST(RenderStudyFiles, ALogStudyHasEveryFileButTheRunsAndTheReportLast) {
   EXPECT_EQ(by_name.at("compensate_table.csv"), s.compensate_table.Csv());
   EXPECT_EQ(by_name.at("noise_terms.csv"), s.terms_table.Csv());
   EXPECT_EQ(by_name.at("models/poly_compensate.json"), s.model_files.at(0).contents);
-  EXPECT_EQ(by_name.at("report.html"), RenderStudyReport(s, FakeAssets()));
+  EXPECT_EQ(by_name.at("report.html"), RenderStudyReport(s, test::FakeDygraphs()));
 }
 
 TEST(RenderStudyFiles, ImfsCsvHoldsTheDecompositionAndTheGroupsExactly) {
   const StudyResult& s = LogStudy();
-  const CsvCells t(ByName(RenderStudyFiles(s, FakeAssets())).at("imfs.csv"));
+  const CsvCells t(ByName(RenderStudyFiles(s, test::FakeDygraphs())).at("imfs.csv"));
   const int k = s.decomposition.num_imfs();
   ASSERT_GE(k, 2);
   std::vector<std::string> header = {"time_s"};
@@ -150,7 +131,7 @@ TEST(RenderStudyFiles, ImfsCsvHoldsTheDecompositionAndTheGroupsExactly) {
 
 TEST(RenderStudyFiles, SelectionCsvHasOneRowPerImfWithItsGroupAndCurves) {
   const StudyResult& s = LogStudy();
-  const CsvCells t(ByName(RenderStudyFiles(s, FakeAssets())).at("selection.csv"));
+  const CsvCells t(ByName(RenderStudyFiles(s, test::FakeDygraphs())).at("selection.csv"));
   const int k = s.decomposition.num_imfs();
   EXPECT_EQ(t.header, (std::vector<std::string>{"k", "group", "pdf_distance", "self_distance",
                                                 "noise_level", "log2_energy", "band_log2_upper"}));
@@ -178,7 +159,7 @@ TEST(RenderStudyFiles, SelectionCsvHasOneRowPerImfWithItsGroupAndCurves) {
 
 TEST(RenderStudyFiles, EstimatesCsvsHoldEveryRowsEstimateOnItsTimeAxis) {
   const StudyResult& s = LogStudy();
-  const auto files = ByName(RenderStudyFiles(s, FakeAssets()));
+  const auto files = ByName(RenderStudyFiles(s, test::FakeDygraphs()));
   // Predict mode: the test block's times, the measured output (a log has no truth), one column
   // per method and protocol.
   const CsvCells p(files.at("predict_estimates.csv"));
@@ -214,7 +195,7 @@ TEST(RenderStudyFiles, EstimatesCsvsHoldEveryRowsEstimateOnItsTimeAxis) {
 
 TEST(RenderStudyFiles, AllanCsvHoldsEachCurveWithItsBands) {
   const StudyResult& s = LogStudy();
-  const CsvCells t(ByName(RenderStudyFiles(s, FakeAssets())).at("allan.csv"));
+  const CsvCells t(ByName(RenderStudyFiles(s, test::FakeDygraphs())).at("allan.csv"));
   std::vector<std::pair<std::string, const allan::AllanResult*>> curves = {
       {"raw", &s.allan_raw}, {"compensated", &s.allan_compensated}};
   // The best method's curve only when one is clearly better; no noise truth for a log.

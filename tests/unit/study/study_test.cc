@@ -12,20 +12,13 @@
 #include <vector>
 
 #include "gyrodrift/common/error.h"
-#include "gyrodrift/simulation/fog_simulator.h"
-#include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/study/files.h"
 #include "gyrodrift/study/table.h"
+#include "unit/study/chamber_log.h"
+#include "support/test_support.h"
 
 namespace gyrodrift::study {
 namespace {
-
-namespace sim = gyrodrift::simulation;
-
-// Stand-in for dygraphs: the report's composition, not the package, is under test here.
-io::DygraphsAssets FakeAssets() {
-  return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
-}
 
 // The option a call refused, or "" when it did not throw an OptionError.
 template <typename F>
@@ -47,24 +40,6 @@ StudyOptions Quick(std::vector<drift::Method> methods) {
   o.duration_s = 2 * 3600.0;
   o.methods = std::move(methods);
   return o;
-}
-
-// A 40-minute chamber log (the simulator's rate_dph and case sensor) as a user's log.
-StudyLog ChamberLog() {
-  sim::SimulationOptions so;
-  so.duration_s = 2400.0;
-  so.seed = 5;
-  const sim::SimulationResult run = sim::Simulate(
-      sim::BuiltinProgramme("chamber"), sim::PresetParameters(sim::Preset::kNavigation), so);
-  StudyLog log;
-  log.source = "chamber.csv";
-  log.target_name = "rate_dph";
-  log.temperature_name = "temperature_c";
-  log.output = run.rate_dph;
-  log.temperature = run.temperature_c;
-  log.rate_hz = 1.0;
-  log.rate_source = "given";
-  return log;
 }
 
 std::set<std::string> Pairs(const Table& t) {
@@ -168,7 +143,7 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
   EXPECT_EQ(s.stage_s[0].first, "read");
   EXPECT_EQ(s.timing_table.csv.size(), 6u);
 
-  const std::vector<StudyFile> files = RenderStudyFiles(s, FakeAssets());
+  const std::vector<StudyFile> files = RenderStudyFiles(s, test::FakeDygraphs());
   EXPECT_EQ(Names(files),
             (std::set<std::string>{"imfs.csv", "selection.csv", "predict_table.csv",
                                    "compensate_table.csv", "noise_terms.csv",
@@ -219,7 +194,7 @@ TEST(Study, ShortSimulationComparesRunsAAndB) {
   }
   EXPECT_EQ(s.compensated_by, "poly (train A test B)");  // the first method: no ms-elm
   EXPECT_EQ(s.terms_table.header.back(), "simulator setting");
-  const std::set<std::string> names = Names(RenderStudyFiles(s, FakeAssets()));
+  const std::set<std::string> names = Names(RenderStudyFiles(s, test::FakeDygraphs()));
   EXPECT_TRUE(names.count("run_a.csv") && names.count("run_b.csv"));
   EXPECT_TRUE(names.count("models/thermal_compensate.json"));
 }
