@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
 #include "progress.h"
@@ -24,9 +25,7 @@ struct CalibrateArgs {
 };
 
 void Run(const CalibrateArgs& a) {
-  if (a.threads < 0 || a.threads > 1024) {
-    throw UsageError(fmt::format("--threads = {}: must be in [0, 1024] (0: every core)", a.threads));
-  }
+  ValidateThreads(a.threads);  // named as --threads, the flag bound to it
   const fleet::Manifest manifest = fleet::ReadManifest(a.manifest);
   std::vector<std::string> inputs = {a.manifest};
   for (const fleet::UnitSpec& u : manifest.units) {

@@ -11,6 +11,7 @@
 #include "drift_cli.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -38,9 +39,7 @@ void Run(const PredictArgs& a) {
   if (a.window < 16 || a.window > 1000000) {
     ThrowOption("--window", std::to_string(a.window), "an integer in [16, 1000000]");
   }
-  if (a.threads < 0 || a.threads > 1024) {
-    ThrowOption("--threads", std::to_string(a.threads), "an integer in [0, 1024] (0 = all cores)");
-  }
+  ValidateThreads(a.threads);  // named as --threads, the flag bound to it
   const io::LoadedModel loaded = io::ReadModelFile(a.model);
   const drift::DriftModel& model = loaded.model;
   if (model.options.mode != drift::Mode::kPredict) {

@@ -185,7 +185,7 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
       // has no spread, and its stages would divide by a standard deviation of rounding error
       // and never end. (EEMD adds the noise as given: a constant column only shifts x.)
       const double spread = w.col(j).maxCoeff() - w.col(j).minCoeff();
-      if (!(spread > 1e-9 * w.col(j).cwiseAbs().maxCoeff()) || spread == 0.0) {
+      if (!(spread > 1e-9 * w.col(j).cwiseAbs().maxCoeff())) {
         throw DataError("supplied noise column " + std::to_string(j + 1) +
                         " is constant: a noise realisation must vary");
       }

@@ -19,20 +19,15 @@ namespace gyrodrift::drift {
 namespace {
 
 using fixtures::Data;
+using fixtures::OptionsOf;
 using fixtures::SameBits;
 using fixtures::SineBowl;
-
-LearnerOptions BpOptions() {
-  LearnerOptions o;
-  o.kind = LearnerKind::kBp;
-  return o;
-}
 
 // The standardised training MSE FANN reports is that of the weights before the last epoch's
 // update, so one epoch reports the untrained network's error.
 TEST(LearnerBp, TrainingReducesTheError) {
   const Data train = SineBowl(300, 0.05, 51);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_desired_mse = 0.0;
   std::vector<double> mse, rmse;
   for (int epochs : {1, 20, 300}) {
@@ -54,7 +49,7 @@ TEST(LearnerBp, TrainingReducesTheError) {
 
 TEST(LearnerBp, BpStopsAtTheDesiredMseOrTheEpochCap) {
   const Data train = SineBowl(200, 0.05, 19);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_epochs = 7;
   o.bp_desired_mse = 0.0;
   EXPECT_EQ(FitLearner(train.x, train.y, o)->Save().scalars.at("epochs"), 7.0);
@@ -84,7 +79,7 @@ TEST(LearnerBp, BpStopsAtTheDesiredMseOrTheEpochCap) {
 // linear: recomputed from the saved weights (bias in the last column) with std::tanh.
 TEST(LearnerBp, PredictIsTheTanhNetworkOfTheSavedWeights) {
   const Data train = SineBowl(150, 0.05, 53);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_hidden = {6, 4};
   o.bp_epochs = 60;
   const auto learner = FitLearner(train.x, train.y, o);
@@ -111,7 +106,7 @@ TEST(LearnerBp, PredictIsTheTanhNetworkOfTheSavedWeights) {
 // distances of every size.
 TEST(LearnerBp, InitialWeightsAreDrawnFromTheSeed) {
   const Data train = SineBowl(100, 0.05, 55);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_hidden = {5};
   o.bp_epochs = 1;
   o.bp_desired_mse = 0.0;
@@ -142,7 +137,7 @@ TEST(LearnerBp, InitialWeightsAreDrawnFromTheSeed) {
 TEST(LearnerBp, SeedReproducesAndDifferentSeedsDiffer) {
   const Data train = SineBowl(200, 0.05, 11);
   const Data test = SineBowl(100, 0.0, 12);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_epochs = 100;
   o.seed = 5;
   const auto a = FitLearner(train.x, train.y, o, {.threads = 2});
@@ -160,7 +155,7 @@ TEST(LearnerBp, SeedReproducesAndDifferentSeedsDiffer) {
 
 TEST(LearnerBp, LoadRejectsABrokenLayerLayout) {
   const Data train = SineBowl(60, 0.05, 56);
-  LearnerOptions o = BpOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kBp);
   o.bp_epochs = 5;
   const Parameters saved = FitLearner(train.x, train.y, o)->Save();
   EXPECT_NO_THROW(LoadLearner(LearnerKind::kBp, saved));

@@ -19,18 +19,13 @@ namespace gyrodrift::drift {
 namespace {
 
 using fixtures::Data;
+using fixtures::OptionsOf;
 using fixtures::SameBits;
 using fixtures::SineBowl;
 
-LearnerOptions ElmLearnerOptions() {
-  LearnerOptions o;
-  o.kind = LearnerKind::kElm;
-  return o;
-}
-
 TEST(LearnerElm, ElmUsesTheLearnerSeedAndAutoSelection) {
   const Data train = SineBowl(300, 0.05, 13);
-  LearnerOptions o = ElmLearnerOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kElm);
   o.seed = 21;
   o.elm.seed = 99;  // overridden by o.seed
   o.elm.hidden_units = 50;
@@ -50,7 +45,7 @@ TEST(LearnerElm, ElmUsesTheLearnerSeedAndAutoSelection) {
 TEST(LearnerElm, IsTheElmFitWithTheLearnerSeed) {
   const Data train = SineBowl(250, 0.05, 61);
   const Data test = SineBowl(80, 0.0, 62);
-  LearnerOptions o = ElmLearnerOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kElm);
   o.seed = 8;
   o.elm.hidden_units = 17;
   o.elm.activation = elm::Activation::kTanh;
@@ -82,15 +77,15 @@ TEST(LearnerElm, SaveLoadRoundTripForEveryConfiguration) {
   for (elm::Activation a :
        {elm::Activation::kSigmoid, elm::Activation::kTanh, elm::Activation::kSine,
         elm::Activation::kRbf, elm::Activation::kLinear}) {
-    LearnerOptions o = ElmLearnerOptions();
+    LearnerOptions o = OptionsOf(LearnerKind::kElm);
     o.elm.activation = a;
     configurations.push_back(o);
   }
-  LearnerOptions qr = ElmLearnerOptions();
+  LearnerOptions qr = OptionsOf(LearnerKind::kElm);
   qr.elm.solver = elm::Solver::kQr;
   qr.elm.ridge_c = std::numeric_limits<double>::infinity();
   configurations.push_back(qr);
-  LearnerOptions automatic = ElmLearnerOptions();
+  LearnerOptions automatic = OptionsOf(LearnerKind::kElm);
   automatic.elm.hidden_units = 100;
   automatic.elm.selection = elm::Selection::kAuto;
   automatic.elm.hidden_unit_candidates = {5, 100};
@@ -127,7 +122,7 @@ TEST(LearnerElm, SaveLoadRoundTripForEveryConfiguration) {
 TEST(LearnerElm, SeedReproducesForAnyThreadCountAndDifferentSeedsDiffer) {
   const Data train = SineBowl(6000, 0.05, 11);
   const Data test = SineBowl(100, 0.0, 12);
-  LearnerOptions o = ElmLearnerOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kElm);
   o.seed = 5;
   const auto a = FitLearner(train.x, train.y, o, {.threads = 2});
   const auto b = FitLearner(train.x, train.y, o, {.threads = 1});
@@ -144,7 +139,7 @@ TEST(LearnerElm, SeedReproducesForAnyThreadCountAndDifferentSeedsDiffer) {
 
 TEST(LearnerElm, LoadRejectsInconsistentParameters) {
   const Data train = SineBowl(80, 0.05, 65);
-  const Parameters saved = FitLearner(train.x, train.y, ElmLearnerOptions())->Save();
+  const Parameters saved = FitLearner(train.x, train.y, OptionsOf(LearnerKind::kElm))->Save();
   EXPECT_NO_THROW(LoadLearner(LearnerKind::kElm, saved));
   Parameters units = saved;
   units.scalars["hidden_units"] = 19;  // input_weights has 20 columns

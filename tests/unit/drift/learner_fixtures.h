@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/learner.h"
 
 namespace gyrodrift::drift::fixtures {
 
@@ -31,6 +32,15 @@ inline Data SineBowl(int n, double noise_sd, std::uint64_t seed) {
     d.y[i] = d.truth[i] + noise_sd * rng.Normal();
   }
   return d;
+}
+
+// The default options of a learner kind; polynomials of degree 3 (the default 2 cannot fit the
+// bowl's sine).
+inline LearnerOptions OptionsOf(LearnerKind kind) {
+  LearnerOptions o;
+  o.kind = kind;
+  o.poly_degree = 3;
+  return o;
 }
 
 inline double Rmse(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {

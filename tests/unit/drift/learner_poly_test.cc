@@ -19,15 +19,9 @@ namespace gyrodrift::drift {
 namespace {
 
 using fixtures::Data;
+using fixtures::OptionsOf;
 using fixtures::SameBits;
 using fixtures::SineBowl;
-
-LearnerOptions PolyOptions() {
-  LearnerOptions o;
-  o.kind = LearnerKind::kPoly;
-  o.poly_degree = 3;
-  return o;
-}
 
 // Population mean and standard deviation, the statistics the learner standardises with.
 double Mean(const Eigen::VectorXd& v) { return v.mean(); }
@@ -52,7 +46,7 @@ TEST(LearnerPoly, PolyRecoversAnExactPolynomial) {
   Eigen::MatrixXd probe(5, 2);
   probe << 21.0, 0.5, 25.0, -0.9, 29.5, 0.0, 22.2, 0.3, 27.0, -0.1;
   for (double ridge : {0.0, 1e-10}) {
-    LearnerOptions o = PolyOptions();
+    LearnerOptions o = OptionsOf(LearnerKind::kPoly);
     o.poly_degree = 2;
     o.poly_ridge = ridge;
     const auto learner = FitLearner(x, y, o);
@@ -63,7 +57,7 @@ TEST(LearnerPoly, PolyRecoversAnExactPolynomial) {
     EXPECT_EQ(learner->Save().arrays.at("coefficients").rows(), 6);  // C(4, 2)
   }
   // Degree 1 cannot represent it: the training error is visible.
-  LearnerOptions o1 = PolyOptions();
+  LearnerOptions o1 = OptionsOf(LearnerKind::kPoly);
   o1.poly_degree = 1;
   EXPECT_GT(FitLearner(x, y, o1)->Save().scalars.at("train_rmse"), 0.1);
 }
@@ -71,7 +65,7 @@ TEST(LearnerPoly, PolyRecoversAnExactPolynomial) {
 TEST(LearnerPoly, PolyRejectsTooManyTerms) {
   const Eigen::MatrixXd x = Eigen::MatrixXd::Random(40, 30);
   const Eigen::VectorXd y = Eigen::VectorXd::Random(40);
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.poly_degree = 4;  // C(34, 4) = 46376 terms
   try {
     FitLearner(x, y, o);
@@ -95,7 +89,7 @@ TEST(LearnerPoly, CoefficientsAreThePolynomialInStandardisedUnits) {
     x(i, 0) = rng.Uniform(20.0, 30.0);
     y[i] = a + b * x(i, 0) + c * x(i, 0) * x(i, 0);
   }
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.poly_degree = 2;
   o.poly_ridge = 0.0;
   const Parameters p = FitLearner(x, y, o)->Save();
@@ -120,7 +114,7 @@ TEST(LearnerPoly, MonomialsAreGradedAndPredictEvaluatesThem) {
   const Data train = SineBowl(200, 0.05, 32);
   Eigen::MatrixXd x(200, 3);
   x << train.x, train.x.col(0).cwiseProduct(train.x.col(1));
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.poly_degree = 3;
   const auto learner = FitLearner(x, train.y, o);
   const Parameters p = learner->Save();
@@ -174,7 +168,7 @@ TEST(LearnerPoly, DegreeDecidesWhichPolynomialsAreRecovered) {
   }
   const double y_sd = PopulationSd(y);
   for (int degree = 1; degree <= 4; ++degree) {
-    LearnerOptions o = PolyOptions();
+    LearnerOptions o = OptionsOf(LearnerKind::kPoly);
     o.poly_degree = degree;
     o.poly_ridge = 0.0;
     const Parameters p = FitLearner(x, y, o)->Save();
@@ -197,7 +191,7 @@ TEST(LearnerPoly, DegreeOneIsOrdinaryLeastSquares) {
   const Data train = SineBowl(150, 0.1, 35);
   Eigen::MatrixXd x = train.x;
   x.col(1).array() = 25.0 + 3.0 * x.col(1).array();
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.poly_degree = 1;
   o.poly_ridge = 0.0;
   const auto learner = FitLearner(x, train.y, o);
@@ -221,7 +215,7 @@ TEST(LearnerPoly, RankDeficientDesignIsReportedAndTheRidgeSplitsTwins) {
     x(i, 0) = x(i, 1) = rng.Uniform(-1.0, 1.0);
     y[i] = 1.0 + 3.0 * x(i, 0);
   }
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.poly_degree = 1;
   o.poly_ridge = 0.0;
   const auto plain = FitLearner(x, y, o);
@@ -242,7 +236,7 @@ TEST(LearnerPoly, RankDeficientDesignIsReportedAndTheRidgeSplitsTwins) {
 // The fit draws no random numbers: the seed is only recorded.
 TEST(LearnerPoly, SeedChangesNothingButTheRecord) {
   const Data train = SineBowl(120, 0.05, 37);
-  LearnerOptions o = PolyOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kPoly);
   o.seed = 1;
   const Parameters a = FitLearner(train.x, train.y, o)->Save();
   o.seed = 987654321987654321ULL;
@@ -253,7 +247,7 @@ TEST(LearnerPoly, SeedChangesNothingButTheRecord) {
 
 TEST(LearnerPoly, LoadRejectsAnyOtherMonomialLayout) {
   const Data train = SineBowl(80, 0.05, 38);
-  const Parameters saved = FitLearner(train.x, train.y, PolyOptions())->Save();
+  const Parameters saved = FitLearner(train.x, train.y, OptionsOf(LearnerKind::kPoly))->Save();
   Parameters swapped = saved;
   swapped.arrays["exponents"].row(1).swap(swapped.arrays["exponents"].row(2));
   EXPECT_THROW(LoadLearner(LearnerKind::kPoly, swapped), DataError);

@@ -17,14 +17,9 @@ namespace gyrodrift::drift {
 namespace {
 
 using fixtures::Data;
+using fixtures::OptionsOf;
 using fixtures::SameBits;
 using fixtures::SineBowl;
-
-LearnerOptions SvrOptions() {
-  LearnerOptions o;
-  o.kind = LearnerKind::kSvr;
-  return o;
-}
 
 // libsvm stops when the KKT violation is below 1e-3 (its default tolerance, learner_svr.cc), so
 // the tube conditions hold to about that in standardised target units.
@@ -60,7 +55,7 @@ Eigen::Index RowOf(const Eigen::MatrixXd& x, const Parameters& p, Eigen::Index s
 // tube, |y_s - f| <= epsilon; test rows inside the sampled square stay close to the plane too.
 TEST(LearnerSvr, FitsALinearTargetWithinTheTube) {
   const Data train = Plane(200, 41);
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.svr_c = 1000.0;
   o.svr_epsilon = 0.05;
   const auto learner = FitLearner(train.x, train.y, o);
@@ -82,7 +77,7 @@ TEST(LearnerSvr, FitsALinearTargetWithinTheTube) {
 // coefficient alpha - alpha* lies in [-C, C], and the equality constraint makes them sum to 0.
 TEST(LearnerSvr, SupportVectorsFollowTheKktConditions) {
   const Data train = SineBowl(250, 0.1, 43);
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.svr_c = 3.0;
   o.svr_epsilon = 0.1;
   const auto learner = FitLearner(train.x, train.y, o);
@@ -118,7 +113,7 @@ TEST(LearnerSvr, SupportVectorsFollowTheKktConditions) {
 // (0 < |coef| < C) the KKT conditions put the residual exactly on the epsilon tube.
 TEST(LearnerSvr, SvrFreeSupportVectorsSitOnTheEpsilonTube) {
   const Data train = SineBowl(300, 0.1, 16);
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.svr_c = 5.0;
   o.svr_epsilon = 0.1;
   const auto learner = FitLearner(train.x, train.y, o);
@@ -150,7 +145,7 @@ TEST(LearnerSvr, SvrFreeSupportVectorsSitOnTheEpsilonTube) {
 
 TEST(LearnerSvr, SvrTrainsOnAnEvenlySpacedSubsample) {
   const Data train = SineBowl(500, 0.05, 17);
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.svr_max_rows = 100;
   const auto learner = FitLearner(train.x, train.y, o);
   const Parameters p = learner->Save();
@@ -179,7 +174,7 @@ TEST(LearnerSvr, SvrTrainsOnAnEvenlySpacedSubsample) {
 TEST(LearnerSvr, SvrConstantTargetHasNoSupportVectorsAndRoundTrips) {
   const Data train = SineBowl(40, 0.0, 18);
   const Eigen::VectorXd y = Eigen::VectorXd::Constant(40, 3.25);
-  const auto learner = FitLearner(train.x, y, SvrOptions());
+  const auto learner = FitLearner(train.x, y, OptionsOf(LearnerKind::kSvr));
   const Parameters p = learner->Save();
   const auto loaded = LoadLearner(LearnerKind::kSvr, p);
   const Eigen::VectorXd a = learner->Predict(train.x);
@@ -197,7 +192,7 @@ TEST(LearnerSvr, SvrConstantTargetHasNoSupportVectorsAndRoundTrips) {
 // standardised inputs, with gamma = 1 / #inputs by default.
 TEST(LearnerSvr, PredictIsTheSavedRbfExpansion) {
   const Data train = SineBowl(200, 0.05, 44);
-  const auto learner = FitLearner(train.x, train.y, SvrOptions());
+  const auto learner = FitLearner(train.x, train.y, OptionsOf(LearnerKind::kSvr));
   const Parameters p = learner->Save();
   EXPECT_EQ(p.scalars.at("gamma"), 0.5);
   const Eigen::RowVectorXd mean = p.arrays.at("input_mean"), scale = p.arrays.at("input_scale");
@@ -214,7 +209,7 @@ TEST(LearnerSvr, PredictIsTheSavedRbfExpansion) {
     EXPECT_NEAR(predicted[i], y, 1e-12 * (1.0 + std::abs(y))) << "row " << i;
   }
   // A given gamma is used as given.
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.svr_gamma = 2.0;
   EXPECT_EQ(FitLearner(train.x, train.y, o)->Save().scalars.at("gamma"), 2.0);
 }
@@ -224,7 +219,7 @@ TEST(LearnerSvr, PredictIsTheSavedRbfExpansion) {
 TEST(LearnerSvr, FitsRepeatToTheBitForAnySeedAndThreadCount) {
   const Data train = SineBowl(300, 0.05, 46);
   const Data test = SineBowl(700, 0.0, 47);  // several prediction blocks
-  LearnerOptions o = SvrOptions();
+  LearnerOptions o = OptionsOf(LearnerKind::kSvr);
   o.seed = 3;
   const auto a = FitLearner(train.x, train.y, o, {.threads = 1});
   o.seed = 4;

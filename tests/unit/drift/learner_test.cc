@@ -23,16 +23,10 @@ namespace gyrodrift::drift {
 namespace {
 
 using fixtures::Data;
+using fixtures::OptionsOf;
 using fixtures::Rmse;
 using fixtures::SameBits;
 using fixtures::SineBowl;
-
-LearnerOptions Options(LearnerKind kind) {
-  LearnerOptions o;
-  o.kind = kind;
-  o.poly_degree = 3;
-  return o;
-}
 
 const std::vector<LearnerKind> kAllKinds{LearnerKind::kElm, LearnerKind::kPoly, LearnerKind::kSvr,
                                          LearnerKind::kBp};
@@ -42,7 +36,7 @@ class EveryKind : public ::testing::TestWithParam<LearnerKind> {};
 TEST_P(EveryKind, LearnsSineBowlFarBetterThanTheMean) {
   const Data train = SineBowl(600, 0.05, 1);
   const Data test = SineBowl(400, 0.0, 2);
-  const auto learner = FitLearner(train.x, train.y, Options(GetParam()));
+  const auto learner = FitLearner(train.x, train.y, OptionsOf(GetParam()));
   EXPECT_EQ(learner->kind(), GetParam());
   EXPECT_EQ(learner->num_inputs(), 2);
   const Eigen::VectorXd p = learner->Predict(test.x);
@@ -62,7 +56,7 @@ TEST_P(EveryKind, LearnsSineBowlFarBetterThanTheMean) {
 TEST_P(EveryKind, SaveLoadRoundTripGivesIdenticalBits) {
   const Data train = SineBowl(300, 0.05, 3);
   const Data test = SineBowl(200, 0.0, 4);
-  const auto learner = FitLearner(train.x, train.y, Options(GetParam()));
+  const auto learner = FitLearner(train.x, train.y, OptionsOf(GetParam()));
   const Parameters saved = learner->Save();
   const auto loaded = LoadLearner(GetParam(), saved);
   EXPECT_EQ(loaded->kind(), GetParam());
@@ -90,7 +84,7 @@ TEST_P(EveryKind, SaveLoadRoundTripGivesIdenticalBits) {
 TEST_P(EveryKind, ScalersComeFromTheTrainingRowsOnly) {
   Data train = SineBowl(200, 0.05, 5);
   train.x.col(0).array() += 7.0;  // an offset the scaler must see
-  const auto learner = FitLearner(train.x, train.y, Options(GetParam()));
+  const auto learner = FitLearner(train.x, train.y, OptionsOf(GetParam()));
   const Parameters p = learner->Save();
   ASSERT_TRUE(p.arrays.count("input_mean") && p.arrays.count("target_mean"));
   const Eigen::RowVectorXd mean = train.x.colwise().mean();
@@ -107,7 +101,7 @@ TEST_P(EveryKind, ScalersComeFromTheTrainingRowsOnly) {
 
 TEST_P(EveryKind, LoadRejectsMissingOrMisShapedArrays) {
   const Data train = SineBowl(120, 0.05, 7);
-  const Parameters saved = FitLearner(train.x, train.y, Options(GetParam()))->Save();
+  const Parameters saved = FitLearner(train.x, train.y, OptionsOf(GetParam()))->Save();
   for (const auto& [name, a] : saved.arrays) {
     Parameters missing = saved;
     missing.arrays.erase(name);
@@ -146,7 +140,7 @@ TEST_P(EveryKind, LoadRejectsMissingOrMisShapedArrays) {
 
 TEST_P(EveryKind, RejectsBadTrainingAndPredictionData) {
   const Data train = SineBowl(50, 0.05, 8);
-  const LearnerOptions o = Options(GetParam());
+  const LearnerOptions o = OptionsOf(GetParam());
   EXPECT_THROW(FitLearner(train.x, train.y.head(49), o), DataError);
   EXPECT_THROW(FitLearner(train.x.topRows(1), train.y.head(1), o), DataError);
   Eigen::MatrixXd x = train.x;
@@ -174,7 +168,7 @@ TEST_P(EveryKind, RejectsBadTrainingAndPredictionData) {
 TEST_P(EveryKind, PredictsEachRowIndependentlyOfTheBatch) {
   const Data train = SineBowl(150, 0.05, 9);
   const Data test = SineBowl(40, 0.0, 10);
-  const auto learner = FitLearner(train.x, train.y, Options(GetParam()));
+  const auto learner = FitLearner(train.x, train.y, OptionsOf(GetParam()));
   const Eigen::VectorXd all = learner->Predict(test.x);
   for (Eigen::Index i = 0; i < test.x.rows(); i += 7) {
     // Every kind, ELM included (its row kernels fix the summation order, docs/elm.md), gives
@@ -201,7 +195,7 @@ TEST(Learner, ConcurrentFitsMatchSequentialFits) {
   const std::vector<LearnerKind> kinds{LearnerKind::kSvr, LearnerKind::kBp,   LearnerKind::kSvr,
                                        LearnerKind::kBp,  LearnerKind::kPoly, LearnerKind::kElm};
   auto fit = [&](int task) {
-    LearnerOptions o = Options(kinds[static_cast<size_t>(task)]);
+    LearnerOptions o = OptionsOf(kinds[static_cast<size_t>(task)]);
     o.seed = static_cast<std::uint64_t>(task);
     o.bp_epochs = 100;
     return FitLearner(train.x, train.y, o, {.threads = 1})->Predict(test.x);
