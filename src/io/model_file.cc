@@ -19,7 +19,7 @@ using nlohmann::json;
 namespace dec = gyrodrift::decomposition;
 namespace sel = gyrodrift::selection;
 
-// The last format that stored thread counts (model_file.h, version 6).
+// The last format that stored thread counts (model_file.h: version 6 dropped them).
 constexpr int kLastModelFormatVersionWithThreads = 5;
 
 // ---------------------------------------------------------------------------------------------
