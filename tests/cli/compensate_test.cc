@@ -184,7 +184,7 @@ TEST_F(CompensateCli, WarnsUpFrontOfATemperatureInCounts) {
   // A degC log has no such warning.
   const auto clean = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
                                   "/test.csv' -o '" + Dir() + "/clean_out.csv'");
-  EXPECT_EQ(clean.out.find("warning:"), std::string::npos) << clean.out;
+  EXPECT_EQ(clean.out.find("warning: " + Dir() + "/test.csv"), std::string::npos) << clean.out;
 }
 
 TEST_F(CompensateCli, RunsOnALogWithOnlyTheModelsColumns) {
@@ -346,7 +346,7 @@ TEST(CompensateCliAxes, SeveralTargetsFitOneFileAndCompensateEveryAxis) {
     for (const char* column : {"drift_est_", "drift_sd_", "compensated_"}) {
       EXPECT_TRUE(out.HasColumn(std::string(column) + axis)) << column << axis;
     }
-    EXPECT_NE(r.out.find(std::string(axis) + ": std"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(std::string(axis) + " (dph), "), std::string::npos) << r.out;
   }
   // The three-axis file estimates gyro_y as the one-axis model does.
   r = test::RunCli("compensate '" + dir + "/y.json' '" + dir + "/imu.csv' -o '" + dir +
