@@ -262,8 +262,8 @@ def temperature_warning(temperature, name="temperature"):
     >>> import gyrodrift as gd
     >>> gd.temperature_warning([25.1, 25.2, 25.4])
     ''
-    >>> gd.temperature_warning([64000.0, 64012.0, 64100.0], "temp")[:60]
-    "temperature column 'temp' runs from 64000 to 64100, outside -"
+    >>> gd.temperature_warning([64000.0, 64012.0, 64100.0], "temp").split(";")[0]
+    "temperature column 'temp' runs from 64000 to 64100, outside -80..200 degC"
     """
     return _gyrodrift.temperature_warning(temperature, name)
 
