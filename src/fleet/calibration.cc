@@ -66,8 +66,11 @@ std::string Fmt(double v) { return std::isnan(v) ? "" : io::FormatDouble(v); }
 std::vector<std::string> Failures(const Limits& limits, const VerificationResult& v) {
   std::vector<std::string> out;
   if (!std::isnan(limits.residual_drift_rms) && !(v.drift_rms_after <= limits.residual_drift_rms)) {
-    out.push_back(fmt::format("residual drift {:.4g} > {:.4g}", v.drift_rms_after,
-                              limits.residual_drift_rms));
+    out.push_back(std::isnan(v.drift_rms_after)
+                      ? std::string("residual drift not measured (the log is shorter than two "
+                                    "drift_window_s blocks)")
+                      : fmt::format("residual drift {:.4g} > {:.4g}", v.drift_rms_after,
+                                    limits.residual_drift_rms));
   }
   if (!std::isnan(limits.bias_instability_dph)) {
     // Unidentified, B is reported as 0; what bounds it is the curve's flattest point read by the

@@ -276,6 +276,19 @@ TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
   // Without the limit the same log passes: only a set limit needs its figure.
   const Manifest zero_free = Make("", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
   EXPECT_TRUE(CalibrateUnit(zero_free, zero_free.units[0], test::FakeDygraphs()).result.pass());
+
+  // A verification log shorter than two drift_window_s blocks has no residual drift to measure:
+  // an empty cell, and a set limit broken, named so.
+  Manifest long_window = Fleet("residual_drift_rms = 1e6\n");
+  long_window.drift_window_s = static_cast<double>(kVerSamples);
+  const UnitResult w =
+      CalibrateUnit(long_window, long_window.units[1], test::FakeDygraphs()).result;
+  ASSERT_EQ(w.error, "");
+  EXPECT_TRUE(std::isnan(w.axes[0].verification[0].drift_rms_after));
+  ASSERT_EQ(w.axes[0].verification[0].failures.size(), 1u);
+  EXPECT_EQ(w.axes[0].verification[0].failures[0],
+            "residual drift not measured (the log is shorter than two drift_window_s blocks)");
+  EXPECT_EQ(Cell(Rows(w).at(0), "drift_rms_after"), "");
 }
 
 TEST_F(FleetCalibration, AUnitsOwnErrorIsItsResultNotAnException) {
