@@ -12,7 +12,6 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
-#include "gyrodrift/drift/temperature_check.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
@@ -78,7 +77,7 @@ AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& tab
   j["after"] = SummaryJson(summary.after);
   j["slow_variation_block_s"] = summary.block_s;
   j["slow_variation_blocks"] = summary.blocks;
-  // Files before format 4 did not record the unit.
+  // Files before format 4 did not record the unit: the table then names none.
   r.text = model.Summary() + "\n" + summary.Table(loaded.info.target_column, loaded.info.rate_unit);
   // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
   // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
