@@ -69,11 +69,9 @@ CompensationSummary SummariseCompensation(const Eigen::Ref<const Eigen::VectorXd
 
 std::string CompensationSummary::Table(const std::string& target, const std::string& unit) const {
   char line[256];
-  std::string out;
-  std::snprintf(line, sizeof(line), "%s%s%s%s, %lld samples:\n", target.c_str(),
-                unit.empty() ? "" : " (", unit.c_str(), unit.empty() ? "" : ")",
-                static_cast<long long>(samples));
-  out += line;
+  // The names are the user's, of any length: not through the fixed buffer.
+  std::string out = target + (unit.empty() ? "" : " (" + unit + ")") + ", " +
+                    std::to_string(samples) + " samples:\n";
   std::snprintf(line, sizeof(line), "  %-16s %14s %14s\n", "", "before", "after");
   out += line;
   auto row = [&](const char* name, double b, double a, const std::string& note) {
