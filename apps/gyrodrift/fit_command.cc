@@ -56,6 +56,12 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
       PrintThermalModel(sub.name, *sub.thermal, channels);
       continue;
     }
+    if (sub.mean) {
+      fmt::print("  {:<8} its training mean {:.6g} (white; its learner did not beat the mean on "
+                 "held-out data)\n",
+                 sub.name, *sub.mean);
+      continue;
+    }
     fmt::print(
         "  {:<8} {}\n", sub.name,
         sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");

@@ -54,7 +54,9 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // "threads" scalar of ELM and SVR learners): they are how a fit ran (common/execution.h), never
 // part of the model, whose every bit is the same for any count. Older files still load, the
 // counts read and dropped; a version-6 file that holds one is refused as an unknown field.
-inline constexpr int kModelFormatVersion = 6;
+// Version 7 adds "mean" to a predict-mode sub-model predicted by its training mean (MS-ELM's
+// noise group, drift_model.h SubModel::mean), whose "learner" is then null; older files have none.
+inline constexpr int kModelFormatVersion = 7;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 
