@@ -57,9 +57,10 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
       continue;
     }
     if (sub.mean) {
-      fmt::print("  {:<8} its training mean {:.6g} (white; its learner did not beat the mean on "
-                 "held-out data)\n",
-                 sub.name, *sub.mean);
+      fmt::print(
+          "  {:<8} its training mean {:.6g} (white; its learner did not beat the mean by "
+          "10 % on held-out data)\n",
+          sub.name, *sub.mean);
       continue;
     }
     fmt::print(

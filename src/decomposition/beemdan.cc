@@ -34,9 +34,8 @@ NoiseStagePolicy FixedStages(const DecompositionOptions& o) {
 NoiseStagePolicy EnergyBandExit(const DecompositionOptions& o) {
   EnergyBand band;
   band.confidence = o.band_confidence;
-  return [band](int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r,
-                Sifter& sifter, Eigen::VectorXd& imf, const NoiseEnergies&,
-                DecompositionReport& report) mutable {
+  return [band](int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r, Sifter& sifter,
+                Eigen::VectorXd& imf, const NoiseEnergies&, DecompositionReport& report) mutable {
     if (stage == 1) band.log2_e1 = RobustLog2NoiseEnergy(modes.front());
     // Probe: the plain EMD mode of r_k. Outside the band it is the first signal mode, kept as
     // the first IMF of the plain EMD that finishes the decomposition.
@@ -102,10 +101,11 @@ NoiseStagePolicy EnsembleBandExit(const DecompositionOptions& o) {
     const int k = stage + 1;  // mode number under test
     std::vector<double> relative;
     for (const auto& ratios : noise.relative_log2) {
-      if (static_cast<int>(ratios.size()) >= k) relative.push_back(ratios[static_cast<size_t>(k - 1)]);
+      if (static_cast<int>(ratios.size()) >= k) {
+        relative.push_back(ratios[static_cast<size_t>(k - 1)]);
+      }
     }
-    const bool has_band =
-        2 * relative.size() >= noise.relative_log2.size() && relative.size() >= 3;
+    const bool has_band = 2 * relative.size() >= noise.relative_log2.size() && relative.size() >= 3;
     const double upper = has_band ? log2_e1 + PredictionUpper(relative, confidence)
                                   : std::numeric_limits<double>::quiet_NaN();
     const SiftOutcome probe = sifter.ExtractImf(r.data(), imf.data());

@@ -205,8 +205,8 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
   if (ceemdan_family) {
     // Each realisation keeps the running residue of its noise EMD (N doubles), and under
     // BEEMDAN's ensemble band its next row too.
-    const bool ahead = options.method == Method::kBeemdan &&
-                       options.beemdan_bound == BeemdanBound::kEnsembleBand;
+    const bool ahead =
+        options.method == Method::kBeemdan && options.beemdan_bound == BeemdanBound::kEnsembleBand;
     internal::RequireNoiseStateFits(internal::EnsembleSize(job), n, ahead ? 2.0 : 1.0);
   }
   // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.

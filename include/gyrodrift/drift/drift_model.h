@@ -5,8 +5,8 @@
 // grouped by PDF similarity into noise / mixed / drift sub-series (selection.h), one learner is
 // trained per sub-series and the model's output is the sum of the sub-models' outputs. In predict
 // mode the noise group, white by the selection's test, is predicted by its training mean unless
-// its learner beats that mean on the last validation_fraction of the training block (fitted on
-// the rest): a learner on white noise's lags adds noise to the sum.
+// its learner beats that mean by 10 % of its mean-square error on the last validation_fraction of
+// the training block (fitted on the rest): a learner on white noise's lags adds noise to the sum.
 // Two modes:
 //   kPredict    the paper's task: one-step-ahead prediction of y[t] from the sub-series' own
 //               lags s_g[t-1..t-p] (optionally with the thermal history at t-1).

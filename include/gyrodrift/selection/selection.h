@@ -107,7 +107,7 @@ struct SelectionResult {
   // max_t |x - (sum_k imf_k + residue)| / max_t |x|: the groups add up to the decomposition's
   // reconstruction; for a non-complete decomposition (EEMD) that differs from x by this much.
   double reconstruction_error = 0.0;
-  std::string note;  // edge cases met (e.g. "noise run reaches k*: no mixed group"), empty otherwise
+  std::string note;  // edge cases met (e.g. "noise run reaches k*"), empty otherwise
 
   const ModeGroup* Group(GroupKind kind) const;  // nullptr when that group was dropped
   std::string Summary() const;                   // one line

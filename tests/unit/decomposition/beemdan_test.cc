@@ -49,9 +49,9 @@ TEST(Beemdan, FixedStagesAreIceemdanThenPlainEmdOfTheResidue) {
   const internal::NoiseStagePolicy watch =
       [&r3](int stage, std::vector<Eigen::VectorXd>&, Eigen::VectorXd& r, internal::Sifter&,
             Eigen::VectorXd&, const internal::NoiseEnergies&, DecompositionReport&) {
-    if (stage == 3) r3 = r;
-    return true;
-  };
+        if (stage == 3) r3 = r;
+        return true;
+      };
   DecompositionOptions ice_options = o;
   ice_options.method = Method::kIceemdan;
   const DecompositionContext context;
@@ -217,7 +217,8 @@ TEST(Beemdan, EnsembleBandHoldsItsConfidenceOnWhiteNoise) {
       }
     }
     const double share = static_cast<double>(outside) / tested;
-    SCOPED_TRACE(std::to_string(outside) + " of " + std::to_string(tested) + " tested modes outside");
+    SCOPED_TRACE(std::to_string(outside) + " of " + std::to_string(tested) +
+                 " tested modes outside");
     EXPECT_GE(tested, 150);
     if (confidence == 0.99) {
       EXPECT_LE(share, 0.03);

@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include "drift/fit_steps.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
-#include "drift/fit_steps.h"
 #include "gyrodrift/drift/evaluation.h"
 #include "unit/drift/drift_fixtures.h"
 
@@ -168,9 +168,8 @@ TEST(DriftModel, WhiteNoiseGroupIsPredictedByItsMeanUnlessItsLearnerBeatsIt) {
   for (int horizon : {1, 5}) {
     const Eigen::VectorXd with_mean =
         PredictFromSeries(white_model, white_series, Eigen::MatrixXd(n, 0), 100, 50, horizon);
-    const Eigen::VectorXd alone =
-        PredictFromSeries(drift_only, white_series.rightCols(1), Eigen::MatrixXd(n, 0), 100, 50,
-                          horizon);
+    const Eigen::VectorXd alone = PredictFromSeries(drift_only, white_series.rightCols(1),
+                                                    Eigen::MatrixXd(n, 0), 100, 50, horizon);
     EXPECT_LE(((with_mean - alone).array() - white.mean()).abs().maxCoeff(), 1e-12) << horizon;
   }
   const auto [ar_model, ar_series] = fit(ar, "noise");
