@@ -8,8 +8,8 @@
 //   CEEMDAN  Torres, Colominas, Schlotthauer & Flandrin, ICASSP 2011.
 //   ICEEMDAN Colominas, Schlotthauer & Torres, Biomed. Signal Process. Control 14 (2014).
 //   BEEMDAN  ICEEMDAN stages bounded to the noise-dominated early modes (Chen & Cui, Signal
-//            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11
-//            (2004).
+//            Processing 128, 2016): by default the band of the ensemble's own white-noise mode
+//            energies; or the noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11 (2004).
 // Cost: one sift is O(N); EMD is O(N * total sifts); the ensemble methods multiply the per-mode
 // cost by the ensemble size I and spread realisations over the context's threads. Results are the
 // same bits for any thread count (realisation i draws from stream (seed, i), sums run in i order).
