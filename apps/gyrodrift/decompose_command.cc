@@ -36,7 +36,7 @@ struct DecomposeArgs {
   int fixed_sifts = 10;
   double sd = 0.2;
   std::string scaling = "colominas2014";
-  std::string bound = "energy";
+  std::string bound{dec::ToString(dec::DecompositionOptions{}.beemdan_bound)};
   double band = 0.99;
   int noise_stages = 3;
   std::string noise_file;
@@ -232,10 +232,11 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
               {"noise_scaling"});
   BindSetting(
       cmd->add_option("--bound", args->bound,
-                      "BEEMDAN noise bound: energy (white-noise band) | stages | full (= ICEEMDAN)")
+                      "BEEMDAN noise bound: ensemble (band of the ensemble's white-noise modes) | "
+                      "energy (Flandrin et al.'s band) | stages | full (= ICEEMDAN)")
           ->capture_default_str(),
       {"beemdan_bound"});
-  BindSetting(cmd->add_option("--band", args->band, "BEEMDAN energy band confidence: 0.95 or 0.99")
+  BindSetting(cmd->add_option("--band", args->band, "BEEMDAN band confidence: 0.95 or 0.99")
                   ->capture_default_str(),
               {"band_confidence"});
   BindSetting(

@@ -82,6 +82,13 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
       PrintThermalModel(sub.name, *sub.thermal, channels, o.reference_c, axis.info.rate_unit);
       continue;
     }
+    if (sub.mean) {
+      fmt::print(
+          "  {:<8} its training mean {:.6g} (white; its learner did not beat the mean by "
+          "10 % on held-out data)\n",
+          sub.name, *sub.mean);
+      continue;
+    }
     fmt::print(
         "  {:<8} {}\n", sub.name,
         sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");

@@ -29,7 +29,7 @@ __all__ = [
 
 def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, seed=1, threads=0,
               max_imfs=0, max_sifts=0, s_number=4, fixed_sifts=10, sd=0.2,
-              noise_scaling="colominas2014", bound="energy", band=0.99, noise_stages=3,
+              noise_scaling="colominas2014", bound="ensemble", band=0.99, noise_stages=3,
               noise_realisations=None, progress=None):
     """Splits a signal into IMFs and a residue (EMD, EEMD, CEEMDAN, ICEEMDAN, BEEMDAN).
 
@@ -239,7 +239,8 @@ class DriftModel:
     summary = property(lambda self: self._core.summary, doc="One-line summary of the model.")
     sub_models = property(
         lambda self: self._core.sub_models,
-        doc="Sub-models: name, imfs, learner summary, and for identified thermal models "
+        doc="Sub-models: name, imfs, learner summary (None for one predicted by its training "
+            "``mean``), and for identified thermal models "
             "``thermal`` (regressors named by the temperature columns, coefficients, sd).")
     mode = property(lambda self: self._core.mode)
     method = property(lambda self: self._core.method)

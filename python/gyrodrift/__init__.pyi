@@ -21,7 +21,7 @@ def decompose(
     ensemble: int = ..., noise: float = ..., seed: int = ..., threads: int = ...,
     max_imfs: int = ..., max_sifts: int = ..., s_number: int = ..., fixed_sifts: int = ...,
     sd: float = ..., noise_scaling: Literal["colominas2014", "constant-snr"] = ...,
-    bound: Literal["energy", "stages", "full"] = ..., band: float = ..., noise_stages: int = ...,
+    bound: Literal["ensemble", "energy", "stages", "full"] = ..., band: float = ..., noise_stages: int = ...,
     noise_realisations: ArrayLike | None = ...,
     progress: Callable[[float], object] | None = ...,
 ) -> tuple[Array, Array, dict[str, Any]]: ...

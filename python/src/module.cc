@@ -818,6 +818,7 @@ class PyDriftModel {
       d["imfs"] = sub.imfs;
       d["has_residue"] = sub.has_residue;
       d["learner"] = sub.learner ? py::cast(sub.learner->Summary()) : py::none();
+      d["mean"] = sub.mean ? py::cast(*sub.mean) : py::none();
       if (sub.thermal) {
         const drift::ThermalRegression& t = *sub.thermal;
         Eigen::VectorXd sd(t.coefficients.size());
@@ -1127,7 +1128,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
         arg("stop") = "rilling", arg("ensemble") = 100, arg("noise") = 0.2, arg("seed") = 1,
         arg("threads") = 0, arg("max_imfs") = 0, arg("max_sifts") = 0, arg("s_number") = 4,
         arg("fixed_sifts") = 10, arg("sd") = 0.2, arg("noise_scaling") = "colominas2014",
-        arg("bound") = "energy", arg("band") = 0.99, arg("noise_stages") = 3,
+        arg("bound") = "ensemble", arg("band") = 0.99, arg("noise_stages") = 3,
         arg("noise_realisations") = py::none(), arg("progress") = py::none());
   m.def("allan", &gp::Allan, arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = "rate",
         arg("dev") = "oadev", arg("taus") = "octave", arg("units") = "dph",

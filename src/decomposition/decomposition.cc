@@ -33,10 +33,11 @@ constexpr std::array<std::pair<StopRule, std::string_view>, 4> kStopRules{{
     {StopRule::kFixed, "fixed"},
     {StopRule::kCauchySd, "sd"},
 }};
-constexpr std::array<std::pair<BeemdanBound, std::string_view>, 3> kBounds{{
+constexpr std::array<std::pair<BeemdanBound, std::string_view>, 4> kBounds{{
     {BeemdanBound::kEnergyBand, "energy"},
     {BeemdanBound::kFixedStages, "stages"},
     {BeemdanBound::kFull, "full"},
+    {BeemdanBound::kEnsembleBand, "ensemble"},
 }};
 constexpr std::array<std::pair<NoiseScaling, std::string_view>, 2> kScalings{{
     {NoiseScaling::kColominas2014, "colominas2014"},
@@ -202,8 +203,11 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
                      "ensemble size and sifting, without supplied noise");
   }
   if (ceemdan_family) {
-    // Each realisation keeps the running residue of its noise EMD (N doubles).
-    internal::RequireNoiseStateFits(internal::EnsembleSize(job), n, 1.0);
+    // Each realisation keeps the running residue of its noise EMD (N doubles), and under
+    // BEEMDAN's ensemble band its next row too.
+    const bool ahead =
+        options.method == Method::kBeemdan && options.beemdan_bound == BeemdanBound::kEnsembleBand;
+    internal::RequireNoiseStateFits(internal::EnsembleSize(job), n, ahead ? 2.0 : 1.0);
   }
   // A signal with fewer than 3 extrema (constant, linear, monotone) has no IMF by definition.
   if (internal::CountExtrema(x.data(), n).extrema() < 3) {

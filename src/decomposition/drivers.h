@@ -63,15 +63,27 @@ Decomposition RunCeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& 
 Decomposition RunIceemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
 Decomposition RunBeemdan(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job);
 
+// The energies of the realisations' white-noise modes so far: relative_log2[i][k - 1] =
+// log2 ||E_k(w_i)||^2 - RobustLog2NoiseEnergy(E_1(w_i)) for every IMF row k of realisation i's
+// EMD taken so far (a realisation whose EMD ended early has fewer entries). The record's own
+// modes compare with them on the same terms, whatever N and the sifting options are.
+struct NoiseEnergies {
+  std::vector<std::vector<double>> relative_log2;
+};
+
 // What ends the noise assistance of the ICEEMDAN stages, asked before every stage k >= 1 with
-// the modes so far (normalised input), the residue r, a free sifter and N-vector: true goes on
-// with noise; false ends it, after the policy has set report.stop_reason and appended to modes
-// (taking it from r) any mode it extracted to decide. Plain EMD then finishes the decomposition.
-using NoiseStagePolicy =
-    std::function<bool(int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r,
-                       Sifter& sifter, Eigen::VectorXd& scratch, DecompositionReport& report)>;
+// the modes so far (normalised input), the residue r, a free sifter and N-vector, and the noise
+// modes' energies (empty unless asked for; then up to mode k + 1, the one stage k would use):
+// true goes on with noise; false ends it, after the policy has set report.stop_reason and
+// appended to modes (taking it from r) any mode it extracted to decide. Plain EMD then finishes
+// the decomposition.
+using NoiseStagePolicy = std::function<bool(
+    int stage, std::vector<Eigen::VectorXd>& modes, Eigen::VectorXd& r, Sifter& sifter,
+    Eigen::VectorXd& scratch, const NoiseEnergies& noise, DecompositionReport& report)>;
 // ICEEMDAN's stages under a policy (empty: noise assistance to the end, ICEEMDAN itself).
+// noise_energies: the policy reads them, so each stage takes its noise rows before asking (one
+// more N-vector per realisation); the modes are the same bits either way.
 Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, const Job& job,
-                                const NoiseStagePolicy& go_on);
+                                const NoiseStagePolicy& go_on, bool noise_energies = false);
 
 }  // namespace gyrodrift::decomposition::internal

@@ -41,6 +41,46 @@ LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
   return l;
 }
 
+// The share of the held-out mean-square error of the training mean that the noise group's
+// learner must remove to be kept [choice, docs/drift.md 1.2]. The sum of white-noise IMFs 1..k_N
+// is white noise less its slow modes: a learner on its lags predicts a few per cent of it (4.5 %
+// of the training MSE on the chamber record), which is noise, not drift, and what it predicts is
+// added to the sum, so against the drift it costs as much as it gains against the next sample.
+// Drift content misjudged as noise would be predicted far better than that.
+constexpr double kWhiteGroupMinSkill = 0.1;
+
+// The noise group of MS-ELM is white by the selection's test, so its next value is its mean and
+// a learner on its lags mostly adds noise to the sum. It keeps its learner only if that learner,
+// fitted on the first 1 - validation_fraction of the block, predicts the rest one step ahead with
+// a mean-square error at least kWhiteGroupMinSkill below that of the mean of the first part
+// (chronological split); otherwise the training mean of the whole block predicts it.
+void PredictWhiteGroupByMean(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
+                             const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
+                             const Execution& learners) {
+  const DriftOptions& o = model.options;
+  const int p = model.lags;
+  const Eigen::Index validation =
+      static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
+  const Eigen::Index inner_end = fit_end - validation;
+  if (validation < 1 || inner_end - p < 8) return;  // too short to judge: the learner stays
+  for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    SubModel& sub = model.sub_models[g];
+    if (sub.name != selection::ToString(selection::GroupKind::kNoise)) continue;
+    const auto s = series.col(static_cast<Eigen::Index>(g));
+    const auto held_out = s.segment(inner_end, validation);
+    const std::unique_ptr<Learner> inner =
+        FitLearner(PredictRows(model, s, thermal, p, inner_end - p), s.segment(p, inner_end - p),
+                   SubModelLearner(o, g), learners);
+    const double learner_sse =
+        (inner->Predict(PredictRows(model, s, thermal, inner_end, validation)) - held_out)
+            .squaredNorm();
+    const double mean_sse = (held_out.array() - s.head(inner_end).mean()).square().sum();
+    if (learner_sse < (1.0 - kWhiteGroupMinSkill) * mean_sse) continue;
+    sub.learner = nullptr;
+    sub.mean = s.head(fit_end).mean();
+  }
+}
+
 }  // namespace
 
 namespace internal {
@@ -180,6 +220,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
   };
   if (!o.auto_lags) {
     fit_with_lags(o.features.lags, fit_end);
+    if (o.method == Method::kMsElm)
+      PredictWhiteGroupByMean(model, series, thermal, fit_end, learners);
     return;
   }
   const Eigen::Index validation =
@@ -200,6 +242,8 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
     }
   }
   fit_with_lags(best_p, fit_end);
+  if (o.method == Method::kMsElm)
+    PredictWhiteGroupByMean(model, series, thermal, fit_end, learners);
 }
 
 }  // namespace internal

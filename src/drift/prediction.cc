@@ -54,6 +54,10 @@ Eigen::VectorXd PredictRecursively(const DriftModel& model,
   const Eigen::Index count = lags.front().rows();
   Eigen::VectorXd prediction = Eigen::VectorXd::Zero(count);
   for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    if (model.sub_models[g].mean) {  // a constant at every step
+      prediction.array() += *model.sub_models[g].mean;
+      continue;
+    }
     Eigen::MatrixXd x(count, p + thermal.cols());
     x.leftCols(p) = lags[g];
     for (int j = 0; j < horizon; ++j) {

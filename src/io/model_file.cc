@@ -215,15 +215,19 @@ json ThermalJson(const drift::ThermalRegression& t) {
 json ModelJson(const drift::DriftModel& model) {
   json subs = json::array();
   for (const auto& sub : model.sub_models) {
-    if (!sub.learner && model.options.mode == drift::Mode::kPredict) {
+    if (!sub.learner && !sub.mean && model.options.mode == drift::Mode::kPredict) {
       throw UsageError("sub-model '" + sub.name +
-                       "' has no learner: a predict-mode model needs one per sub-model");
+                       "' has no learner: a predict-mode model needs one per sub-model (or its "
+                       "mean)");
     }
-    subs.push_back({{"name", sub.name},
-                    {"imfs", sub.imfs},
-                    {"has_residue", sub.has_residue},
-                    {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)},
-                    {"thermal", sub.thermal ? ThermalJson(*sub.thermal) : json(nullptr)}});
+    json j = {{"name", sub.name},
+              {"imfs", sub.imfs},
+              {"has_residue", sub.has_residue},
+              {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)},
+              {"thermal", sub.thermal ? ThermalJson(*sub.thermal) : json(nullptr)}};
+    // Written only for a sub-model predicted by its mean (version 7), so others are unchanged.
+    if (sub.mean) j["mean"] = Number(*sub.mean);
+    subs.push_back(std::move(j));
   }
   return {{"lags", model.lags},
           {"training_imfs", model.training_imfs},
@@ -684,8 +688,15 @@ drift::DriftModel ReadModel(const Node& root) {
     }
     sub.has_residue = s["has_residue"].Bool();
     const Node learner = s["learner"];
-    if (learner.IsNull()) {
-      if (predict) learner.Fail("is null: a predict-mode sub-model needs a learner");
+    if (s.raw().contains("mean")) {
+      const double mean = s["mean"].Double();
+      if (!std::isfinite(mean)) s["mean"].Fail("must be a finite number");
+      if (!predict || !learner.IsNull()) {
+        s["mean"].Fail("is for a predict-mode sub-model without a learner");
+      }
+      sub.mean = mean;
+    } else if (learner.IsNull()) {
+      if (predict) learner.Fail("is null: a predict-mode sub-model needs a learner (or a mean)");
     } else {
       sub.learner = ReadLearner(learner, sub.name);
       if (sub.learner->num_inputs() != model.num_inputs()) {

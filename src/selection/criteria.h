@@ -26,9 +26,9 @@ void EnergyCurve(const Eigen::Ref<const Eigen::MatrixXd>& imfs, double band_conf
 // The boundary rules: each sets k_noise and mixed_end of a result that holds the curves
 // (num_imfs, pdf_distance, self_distance, k_star, energy_signal_start), and may add notes.
 
-// kPdfSimilarity: k_N = the leading run of IMFs with G_k under the white-noise level of
+// kPdfSimilarity: k_N = the leading run of IMFs 1..k* with G_k under the white-noise level of
 // `length`-sample records (options.noise_level, or NoiseLevelCache::Global(), which also completes
-// a partial level the run outlasts); mixed_end = max(k_N, k*). Also sets noise_level,
+// a partial level the run outlasts); mixed_end = k*. Also sets noise_level,
 // noise_level_realisations, noise_level_seed and noise_level_computed. A Monte-Carlo runs on the
 // execution's threads.
 void PdfSimilarityBoundaries(int length, const SelectionOptions& options,

@@ -8,8 +8,8 @@
 //   CEEMDAN  Torres, Colominas, Schlotthauer & Flandrin, ICASSP 2011.
 //   ICEEMDAN Colominas, Schlotthauer & Torres, Biomed. Signal Process. Control 14 (2014).
 //   BEEMDAN  ICEEMDAN stages bounded to the noise-dominated early modes (Chen & Cui, Signal
-//            Processing 128, 2016), noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11
-//            (2004).
+//            Processing 128, 2016): by default the band of the ensemble's own white-noise mode
+//            energies; or the noise model of Flandrin, Goncalves & Rilling, IEEE SPL 11 (2004).
 // Cost: one sift is O(N); EMD is O(N * total sifts); the ensemble methods multiply the per-mode
 // cost by the ensemble size I and spread realisations over the context's threads. Results are the
 // same bits for any thread count (realisation i draws from stream (seed, i), sums run in i order).
@@ -69,12 +69,15 @@ struct SiftingOptions {
 
 // How BEEMDAN decides how many stages get noise assistance.
 enum class BeemdanBound {
-  kEnergyBand,   // stop at the first mode whose energy leaves the white-noise band
-  kFixedStages,  // exactly noise_stages noise-assisted stages
-  kFull,         // every stage (then BEEMDAN equals ICEEMDAN bit for bit)
+  kEnergyBand,    // stop at the first mode whose energy leaves Flandrin et al.'s fitted band
+  kFixedStages,   // exactly noise_stages noise-assisted stages
+  kFull,          // every stage (then BEEMDAN equals ICEEMDAN bit for bit)
+  kEnsembleBand,  // stop after the first mode whose energy leaves the band of the ensemble's own
+                  // white-noise modes (the record's length and sifting; the default)
 };
 std::string_view ToString(BeemdanBound bound);
-BeemdanBound BeemdanBoundFromString(std::string_view name);  // "energy", "stages", "full"
+// "energy", "stages", "full", "ensemble"
+BeemdanBound BeemdanBoundFromString(std::string_view name);
 
 // ICEEMDAN noise scaling (the SNRFlag of the reference code).
 enum class NoiseScaling {
@@ -97,8 +100,10 @@ struct DecompositionOptions {
   std::uint64_t seed = 1;       // realisation i draws from stream (seed, i)
   NoiseScaling noise_scaling = NoiseScaling::kColominas2014;
   // BEEMDAN.
-  BeemdanBound beemdan_bound = BeemdanBound::kEnergyBand;
-  double band_confidence = 0.99;  // 0.95 or 0.99 (the two bands Flandrin et al. 2004 fitted)
+  BeemdanBound beemdan_bound = BeemdanBound::kEnsembleBand;
+  // 0.95 or 0.99: the quantile of the ensemble band, or which of the two bands Flandrin et al.
+  // (2004) fitted
+  double band_confidence = 0.99;
   int noise_stages = 3;           // for kFixedStages, >= 1
 
   void Validate() const;  // throws UsageError naming the field, value and allowed range

@@ -3,7 +3,10 @@
 //
 // MS-ELM: the drift record y is decomposed (BEEMDAN by default, decomposition.h), the IMFs are
 // grouped by PDF similarity into noise / mixed / drift sub-series (selection.h), one learner is
-// trained per sub-series and the model's output is the sum of the sub-models' outputs.
+// trained per sub-series and the model's output is the sum of the sub-models' outputs. In predict
+// mode the noise group, white by the selection's test, is predicted by its training mean unless
+// its learner beats that mean by 10 % of its mean-square error on the last validation_fraction of
+// the training block (fitted on the rest): a learner on white noise's lags adds noise to the sum.
 // Two modes:
 //   kPredict    the paper's task: one-step-ahead prediction of y[t] from the sub-series' own
 //               lags s_g[t-1..t-p] (optionally with the thermal history at t-1).
@@ -63,7 +66,8 @@ struct DriftOptions {
   // chosen by leave-one-out error.
   LearnerOptions learner;
   // Predict mode: choose p among lag_candidates on the last validation_fraction of the training
-  // record (sub-models fitted on the rest), instead of features.lags.
+  // record (sub-models fitted on the rest), instead of features.lags. MS-ELM's noise group is
+  // judged on the same held-out share (SubModel::mean).
   bool auto_lags = false;
   std::vector<int> lag_candidates{1, 2, 4, 8, 16};
   double validation_fraction = 0.2;  // in [0.05, 0.5]
@@ -100,6 +104,9 @@ struct SubModel {
   // files written before identification, the zero function of a noise group).
   std::shared_ptr<const Learner> learner;
   std::shared_ptr<const ThermalRegression> thermal;
+  // Predict mode, MS-ELM's noise group (white by the selection's test): its training mean, which
+  // predicts it (learner null) when its learner did not beat that mean on held-out data.
+  std::optional<double> mean;
 };
 
 struct DriftModel {

@@ -5,9 +5,9 @@
 //   kPdfSimilarity [reconstructed from Komaty, Boudraa, Augier & Dare-Emzivat, IEEE TIM 63(1)
 //     2014; METHOD.md section 4]: Gaussian KDEs of the (centred) signal x and of every IMF on one
 //     common grid; D_k = distance(pdf(x), pdf(IMF k)), k* = argmax D_k. G_k = distance of the
-//     standardised IMF k to N(0, 1); k_N = length of the leading run of IMFs with G_k under the
-//     Monte-Carlo level of white-noise IMFs of the same length (noise_level.h, cached).
-//     noise = 1..k_N, mixed = k_N+1..k*, drift = max(k_N, k*)+1..K plus the residue.
+//     standardised IMF k to N(0, 1); k_N = length of the leading run of IMFs 1..k* with G_k under
+//     the Monte-Carlo level of white-noise IMFs of the same length (noise_level.h, cached): the
+//     run never passes k*. noise = 1..k_N, mixed = k_N+1..k*, drift = k*+1..K plus the residue.
 //   kKomaty: the two-way split of Komaty et al.: noise = 1..k*, drift = k*+1..K plus the residue.
 //   kEnergyModel: white-noise IMF energy model of Flandrin, Goncalves & Rilling, IEEE SPL 11(2)
 //     2004: E_k = E_1 / 0.719 * 2.01^-k with E_1 = N (median|imf_1| / 0.6745)^2; mode k >= 2 is
@@ -92,7 +92,7 @@ struct SelectionResult {
   // Boundaries (IMF indices, 1-based; 0 = none).
   int k_star = 0;                 // argmax_k D_k (first maximum)
   int k_noise = 0;                // last noise IMF of the chosen criterion (k_N for kPdfSimilarity)
-  int mixed_end = 0;              // last mixed IMF (kPdfSimilarity: max(k_N, k*); others: k_noise)
+  int mixed_end = 0;              // last mixed IMF (kPdfSimilarity: k*; others: k_noise)
   int energy_signal_start = 0;    // first IMF outside the energy band (K + 1 if none)
   std::vector<ModeGroup> groups;  // the non-empty groups, in the order noise, mixed, drift
   // Diagnostics.
@@ -107,7 +107,7 @@ struct SelectionResult {
   // max_t |x - (sum_k imf_k + residue)| / max_t |x|: the groups add up to the decomposition's
   // reconstruction; for a non-complete decomposition (EEMD) that differs from x by this much.
   double reconstruction_error = 0.0;
-  std::string note;  // edge cases met (e.g. "k* <= k_N: no mixed group"), empty otherwise
+  std::string note;  // edge cases met (e.g. "noise run reaches k*"), empty otherwise
 
   const ModeGroup* Group(GroupKind kind) const;  // nullptr when that group was dropped
   std::string Summary() const;                   // one line

@@ -274,7 +274,8 @@ TEST_P(Decomposer, SharedNoiseEmdsGiveTheSameBits) {
   }
   std::vector<BeemdanBound> bounds = {BeemdanBound::kEnergyBand};
   if (GetParam() == Method::kBeemdan) {
-    bounds = {BeemdanBound::kEnergyBand, BeemdanBound::kFixedStages, BeemdanBound::kFull};
+    bounds = {BeemdanBound::kEnsembleBand, BeemdanBound::kEnergyBand, BeemdanBound::kFixedStages,
+              BeemdanBound::kFull};
   }
   for (BeemdanBound bound : bounds) {
     o.beemdan_bound = bound;

@@ -52,7 +52,8 @@ TEST(Decomposition, EnumNamesRoundTrip) {
   const std::vector<std::pair<BeemdanBound, std::string>> bounds = {
       {BeemdanBound::kEnergyBand, "energy"},
       {BeemdanBound::kFixedStages, "stages"},
-      {BeemdanBound::kFull, "full"}};
+      {BeemdanBound::kFull, "full"},
+      {BeemdanBound::kEnsembleBand, "ensemble"}};
   for (const auto& [b, name] : bounds) {
     EXPECT_EQ(ToString(b), name);
     EXPECT_EQ(BeemdanBoundFromString(name), b);

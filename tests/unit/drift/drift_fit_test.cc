@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -11,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "drift/fit_steps.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -68,6 +70,7 @@ TEST(DriftModel, NoTwoRandomStreamsOfAFitCoincide) {
   ASSERT_GE(model.sub_models.size(), 2u) << model.Summary();
   std::set<std::string> seeds{std::to_string(o.seed)};
   for (size_t g = 0; g < model.sub_models.size(); ++g) {
+    if (model.sub_models[g].mean) continue;  // a white group predicted by its mean draws nothing
     ASSERT_TRUE(model.sub_models[g].learner) << g;
     const std::string used = model.sub_models[g].learner->Save().texts.at("seed");
     EXPECT_EQ(used, std::to_string(SeedFor(o.seed, "sub-model", g)));
@@ -124,6 +127,56 @@ TEST(DriftModel, AutoLagsPickACandidateOnTheValidationBlock) {
       std::min_element(model.lag_validation_rmse.begin(), model.lag_validation_rmse.end());
   EXPECT_EQ(model.lags,
             o.lag_candidates[static_cast<size_t>(best - model.lag_validation_rmse.begin())]);
+}
+
+// MS-ELM's noise group: white, it is predicted by its training mean unless its learner beats the
+// mean on the held-out last validation_fraction of the block (learner fitted on the rest). A
+// white series gets the mean; an autocorrelated one, which its lags predict, keeps its learner;
+// only the group named noise is judged.
+TEST(DriftModel, WhiteNoiseGroupIsPredictedByItsMeanUnlessItsLearnerBeatsIt) {
+  const Eigen::Index n = 1500;
+  Eigen::VectorXd white(n), ar(n), slow(n);
+  Rng rng(9, 0);
+  rng.FillNormal(white);
+  white.array() += 0.3;
+  double state = 0.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    state = 0.95 * state + rng.Normal();
+    ar[t] = state;
+    slow[t] = std::sin(static_cast<double>(t) / 200.0);
+  }
+  auto fit = [&](const Eigen::VectorXd& noise_series, const std::string& first_name) {
+    DriftModel model;
+    model.options = Fast(Mode::kPredict, Method::kMsElm);
+    model.sub_models.push_back({first_name, {1}, false, nullptr});
+    model.sub_models.push_back({"drift", {}, true, nullptr});
+    Eigen::MatrixXd series(n, 2);
+    series << noise_series, slow;
+    internal::FitLearners(model, series, series.rowwise().sum(), Eigen::MatrixXd(n, 0), n,
+                          Eigen::MatrixXd(), {}, 1);
+    return std::make_pair(model, series);
+  };
+  const auto [white_model, white_series] = fit(white, "noise");
+  ASSERT_TRUE(white_model.sub_models[0].mean.has_value());
+  EXPECT_EQ(white_model.sub_models[0].learner, nullptr);
+  EXPECT_EQ(*white_model.sub_models[0].mean, white.mean());
+  EXPECT_NE(white_model.sub_models[1].learner, nullptr);  // the drift group is not judged
+  EXPECT_FALSE(white_model.sub_models[1].mean.has_value());
+  // The prediction is the drift learner's plus the constant, at every horizon.
+  DriftModel drift_only = white_model;
+  drift_only.sub_models.erase(drift_only.sub_models.begin());
+  for (int horizon : {1, 5}) {
+    const Eigen::VectorXd with_mean =
+        PredictFromSeries(white_model, white_series, Eigen::MatrixXd(n, 0), 100, 50, horizon);
+    const Eigen::VectorXd alone = PredictFromSeries(drift_only, white_series.rightCols(1),
+                                                    Eigen::MatrixXd(n, 0), 100, 50, horizon);
+    EXPECT_LE(((with_mean - alone).array() - white.mean()).abs().maxCoeff(), 1e-12) << horizon;
+  }
+  const auto [ar_model, ar_series] = fit(ar, "noise");
+  EXPECT_NE(ar_model.sub_models[0].learner, nullptr);
+  EXPECT_FALSE(ar_model.sub_models[0].mean.has_value());
+  const auto [mixed_model, mixed_series] = fit(white, "mixed");
+  EXPECT_NE(mixed_model.sub_models[0].learner, nullptr);
 }
 
 // Several records are for the thermal method in compensate mode (its lag states restart at each);

@@ -539,6 +539,35 @@ TEST(ModelFile, RefusesToStoreWhatItCannotRebuild) {
   EXPECT_THROW(RenderModelFile(model, Info()), UsageError);
 }
 
+// A sub-model predicted by its training mean (version 7) comes back as one, with predictions
+// equal to the bit; a mean beside a learner, or a non-finite one, is refused; a version-6 file
+// (no "mean") reads as before.
+TEST(ModelFile, ASubModelPredictedByItsMeanComesBackExactly) {
+  const Log log = MakeLog(400, 42);
+  drift::DriftModel model =
+      drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kMsElm));
+  ASSERT_GE(model.sub_models.size(), 2u);
+  model.sub_models[0].learner = nullptr;
+  model.sub_models[0].mean = 0.1 + 1.0 / 3.0;
+  const std::string text = RenderModelFile(model, Info());
+  const LoadedModel loaded = ParseModelFile(text, "m.json");
+  ASSERT_TRUE(loaded.model.sub_models[0].mean.has_value());
+  EXPECT_EQ(*loaded.model.sub_models[0].mean, *model.sub_models[0].mean);
+  EXPECT_EQ(loaded.model.sub_models[0].learner, nullptr);
+  EXPECT_FALSE(loaded.model.sub_models[1].mean.has_value());
+  EXPECT_EQ(RenderModelFile(loaded.model, loaded.info), text);
+  const Log test = MakeLog(120, 43);
+  EXPECT_EQ(drift::PredictOneStep(model, test.rate, Eigen::VectorXd(), 20, drift::Protocol::kPaper),
+            drift::PredictOneStep(loaded.model, test.rate, Eigen::VectorXd(), 20,
+                                  drift::Protocol::kPaper));
+  json j = json::parse(text);
+  j["model"]["sub_models"][0]["mean"] = "nan";
+  ExpectRefused(Reseal(j), "mean' must be a finite number");
+  j = json::parse(text);
+  j["model"]["sub_models"][1]["mean"] = 0.5;
+  ExpectRefused(Reseal(j), "mean' is for a predict-mode sub-model without a learner");
+}
+
 TEST(ModelFile, FilesOnDisk) {
   const std::string dir = test::TempDir("model_file");
   const Log log = MakeLog(200, 31);

@@ -46,7 +46,7 @@ TEST(Criteria, KStarIsTheFirstMaximumOfTheDistance) {
 }
 
 // The noise run is the leading IMFs with G_k at or under the level: a later IMF under it does not
-// rejoin, and a NaN level ends the run. mixed_end = max(k_N, k*).
+// rejoin, and a NaN level ends the run. mixed_end = k*: the run never passes k*.
 TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   const SelectionOptions o = WithLevel({0.5, 0.5, 0.5, 0.5, 0.5});
   SelectionResult r = Curves({0.1, 0.5, 0.9, 0.1, 0.1}, 4);
@@ -59,10 +59,25 @@ TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   EXPECT_FALSE(r.noise_level_computed);
   EXPECT_EQ(r.note, "");
 
+  // Modes after k* are not judged: mode 2 is under the level but stays with the drift.
   r = Curves({0.1, 0.5, 0.9, 0.1, 0.1}, 1);
   PdfSimilarityBoundaries(100, o, {}, &r);
+  EXPECT_EQ(r.k_noise, 1);
+  EXPECT_EQ(r.mixed_end, 1);
+  EXPECT_EQ(r.note,
+            "noise run reaches k*: no mixed group (modes 2..2 also pass the white-noise test, "
+            "left to the drift group)");
+  r = Curves({0.1, 0.5, 0.1, 0.1, 0.1}, 2);
+  PdfSimilarityBoundaries(100, o, {}, &r);
+  EXPECT_EQ(r.k_noise, 2);
   EXPECT_EQ(r.mixed_end, 2);
-  EXPECT_EQ(r.note, "k* <= k_N: no mixed group, drift starts after k_N");
+  EXPECT_EQ(r.note,
+            "noise run reaches k*: no mixed group (modes 3..5 also pass the white-noise test, "
+            "left to the drift group)");
+  r = Curves({0.1, 0.9, 0.1, 0.1, 0.1}, 1);
+  PdfSimilarityBoundaries(100, o, {}, &r);
+  EXPECT_EQ(r.k_noise, 1);
+  EXPECT_EQ(r.note, "noise run reaches k*: no mixed group");
 
   r = Curves({0.9, 0.1, 0.1, 0.1, 0.1}, 3);
   PdfSimilarityBoundaries(100, o, {}, &r);
