@@ -61,6 +61,40 @@ TEST_F(EvaluateCli, CompensateTableAgainstTruth) {
   EXPECT_EQ(json["result"]["rows"][0]["rmse"].get<double>(), rmse[0]);
 }
 
+// Every table opens with none and constant, scores against the measured output beside the
+// truth, and gives the share of the slow variation removed (10-min blocks: a 40-min log).
+TEST_F(EvaluateCli, ReferencesBaselinesAndSlowVariationInEveryTable) {
+  const std::string log = dir_ + "/long.csv", out = dir_ + "/base.csv";
+  io::WriteFileAtomically(log, test::ThermalLogCsv(2400, 2));
+  const auto r = test::RunCli("evaluate '" + log +
+                              "' -t rate_dph --truth drift_dph --mode predict --protocol causal "
+                              "--methods persistence,trailing-mean,exp-smoothing,kalman-level,"
+                              "kalman-trend --horizon 10 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("slow_rm"), std::string::npos) << r.out;
+  const std::string text = io::ReadTextFile(out);
+  EXPECT_EQ(text.substr(0, text.find('\n')),
+            "method,protocol,rmse,rmse_std,mae,max_abs,rmse_measured,slow_removed,train_s,"
+            "predict_s");
+  const auto table = io::CsvTable::Parse(text, out);
+  ASSERT_EQ(table.rows(), 7);
+  EXPECT_EQ(text.find("\nnone,causal,"), text.find('\n'));  // the first row
+  EXPECT_NE(text.find("\nconstant,causal,"), std::string::npos);
+  EXPECT_NE(text.find("\nkalman-trend,causal,"), std::string::npos);
+  const Eigen::VectorXd slow = table.Column("slow_removed"), rmse = table.Column("rmse"),
+                        measured = table.Column("rmse_measured");
+  EXPECT_EQ(slow[0], 0.0);  // doing nothing removes nothing
+  for (Eigen::Index i = 0; i < 7; ++i) {
+    EXPECT_TRUE(std::isfinite(slow[i]));
+    EXPECT_LE(slow[i], 1.0);
+    EXPECT_GT(measured[i], rmse[i]);  // the measured output carries the white noise too
+  }
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["result"]["slow_variation_block_s"], 600.0);
+  EXPECT_EQ(json["result"]["rows"][1]["method"], "constant");
+  EXPECT_EQ(json["result"]["rows"][1]["slow_removed"].get<double>(), slow[1]);
+}
+
 TEST_F(EvaluateCli, HorizonScoresPredictionsAhead) {
   const std::string one = dir_ + "/h1.csv", ahead = dir_ + "/h8.csv";
   const std::string run = "evaluate '" + input_ +

@@ -54,7 +54,10 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // "threads" scalar of ELM and SVR learners): they are how a fit ran (common/execution.h), never
 // part of the model, whose every bit is the same for any count. Older files still load, the
 // counts read and dropped; a version-6 file that holds one is refused as an unknown field.
-inline constexpr int kModelFormatVersion = 6;
+// Version 7 adds the baselines (drift/baseline.h: methods none, constant, persistence,
+// trailing-mean, exp-smoothing, kalman-level, kalman-trend), whose one sub-model holds a
+// "baseline" (its parameters) and no learner; every other model's content is that of version 6.
+inline constexpr int kModelFormatVersion = 7;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 
