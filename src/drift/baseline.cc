@@ -5,7 +5,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <fmt/core.h>
+#include <cstdarg>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -20,6 +21,16 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kLongestWindow = 4096;
+
+// printf into a string (the core links no formatting library).
+std::string Format(const char* format, ...) {
+  char buffer[256];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_end(args);
+  return buffer;
+}
 
 bool IsKalman(Method m) { return m == Method::kKalmanLevel || m == Method::kKalmanTrend; }
 
@@ -111,7 +122,7 @@ Baseline FitKalman(Method method, const Eigen::Ref<const Eigen::VectorXd>& y) {
   };
   // Whole decades, then eighths of a decade within one of the best.
   const int slope_lo = trend ? -20 : 0, slope_hi = trend ? -2 : 0;
-  for (int l = -12; l <= 2; ++l) {
+  for (int l = -16; l <= 2; ++l) {
     for (int s = slope_lo; s <= slope_hi; ++s) consider(l, s);
   }
   const double centre_l = best_l, centre_s = best_s;
@@ -199,8 +210,8 @@ void Baseline::Validate() const {
   if (!IsBaseline(method)) {
     throw DataError("baseline: method " + std::string(ToString(method)) + " is not a baseline");
   }
-  auto fail = [](const std::string& field, double value, const std::string& rule) {
-    throw DataError(fmt::format("baseline {} = {}: must be {}", field, value, rule));
+  auto fail = [](const char* field, double value, const std::string& rule) {
+    throw DataError(Format("baseline %s = %.17g: must be %s", field, value, rule.c_str()));
   };
   if (method == Method::kConstant && !std::isfinite(constant)) fail("constant", constant, "finite");
   if (method == Method::kTrailingMean && (window < 1 || window > kLongestWindow)) {
@@ -225,24 +236,24 @@ std::string Baseline::Summary() const {
     case Method::kNone:
       return "zero estimate (doing nothing)";
     case Method::kConstant:
-      return fmt::format("training mean {:.6g}", constant);
+      return Format("training mean %.6g", constant);
     case Method::kPersistence:
       return "the last sample";
     case Method::kTrailingMean:
-      return fmt::format("mean of the last {} samples (one-step validation RMSE {:.4g})", window,
-                         criterion);
+      return Format("mean of the last %d samples (one-step validation RMSE %.4g)", window,
+                    criterion);
     case Method::kExpSmoothing:
-      return fmt::format("exponential smoothing, alpha {:.4g} (one-step validation RMSE {:.4g})",
-                         alpha, criterion);
+      return Format("exponential smoothing, alpha %.4g (one-step validation RMSE %.4g)", alpha,
+                    criterion);
     case Method::kKalmanLevel:
-      return fmt::format(
-          "Kalman local level: level step sd {:.4g}, noise sd {:.4g} (maximum likelihood, "
-          "log-likelihood {:.6g})",
+      return Format(
+          "Kalman local level: level step sd %.4g, noise sd %.4g (maximum likelihood, "
+          "log-likelihood %.6g)",
           std::sqrt(level_var), std::sqrt(noise_var), criterion);
     case Method::kKalmanTrend:
-      return fmt::format(
-          "Kalman local linear trend: level step sd {:.4g}, slope step sd {:.4g}, noise sd {:.4g} "
-          "(maximum likelihood, log-likelihood {:.6g})",
+      return Format(
+          "Kalman local linear trend: level step sd %.4g, slope step sd %.4g, noise sd %.4g "
+          "(maximum likelihood, log-likelihood %.6g)",
           std::sqrt(level_var), std::sqrt(slope_var), std::sqrt(noise_var), criterion);
     default:
       return "";
@@ -306,10 +317,12 @@ Eigen::VectorXd ForecastBaseline(const Baseline& baseline,
   const Eigen::Index first_origin = first - horizon + 1;
   const Eigen::Index end = first_origin + count - 1;  // the last origin: reads y[0 .. end - 1]
   if (horizon < 1 || count < 0 || first_origin < 1 || end > y.size()) {
-    throw DataError(fmt::format(
-        "{} forecast of samples {}..{} {} step(s) ahead needs samples 1..{} before them, {} given",
-        ToString(baseline.method), first + 1, first + count, horizon, std::max<Eigen::Index>(1, end),
-        y.size()));
+    throw DataError(Format(
+        "%s forecast of samples %lld..%lld %d step(s) ahead needs samples 1..%lld before them, "
+        "%lld given",
+        std::string(ToString(baseline.method)).c_str(), static_cast<long long>(first + 1),
+        static_cast<long long>(first + count), horizon,
+        static_cast<long long>(std::max<Eigen::Index>(1, end)), static_cast<long long>(y.size())));
   }
   if (count == 0) return Eigen::VectorXd(0);
   RequireFiniteSignal("target", y.head(end), 1);

@@ -78,13 +78,17 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   }
   // Tables: a row per method and protocol.
   const std::set<std::string> predict = Pairs(dir + "/predict_table.csv");
-  EXPECT_EQ(predict.size(), 12u);
+  EXPECT_EQ(predict.size(), 26u);  // and none, constant and the five filters of the output
   for (const char* m : kMethods) {
     EXPECT_TRUE(predict.count(std::string(m) + "/paper")) << m;
     EXPECT_TRUE(predict.count(std::string(m) + "/causal")) << m;
   }
   const std::set<std::string> compensate = Pairs(dir + "/compensate_table.csv");
-  EXPECT_EQ(compensate.size(), 7u);  // and the compensate-only thermal method
+  EXPECT_EQ(compensate.size(), 9u);  // and thermal, none and constant
+  EXPECT_TRUE(compensate.count("none/train A test B"));
+  EXPECT_TRUE(compensate.count("constant/train A test B"));
+  EXPECT_TRUE(predict.count("kalman-trend/causal"));
+  EXPECT_FALSE(test::FileExists(dir + "/models/none_compensate.json"));
   for (const char* m : kMethods)
     EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
   EXPECT_TRUE(compensate.count("thermal/train A test B"));

@@ -39,7 +39,7 @@ TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   EXPECT_NE(r.out.find("wrote " + model), std::string::npos) << r.out;
   const auto json = nlohmann::json::parse(io::ReadTextFile(model));
   EXPECT_EQ(json["format"], "gyrodrift-model");
-  EXPECT_EQ(json["format_version"], 6);
+  EXPECT_EQ(json["format_version"], 7);
   EXPECT_EQ(json["training"]["target_column"], "rate_dph");
   EXPECT_EQ(json["training"]["temperature_column"], "temperature_c");
   EXPECT_EQ(json["training"]["samples"], 400);

@@ -18,15 +18,15 @@
 // against the measured samples y[j], j in [N/4, N) (the first quarter warms the filters up; the
 // smallest W or largest alpha wins a tie). The Kalman variances maximise the likelihood, the
 // observation variance concentrated out (Harvey 3.4.5): the ratios q/r (level, and slope for the
-// trend model) on a grid of whole decades (level 1e-12..1e2, slope 1e-20..1e-2), then refined to
+// trend model) on a grid of whole decades (level 1e-16..1e2, slope 1e-20..1e-2), then refined to
 // 1/8 decade within a decade of the best. Initialisation is diffuse (prior variance 1e7 r, the
 // first one or two innovations left out of the likelihood).
 // All forecasts are causal by construction: the prediction of y[t] made h steps ahead, from the
 // origin o = t - h + 1, reads y[0 .. o-1] only. h steps ahead every baseline is flat (its level)
 // but kalman-trend, which adds h slopes.
 // Units: those of y (variances in y's units squared, per sample). Cost: a forecast is O(N); a fit
-// O(N) per candidate: 17 windows, 29 smoothing constants, 31 level ratios (kalman-level) or
-// 285 + 288 pairs of level and slope ratios (kalman-trend).
+// O(N) per candidate: 17 windows, 29 smoothing constants, 35 level ratios (kalman-level) or
+// 361 + 288 pairs of level and slope ratios (kalman-trend).
 #pragma once
 
 #include <Eigen/Core>
