@@ -250,10 +250,14 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
 }
 
 void AllanStep(StudyResult& s) {
-  // The compensated output: MS-ELM if it ran (causal row for a split), else the first method.
+  // The compensated output: MS-ELM if it ran (causal row for a split), else the first method
+  // that is not a reference.
   const StudyResult::CompensateRow* best = nullptr;
   for (const auto& r : s.compensate) {
     if (r.method == drift::Method::kMsElm && (r.protocol != "paper")) best = &r;
+  }
+  for (const auto& r : s.compensate) {
+    if (!best && !drift::IsBaseline(r.method)) best = &r;
   }
   if (!best && !s.compensate.empty()) best = &s.compensate.front();
   s.compensated_by =

@@ -123,9 +123,11 @@ TEST(DemoCli, UserLogStudy) {
   EXPECT_NE(r.out.find("from the median step of time_s"), std::string::npos) << r.out;
   EXPECT_FALSE(test::FileExists(work + "/out/run_a.csv"));  // no simulation
   const std::set<std::string> compensate = Pairs(work + "/out/compensate_table.csv");
-  EXPECT_EQ(compensate, (std::set<std::string>{"ms-elm/paper", "ms-elm/causal", "elm/paper",
-                                               "elm/causal", "poly/paper", "poly/causal"}));
-  EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 6u);
+  EXPECT_EQ(compensate,
+            (std::set<std::string>{"none/paper", "none/causal", "constant/paper", "constant/causal",
+                                   "ms-elm/paper", "ms-elm/causal", "elm/paper", "elm/causal",
+                                   "poly/paper", "poly/causal"}));
+  EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 20u);  // and the 5 filters
   const std::string html = io::ReadTextFile(work + "/out/report.html");
   const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
