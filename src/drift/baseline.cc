@@ -102,8 +102,7 @@ Likelihood ConcentratedLikelihood(const Eigen::Ref<const Eigen::VectorXd>& y, bo
   out.noise_var = weighted / static_cast<double>(m);
   if (!(out.noise_var > 0.0)) return out;  // a series the model fits exactly: no likelihood
   const double md = static_cast<double>(m);
-  out.log_likelihood =
-      -0.5 * (md * std::log(2.0 * std::numbers::pi * out.noise_var) + md + log_f);
+  out.log_likelihood = -0.5 * (md * std::log(2.0 * std::numbers::pi * out.noise_var) + md + log_f);
   return out;
 }
 
@@ -222,7 +221,8 @@ void Baseline::Validate() const {
   }
   if (IsKalman(method)) {
     if (!(noise_var > 0.0 && std::isfinite(noise_var))) fail("noise_var", noise_var, "> 0, finite");
-    if (!(level_var >= 0.0 && std::isfinite(level_var))) fail("level_var", level_var, ">= 0, finite");
+    if (!(level_var >= 0.0 && std::isfinite(level_var)))
+      fail("level_var", level_var, ">= 0, finite");
     if (!(slope_var >= 0.0 && std::isfinite(slope_var)) ||
         (method == Method::kKalmanLevel && slope_var != 0.0)) {
       fail("slope_var", slope_var,

@@ -150,7 +150,8 @@ TEST_F(PredictCli, BaselinesRoundTripThroughTheModelFile) {
   const io::CsvTable predicted = io::CsvTable::Read(out);
   EXPECT_EQ(predicted.rows(), 120 - 3);
   EXPECT_EQ(predicted.Column("prediction"),
-            drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 3, 3, drift::Protocol::kCausal));
+            drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 3, 3,
+                                drift::Protocol::kCausal));
   // The filters forecast the output: compensate mode refuses them, naming the mode to use.
   const auto refused = test::RunCli("fit '" + Dir() + "/train.csv' -t rate_dph -T temperature_c "
                                     "--mode compensate -m exp-smoothing -o '" + Dir() + "/x.json'");

@@ -213,7 +213,8 @@ TEST(Baseline, RunsAsADriftModelInBothModes) {
   EXPECT_EQ(EstimateDrift(constant, temperature),
             Eigen::VectorXd::Constant(800, y.head(500).mean()));
   o.method = Method::kNone;
-  EXPECT_EQ(EstimateDrift(FitDriftModel(y, temperature, o), temperature), Eigen::VectorXd::Zero(800));
+  EXPECT_EQ(EstimateDrift(FitDriftModel(y, temperature, o), temperature),
+            Eigen::VectorXd::Zero(800));
   o.method = Method::kPersistence;
   EXPECT_THROW(FitDriftModel(y, temperature, o), UsageError);
   EXPECT_FALSE(SupportsMode(Method::kKalmanTrend, Mode::kCompensate));

@@ -177,8 +177,8 @@ INSTANTIATE_TEST_SUITE_P(
 // A baseline's parameters are checked on reading; a learner's model cannot claim one.
 TEST(ModelFile, ABaselineOutOfRangeOrMisplacedIsRefused) {
   const Log log = MakeLog(260, 13);
-  const drift::DriftModel model =
-      drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kExpSmoothing));
+  const drift::DriftModel model = drift::FitDriftModel(
+      log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kExpSmoothing));
   json j = json::parse(RenderModelFile(model, Info()));
   j["model"]["sub_models"][0]["baseline"]["alpha"] = 2.0;
   ExpectRefused(Reseal(j), "baseline alpha = 2: must be in (0, 1]");

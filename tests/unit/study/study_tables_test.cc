@@ -68,8 +68,8 @@ TEST(PredictTable, OneRowPerEvaluationRowInItsOrder) {
   internal::FillPredictTable(s);
   const Table& t = s.predict_table;
   EXPECT_EQ(t.header,
-            (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs", "rmse_measured",
-                                      "slow_removed_%", "train_s", "predict_s"}));
+            (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs",
+                                      "rmse_measured", "slow_removed_%", "train_s", "predict_s"}));
   ASSERT_EQ(t.csv.size(), 3u);
   ASSERT_EQ(t.shown.size(), 3u);
   for (size_t i = 0; i < t.csv.size(); ++i) EXPECT_EQ(t.csv[i].size(), t.header.size()) << i;

@@ -201,7 +201,8 @@ TEST(Study, ShortSimulationComparesRunsAAndB) {
       EXPECT_GT(row.share_removed, 0.5);
     }
   }
-  EXPECT_EQ(s.compensated_by, "poly (train A test B)");  // the first method (no ms-elm), not a reference
+  // The first method (no ms-elm) that is not a reference.
+  EXPECT_EQ(s.compensated_by, "poly (train A test B)");
   EXPECT_EQ(s.terms_table.header.back(), "simulator setting");
   const std::set<std::string> names = Names(RenderStudyFiles(s, test::FakeDygraphs()));
   EXPECT_TRUE(names.count("run_a.csv") && names.count("run_b.csv"));
