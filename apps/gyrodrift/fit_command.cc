@@ -89,6 +89,7 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
           sub.name, *sub.mean);
       continue;
     }
+    if (sub.baseline) continue;  // the summary line above says it all
     fmt::print(
         "  {:<8} {}\n", sub.name,
         sub.learner ? sub.learner->Summary() : "zero (noise carries no thermal information)");
@@ -215,7 +216,9 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/true);
   BindSetting(cmd->add_option("--method,-m", args->method,
-                              "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp (auto: ms-elm in "
+                              "auto|ms-elm|thermal|elm|emd-elm|poly|svr|bp, the predict-mode "
+                              "baselines persistence|trailing-mean|exp-smoothing|kalman-level|"
+                              "kalman-trend, or the references none|constant (auto: ms-elm in "
                               "predict mode, thermal in compensate mode)")
                   ->capture_default_str(),
               {"method"});

@@ -240,8 +240,9 @@ class DriftModel:
     sub_models = property(
         lambda self: self._core.sub_models,
         doc="Sub-models: name, imfs, learner summary (None for one predicted by its training "
-            "``mean``), and for identified thermal models "
-            "``thermal`` (regressors named by the temperature columns, coefficients, sd).")
+            "``mean``), baseline summary (the baselines' one sub-model), and for identified "
+            "thermal models ``thermal`` (regressors named by the temperature columns, "
+            "coefficients, sd).")
     mode = property(lambda self: self._core.mode)
     method = property(lambda self: self._core.method)
     target = property(lambda self: self._core.target)
@@ -304,18 +305,21 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
     paper and causal protocols (predict mode), against ``truth`` when given (else the output).
 
-    ``methods`` is "all" or a list (or comma-separated string) of method names; the model
+    ``methods`` is "all" or a list (or comma-separated string) of method names; the references
+    "none" (a zero estimate) and "constant" (the training mean) are always scored first. The model
     keywords are ``DriftModel.fit``'s; ``progress`` as for ``decompose``. Returns a dict:
-    ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, train_s,
-    predict_s, the last repeat's ``estimate`` on the test block, model_summary, notes),
-    ``first_test_sample``, ``reference`` (what the rows were scored against), ``table`` (text).
+    ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, rmse_measured
+    (against the output itself), slow_removed (share of the slow variation, 10-min block means,
+    removed; nan on a test block shorter than 10 min), train_s, predict_s, the last repeat's
+    ``estimate`` on the test block, model_summary, notes), ``first_test_sample``, ``reference``
+    (what the rows were scored against), ``table`` (text).
 
     >>> import gyrodrift as gd
     >>> sim = gd.simulate(duration=7200, seed=3)
     >>> r = gd.evaluate(sim["rate_dph"], truth=sim["truth"]["drift_dph"], methods=["poly"],
     ...                 protocol="paper")
-    >>> r["rows"][0]["method"], r["first_test_sample"]
-    ('poly', 5040)
+    >>> [row["method"] for row in r["rows"]], r["first_test_sample"]
+    (['none', 'constant', 'poly'], 5040)
     """
     return _gyrodrift.evaluate(
         y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,

@@ -819,6 +819,7 @@ class PyDriftModel {
       d["has_residue"] = sub.has_residue;
       d["learner"] = sub.learner ? py::cast(sub.learner->Summary()) : py::none();
       d["mean"] = sub.mean ? py::cast(*sub.mean) : py::none();
+      d["baseline"] = sub.baseline ? py::cast(sub.baseline->Summary()) : py::none();
       if (sub.thermal) {
         const drift::ThermalRegression& t = *sub.thermal;
         Eigen::VectorXd sd(t.coefficients.size());
@@ -981,6 +982,8 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
     row["rmse_std"] = r.rmse_std;
     row["mae"] = r.mae;
     row["max_abs"] = r.max_abs;
+    row["rmse_measured"] = r.rmse_measured;
+    row["slow_removed"] = r.slow_removed;
     row["train_s"] = r.train_s;
     row["predict_s"] = r.predict_s;
     row["estimate"] = ToArray(r.estimate);

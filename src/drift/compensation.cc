@@ -57,6 +57,13 @@ Eigen::MatrixXd EstimateDriftWithSd(const DriftModel& model,
       continue;
     }
     every_band = false;
+    if (sub.baseline) {
+      // none or constant: no temperature dependence, so nothing is left relative to a reference.
+      if (!referenced && sub.baseline->method == Method::kConstant) {
+        out.col(0).array() += sub.baseline->constant;
+      }
+      continue;
+    }
     if (!sub.learner) continue;
     if (f.size() == 0) {
       const FeatureOptions features = EffectiveFeatures(model.options);

@@ -277,6 +277,21 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   }
   DriftOptions o = options;
   o.features = ForTrainingRecord(o.features, y.size());
+  if (IsBaseline(o.method)) {
+    // A filter of y itself (baseline.h): one sub-model, no decomposition, no learner.
+    DriftModel model;
+    model.options = o;
+    model.lags = o.mode == Mode::kPredict ? 1 : 0;
+    model.training_samples = y.size();
+    auto baseline = std::make_shared<const Baseline>(FitBaseline(o.method, y));
+    model.sub_models.push_back({"signal", {}, true, nullptr, nullptr, std::move(baseline)});
+    if (model.uses_temperature()) {
+      model.temperature_min_c = temperature_c.col(0).minCoeff();
+      model.temperature_max_c = temperature_c.col(0).maxCoeff();
+    }
+    execution.Report(1.0, "fit sub-models");
+    return model;
+  }
   internal::SubSeries prepared = internal::PrepareSubSeries(y, o, execution);
   const Eigen::MatrixXd thermal = internal::ThermalOrEmpty(prepared.model, temperature_c, y.size());
   const bool decomposed = UsesDecomposition(options.method);

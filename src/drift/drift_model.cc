@@ -23,7 +23,7 @@ constexpr std::array<std::pair<Mode, std::string_view>, 2> kModes{{
     {Mode::kPredict, "predict"},
     {Mode::kCompensate, "compensate"},
 }};
-constexpr std::array<std::pair<Method, std::string_view>, 7> kMethods{{
+constexpr std::array<std::pair<Method, std::string_view>, 14> kMethods{{
     {Method::kMsElm, "ms-elm"},
     {Method::kElm, "elm"},
     {Method::kEmdElm, "emd-elm"},
@@ -31,6 +31,13 @@ constexpr std::array<std::pair<Method, std::string_view>, 7> kMethods{{
     {Method::kSvr, "svr"},
     {Method::kBp, "bp"},
     {Method::kThermal, "thermal"},
+    {Method::kPersistence, "persistence"},
+    {Method::kTrailingMean, "trailing-mean"},
+    {Method::kExpSmoothing, "exp-smoothing"},
+    {Method::kKalmanLevel, "kalman-level"},
+    {Method::kKalmanTrend, "kalman-trend"},
+    {Method::kNone, "none"},
+    {Method::kConstant, "constant"},
 }};
 constexpr std::array<std::pair<Protocol, std::string_view>, 2> kProtocols{{
     {Protocol::kPaper, "paper"},
@@ -52,13 +59,20 @@ Protocol ProtocolFromString(std::string_view name) {
 }
 
 bool SupportsMode(Method method, Mode mode) {
-  return method != Method::kThermal || mode == Mode::kCompensate;
+  if (method == Method::kThermal) return mode == Mode::kCompensate;
+  // The filters forecast the measured output, which a compensation never has at run time.
+  if (IsBaseline(method) && method != Method::kNone && method != Method::kConstant) {
+    return mode == Mode::kPredict;
+  }
+  return true;
 }
+
+std::vector<Method> ReferenceMethods() { return {Method::kNone, Method::kConstant}; }
 
 std::vector<Method> AllMethods(Mode mode) {
   std::vector<Method> all;
   for (const auto& [m, name] : kMethods) {
-    if (SupportsMode(m, mode)) all.push_back(m);
+    if (SupportsMode(m, mode) && m != Method::kNone && m != Method::kConstant) all.push_back(m);
   }
   return all;
 }
@@ -92,8 +106,11 @@ void DriftOptions::Validate() const {
   if (reference_c) RequireInRange("reference_c", *reference_c, -100.0, 200.0);
   if (!SupportsMode(method, mode)) {
     ThrowOption("method", std::string(ToString(method)),
-                "a method of " + std::string(ToString(mode)) +
-                    " mode (thermal identifies a compensation model: mode = compensate)");
+                "a method of " + std::string(ToString(mode)) + " mode (" +
+                    (method == Method::kThermal
+                         ? "thermal identifies a compensation model: mode = compensate"
+                         : "a filter of the measured output forecasts it: mode = predict") +
+                    ")");
   }
   ValidateNested("thermal", [&] { thermal.Validate(); });
   LearnerOptions l = learner;
@@ -109,7 +126,7 @@ void DriftOptions::Validate() const {
 }
 
 bool DriftOptions::uses_temperature() const {
-  return mode == Mode::kCompensate || features.use_temperature;
+  return mode == Mode::kCompensate || (features.use_temperature && !IsBaseline(method));
 }
 
 int DriftModel::temperature_channels() const {
@@ -130,6 +147,11 @@ int DriftModel::num_inputs() const {
 }
 
 std::string DriftModel::Summary() const {
+  if (sub_models.size() == 1 && sub_models.front().baseline) {
+    return std::string(ToString(options.method)) + " (" + std::string(ToString(options.mode)) +
+           "): " + sub_models.front().baseline->Summary() + ", trained on " +
+           std::to_string(training_samples) + " samples";
+  }
   std::string s = std::string(ToString(options.method)) + " (" +
                   std::string(ToString(options.mode)) + "): " + std::to_string(sub_models.size()) +
                   " sub-model" + (sub_models.size() == 1 ? "" : "s") + " [";

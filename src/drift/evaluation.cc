@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "drift/fit_steps.h"
 #include "drift/prediction_steps.h"
@@ -37,6 +40,12 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
                const Execution& windows) {
   const Execution fit{.threads = windows.threads};  // a trial's fit reports nothing
   DriftOptions o = given;
+  // The references read no temperature: the first channel serves for the record's length, so
+  // that they score beside identified models of several channels.
+  if (IsBaseline(o.method) && temperature_c.cols() > 1) {
+    return RunTrial(y, Eigen::MatrixXd(temperature_c.leftCols(1)), given, protocol, split, horizon,
+                    causal, windows);
+  }
   o.features = ForTrainingRecord(o.features, split);  // as FitDriftModel does on the block
   const Eigen::Index n = y.size();
   const Eigen::Index test = n - split;
@@ -108,6 +117,40 @@ void EvaluationOptions::Validate() const {
   internal::RequireHorizon(horizon);
 }
 
+std::vector<Method> EvaluatedMethods(const EvaluationOptions& options) {
+  std::vector<Method> methods = ReferenceMethods();
+  for (Method m : options.methods) {
+    if (std::find(methods.begin(), methods.end(), m) == methods.end()) methods.push_back(m);
+  }
+  return methods;
+}
+
+double SlowVariation(const Eigen::Ref<const Eigen::VectorXd>& x, double rate_hz, double block_s) {
+  RequireInRange("rate_hz", rate_hz, 1e-9, 1e9);
+  RequireInRange("block_s", block_s, 1e-9, 1e12);
+  const auto block = std::max<Eigen::Index>(1, std::llround(block_s * rate_hz));
+  const Eigen::Index blocks = x.size() / block;
+  if (blocks == 0) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0.0;
+  for (Eigen::Index b = 0; b < blocks; ++b) {
+    const double mean = x.segment(b * block, block).mean();
+    sum += mean * mean;
+  }
+  return std::sqrt(sum / static_cast<double>(blocks));
+}
+
+double SlowVariationRemoved(const Eigen::Ref<const Eigen::VectorXd>& reference,
+                            const Eigen::Ref<const Eigen::VectorXd>& estimate, double rate_hz,
+                            double block_s) {
+  if (reference.size() != estimate.size()) {
+    throw DataError("slow variation: the estimate has " + std::to_string(estimate.size()) +
+                    " samples, the reference " + std::to_string(reference.size()));
+  }
+  const double before = SlowVariation(reference, rate_hz, block_s);
+  if (!(before > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return 1.0 - SlowVariation(reference - estimate, rate_hz, block_s) / before;
+}
+
 EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                           const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                           const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
@@ -122,6 +165,13 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   }
   RequireFiniteSignal("target", y, 64);
   const Eigen::Index n = y.size();
+  const std::vector<Method> methods = EvaluatedMethods(options);
+  for (Method m : methods) {
+    if (!SupportsMode(m, base.mode)) {
+      ThrowOption("methods", std::string(ToString(m)),
+                  "methods of " + std::string(ToString(base.mode)) + " mode");
+    }
+  }
   const bool thermal_needed = base.uses_temperature();
   if (thermal_needed) {
     if (temperature_c.rows() != n || temperature_c.cols() < 1) {
@@ -133,7 +183,8 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
       RequireFiniteSignal("temperature", temperature_c.col(c), n);
     }
     // Several channels serve only identified models: refused before any fit.
-    for (Method method : options.methods) {
+    for (Method method : methods) {
+      if (IsBaseline(method)) continue;  // reads no temperature (RunTrial)
       DriftOptions o = base;
       o.method = method;
       internal::RequireChannelsFor(o, temperature_c.cols());
@@ -177,10 +228,11 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
   result.against_truth = truth.size() != 0;
   result.reference = result.against_truth ? Eigen::VectorXd(truth.tail(n - split))
                                           : Eigen::VectorXd(y.tail(n - split));
-  const double total = static_cast<double>(options.methods.size() * options.protocols.size() *
+  const Eigen::VectorXd measured = y.tail(n - split);
+  const double total = static_cast<double>(methods.size() * options.protocols.size() *
                                            static_cast<size_t>(options.repeats));
   double done = 0;
-  for (Method method : options.methods) {
+  for (Method method : methods) {
     // Single models never decompose: both protocols are the same computation, run once.
     std::vector<EvaluationRow> computed;
     for (Protocol protocol : options.protocols) {
@@ -217,6 +269,10 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
         rmse.push_back(m.rmse);
         row.mae += m.mae / options.repeats;
         row.max_abs += m.max_abs / options.repeats;
+        row.rmse_measured += ComputeMetrics(trial.estimate - measured).rmse / options.repeats;
+        row.slow_removed += SlowVariationRemoved(result.reference, trial.estimate,
+                                                 base.features.rate_hz) /
+                            options.repeats;
         row.train_s += trial.train_s / options.repeats;
         row.predict_s += trial.predict_s / options.repeats;
         row.estimate = trial.estimate;
@@ -242,15 +298,21 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
 
 std::string EvaluationResult::Table() const {
   std::string out;
-  char line[256];
-  std::snprintf(line, sizeof(line), "%-8s %-7s %12s %12s %12s %12s %9s %10s\n", "method",
-                "protocol", "rmse", "rmse_std", "mae", "max_abs", "train_s", "predict_s");
+  char line[320];
+  std::snprintf(line, sizeof(line), "%-13s %-8s %12s %12s %12s %12s %13s %8s %9s %10s\n", "method",
+                "protocol", "rmse", "rmse_std", "mae", "max_abs", "rmse_measured", "slow_rm",
+                "train_s", "predict_s");
   out += line;
   for (const auto& r : rows) {
-    std::snprintf(line, sizeof(line), "%-8s %-7s %12.6g %12.3g %12.6g %12.6g %9.3f %10.3f\n",
+    char slow[32] = "-";  // shorter than one 10-min block
+    if (std::isfinite(r.slow_removed)) {
+      std::snprintf(slow, sizeof(slow), "%.1f%%", 100.0 * r.slow_removed);
+    }
+    std::snprintf(line, sizeof(line),
+                  "%-13s %-8s %12.6g %12.3g %12.6g %12.6g %13.6g %8s %9.3f %10.3f\n",
                   std::string(ToString(r.method)).c_str(),
                   std::string(ToString(r.protocol)).c_str(), r.rmse, r.rmse_std, r.mae, r.max_abs,
-                  r.train_s, r.predict_s);
+                  r.rmse_measured, slow, r.train_s, r.predict_s);
     out += line;
   }
   return out;

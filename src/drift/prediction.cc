@@ -88,6 +88,9 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
                     std::to_string(horizon) + " steps ahead needs " + std::to_string(needed) +
                     " samples before it");
   }
+  if (const auto& baseline = model.sub_models.front().baseline) {
+    return ForecastBaseline(*baseline, series.col(0), first, count, horizon);
+  }
   const Eigen::Index origin = first - (horizon - 1);
   std::vector<Eigen::MatrixXd> lags(model.sub_models.size());
   for (size_t g = 0; g < lags.size(); ++g) {

@@ -576,6 +576,12 @@ void RequireExportable(const std::vector<LoadedModel>& axes) {
                        "need only temperature (fit in mode compensate)");
     }
     for (const drift::SubModel& sub : model.sub_models) {
+      if (sub.baseline) {
+        throw UsageError(fmt::format(
+            "{} is a {} model, a reference for evaluation: export takes method thermal, ms-elm or "
+            "emd-elm",
+            axis, drift::ToString(model.options.method)));
+      }
       if (sub.learner) {
         throw UsageError(fmt::format(
             "{}: sub-model '{}' is a {} learner on thermal features, not an identified thermal "

@@ -212,10 +212,18 @@ json ThermalJson(const drift::ThermalRegression& t) {
   return j;
 }
 
+json BaselineJson(const drift::Baseline& b) {
+  return {{"constant", Number(b.constant)},   {"window", b.window},
+          {"alpha", Number(b.alpha)},         {"level_var", Number(b.level_var)},
+          {"slope_var", Number(b.slope_var)}, {"noise_var", Number(b.noise_var)},
+          {"criterion", Number(b.criterion)}};
+}
+
 json ModelJson(const drift::DriftModel& model) {
   json subs = json::array();
   for (const auto& sub : model.sub_models) {
-    if (!sub.learner && !sub.mean && model.options.mode == drift::Mode::kPredict) {
+    if (!sub.learner && !sub.mean && !sub.baseline &&
+        model.options.mode == drift::Mode::kPredict) {
       throw UsageError("sub-model '" + sub.name +
                        "' has no learner: a predict-mode model needs one per sub-model (or its "
                        "mean)");
@@ -225,8 +233,10 @@ json ModelJson(const drift::DriftModel& model) {
               {"has_residue", sub.has_residue},
               {"learner", sub.learner ? LearnerJson(*sub.learner) : json(nullptr)},
               {"thermal", sub.thermal ? ThermalJson(*sub.thermal) : json(nullptr)}};
-    // Written only for a sub-model predicted by its mean (version 7), so others are unchanged.
+    // Written only for a sub-model predicted by its mean, or a baseline's, so others are those
+    // of version 6.
     if (sub.mean) j["mean"] = Number(*sub.mean);
+    if (sub.baseline) j["baseline"] = BaselineJson(*sub.baseline);
     subs.push_back(std::move(j));
   }
   return {{"lags", model.lags},
@@ -687,6 +697,30 @@ drift::DriftModel ReadModel(const Node& root) {
       if (k < 1) s["imfs"].Fail("holds IMF " + std::to_string(k) + ": IMF indices start at 1");
     }
     sub.has_residue = s["has_residue"].Bool();
+    const bool baseline = drift::IsBaseline(model.options.method);
+    if (baseline != s.raw().contains("baseline")) {
+      s.Fail(baseline ? "has no \"baseline\": method " +
+                            std::string(drift::ToString(model.options.method)) + " needs one"
+                      : "has a \"baseline\", which only a baseline method's model has");
+    }
+    if (baseline) {
+      const Node n = s["baseline"];
+      drift::Baseline b;
+      b.method = model.options.method;
+      b.constant = n["constant"].Double();
+      b.window = static_cast<int>(n["window"].Int(0, std::numeric_limits<int>::max()));
+      b.alpha = n["alpha"].Double();
+      b.level_var = n["level_var"].Double();
+      b.slope_var = n["slope_var"].Double();
+      b.noise_var = n["noise_var"].Double();
+      b.criterion = n["criterion"].Double();
+      try {
+        b.Validate();
+      } catch (const DataError& e) {
+        n.Fail(std::string("does not rebuild: ") + e.what());
+      }
+      sub.baseline = std::make_shared<const drift::Baseline>(b);
+    }
     const Node learner = s["learner"];
     if (s.raw().contains("mean")) {
       const double mean = s["mean"].Double();
@@ -696,7 +730,9 @@ drift::DriftModel ReadModel(const Node& root) {
       }
       sub.mean = mean;
     } else if (learner.IsNull()) {
-      if (predict) learner.Fail("is null: a predict-mode sub-model needs a learner (or a mean)");
+      if (predict && !baseline) {
+        learner.Fail("is null: a predict-mode sub-model needs a learner (or a mean)");
+      }
     } else {
       sub.learner = ReadLearner(learner, sub.name);
       if (sub.learner->num_inputs() != model.num_inputs()) {

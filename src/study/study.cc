@@ -155,15 +155,25 @@ void PredictStep(StudyResult& s, const Notifier& notify) {
   for (drift::Method m : s.options.methods) {
     if (drift::SupportsMode(m, drift::Mode::kPredict)) methods.push_back(m);
   }
+  // The filters of the measured output a reviewer compares MS-ELM with (predict mode only, so not
+  // among the study's methods, which are compensate mode's): cheap, always shown.
+  for (drift::Method m : drift::AllMethods(drift::Mode::kPredict)) {
+    if (drift::IsBaseline(m) && std::find(methods.begin(), methods.end(), m) == methods.end()) {
+      methods.push_back(m);
+    }
+  }
   const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{
-      .threads = s.threads,
-      .progress = TrialProgress(notify, 2, e.methods, drift::Mode::kPredict, "predict: ")};
+  const Execution execution{.threads = s.threads,
+                            .progress = TrialProgress(notify, 2, drift::EvaluatedMethods(e),
+                                                      drift::Mode::kPredict, "predict: ")};
   s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e, execution);
 }
 
 void CompensateSimulated(StudyResult& s, const Notifier& notify) {
-  const std::vector<drift::Method>& methods = s.options.methods;
+  // The references first, as every evaluation shows them (no model files: nothing to deploy).
+  drift::EvaluationOptions e;
+  e.methods = s.options.methods;
+  const std::vector<drift::Method> methods = drift::EvaluatedMethods(e);
   drift::DriftOptions base = s.drift_options;
   base.mode = drift::Mode::kCompensate;
   s.compensate_reference = s.run_b.drift_dph;
@@ -186,10 +196,13 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
     row.metrics = drift::ComputeMetrics(s.compensate_reference - row.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
     row.summary = model.Summary();
-    io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"};
-    s.model_files.push_back(
-        {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
-         io::RenderModelFile(model, info)});
+    row.slow_removed = drift::SlowVariationRemoved(s.compensate_reference, row.estimate, s.rate_hz);
+    if (!drift::IsBaseline(methods[i])) {
+      io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"};
+      s.model_files.push_back(
+          {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
+           io::RenderModelFile(model, info)});
+    }
     s.compensate.push_back(std::move(row));
   }
 }
@@ -199,9 +212,9 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
   drift::DriftOptions base = s.drift_options;
   base.mode = drift::Mode::kCompensate;
   const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{
-      .threads = s.threads,
-      .progress = TrialProgress(notify, 3, methods, drift::Mode::kCompensate, "compensate: ")};
+  const Execution execution{.threads = s.threads,
+                            .progress = TrialProgress(notify, 3, drift::EvaluatedMethods(e),
+                                                      drift::Mode::kCompensate, "compensate: ")};
   s.compensate_split =
       drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e, execution);
   const Eigen::Index split = s.compensate_split.split_index;
@@ -219,6 +232,7 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
                                    r.estimate, r.model_summary};
     row.metrics = drift::ComputeMetrics(s.compensate_reference - r.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
+    row.slow_removed = r.slow_removed;
     s.compensate.push_back(std::move(row));
   }
   // Models for the files: fitted on the whole record (what a user would deploy).
@@ -236,10 +250,14 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
 }
 
 void AllanStep(StudyResult& s) {
-  // The compensated output: MS-ELM if it ran (causal row for a split), else the first method.
+  // The compensated output: MS-ELM if it ran (causal row for a split), else the first method
+  // that is not a reference.
   const StudyResult::CompensateRow* best = nullptr;
   for (const auto& r : s.compensate) {
     if (r.method == drift::Method::kMsElm && (r.protocol != "paper")) best = &r;
+  }
+  for (const auto& r : s.compensate) {
+    if (!best && !drift::IsBaseline(r.method)) best = &r;
   }
   if (!best && !s.compensate.empty()) best = &s.compensate.front();
   s.compensated_by =

@@ -78,13 +78,17 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   }
   // Tables: a row per method and protocol.
   const std::set<std::string> predict = Pairs(dir + "/predict_table.csv");
-  EXPECT_EQ(predict.size(), 12u);
+  EXPECT_EQ(predict.size(), 26u);  // and none, constant and the five filters of the output
   for (const char* m : kMethods) {
     EXPECT_TRUE(predict.count(std::string(m) + "/paper")) << m;
     EXPECT_TRUE(predict.count(std::string(m) + "/causal")) << m;
   }
   const std::set<std::string> compensate = Pairs(dir + "/compensate_table.csv");
-  EXPECT_EQ(compensate.size(), 7u);  // and the compensate-only thermal method
+  EXPECT_EQ(compensate.size(), 9u);  // and thermal, none and constant
+  EXPECT_TRUE(compensate.count("none/train A test B"));
+  EXPECT_TRUE(compensate.count("constant/train A test B"));
+  EXPECT_TRUE(predict.count("kalman-trend/causal"));
+  EXPECT_FALSE(test::FileExists(dir + "/models/none_compensate.json"));
   for (const char* m : kMethods)
     EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
   EXPECT_TRUE(compensate.count("thermal/train A test B"));
@@ -119,9 +123,11 @@ TEST(DemoCli, UserLogStudy) {
   EXPECT_NE(r.out.find("from the median step of time_s"), std::string::npos) << r.out;
   EXPECT_FALSE(test::FileExists(work + "/out/run_a.csv"));  // no simulation
   const std::set<std::string> compensate = Pairs(work + "/out/compensate_table.csv");
-  EXPECT_EQ(compensate, (std::set<std::string>{"ms-elm/paper", "ms-elm/causal", "elm/paper",
-                                               "elm/causal", "poly/paper", "poly/causal"}));
-  EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 6u);
+  EXPECT_EQ(compensate,
+            (std::set<std::string>{"none/paper", "none/causal", "constant/paper", "constant/causal",
+                                   "ms-elm/paper", "ms-elm/causal", "elm/paper", "elm/causal",
+                                   "poly/paper", "poly/causal"}));
+  EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 20u);  // and the 5 filters
   const std::string html = io::ReadTextFile(work + "/out/report.html");
   const io::ReportCheck check = io::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();

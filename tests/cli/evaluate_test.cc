@@ -31,23 +31,39 @@ TEST_F(EvaluateCli, CompensateTableAgainstTruth) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;  // no progress line: stderr is not a terminal
   EXPECT_NE(r.out.find("against drift_dph"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("method   protocol"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("method        protocol"), std::string::npos) << r.out;
   const std::string text = io::ReadTextFile(out);
   EXPECT_EQ(text.substr(0, text.find('\n')),
-            "method,protocol,rmse,rmse_std,mae,max_abs,train_s,predict_s");
-  const auto table = io::CsvTable::Parse(text, out);
-  ASSERT_EQ(table.rows(), 4);  // 2 methods x 2 protocols
+            "method,protocol,rmse,rmse_std,mae,max_abs,rmse_measured,slow_removed,train_s,"
+            "predict_s");
+  // 120 test samples at 1 Hz: shorter than one 10-min block, no slow variation to score ("nan",
+  // which this reader refuses: the column is dropped to read the others).
+  EXPECT_NE(text.find(",nan,"), std::string::npos);
+  std::string finite;
+  for (size_t at = 0, end; at < text.size(); at = end + 1) {
+    end = text.find('\n', at);
+    std::string line = text.substr(at, end - at);
+    const size_t slow = line.find(",nan,");
+    if (slow != std::string::npos) line.replace(slow, 5, ",");
+    const size_t name = line.find(",slow_removed,");
+    if (name != std::string::npos) line.replace(name, 14, ",");
+    finite += line + "\n";
+  }
+  const auto table = io::CsvTable::Parse(finite, out);
+  ASSERT_EQ(table.rows(), 8);  // none, constant and 2 methods x 2 protocols
+  EXPECT_NE(text.find("\nnone,paper,"), std::string::npos);
+  EXPECT_NE(text.find("\nconstant,causal,"), std::string::npos);
   EXPECT_NE(text.find("\nms-elm,paper,"), std::string::npos);
   EXPECT_NE(text.find("\nms-elm,causal,"), std::string::npos);
   EXPECT_NE(text.find("\npoly,paper,"), std::string::npos);
   const Eigen::VectorXd rmse = table.Column("rmse"), mae = table.Column("mae"),
                         max_abs = table.Column("max_abs");
-  for (Eigen::Index i = 0; i < 4; ++i) {
+  for (Eigen::Index i = 0; i < 8; ++i) {
     EXPECT_GT(rmse[i], 0.0);
     EXPECT_LE(mae[i], rmse[i]);
     EXPECT_LE(rmse[i], max_abs[i]);
   }
-  EXPECT_EQ(table.Column("rmse_std"), Eigen::VectorXd::Zero(4));  // one repeat
+  EXPECT_EQ(table.Column("rmse_std"), Eigen::VectorXd::Zero(8));  // one repeat
   const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
   EXPECT_EQ(json["command"], "evaluate");
   EXPECT_EQ(json["options"]["methods"], nlohmann::json({"ms-elm", "poly"}));
@@ -57,8 +73,43 @@ TEST_F(EvaluateCli, CompensateTableAgainstTruth) {
   EXPECT_EQ(json["options"]["drift"]["seed"], 3);
   EXPECT_EQ(json["options"]["drift"]["decomposition"]["ensemble_size"], 10);
   EXPECT_EQ(json["result"]["first_test_sample"], 281);
-  EXPECT_EQ(json["result"]["rows"].size(), 4u);
-  EXPECT_EQ(json["result"]["rows"][0]["rmse"].get<double>(), rmse[0]);
+  EXPECT_EQ(json["result"]["rows"].size(), 8u);
+  EXPECT_EQ(json["result"]["rows"][4]["rmse"].get<double>(), rmse[4]);
+  EXPECT_TRUE(json["result"]["rows"][0]["slow_removed"].is_null());
+}
+
+// Every table opens with none and constant, scores against the measured output beside the
+// truth, and gives the share of the slow variation removed (10-min blocks: a 40-min log).
+TEST_F(EvaluateCli, ReferencesBaselinesAndSlowVariationInEveryTable) {
+  const std::string log = dir_ + "/long.csv", out = dir_ + "/base.csv";
+  io::WriteFileAtomically(log, test::ThermalLogCsv(2400, 2));
+  const auto r = test::RunCli("evaluate '" + log +
+                              "' -t rate_dph --truth drift_dph --mode predict --protocol causal "
+                              "--methods persistence,trailing-mean,exp-smoothing,kalman-level,"
+                              "kalman-trend --horizon 10 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("slow_rm"), std::string::npos) << r.out;
+  const std::string text = io::ReadTextFile(out);
+  EXPECT_EQ(text.substr(0, text.find('\n')),
+            "method,protocol,rmse,rmse_std,mae,max_abs,rmse_measured,slow_removed,train_s,"
+            "predict_s");
+  const auto table = io::CsvTable::Parse(text, out);
+  ASSERT_EQ(table.rows(), 7);
+  EXPECT_EQ(text.find("\nnone,causal,"), text.find('\n'));  // the first row
+  EXPECT_NE(text.find("\nconstant,causal,"), std::string::npos);
+  EXPECT_NE(text.find("\nkalman-trend,causal,"), std::string::npos);
+  const Eigen::VectorXd slow = table.Column("slow_removed"), rmse = table.Column("rmse"),
+                        measured = table.Column("rmse_measured");
+  EXPECT_EQ(slow[0], 0.0);  // doing nothing removes nothing
+  for (Eigen::Index i = 0; i < 7; ++i) {
+    EXPECT_TRUE(std::isfinite(slow[i]));
+    EXPECT_LE(slow[i], 1.0);
+    EXPECT_GT(measured[i], rmse[i]);  // the measured output carries the white noise too
+  }
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["result"]["slow_variation_block_s"], 600.0);
+  EXPECT_EQ(json["result"]["rows"][1]["method"], "constant");
+  EXPECT_EQ(json["result"]["rows"][1]["slow_removed"].get<double>(), slow[1]);
 }
 
 TEST_F(EvaluateCli, HorizonScoresPredictionsAhead) {
@@ -70,7 +121,9 @@ TEST_F(EvaluateCli, HorizonScoresPredictionsAhead) {
   const auto r = test::RunCli(run + "--horizon 8 -o '" + ahead + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("predict mode (8-step-ahead predictions)"), std::string::npos) << r.out;
-  EXPECT_NE(io::CsvTable::Read(one).Column("rmse")[0], io::CsvTable::Read(ahead).Column("rmse")[0]);
+  // Row 2: poly, after none and constant (which do not depend on the horizon).
+  EXPECT_NE(io::CsvTable::Read(one).Column("rmse")[2], io::CsvTable::Read(ahead).Column("rmse")[2]);
+  EXPECT_EQ(io::CsvTable::Read(one).Column("rmse")[0], io::CsvTable::Read(ahead).Column("rmse")[0]);
   const auto json = nlohmann::json::parse(io::ReadTextFile(ahead + ".json"));
   EXPECT_EQ(json["options"]["horizon"], 8);
 }
@@ -84,10 +137,11 @@ TEST_F(EvaluateCli, RepeatsGiveASpreadOnlyWhereTheSeedMatters) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());
   const auto table = io::CsvTable::Read(out);
-  ASSERT_EQ(table.rows(), 2);
+  ASSERT_EQ(table.rows(), 4);  // none, constant, elm, poly
   const Eigen::VectorXd spread = table.Column("rmse_std");
-  EXPECT_GT(spread[0], 0.0);  // elm: random hidden layer per seed
-  EXPECT_EQ(spread[1], 0.0);  // poly: no randomness
+  EXPECT_GT(spread[2], 0.0);  // elm: random hidden layer per seed
+  EXPECT_EQ(spread[3], 0.0);  // poly: no randomness
+  EXPECT_EQ(spread[1], 0.0);  // constant: no randomness
   const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
   EXPECT_EQ(json["result"]["first_test_sample"], 241);
   EXPECT_EQ(json["result"]["scored_against"], "rate_dph");

@@ -131,6 +131,34 @@ TEST_F(PredictCli, SingleModelsAreCausalUnderBothProtocols) {
   EXPECT_EQ(io::CsvTable::Read(a).rows(), 120 - 4);  // default p = 4
 }
 
+// A baseline's model file: fitted, written, read back and run by predict as the library runs it,
+// h steps ahead (the filters need one sample before the first origin).
+TEST_F(PredictCli, BaselinesRoundTripThroughTheModelFile) {
+  const std::string model = Dir() + "/trend.json", out = Dir() + "/trend.csv";
+  ASSERT_EQ(test::RunCli("fit '" + Dir() + "/train.csv' -t rate_dph -q --mode predict "
+                         "-m kalman-trend -o '" + model + "'")
+                .exit_code,
+            0);
+  const auto r =
+      test::RunCli("predict '" + model + "' '" + Dir() + "/test.csv' --horizon 3 -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::LoadedModel loaded = io::ReadModelFile(model);
+  ASSERT_TRUE(loaded.model.sub_models.front().baseline);
+  EXPECT_EQ(nlohmann::json::parse(io::ReadTextFile(model))["format_version"],
+            io::kModelFormatVersion);
+  const Eigen::VectorXd y = io::CsvTable::Read(Dir() + "/test.csv").Column("rate_dph");
+  const io::CsvTable predicted = io::CsvTable::Read(out);
+  EXPECT_EQ(predicted.rows(), 120 - 3);
+  EXPECT_EQ(predicted.Column("prediction"),
+            drift::PredictAhead(loaded.model, y, Eigen::VectorXd(), 3, 3,
+                                drift::Protocol::kCausal));
+  // The filters forecast the output: compensate mode refuses them, naming the mode to use.
+  const auto refused = test::RunCli("fit '" + Dir() + "/train.csv' -t rate_dph -T temperature_c "
+                                    "--mode compensate -m exp-smoothing -o '" + Dir() + "/x.json'");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.err.find("mode = predict"), std::string::npos) << refused.err;
+}
+
 struct BadCase {
   const char* name;
   std::string args;  // %DIR% is substituted

@@ -14,8 +14,11 @@
 //               history of the temperature channel(s) only, so the model needs nothing but
 //               temperature at run time; compensated output = y - estimate.
 // Methods: kMsElm (groups), kEmdElm (one ELM per IMF and one for the residue), kThermal (compensate
-// mode only: one identified thermal model of y itself), and the single models kElm, kPoly, kSvr,
-// kBp trained on y itself (thermal features: features.h; poly uses the classic T and dT/dt).
+// mode only: one identified thermal model of y itself), the single models kElm, kPoly, kSvr,
+// kBp trained on y itself (thermal features: features.h; poly uses the classic T and dT/dt), and
+// the baselines of baseline.h: the references kNone and kConstant (both modes) and the causal
+// filters kPersistence, kTrailingMean, kExpSmoothing, kKalmanLevel, kKalmanTrend (predict mode),
+// which read neither a decomposition nor the temperature.
 // In compensate mode kThermal, kMsElm and kEmdElm identify a thermal model per sub-series from
 // the calibration run (thermal_model.h: states, time constants and terms chosen by blocked
 // cross-validation); the fitted intercept keeps the unit's repeatable bias (docs/drift.md 1.2).
@@ -35,6 +38,7 @@
 
 #include "gyrodrift/common/execution.h"
 #include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/baseline.h"
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/drift/learner.h"
 #include "gyrodrift/drift/thermal_model.h"
@@ -46,12 +50,33 @@ enum class Mode { kPredict, kCompensate };
 std::string_view ToString(Mode mode);
 Mode ModeFromString(std::string_view name);  // "predict", "compensate"
 
-enum class Method { kMsElm, kElm, kEmdElm, kPoly, kSvr, kBp, kThermal };
+enum class Method {
+  kMsElm,
+  kElm,
+  kEmdElm,
+  kPoly,
+  kSvr,
+  kBp,
+  kThermal,
+  kPersistence,
+  kTrailingMean,
+  kExpSmoothing,
+  kKalmanLevel,
+  kKalmanTrend,
+  kNone,
+  kConstant,
+};
 std::string_view ToString(Method method);
-// "ms-elm", "elm", "emd-elm", "poly", "svr", "bp", "thermal"
+// "ms-elm", "elm", "emd-elm", "poly", "svr", "bp", "thermal", "persistence", "trailing-mean",
+// "exp-smoothing", "kalman-level", "kalman-trend", "none", "constant"
 Method MethodFromString(std::string_view name);
-// The methods that run in `mode` (kThermal is compensate-only), in the order above.
+// The methods that run in `mode` (kThermal is compensate-only, the filters kPersistence ..
+// kKalmanTrend predict-only), in the order above, without the references kNone and kConstant,
+// which Evaluate always scores (ReferenceMethods).
 std::vector<Method> AllMethods(Mode mode);
+// kNone and kConstant: what every evaluation shows first, so that a method worse than doing
+// nothing, or than removing the training mean, shows as such.
+std::vector<Method> ReferenceMethods();
 bool SupportsMode(Method method, Mode mode);
 bool UsesDecomposition(Method method);  // kMsElm, kEmdElm
 
@@ -91,7 +116,8 @@ struct DriftOptions {
   DriftOptions();         // sets the learner defaults described above
   void Validate() const;  // throws UsageError naming the field
   bool operator==(const DriftOptions&) const = default;
-  // Compensate mode, or predict mode with features.use_temperature: needs the temperature channel.
+  // Compensate mode, or predict mode with features.use_temperature (but for a baseline, which
+  // reads no temperature): needs the temperature channel.
   bool uses_temperature() const;
 };
 
@@ -107,11 +133,12 @@ struct SubModel {
   // Predict mode, MS-ELM's noise group (white by the selection's test): its training mean, which
   // predicts it (learner null) when its learner did not beat that mean on held-out data.
   std::optional<double> mean;
+  std::shared_ptr<const Baseline> baseline;  // a baseline method's one sub-model ("signal")
 };
 
 struct DriftModel {
   DriftOptions options;
-  int lags = 0;           // p used (predict mode)
+  int lags = 0;           // p used (predict mode; 1 for a baseline: it needs one sample)
   int training_imfs = 0;  // K of the training decomposition (0 for single models)
   Eigen::Index training_samples = 0;
   std::vector<SubModel> sub_models;

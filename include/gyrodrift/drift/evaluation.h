@@ -4,8 +4,12 @@
 // causal protocol the training block is decomposed alone; under the paper protocol the whole
 // record is decomposed first and its sub-series split, as the literature does) and scored on the
 // second block. Scores are against the truth column when one is given (the simulator's drift),
-// else against the measured output. Predict mode: one-step-ahead prediction error. Compensate
-// mode: the drift estimate's error (the residual drift left after compensation).
+// else against the measured output; with a truth, each row is also scored against the measured
+// output (predict mode: the measured sample predicted). Predict mode: the (horizon-step-ahead)
+// prediction error. Compensate mode: the drift estimate's error (the residual drift left after
+// compensation). Every evaluation scores the references none (a zero estimate: doing nothing)
+// and constant (the training mean) first, and gives every row the share of the slow variation
+// (SlowVariation) it removes, so that a method worse than doing nothing shows as such.
 // METHOD.md section 5 explains why both protocols are reported: decomposing before splitting lets
 // test-time sub-series see future samples, which alone can explain large gains.
 #pragma once
@@ -26,6 +30,23 @@ struct Metrics {
 };
 Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error);
 
+// The slow variation of a series x sampled at rate_hz: the RMS of its means over whole blocks of
+// block_s seconds (default 10 min), from the first sample on (a last partial block is left out);
+// NaN when x is shorter than one block. It keeps the bias and the slow drift, which a
+// calibration is meant to remove, and leaves little of the sample-to-sample noise (white noise
+// of sd s contributes s / sqrt(samples per block)).
+inline constexpr double kSlowVariationBlockS = 600.0;
+double SlowVariation(const Eigen::Ref<const Eigen::VectorXd>& x, double rate_hz,
+                     double block_s = kSlowVariationBlockS);
+
+// The share of the slow variation of `reference` an estimate removes: 1 - SlowVariation(reference
+// - estimate) / SlowVariation(reference). 0 for a zero estimate, 1 for a perfect one, negative for
+// an estimate that adds slow error; NaN when the series are shorter than one block or the
+// reference has no slow variation.
+double SlowVariationRemoved(const Eigen::Ref<const Eigen::VectorXd>& reference,
+                            const Eigen::Ref<const Eigen::VectorXd>& estimate, double rate_hz,
+                            double block_s = kSlowVariationBlockS);
+
 // The seed of evaluation repeat r of a fit seeded `seed`: the seed itself for r = 0 (a one-repeat
 // evaluation scores the model `fit` writes with that seed), SeedFor(seed, "repeat", r) after.
 std::uint64_t RepeatSeed(std::uint64_t seed, int r);
@@ -33,6 +54,8 @@ std::uint64_t RepeatSeed(std::uint64_t seed, int r);
 struct EvaluationOptions {
   double split = 0.7;  // training share, in [0.1, 0.95]
   int repeats = 1;     // seeds RepeatSeed(seed, r); mean and std over repeats, in [1, 1000]
+  // The methods scored after the references ReferenceMethods(), which are always scored first (a
+  // reference named here too is scored once, first).
   std::vector<Method> methods = AllMethods(Mode::kPredict);
   std::vector<Protocol> protocols{Protocol::kPaper, Protocol::kCausal};
   // Predict mode: score horizon-step-ahead predictions (PredictAhead), in [1, 100000].
@@ -42,10 +65,18 @@ struct EvaluationOptions {
   bool operator==(const EvaluationOptions&) const = default;
 };
 
+// The methods an evaluation scores, in the order of its rows: ReferenceMethods(), then
+// options.methods without them.
+std::vector<Method> EvaluatedMethods(const EvaluationOptions& options);
+
 struct EvaluationRow {
   Method method = Method::kMsElm;
   Protocol protocol = Protocol::kPaper;
   double rmse = 0.0, rmse_std = 0.0, mae = 0.0, max_abs = 0.0;  // means over repeats
+  // Means over repeats: the RMSE against the measured output (rmse itself without a truth), and
+  // the share of the reference's slow variation removed (SlowVariationRemoved; NaN for a test
+  // block shorter than 10 min).
+  double rmse_measured = 0.0, slow_removed = 0.0;
   double train_s = 0.0, predict_s = 0.0;                        // wall-clock means
   Eigen::VectorXd estimate;  // of the last repeat, on the test block
   std::string model_summary;
@@ -57,7 +88,8 @@ struct EvaluationResult {
   Eigen::Index split_index = 0;  // first test sample
   bool against_truth = false;
   Eigen::VectorXd reference;        // what the rows were scored against, on the test block
-  std::vector<EvaluationRow> rows;  // method-major, protocols in the order asked
+  // Method-major (the references none and constant first), protocols in the order asked.
+  std::vector<EvaluationRow> rows;
   // With a temperature channel: its range on the training block and the share of test samples
   // outside it, where every thermal model extrapolates (NaN, NaN, 0 without temperature).
   double training_temperature_min_c = std::numeric_limits<double>::quiet_NaN();

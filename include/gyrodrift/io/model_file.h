@@ -59,7 +59,10 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // rate range (held at its edges; older files' rates run unheld), the structure rules' options
 // (max_condition, standard_errors) and the report's structure, held-out errors and advice; a
 // predict-mode sub-model predicted by its training mean (MS-ELM's noise group,
-// drift_model.h SubModel::mean) holds "mean" and a null "learner"; older files have none.
+// drift_model.h SubModel::mean) holds "mean" and a null "learner"; the baselines
+// (drift/baseline.h: methods none, constant, persistence, trailing-mean, exp-smoothing,
+// kalman-level, kalman-trend) hold a "baseline" (its parameters) in their one sub-model and no
+// learner. Older files have none of these.
 inline constexpr int kModelFormatVersion = 7;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;

@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -152,6 +153,9 @@ struct StudyResult {
     double train_s = 0.0, estimate_s = 0.0;
     Eigen::VectorXd estimate;  // on the test record
     std::string summary;       // the model's one-line summary
+    // Share of the reference's slow variation removed (drift::SlowVariationRemoved; NaN for a
+    // test record shorter than 10 min).
+    double slow_removed = std::numeric_limits<double>::quiet_NaN();
   };
   std::vector<CompensateRow> compensate;
   // The compensate-mode test record: run B or the log's last 30 %.

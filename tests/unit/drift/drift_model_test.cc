@@ -24,7 +24,7 @@ TEST(DriftModel, MethodTableNamesRoundTripAndThermalIsCompensateOnly) {
   const std::vector<Method> compensate = AllMethods(Mode::kCompensate);
   const std::vector<Method> predict = AllMethods(Mode::kPredict);
   EXPECT_EQ(compensate.size(), 7u);
-  EXPECT_EQ(predict.size(), 6u);
+  EXPECT_EQ(predict.size(), 11u);  // and the five filters of baseline.h
   EXPECT_EQ(std::find(predict.begin(), predict.end(), Method::kThermal), predict.end());
   for (Method m : compensate) {
     EXPECT_EQ(MethodFromString(ToString(m)), m) << ToString(m);

@@ -25,7 +25,7 @@ TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
   eo.causal.window = 128;
   const EvaluationResult r =
       Evaluate(log.rate, Eigen::VectorXd(), log.drift, Fast(Mode::kPredict, Method::kMsElm), eo);
-  ASSERT_EQ(r.rows.size(), 4u);
+  ASSERT_EQ(r.rows.size(), 8u);  // none and constant first, then ms-elm and poly
   EXPECT_EQ(r.split_index, 700);
   EXPECT_TRUE(r.against_truth);
   for (const auto& row : r.rows) {
@@ -33,8 +33,9 @@ TEST(Evaluation, ReportsBothProtocolsAndScoresAgainstTruth) {
     EXPECT_GT(row.rmse, 0.0);
     EXPECT_GE(row.max_abs, row.rmse);
   }
+  EXPECT_EQ(r.rows[4].method, Method::kMsElm);
   // Single models do not decompose: both protocols are the same computation.
-  EXPECT_EQ(r.rows[2].rmse, r.rows[3].rmse);
+  EXPECT_EQ(r.rows[6].rmse, r.rows[7].rmse);
   EXPECT_NE(r.Table().find("ms-elm"), std::string::npos);
   EXPECT_TRUE(std::isnan(r.training_temperature_min_c));  // no temperature given
   EXPECT_EQ(r.test_outside_training_temperature_share, 0.0);
@@ -51,18 +52,18 @@ TEST(Evaluation, ScoresPredictionsAheadWithAHorizon) {
   eo.horizon = 6;
   const DriftOptions o = Fast(Mode::kPredict, Method::kMsElm);
   const EvaluationResult r = Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo);
-  ASSERT_EQ(r.rows.size(), 4u);
+  ASSERT_EQ(r.rows.size(), 8u);
   DriftOptions elm = o;
   elm.method = Method::kElm;
   const DriftModel single = FitDriftModel(log.rate.head(700), Eigen::VectorXd(), elm);
-  EXPECT_EQ(r.rows[2].estimate,
+  EXPECT_EQ(r.rows[6].estimate,
             PredictAhead(single, log.rate, Eigen::VectorXd(), 700, 6, Protocol::kCausal));
   const DriftModel ms = FitDriftModel(log.rate.head(700), Eigen::VectorXd(), o);
-  EXPECT_EQ(r.rows[1].estimate,
+  EXPECT_EQ(r.rows[5].estimate,
             PredictAhead(ms, log.rate, Eigen::VectorXd(), 700, 6, Protocol::kCausal, eo.causal));
   eo.horizon = 1;
   const EvaluationResult one = Evaluate(log.rate, Eigen::VectorXd(), log.drift, o, eo);
-  EXPECT_NE(one.rows[0].estimate, r.rows[0].estimate);  // paper protocol: 1 against 6 steps
+  EXPECT_NE(one.rows[4].estimate, r.rows[4].estimate);  // paper protocol: 1 against 6 steps
   eo.horizon = 2;
   EXPECT_THROW(
       Evaluate(log.rate, log.temperature, log.drift, Fast(Mode::kCompensate, Method::kPoly), eo),
@@ -94,6 +95,56 @@ TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
   EXPECT_GT(expected, 0.2);
   EXPECT_EQ(r.test_outside_training_temperature_share, expected);
   EXPECT_EQ(ShareOutsideRange(log.temperature, std::nan(""), std::nan("")), 0.0);
+}
+
+// The slow variation: the RMS of whole blocks' means (a last partial block left out).
+TEST(Evaluation, SlowVariationIsTheRmsOfBlockMeans) {
+  const Eigen::VectorXd x = (Eigen::VectorXd(5) << 1, 1, 3, 3, 5).finished();
+  EXPECT_DOUBLE_EQ(SlowVariation(x, 1.0, 2.0), std::sqrt(5.0));  // means 1 and 3
+  EXPECT_DOUBLE_EQ(SlowVariation(x, 0.5, 4.0), std::sqrt(5.0));  // 2 samples per block too
+  EXPECT_TRUE(std::isnan(SlowVariation(x, 1.0, 600.0)));         // shorter than a block
+  const Eigen::VectorXd estimate = (Eigen::VectorXd(5) << 1, 1, 1, 1, 0).finished();
+  // Left: block means 0 and 2, sqrt(2) of sqrt(5).
+  EXPECT_DOUBLE_EQ(SlowVariationRemoved(x, estimate, 1.0, 2.0), 1.0 - std::sqrt(2.0 / 5.0));
+  EXPECT_EQ(SlowVariationRemoved(x, Eigen::VectorXd::Zero(5), 1.0, 2.0), 0.0);
+  EXPECT_THROW(SlowVariationRemoved(x, x.head(4), 1.0, 2.0), DataError);
+  EXPECT_THROW(SlowVariation(x, 0.0), OptionError);
+}
+
+// none and constant open every table, in both modes, even when not asked for; each row is scored
+// against the measured output too, and gives the share of the slow variation removed.
+TEST(Evaluation, EveryTableOpensWithNoneAndConstant) {
+  const Log log = MakeLog(2000, 11);
+  EvaluationOptions eo;
+  eo.methods = {Method::kPoly, Method::kConstant};  // constant named: scored once, first
+  eo.protocols = {Protocol::kCausal};
+  DriftOptions o = Fast(Mode::kCompensate, Method::kPoly);
+  o.features.rate_hz = 0.5;  // 10-min blocks of 300 samples: 2 in the 600-sample test block
+  EvaluationResult r = Evaluate(log.rate, log.temperature, log.drift, o, eo);
+  ASSERT_EQ(r.rows.size(), 3u);
+  EXPECT_EQ(r.rows[0].method, Method::kNone);
+  EXPECT_EQ(r.rows[1].method, Method::kConstant);
+  EXPECT_EQ(r.rows[2].method, Method::kPoly);
+  EXPECT_EQ(EvaluatedMethods(eo), (std::vector<Method>{Method::kNone, Method::kConstant,
+                                                        Method::kPoly}));
+  const Eigen::VectorXd truth = log.drift.tail(600), measured = log.rate.tail(600);
+  EXPECT_EQ(r.rows[0].estimate, Eigen::VectorXd::Zero(600));
+  EXPECT_DOUBLE_EQ(r.rows[0].rmse, std::sqrt(truth.squaredNorm() / 600.0));
+  EXPECT_DOUBLE_EQ(r.rows[0].rmse_measured, std::sqrt(measured.squaredNorm() / 600.0));
+  EXPECT_EQ(r.rows[0].slow_removed, 0.0);
+  EXPECT_EQ(r.rows[1].estimate, Eigen::VectorXd::Constant(600, log.rate.head(1400).mean()));
+  EXPECT_DOUBLE_EQ(r.rows[2].slow_removed,
+                   SlowVariationRemoved(truth, r.rows[2].estimate, 0.5));
+  EXPECT_NE(r.Table().find("slow_rm"), std::string::npos);
+  // Predict mode, without a truth: scored against the output, so rmse_measured is rmse.
+  eo.methods = {Method::kTrailingMean};
+  r = Evaluate(log.rate, Eigen::MatrixXd(), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kPoly),
+               eo);
+  ASSERT_EQ(r.rows.size(), 3u);
+  for (const auto& row : r.rows) EXPECT_EQ(row.rmse_measured, row.rmse);
+  // A filter of the output in compensate mode is refused before any fit.
+  eo.methods = {Method::kKalmanLevel};
+  EXPECT_THROW(Evaluate(log.rate, log.temperature, log.drift, o, eo), OptionError);
 }
 
 }  // namespace

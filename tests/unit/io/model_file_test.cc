@@ -153,6 +153,44 @@ INSTANTIATE_TEST_SUITE_P(ModelFile, EveryMethod,
                            return name;
                          });
 
+// The baselines (drift/baseline.h): their one sub-model holds a "baseline", no learner.
+INSTANTIATE_TEST_SUITE_P(
+    ModelFileBaselines, EveryMethod,
+    ::testing::Values(std::tuple{Mode::kPredict, Method::kNone},
+                      std::tuple{Mode::kPredict, Method::kConstant},
+                      std::tuple{Mode::kPredict, Method::kPersistence},
+                      std::tuple{Mode::kPredict, Method::kTrailingMean},
+                      std::tuple{Mode::kPredict, Method::kExpSmoothing},
+                      std::tuple{Mode::kPredict, Method::kKalmanLevel},
+                      std::tuple{Mode::kPredict, Method::kKalmanTrend},
+                      std::tuple{Mode::kCompensate, Method::kNone},
+                      std::tuple{Mode::kCompensate, Method::kConstant}),
+    [](const auto& info) {
+      std::string name = std::string(drift::ToString(std::get<0>(info.param))) + "_" +
+                         std::string(drift::ToString(std::get<1>(info.param)));
+      for (char& c : name) {
+        if (c == '-') c = '_';
+      }
+      return name;
+    });
+
+// A baseline's parameters are checked on reading; a learner's model cannot claim one.
+TEST(ModelFile, ABaselineOutOfRangeOrMisplacedIsRefused) {
+  const Log log = MakeLog(260, 13);
+  const drift::DriftModel model = drift::FitDriftModel(
+      log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kExpSmoothing));
+  json j = json::parse(RenderModelFile(model, Info()));
+  j["model"]["sub_models"][0]["baseline"]["alpha"] = 2.0;
+  ExpectRefused(Reseal(j), "baseline alpha = 2: must be in (0, 1]");
+  j["model"]["sub_models"][0].erase("baseline");
+  ExpectRefused(Reseal(j), "has no \"baseline\"");
+  const drift::DriftModel poly =
+      drift::FitDriftModel(log.rate, Eigen::VectorXd(), Small(Mode::kPredict, Method::kPoly));
+  j = json::parse(RenderModelFile(poly, Info()));
+  j["model"]["sub_models"][0]["baseline"] = j["model"]["sub_models"][0]["learner"];
+  ExpectRefused(Reseal(j), "only a baseline method's model has");
+}
+
 TEST(ModelFile, IdentifiedModelsOfTwoChannelsWithACorrectionComeBackExactly) {
   const Log log = MakeLog(4000, 13);
   Eigen::MatrixXd two(log.temperature.size(), 2);

@@ -31,6 +31,8 @@ drift::EvaluationRow PredictRow(drift::Method method, drift::Protocol protocol, 
   r.max_abs = rmse * 7.0;
   r.train_s = 1.23456;
   r.predict_s = 0.0456789;
+  r.rmse_measured = rmse * 2.0;
+  r.slow_removed = 0.75;
   return r;
 }
 
@@ -65,8 +67,9 @@ TEST(PredictTable, OneRowPerEvaluationRowInItsOrder) {
                     PredictRow(drift::Method::kPoly, drift::Protocol::kPaper, kNan)};
   internal::FillPredictTable(s);
   const Table& t = s.predict_table;
-  EXPECT_EQ(t.header, (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs",
-                                                "train_s", "predict_s"}));
+  EXPECT_EQ(t.header,
+            (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs",
+                                      "rmse_measured", "slow_removed_%", "train_s", "predict_s"}));
   ASSERT_EQ(t.csv.size(), 3u);
   ASSERT_EQ(t.shown.size(), 3u);
   for (size_t i = 0; i < t.csv.size(); ++i) EXPECT_EQ(t.csv[i].size(), t.header.size()) << i;
@@ -81,6 +84,8 @@ TEST(PredictTable, OneRowPerEvaluationRowInItsOrder) {
   EXPECT_EQ(Csv(t, 0, "max_abs"), io::FormatDouble(r.max_abs));
   EXPECT_EQ(Csv(t, 0, "train_s"), io::FormatDouble(r.train_s));
   EXPECT_EQ(Csv(t, 0, "predict_s"), io::FormatDouble(r.predict_s));
+  EXPECT_EQ(Csv(t, 0, "rmse_measured"), io::FormatDouble(r.rmse_measured));
+  EXPECT_EQ(Csv(t, 0, "slow_removed_%"), io::FormatDouble(100.0 * r.slow_removed));
   // Scores shown to 4 significant digits, seconds to 3; a missing score is a dash.
   EXPECT_EQ(Shown(t, 0, "rmse"), "0.01235");
   EXPECT_EQ(Shown(t, 0, "train_s"), "1.23");
@@ -111,8 +116,9 @@ TEST(CompensateTable, SharesRemovedArePercentagesAndProtocolsAreKept) {
   s.compensate = {a, b};
   internal::FillCompensateTable(s);
   const Table& t = s.compensate_table;
-  EXPECT_EQ(t.header, (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs",
-                                                "removed_%", "train_s", "estimate_s"}));
+  EXPECT_EQ(t.header,
+            (std::vector<std::string>{"method", "protocol", "rmse", "mae", "max_abs", "removed_%",
+                                      "slow_removed_%", "train_s", "estimate_s"}));
   EXPECT_EQ(FirstColumn(t), (std::vector<std::string>{"thermal", "poly"}));
   EXPECT_EQ(Csv(t, 0, "protocol"), "train A test B");
   EXPECT_EQ(Csv(t, 0, "rmse"), io::FormatDouble(a.metrics.rmse));
@@ -121,6 +127,7 @@ TEST(CompensateTable, SharesRemovedArePercentagesAndProtocolsAreKept) {
   EXPECT_EQ(Csv(t, 0, "removed_%"), io::FormatDouble(100.0 * a.share_removed));
   EXPECT_EQ(Shown(t, 0, "removed_%"), "95.12");
   EXPECT_EQ(Shown(t, 1, "removed_%"), "-25");
+  EXPECT_EQ(Shown(t, 0, "slow_removed_%"), "-");  // not set: a record shorter than 10 min
   EXPECT_EQ(Csv(t, 0, "estimate_s"), io::FormatDouble(a.estimate_s));
   EXPECT_EQ(Shown(t, 0, "estimate_s"), "0.00123");
   EXPECT_NE(t.title.find("run A"), std::string::npos);

@@ -129,9 +129,16 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
   EXPECT_FALSE(s.drift_options.reference_c);  // a log keeps the fitted intercept
   EXPECT_EQ(s.threads, 2);
   EXPECT_GE(s.decomposition.num_imfs(), 3);
-  const std::set<std::string> both{"ms-elm/paper", "ms-elm/causal", "poly/paper", "poly/causal"};
-  EXPECT_EQ(Pairs(s.predict_table), both);
+  // Every table opens with the references none and constant; predict mode adds the filters.
+  std::set<std::string> both{"none/paper",   "none/causal", "constant/paper", "constant/causal",
+                             "ms-elm/paper", "ms-elm/causal", "poly/paper",   "poly/causal"};
   EXPECT_EQ(Pairs(s.compensate_table), both);
+  for (const char* m :
+       {"persistence", "trailing-mean", "exp-smoothing", "kalman-level", "kalman-trend"}) {
+    both.insert(std::string(m) + "/paper");
+    both.insert(std::string(m) + "/causal");
+  }
+  EXPECT_EQ(Pairs(s.predict_table), both);
   for (const auto& row : s.compensate) {
     EXPECT_EQ(row.estimate.size(), s.compensate_reference.size());
     EXPECT_TRUE(std::isfinite(row.metrics.rmse));
@@ -183,16 +190,19 @@ TEST(Study, ShortSimulationComparesRunsAAndB) {
   EXPECT_EQ(s.output.size(), 7200);
   EXPECT_EQ(s.run_b.samples, 7200);
   EXPECT_EQ(s.drift_options.reference_c, 20.0);  // the simulator's equilibrium
-  EXPECT_EQ(Pairs(s.predict_table), (std::set<std::string>{"poly/paper", "poly/causal"}));
+  EXPECT_EQ(Pairs(s.predict_table).size(), 16u);  // none, constant, poly and 5 filters, x 2
+  EXPECT_TRUE(Pairs(s.predict_table).count("kalman-trend/causal"));
   EXPECT_EQ(Pairs(s.compensate_table),
-            (std::set<std::string>{"poly/train A test B", "thermal/train A test B"}));
+            (std::set<std::string>{"none/train A test B", "constant/train A test B",
+                                   "poly/train A test B", "thermal/train A test B"}));
   // Scored against run B's true drift: the identified thermal model removes most of it.
   for (const auto& row : s.compensate) {
     if (row.method == drift::Method::kThermal) {
       EXPECT_GT(row.share_removed, 0.5);
     }
   }
-  EXPECT_EQ(s.compensated_by, "poly (train A test B)");  // the first method: no ms-elm
+  // The first method (no ms-elm) that is not a reference.
+  EXPECT_EQ(s.compensated_by, "poly (train A test B)");
   EXPECT_EQ(s.terms_table.header.back(), "simulator setting");
   const std::set<std::string> names = Names(RenderStudyFiles(s, test::FakeDygraphs()));
   EXPECT_TRUE(names.count("run_a.csv") && names.count("run_b.csv"));
