@@ -284,7 +284,7 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
     model.lags = o.mode == Mode::kPredict ? 1 : 0;
     model.training_samples = y.size();
     auto baseline = std::make_shared<const Baseline>(FitBaseline(o.method, y));
-    model.sub_models.push_back({"signal", {}, true, nullptr, nullptr, std::move(baseline)});
+    model.sub_models.push_back({.name = "signal", .has_residue = true, .baseline = std::move(baseline)});
     if (model.uses_temperature()) {
       model.temperature_min_c = temperature_c.col(0).minCoeff();
       model.temperature_max_c = temperature_c.col(0).maxCoeff();

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
 
 namespace gyrodrift::drift {
@@ -30,12 +31,12 @@ struct Metrics {
 };
 Metrics ComputeMetrics(const Eigen::Ref<const Eigen::VectorXd>& error);
 
-// The slow variation of a series x sampled at rate_hz: the RMS of its means over whole blocks of
-// block_s seconds (default 10 min), from the first sample on (a last partial block is left out);
-// NaN when x is shorter than one block. It keeps the bias and the slow drift, which a
-// calibration is meant to remove, and leaves little of the sample-to-sample noise (white noise
-// of sd s contributes s / sqrt(samples per block)).
-inline constexpr double kSlowVariationBlockS = 600.0;
+// The slow variation of a series x sampled at rate_hz: the RMS about zero of its means over whole
+// blocks of block_s seconds (default 10 min, compensation_summary.h), from the first sample on (a
+// last partial block is left out); NaN when x is shorter than one block. It keeps the bias and
+// the slow drift, which a calibration is meant to remove, and leaves little of the
+// sample-to-sample noise (white noise of sd s contributes s / sqrt(samples per block)). (The
+// compensation summary reports the block means' RMS about their mean beside the mean itself.)
 double SlowVariation(const Eigen::Ref<const Eigen::VectorXd>& x, double rate_hz,
                      double block_s = kSlowVariationBlockS);
 
