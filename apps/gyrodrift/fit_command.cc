@@ -58,6 +58,9 @@ void PrintThermalModel(const std::string& name, const drift::ThermalRegression& 
   for (const std::string& w : t.report.warnings) {
     fmt::print("warning: calibration run ({}): {}\n", name, w);
   }
+  for (const std::string& a : t.report.advice) {
+    fmt::print("advice: calibration run ({}): {}\n", name, a);
+  }
 }
 
 // What fit learnt about one axis: the model, its decomposition and grouping reports, the lag

@@ -831,6 +831,8 @@ class PyDriftModel {
         th["sd"] = ToArray(sd);
         th["calibration"] = t.report.Summary();
         th["warnings"] = t.report.warnings;
+        th["advice"] = t.report.advice;
+        th["structure"] = t.report.level;  // CalibrationReport::Level: 0 the constant .. 5
         if (t.has_hysteresis()) {
           py::dict h;
           h["tau_s"] = t.states[static_cast<size_t>(t.hysteresis_state)].tau_s;

@@ -198,6 +198,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
       // A warning of the calibration report: the run could not identify this sub-model.
       a.identified = a.identified.value_or(true) && t.report.warnings.empty();
       for (const std::string& w : t.report.warnings) a.warnings.push_back(sub.name + ": " + w);
+      for (const std::string& w : t.report.advice) a.warnings.push_back(sub.name + ": advice: " + w);
     }
     for (const Log& log : cal) {
       a.warnings.insert(a.warnings.end(), log.warnings.begin(), log.warnings.end());
