@@ -250,6 +250,8 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
        "bad.toml:15: several calibration logs need method = 'thermal', not 'ms-elm'"},
       {"split, not thermal", "method = \"ms-elm\"\ngaps = \"split\"\n" + std::string(kAxes) + unit,
        "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
+      {"carry, decomposition", "method = \"ms-elm\"\ngaps = \"carry\"\n" + std::string(kAxes) + unit,
+       "bad.toml:2: gaps = 'carry' needs a method that fits on the logged rows only"},
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
       {"bad hysteresis", "hysteresis = \"sometimes\"\n" + std::string(kAxes) + unit,
