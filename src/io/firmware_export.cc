@@ -24,7 +24,9 @@ constexpr internal::EnumNames<ExportFormat, 2> kFormats{{
 constexpr size_t kLongestPrefix = 32;
 constexpr std::string_view kCoefficientsFormat = "gyrodrift-coefficients";
 // 2: a sub-model may hold a hysteresis term.
-constexpr int kCoefficientsFormatVersion = 2;
+// 3: "static" (powers of a channel with their range) replaces "linear"; a state's rate holds
+// within [rate_min, rate_max] (null: unheld, models of format 6 and older).
+constexpr int kCoefficientsFormatVersion = 3;
 
 // ---------------------------------------------------------------------------------------------
 // The models reduced to what the step computes, shared by both renderers.
@@ -46,12 +48,17 @@ struct State {
   double level_min = 0.0, level_max = 0.0;
   std::vector<double> powers;  // coefficients of the level's powers 1..max_power
   double rate = 0.0;           // coefficient of the level's rate, per K/s
+  double rate_min = -std::numeric_limits<double>::infinity();  // the rate is held within
+  double rate_max = std::numeric_limits<double>::infinity();
 };
 
-struct Linear {
+// Static powers of one channel's standardised level, continued along their tangent beyond
+// [level_min, level_max].
+struct Static {
   int channel = 0;  // global channel index
   double centre_c = 0.0, scale_k = 0.0;
-  double coefficient = 0.0;
+  double level_min = 0.0, level_max = 0.0;
+  std::vector<double> powers;  // coefficients of the powers 1..
 };
 
 // The hysteresis term of a sub-model: the play operator of one of its states' level.
@@ -67,7 +74,7 @@ struct Sub {
   bool zero = false;  // a sub-model without a model (old files' noise group): contributes 0
   double intercept = 0.0;
   double reference_estimate = 0.0;  // subtracted when the model has a reference temperature
-  std::vector<Linear> linear;
+  std::vector<Static> statics;
   std::vector<State> states;
   Hysteresis hysteresis;
 };
@@ -140,8 +147,10 @@ Plan MakePlan(const std::vector<LoadedModel>& axes) {
       s.intercept = t.coefficients[k++];
       for (int c = 0; c < t.channels(); ++c) {
         const auto cu = static_cast<size_t>(c);
-        if (!t.linear[cu]) continue;
-        s.linear.push_back({global[cu], t.centre_c[cu], t.scale_k[cu], t.coefficients[k++]});
+        if (t.static_power[cu] == 0) continue;
+        Static st{global[cu], t.centre_c[cu], t.scale_k[cu], t.static_min[cu], t.static_max[cu], {}};
+        for (int p = 1; p <= t.static_power[cu]; ++p) st.powers.push_back(t.coefficients[k++]);
+        s.statics.push_back(std::move(st));
       }
       const double dt_s = 1.0 / t.rate_hz;  // as ThermalRegression::Regressors
       for (const drift::ThermalState& ts : t.states) {
@@ -165,6 +174,8 @@ Plan MakePlan(const std::vector<LoadedModel>& axes) {
         state.level_max = ts.level_max;
         for (int p = 1; p <= t.max_power; ++p) state.powers.push_back(t.coefficients[k++]);
         state.rate = t.coefficients[k++];
+        state.rate_min = ts.rate_min;
+        state.rate_max = ts.rate_max;
         s.states.push_back(std::move(state));
         ++plan.states;
       }
@@ -291,8 +302,9 @@ class CWriter {
         " * drift[a] is what 'gyrodrift compensate' writes as drift_est, the same model:\n"
         " * thermal states are cascaded first-order lags started in equilibrium at the first\n"
         " * sample; a state's standardised level z has its powers continued along their tangent\n"
-        " * beyond the calibration's range; its rate is (input - output of its last lag) / tau,\n"
-        " * K/s; a hysteresis term is the play operator (backlash) of half-width w on a state's\n"
+        " * beyond the calibration's range, as are the static powers of a channel; its rate is\n"
+        " * (input - output of its last lag) / tau, K/s, held within the rates the calibration\n"
+        " * showed; a hysteresis term is the play operator (backlash) of half-width w on a state's\n"
         " * level, (level - play) / w, started with no direction. The lags run on each stage's\n"
         " * deviation u below its input, the same recursion rewritten so that a slow lag's small\n"
         " * increments do not vanish against T in float.\n"
@@ -338,6 +350,9 @@ class CWriter {
     for (const Axis& a : plan_.axes) {
       for (const Sub& s : a.subs) {
         for (const State& st : s.states) {
+          max_power = std::max(max_power, static_cast<int>(st.powers.size()));
+        }
+        for (const Static& st : s.statics) {
           max_power = std::max(max_power, static_cast<int>(st.powers.size()));
         }
       }
@@ -393,16 +408,18 @@ class CWriter {
         "{indent}{r} drift[{P}_N_AXES]) {{\n",
         fmt::arg("p", p_), fmt::arg("r", real_), fmt::arg("P", P_),
         fmt::arg("indent", std::string(p_.size() + 25, ' ')));
-    bool any_power = false, any_estimate = false;
+    bool any_z = false, any_estimate = false, any_held = false;
     for (const Axis& a : plan_.axes) {
       for (const Sub& s : a.subs) {
         any_estimate = any_estimate || !s.zero;
-        for (const State& st : s.states) any_power = any_power || st.powers.size() >= 2;
+        any_z = any_z || !s.states.empty() || !s.statics.empty();
+        for (const State& st : s.states) any_held = any_held || std::isfinite(st.rate_min);
       }
     }
     if (!plan_.chains.empty()) out_ += fmt::format("  {} d, w;\n", real_);
+    if (any_held) out_ += fmt::format("  {} r;\n", real_);
     if (plan_.plays > 0) out_ += fmt::format("  {} v;\n", real_);
-    if (any_power) out_ += fmt::format("  {} z;\n", real_);
+    if (any_z) out_ += fmt::format("  {} z;\n", real_);
     if (any_estimate) out_ += fmt::format("  {} e;\n", real_);
     // Lags: stage k of a chain sees its input move by d; its deviation u = input - output becomes
     // (u + d)(1 - g) and its output moves by g (u + d), the next stage's d.
@@ -452,29 +469,44 @@ class CWriter {
                        deviations);
   }
 
-  // One sub-model's estimate in the library's order: the regressors' columns (intercept, linear
-  // terms, per state its powers and rate, then the hysteresis term) times their coefficients,
+  // e += each power of z (the first plain, the others along their tangent beyond [lo, hi]).
+  void Powers(const std::vector<double>& powers, double lo, double hi) {
+    out_ += fmt::format("  e += {} * z;\n", Literal(powers[0]));
+    for (size_t p = 2; p <= powers.size(); ++p) {
+      out_ += fmt::format("  e += {} * {}_power{}(z, {}, {});\n", Literal(powers[p - 1]), p_, p,
+                          Literal(lo), Literal(hi));
+    }
+  }
+
+  // One sub-model's estimate in the library's order: the regressors' columns (intercept, static
+  // powers, per state its powers and rate, then the hysteresis term) times their coefficients,
   // summed into the axis, less its estimate in equilibrium at the reference temperature.
   void SubModel(size_t a, const Sub& sub, bool referenced) {
     out_ += fmt::format("  /* sub-model {} */\n  e = {};\n", CommentText(sub.name),
                         Literal(sub.intercept));
-    for (const Linear& l : sub.linear) {
-      out_ +=
-          fmt::format("  e += {} * ((temperature_c[{}] - {}) / {}); /* {} */\n",
-                      Literal(l.coefficient), l.channel, Literal(l.centre_c), Literal(l.scale_k),
-                      CommentText(plan_.channels[static_cast<size_t>(l.channel)]));
+    for (const Static& st : sub.statics) {
+      out_ += fmt::format("  /* {} */\n  z = (temperature_c[{}] - {}) / {};\n",
+                          CommentText(plan_.channels[static_cast<size_t>(st.channel)]), st.channel,
+                          Literal(st.centre_c), Literal(st.scale_k));
+      Powers(st.powers, st.level_min, st.level_max);
     }
     for (const State& st : sub.states) {
       const Chain& chain = plan_.chains[static_cast<size_t>(st.chain)];
       out_ += fmt::format("  /* {} */\n", CommentText(StateName(st)));
       out_ += fmt::format("  z = ({}) / {};\n", LevelLessCentre(st), Literal(st.scale_k));
-      out_ += fmt::format("  e += {} * z;\n", Literal(st.powers[0]));
-      for (size_t p = 2; p <= st.powers.size(); ++p) {
-        out_ += fmt::format("  e += {} * {}_power{}(z, {}, {});\n", Literal(st.powers[p - 1]), p_,
-                            p, Literal(st.level_min), Literal(st.level_max));
+      Powers(st.powers, st.level_min, st.level_max);
+      if (std::isfinite(st.rate_min)) {
+        // The rate held within the calibration's, as the library holds it.
+        out_ += fmt::format(
+            "  r = s->lag[{i}] / {tau};\n  r = r < {lo} ? {lo} : ({hi} < r ? {hi} : r);\n"
+            "  e += {c} * r;\n",
+            fmt::arg("i", chain.first + st.order - 1), fmt::arg("tau", Literal(chain.tau_s)),
+            fmt::arg("lo", Literal(st.rate_min)), fmt::arg("hi", Literal(st.rate_max)),
+            fmt::arg("c", Literal(st.rate)));
+      } else {
+        out_ += fmt::format("  e += {} * (s->lag[{}] / {});\n", Literal(st.rate),
+                            chain.first + st.order - 1, Literal(chain.tau_s));
       }
-      out_ += fmt::format("  e += {} * (s->lag[{}] / {});\n", Literal(st.rate),
-                          chain.first + st.order - 1, Literal(chain.tau_s));
     }
     if (sub.hysteresis.state >= 0) {
       // The play p follows the level v only where v is more than w away: p is held or set to
@@ -590,12 +622,15 @@ std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
   for (const Axis& axis : plan.axes) {
     json subs = json::array();
     for (const Sub& sub : axis.subs) {
-      json linear = json::array();
-      for (const Linear& l : sub.linear) {
-        linear.push_back({{"channel", l.channel},
-                          {"centre_c", l.centre_c},
-                          {"scale_k", l.scale_k},
-                          {"coefficient", l.coefficient}});
+      auto finite = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+      json statics = json::array();
+      for (const Static& st : sub.statics) {
+        statics.push_back({{"channel", st.channel},
+                           {"centre_c", st.centre_c},
+                           {"scale_k", st.scale_k},
+                           {"level_min", finite(st.level_min)},
+                           {"level_max", finite(st.level_max)},
+                           {"powers", st.powers}});
       }
       json states = json::array();
       for (const State& st : sub.states) {
@@ -609,14 +644,16 @@ std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                           {"level_min", st.level_min},
                           {"level_max", st.level_max},
                           {"powers", st.powers},
-                          {"rate", st.rate}});
+                          {"rate", st.rate},
+                          {"rate_min", finite(st.rate_min)},
+                          {"rate_max", finite(st.rate_max)}});
       }
       const Hysteresis& h = sub.hysteresis;
       subs.push_back({{"name", sub.name},
                       {"zero", sub.zero},
                       {"intercept", sub.intercept},
                       {"reference_estimate", sub.reference_estimate},
-                      {"linear", std::move(linear)},
+                      {"static", std::move(statics)},
                       {"states", std::move(states)},
                       {"hysteresis", h.state < 0 ? json(nullptr)
                                                  : json{{"state", h.state},

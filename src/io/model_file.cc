@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -143,7 +144,9 @@ json ThermalOptionsJson(const drift::ThermalModelOptions& t) {
           {"folds_at_regimes", t.folds_at_regimes},
           {"ramp_rate_k_per_min", Number(t.ramp_rate_k_per_min)},
           {"hysteresis", drift::ToString(t.hysteresis)},
-          {"hysteresis_widths_k", Numbers(t.hysteresis_widths_k)}};
+          {"hysteresis_widths_k", Numbers(t.hysteresis_widths_k)},
+          {"max_condition", Number(t.max_condition)},
+          {"standard_errors", Number(t.standard_errors)}};
 }
 
 json ThermalJson(const drift::ThermalRegression& t) {
@@ -151,17 +154,21 @@ json ThermalJson(const drift::ThermalRegression& t) {
   for (const auto& s : t.states) {
     states.push_back({{"channel", s.channel},
                       {"tau_s", Number(s.tau_s)},
-                      {"level_range", Numbers({s.level_min, s.level_max})}});
+                      {"level_range", Numbers({s.level_min, s.level_max})},
+                      {"rate_range", Numbers({s.rate_min, s.rate_max})}});
   }
-  json linear = json::array();
-  for (bool b : t.linear) linear.push_back(b);
+  json static_range = json::array();
+  for (size_t c = 0; c < t.static_min.size(); ++c) {
+    static_range.push_back(Numbers({t.static_min[c], t.static_max[c]}));
+  }
   const drift::CalibrationReport& r = t.report;
   json j = {{"rate_hz", Number(t.rate_hz)},
           {"order", t.order},
           {"max_power", t.max_power},
           {"centre_c", Numbers(t.centre_c)},
           {"scale_k", Numbers(t.scale_k)},
-          {"linear", std::move(linear)},
+          {"static_power", t.static_power},
+          {"static_range", std::move(static_range)},
           {"states", std::move(states)},
           {"hysteresis", t.has_hysteresis() ? json{{"state", t.hysteresis_state},
                                                    {"width_k", Number(t.hysteresis_width_k)}}
@@ -183,6 +190,18 @@ json ThermalJson(const drift::ThermalRegression& t) {
             {"cv_rmse_constant", Number(r.cv_rmse_constant)},
             {"skill", Number(r.skill)},
             {"condition", Number(r.condition)},
+            {"level", r.level},
+            {"best_level", r.best_level},
+            {"regime_folds", r.regime_folds},
+            {"range_folds", r.range_folds},
+            {"held_out_rmse", Number(r.held_out_rmse)},
+            {"held_out_rmse_constant", Number(r.held_out_rmse_constant)},
+            {"held_out_rmse_static", Number(r.held_out_rmse_static)},
+            {"held_out_rmse_best", Number(r.held_out_rmse_best)},
+            {"regime_rmse", Number(r.regime_rmse)},
+            {"regime_rmse_constant", Number(r.regime_rmse_constant)},
+            {"regime_rmse_static", Number(r.regime_rmse_static)},
+            {"advice", r.advice},
             {"nonlinear_units", r.nonlinear_units},
             {"hysteresis_tried", r.hysteresis_tried},
             {"nonlinear_ridge_c", Number(r.nonlinear_ridge_c)},
@@ -489,6 +508,11 @@ drift::ThermalModelOptions ReadThermalOptions(const Node& n) {
   if (n.raw().contains("hysteresis_widths_k")) {
     t.hysteresis_widths_k = n["hysteresis_widths_k"].Doubles();
   }
+  // Files before version 7 chose the richest structure of least error, without these rules.
+  if (n.raw().contains("max_condition")) {
+    t.max_condition = n["max_condition"].Double();
+    t.standard_errors = n["standard_errors"].Double();
+  }
   return t;
 }
 
@@ -499,12 +523,33 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   t->max_power = n["max_power"].Int(1, 3);
   t->centre_c = n["centre_c"].Doubles();
   t->scale_k = n["scale_k"].Doubles();
-  for (const Node& b : n["linear"].Items()) t->linear.push_back(b.Bool());
+  auto pair = [](const Node& node) {
+    const std::vector<double> range = node.Doubles();
+    if (range.size() != 2) node.Fail("must hold [min, max]");
+    return std::pair{range[0], range[1]};
+  };
+  if (n.raw().contains("static_power")) {
+    for (const Node& p : n["static_power"].Items()) {
+      t->static_power.push_back(static_cast<int>(p.Int(0, 3)));
+    }
+    for (const Node& r : n["static_range"].Items()) {
+      const auto [lo, hi] = pair(r);
+      t->static_min.push_back(lo);
+      t->static_max.push_back(hi);
+    }
+  } else {  // before version 7: a linear term per channel, unbounded
+    for (const Node& b : n["linear"].Items()) {
+      t->static_power.push_back(b.Bool() ? 1 : 0);
+      t->static_min.push_back(-std::numeric_limits<double>::infinity());
+      t->static_max.push_back(std::numeric_limits<double>::infinity());
+    }
+  }
   for (const Node& s : n["states"].Items()) {
-    const std::vector<double> range = s["level_range"].Doubles();
-    if (range.size() != 2) s["level_range"].Fail("must hold [min, max]");
-    t->states.push_back(
-        {static_cast<int>(s["channel"].Int(0, 1024)), s["tau_s"].Double(), range[0], range[1]});
+    drift::ThermalState state{static_cast<int>(s["channel"].Int(0, 1024)), s["tau_s"].Double()};
+    std::tie(state.level_min, state.level_max) = pair(s["level_range"]);
+    // Before version 7 the rates ran unheld.
+    if (s.raw().contains("rate_range")) std::tie(state.rate_min, state.rate_max) = pair(s["rate_range"]);
+    t->states.push_back(state);
   }
   if (n.raw().contains("hysteresis") && !n["hysteresis"].IsNull()) {
     const Node h = n["hysteresis"];
@@ -530,6 +575,21 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   report.cv_rmse_constant = r["cv_rmse_constant"].Double();
   report.skill = r["skill"].Double();
   report.condition = r["condition"].Double();
+  if (r.raw().contains("level")) {  // version 7
+    report.level = static_cast<int>(r["level"].Int(0, drift::CalibrationReport::kHysteresis));
+    report.best_level =
+        static_cast<int>(r["best_level"].Int(0, drift::CalibrationReport::kHysteresis));
+    report.regime_folds = static_cast<int>(r["regime_folds"].Int(0, 1000000));
+    report.range_folds = static_cast<int>(r["range_folds"].Int(0, 2));
+    report.held_out_rmse = r["held_out_rmse"].Double();
+    report.held_out_rmse_constant = r["held_out_rmse_constant"].Double();
+    report.held_out_rmse_static = r["held_out_rmse_static"].Double();
+    report.held_out_rmse_best = r["held_out_rmse_best"].Double();
+    report.regime_rmse = r["regime_rmse"].Double();
+    report.regime_rmse_constant = r["regime_rmse_constant"].Double();
+    report.regime_rmse_static = r["regime_rmse_static"].Double();
+    for (const Node& a : r["advice"].Items()) report.advice.push_back(a.String());
+  }
   report.nonlinear_units = r["nonlinear_units"].Int(0, 100000);
   report.hysteresis_tried = r.raw().contains("hysteresis_tried") && r["hysteresis_tried"].Bool();
   report.nonlinear_ridge_c = r["nonlinear_ridge_c"].Double();

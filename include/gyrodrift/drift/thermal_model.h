@@ -1,58 +1,62 @@
 // Identification of a gyro's thermal drift model from its calibration run: which thermal states
-// of the temperature channel(s) the drift follows, with their time constants, chosen from the
-// data by cross-validation that holds out contiguous stretches of whole ramps and dwells.
+// of the temperature channel(s) the drift follows, with their time constants, and how rich a model
+// the run supports, chosen from the data by cross-validation on held-out time blocks and held-out
+// thermal regimes.
 //
 // Model [choice, measured in docs/drift.md section 4.5]. For temperature channels T_c (degC,
 // c = 1..C), standardised z_c = (T_c - mean_c) / sd_c over the calibration run, and S chosen
 // thermal states s_j = L^q(T_c(j); tau_j) (q cascaded first-order lags of one channel: the
 // temperature at some depth of a winding pack, or of a board behind the case),
-//   drift(t) = b0 + sum_c a_c z_c(t) + sum_j [ sum_{p=1..P} g_jp zs_j(t)^p + r_j ds_j/dt (t) ]
-//              [ + h H_w(s_k)(t) ]
+//   drift(t) = b0 + sum_c sum_{p=1..Q} a_cp z_c(t)^p
+//              + sum_j [ sum_{p=1..P} g_jp zs_j(t)^p + r_j ds_j/dt (t) ]  [ + h H_w(s_k)(t) ]
 // where zs_j is s_j standardised like its channel and ds_j/dt = (L^(q-1) - L^q)(T; tau_j) / tau_j
-// the state's rate (K/s). The levels and their powers carry the stress and static-bias
-// curvature (the coating stress follows the coil's mean temperature, the electronics their own),
-// the rates the Shupe drift (temperature rates inside the pack), the difference of two levels
-// the static gradient; METHOD.md section 1. The intercept b0 is the unit's repeatable bias.
-// The optional last term is thermal hysteresis, a bias that differs between heating and cooling
-// through the same temperature (coil adhesive and potting relax with a memory of the direction):
-// H_w(s) = (s - P_w[s]) / w in [-1, 1], where P_w is the play operator (backlash) of half-width
-// w K on the level of one chosen state s_k, the elementary hysteron of the Prandtl-Ishlinskii
-// model (Brokate & Sprekels, Hysteresis and Phase Transitions, 1996, ch. 2): +1 after the state
-// has risen by 2w, -1 after it has fallen by 2w, held through dwells.
+// the state's rate (K/s). The static powers (Q <= 3) are the classic polynomial in T; the levels
+// and their powers carry the stress and static-bias curvature (the coating stress follows the
+// coil's mean temperature, the electronics their own), the rates the Shupe drift (temperature
+// rates inside the pack), the difference of two levels the static gradient; METHOD.md section 1.
+// The intercept b0 is the unit's repeatable bias. The optional last term is thermal hysteresis, a
+// bias that differs between heating and cooling through the same temperature (coil adhesive and
+// potting relax with a memory of the direction): H_w(s) = (s - P_w[s]) / w in [-1, 1], where P_w
+// is the play operator (backlash) of half-width w K on the level of one chosen state s_k, the
+// elementary hysteron of the Prandtl-Ishlinskii model (Brokate & Sprekels, Hysteresis and Phase
+// Transitions, 1996, ch. 2): +1 after the state has risen by 2w, -1 after it has fallen by 2w.
 //
-// Identification: every candidate state (channel, tau) with tau on a geometric grid
-// (shortest_tau_s .. longest_tau_s, taus_per_octave per factor 2, and at most
-// longest_tau_share of the run: a slower lag cannot be told from the run's slow noise) gives
-// P + 1 columns; every subset of at most max_states candidates, with or without the channels'
-// linear terms (the intercept alone included), is scored by K-fold cross-validation over
-// contiguous blocks of the run (or groups of whole regimes: Segments below), and the subset of
-// least cross-validated error is refitted on the whole run by least squares (QR). Where the
-// hysteresis term is tried (HysteresisTerm), each subset is also scored with H_w of each of its
-// states for every w in hysteresis_widths_k. The search
-// works on per-block Gram matrices, so it costs one pass over the data (O(N M^2), M = all
-// candidate columns) plus a small solve per subset and fold.
+// Structure: nested models from simple to rich, (0) the constant, (1) static powers of T,
+// (2) the powers of one lag state's level, (3) with its rate, (4) two lag states with their rates,
+// (5) a hysteresis term (a state without its rate term has a rate coefficient of exactly 0). Within each level the subset of least
+// cross-validated error wins; across levels the simplest whose error is within one standard error
+// of the best level's stands (the one-standard-error rule on the paired scores of the held-out
+// time blocks), and a model that does not beat the constant by a standard error is the constant
+// (thermal_search.h). Every thermal regime (ramp or dwell) held out in turn, and the top and the
+// bottom fifth of the temperature range held out, are scored and reported beside (choosing or
+// gating on them chose worse models on the family's one-way heat-ups: docs/drift.md 4.8). Columns
+// that are nearly collinear (condition of the scaled Gram above max_condition: two states of
+// close time constants) never enter together.
 //
-// Beyond the calibration's range the level powers continue linearly (ThermalState).
+// Support: the model keeps the calibration's range of every static level, state level and state
+// rate. Beyond a level's range its powers >= 2 continue along their tangent (a model does not
+// extrapolate a curvature it never saw). A rate extrapolates linearly in a direction the run
+// showed (a heating or cooling ramp: the Shupe and gradient terms are linear in rates), and is held
+// at the edge in one it never showed (a run that only heated says nothing of cooling); the
+// estimate's standard deviation grows by what the held rate leaves out.
 //
-// Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x): s_cv is the
-// slow part of the cross-validated residual (its 10-min block means, less what the fast noise
-// contributes to them, measured on 10-s blocks: the drift error a held-out stretch saw), V the
-// coefficient covariance of the fit, inflated by the residual's correlation (batch means over
-// 10-min blocks), which grows where the temperature leaves the calibration's range.
+// Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x + e^2): s_cv is
+// the slow part of the cross-validated residual (its 10-min block means, less what the fast noise
+// contributes to them, measured on 10-s blocks), V the coefficient covariance of the fit, inflated
+// by the residual's correlation (batch means over 10-min blocks), e what holding the rates at the
+// edge of their support changed.
 //
 // Nonlinear option: a sigmoid ELM (elm.h) of the chosen regressors fitted to the linear model's
 // residual, its hidden units L in {5, 10, 20, 40} and ridge C in {0.01, 1, 100, 10^4} chosen by
-// the same folds (each fold's linear fit, then the network on the training part's residual,
-// scored on the held-out fold; all candidates share one hidden layer, as the first L units of a
-// network are those of any larger one), kept only when it lowers the cross-validated error.
+// the time-block folds, kept only when it lowers the cross-validated error.
 //
 // Calibration sufficiency (CalibrationReport): temperature span, heating and cooling rates,
-// dwells, regimes, cross-validated skill against the intercept alone, the conditioning of the
-// chosen regressors and how far the candidate states can lag, with warnings where the run cannot
-// identify the model.
-// Cost: O(N (C G (q + P + W)) + N M^2) for G grid constants, W hysteresis widths tried and
-// M = 1 + C + C G (P + 1 + W) columns; a 16-h 1 Hz run with one channel takes about 0.3 s
-// (bench_drift's BM_ThermalFit).
+// dwells, regimes, cross-validated skill against the constant and the static cubic, the
+// conditioning of the chosen regressors and how far the candidate states can lag, with warnings
+// where the run cannot identify the model, each saying which regime to add.
+// Cost: O(N M^2) for the fold moments (M = 1 + C Q + C G (P + 1 + W) columns for G grid constants
+// and W hysteresis widths tried), then a small solve per subset and fold; a 16-h 1 Hz run with one
+// channel takes about 0.4 s (bench_drift's BM_ThermalFit).
 #pragma once
 
 #include <Eigen/Core>
@@ -104,6 +108,14 @@ struct ThermalModelOptions {
   // 4.7: a wide play on a slow state acts as one more slow state and imitates the run's slow
   // noise; 8 K failed, 4 K did no better than these on the family].
   std::vector<double> hysteresis_widths_k{0.5, 1.0, 2.0};
+  // Subsets whose scaled Gram matrix is worse conditioned are not candidates, in [1e2, 1e16]
+  // [choice, docs/drift.md 4.8: two lag states of 170 and 240 s with coefficients of +-1.3e5 on
+  // a real record had 3.9e9].
+  double max_condition = 1e8;
+  // The one-standard-error rule's multiple, in [0, 10]: a richer structure (and any structure
+  // against the constant) must win by this many standard errors of the paired fold scores
+  // [choice, docs/drift.md 4.8].
+  double standard_errors = 1.0;
   bool operator==(const ThermalModelOptions&) const = default;
   void Validate() const;  // throws OptionError naming the field
   // The candidate constants for a run of `duration_s` seconds.
@@ -117,10 +129,13 @@ struct ThermalModelOptions {
 // powers >= 2 continue along their tangent at the nearer end (a model does not extrapolate a
 // curvature it never saw: a cubic fitted over 40 K, evaluated 20 K beyond, is what made a short
 // calibration's estimate absurd; docs/drift.md 4.5).
+// Its rate spanned [rate_min, rate_max] K/s; beyond that it is held at the edge.
 struct ThermalState {
   int channel = 0;
   double tau_s = 0.0;
   double level_min = 0.0, level_max = 0.0;
+  double rate_min = -std::numeric_limits<double>::infinity();
+  double rate_max = std::numeric_limits<double>::infinity();
   bool operator==(const ThermalState&) const = default;
 };
 
@@ -137,6 +152,9 @@ std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& te
 
 // What the calibration run offers for identification, and what the fit found.
 struct CalibrationReport {
+  // The structures of the nested ladder (header comment), simplest first.
+  // kLag: one lag state's level and its powers, without its rate.
+  enum Level { kConstant, kStatic, kLag, kOneState, kTwoStates, kHysteresis };
   double duration_s = 0.0;                     // of all records
   int records = 1;                             // stretches whose lag states start afresh
   std::vector<double> span_k;                  // max - min per channel
@@ -146,8 +164,19 @@ struct CalibrationReport {
   int folds = 0;                               // cross-validation folds used
   double cv_rmse = 0.0;                        // of the chosen model, target units
   double cv_rmse_constant = 0.0;               // of the intercept alone
+  // Held-out RMSE over the time blocks (each block weighing equally) of the chosen model, the
+  // constant and the static cubic in T: what the choice and the guarantee compare.
+  double held_out_rmse = 0.0, held_out_rmse_constant = 0.0, held_out_rmse_static = 0.0;
+  double held_out_rmse_best = 0.0;             // of the best level, before the rule
+  // The same three on the held-out regimes and range ends (reported, not chosen on; 0: no such
+  // fold).
+  double regime_rmse = 0.0, regime_rmse_constant = 0.0, regime_rmse_static = 0.0;
+  int level = kConstant;                       // of the chosen structure
+  int best_level = kConstant;                  // of least held-out error, before the rule
+  int regime_folds = 0, range_folds = 0;       // held-out regimes, range ends
   // 1 - slow cross-validated error / that of the intercept alone (10-min block means less the
   // white noise's share): how much of the drift the temperature explains on held-out regimes.
+  // NaN when the run is shorter than 4 such blocks (not measured).
   double skill = 0.0;
   double condition = 0.0;                      // of the chosen regressors' scaled Gram matrix
   // Nonlinear option: the correction's hidden units (0 = none kept) and ridge C, and the
@@ -157,6 +186,9 @@ struct CalibrationReport {
   double cv_rmse_nonlinear = std::numeric_limits<double>::quiet_NaN();
   bool hysteresis_tried = false;               // the search tried the hysteresis term
   std::vector<std::string> warnings;           // empty: the run identifies the model
+  // What the run lacks for identification, as regimes to add ("no cooling: add a ramp down of at
+  // least 20 K at 0.5-2 K/min"); empty: nothing.
+  std::vector<std::string> advice;
   std::string Summary() const;                 // one line
 };
 
@@ -165,7 +197,10 @@ struct ThermalRegression {
   double rate_hz = 1.0;
   int order = 2, max_power = 3;
   std::vector<double> centre_c, scale_k;  // per channel
-  std::vector<bool> linear;               // per channel: z_c is a regressor
+  // Per channel: the highest static power of z_c among the regressors (0: none), and the range
+  // of z_c over the calibration run (powers >= 2 continue along their tangent beyond it).
+  std::vector<int> static_power;
+  std::vector<double> static_min, static_max;
   std::vector<ThermalState> states;
   // The hysteresis term H_w(states[hysteresis_state]) with w = hysteresis_width_k, the last
   // coefficient; hysteresis_state = -1: none. The play operator starts at the state's level at
@@ -186,7 +221,11 @@ struct ThermalRegression {
   // every record start (see IdentifyThermalModel).
   Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                              const std::vector<Eigen::Index>& record_starts = {}) const;
-  // "1", "T1", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)", "H(L2(T1; 480 s); 1 K)"; with one name
+  // Without `within_support`, the rates run unheld (what the held rates leave out).
+  Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                             const std::vector<Eigen::Index>& record_starts,
+                             bool within_support) const;
+  // "1", "T1", "T1^2", "L2(T1; 480 s)^2", "d/dt L2(T1; 480 s)", "H(L2(T1; 480 s); 1 K)"; with one name
   // per channel, the channels are named by them ("L2(coil_c; 480 s)").
   std::vector<std::string> RegressorNames(const std::vector<std::string>& channel_names = {}) const;
   Eigen::VectorXd Estimate(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
@@ -209,12 +248,17 @@ struct ThermalRegression {
 // lag states restart at each (from the record's first temperature, as at the start of a run), so
 // no state runs across the break, and no ramp or dwell spans two records; the regressors of all
 // records are fitted together.
+// `logged` (empty, or one flag per sample): false marks a sample made up across a gap of a
+// duty-cycled log (interpolated temperature, so the lag states run across the gap); the fit, the
+// folds and every figure of the report use the logged samples only, and y is not read elsewhere.
 // Throws DataError for a record the cross-validation cannot split (fewer than 2 folds of at least
-// 16 samples) or non-finite samples; UsageError for bad options.
+// 16 logged samples) or non-finite samples; UsageError for bad options, or the nonlinear option
+// with samples made up.
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
                                        const ThermalModelOptions& options, bool nonlinear = false,
                                        std::uint64_t seed = 1,
-                                       const std::vector<Eigen::Index>& record_starts = {});
+                                       const std::vector<Eigen::Index>& record_starts = {},
+                                       const std::vector<bool>& logged = {});
 
 }  // namespace gyrodrift::drift

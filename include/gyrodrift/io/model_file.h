@@ -54,7 +54,11 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // "threads" scalar of ELM and SVR learners): they are how a fit ran (common/execution.h), never
 // part of the model, whose every bit is the same for any count. Older files still load, the
 // counts read and dropped; a version-6 file that holds one is refused as an unknown field.
-inline constexpr int kModelFormatVersion = 6;
+// Version 7 (issue 22): a thermal model's static powers of T per channel with their range
+// (static_power, static_range; older files' "linear" reads as power 1, unbounded), each state's
+// rate range (held at its edges; older files' rates run unheld), the structure rules' options
+// (max_condition, standard_errors) and the report's structure, held-out errors and advice.
+inline constexpr int kModelFormatVersion = 7;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 

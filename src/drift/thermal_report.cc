@@ -1,0 +1,235 @@
+// The calibration run's regimes and sufficiency: Segments, the report's description, warnings,
+// advice and summary (thermal_report.h, thermal_model.h).
+#include "thermal_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+
+#include "gyrodrift/drift/features.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+constexpr double kRateSmoothingS = 60.0;  // smoothing of the rate that tells ramps from dwells
+constexpr double kShortestSegmentS = 300.0;
+constexpr double kShortestDwellS = 600.0;
+// Calibration sufficiency: warnings below these (docs/drift.md 4.5, 4.8).
+constexpr double kShortestSpanK = 15.0;
+constexpr double kLeastSkill = 0.2;
+constexpr double kLargestCondition = 1e10;
+// Shorter than this, a log is not a calibration run: no regime can be held out.
+constexpr double kShortestCalibrationS = 3600.0;
+// A coil lags its case sensor by up to about an hour (our simulator: 40 min; the family's layer
+// chains: 10-60 min): a run whose slowest candidate state lags less cannot identify such a gyro.
+constexpr double kSlowLagS = 1800.0;
+
+}  // namespace
+
+namespace internal {
+
+std::string Format(const char* format, ...) {
+  char buffer[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_end(args);
+  return buffer;
+}
+
+std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                           double rate_hz, double ramp_rate_k_per_min,
+                                           const std::vector<Eigen::Index>& record_starts) {
+  std::vector<ThermalSegment> all;
+  ForEachRecord(temperature_c.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    for (ThermalSegment s : Segments(temperature_c.segment(begin, length), rate_hz,
+                                     ramp_rate_k_per_min)) {
+      s.begin += begin;
+      s.end += begin;
+      all.push_back(s);
+    }
+  });
+  return all;
+}
+
+void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
+                 const std::vector<ThermalSegment>& segments,
+                 const std::vector<Eigen::Index>& record_starts, CalibrationReport& report) {
+  const double dt = 1.0 / rate_hz;
+  for (Eigen::Index c = 0; c < temperatures_c.cols(); ++c) {
+    report.span_k.push_back(temperatures_c.col(c).maxCoeff() - temperatures_c.col(c).minCoeff());
+  }
+  for (const ThermalSegment& s : segments) {
+    if (s.ramp) {
+      ++report.ramps;
+    } else if (static_cast<double>(s.end - s.begin) * dt >= kShortestDwellS) {
+      ++report.dwells;
+    }
+  }
+  ForEachRecord(temperatures_c.rows(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    const auto t = temperatures_c.col(0).segment(begin, length);
+    Eigen::VectorXd smooth(length);
+    FirstOrderLag(t, kRateSmoothingS, dt, smooth);
+    const Eigen::VectorXd rate = (t - smooth) * (60.0 / kRateSmoothingS);
+    report.max_heating_k_per_min = std::max(report.max_heating_k_per_min, rate.maxCoeff());
+    report.max_cooling_k_per_min = std::max(report.max_cooling_k_per_min, -rate.minCoeff());
+  });
+}
+
+void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
+                 bool fell_back_to_constant, CalibrationReport& report) {
+  auto& w = report.warnings;
+  auto& advice = report.advice;
+  if (report.duration_s < kShortestCalibrationS) {
+    w.push_back(Format("a log of %.3g min is not a calibration run: nothing of its thermal "
+                       "response can be held out and checked",
+                       report.duration_s / 60.0));
+    advice.push_back("log a calibration run of at least 8 h: ramps up and down at 0.5-2 K/min "
+                     "and dwells of 30 min or more at 3 or more temperatures");
+  }
+  const int channels = model.channels();
+  for (int c = 0; c < channels; ++c) {
+    if (report.span_k[static_cast<size_t>(c)] < kShortestSpanK) {
+      w.push_back(Format("temperature %sspans only %.3g K: the model is not identified beyond it",
+                         channels > 1 ? Format("T%d ", c + 1).c_str() : "",
+                         report.span_k[static_cast<size_t>(c)]));
+      advice.push_back(Format("narrow range: cover at least %.0f K, ideally the whole operating "
+                              "range", kShortestSpanK));
+    }
+  }
+  if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min) {
+    w.push_back("no heating ramp: the response to rising temperature is not identified");
+    advice.push_back("no heating: add a ramp up of at least 20 K at 0.5-2 K/min");
+  }
+  if (report.max_cooling_k_per_min < 2.0 * options.ramp_rate_k_per_min) {
+    w.push_back("no cooling ramp: the response to falling temperature is not identified");
+    advice.push_back("no cooling: add a ramp down of at least 20 K at 0.5-2 K/min");
+  }
+  if (report.dwells == 0) {
+    w.push_back(
+        "no dwell of 10 min or more: the level response cannot be told from the rate response");
+  }
+  if (report.dwells < 3) {
+    advice.push_back(Format("%d dwell%s: hold 30 min or more at 3 or more temperatures across the "
+                            "range", report.dwells, report.dwells == 1 ? "" : "s"));
+  }
+  if (report.ramps + report.dwells < 3) {
+    w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
+  }
+  // The slowest candidate state's mean delay: order x tau.
+  const std::vector<double> grid = options.Grid(report.duration_s);
+  const double longest_delay = grid.empty() ? 0.0 : options.state_order * grid.back();
+  if (longest_delay < kSlowLagS) {
+    w.push_back(Format(
+        "thermal states could lag the sensor by at most %.0f s (time constants up to %g of the "
+        "run): a gyro whose coil lags its sensor by more needs a longer calibration run",
+        longest_delay, options.longest_tau_share));
+    advice.push_back(Format(
+        "short run: %.3g h lets states lag by %.0f s at most; %.3g h reaches %.0f s",
+        report.duration_s / 3600.0, longest_delay,
+        kSlowLagS / (options.state_order * options.longest_tau_share) / 3600.0, kSlowLagS));
+  }
+  double slowest = 0.0;
+  for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);
+  if (slowest > 0.0 && report.duration_s < 8.0 * slowest) {
+    w.push_back(Format("the run is shorter than 8 times the slowest chosen time constant (%g s)",
+                       slowest));
+  }
+  if (fell_back_to_constant) {
+    w.push_back(Format(
+        "no temperature dependence beats a constant bias on held-out data (held-out RMSE of the "
+        "best structure %.4g, of the constant %.4g): the model is the constant bias",
+        report.held_out_rmse_best, report.held_out_rmse_constant));
+  } else if (!std::isnan(report.skill) && report.skill < kLeastSkill) {
+    w.push_back(Format(
+        "cross-validation confirms little temperature dependence (skill %.1f %%): the estimate "
+        "is close to a constant bias",
+        100.0 * report.skill));
+  }
+  if (report.regime_rmse > report.regime_rmse_constant && report.level > 0) {
+    w.push_back(Format(
+        "on held-out regimes and range ends the model does worse than a constant bias (RMSE %.4g "
+        "against %.4g): the run cannot confirm it beyond what it spans; see the advice",
+        report.regime_rmse, report.regime_rmse_constant));
+  }
+  if (report.condition > kLargestCondition) {
+    w.push_back(Format("the chosen regressors are nearly collinear (condition %.2g)",
+                       report.condition));
+  }
+}
+
+}  // namespace internal
+
+std::vector<ThermalSegment> Segments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                     double rate_hz, double ramp_rate_k_per_min) {
+  const Eigen::Index n = temperature_c.size();
+  std::vector<ThermalSegment> segments;
+  if (n == 0) return segments;
+  Eigen::VectorXd smooth(n);
+  FirstOrderLag(temperature_c, kRateSmoothingS, 1.0 / rate_hz, smooth);
+  const double threshold = ramp_rate_k_per_min / 60.0 * kRateSmoothingS;  // K of lag
+  const Eigen::Index shortest =
+      std::max<Eigen::Index>(1, static_cast<Eigen::Index>(kShortestSegmentS * rate_hz));
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const bool ramp = std::abs(temperature_c[t] - smooth[t]) > threshold;
+    if (!segments.empty() && segments.back().ramp == ramp) {
+      segments.back().end = t + 1;
+    } else {
+      segments.push_back({t, t + 1, ramp});
+    }
+  }
+  // Merge short stretches into the one before (the first into the one after), then join
+  // neighbours of one kind.
+  std::vector<ThermalSegment> merged;
+  for (const ThermalSegment& s : segments) {
+    if (!merged.empty() && (s.end - s.begin < shortest || merged.back().ramp == s.ramp)) {
+      merged.back().end = s.end;
+    } else if (!merged.empty() && merged.back().end - merged.back().begin < shortest) {
+      merged.back().end = s.end;
+      merged.back().ramp = s.ramp;
+    } else {
+      merged.push_back(s);
+    }
+  }
+  return merged;
+}
+
+std::string CalibrationReport::Summary() const {
+  using internal::Format;
+  static constexpr const char* kLevelNames[] = {"the constant",   "static powers of T",
+                                                "a lagged level", "one lag state",
+                                                "two lag states", "a hysteresis term"};
+  std::string span;
+  for (size_t c = 0; c < span_k.size(); ++c) span += Format("%s%.3g", c ? "/" : "", span_k[c]);
+  const std::string skill_text = std::isnan(skill)
+                                     ? std::string("skill not measured (run under 40 min)")
+                                     : Format("skill %.1f %% of the slow drift", 100.0 * skill);
+  auto gain = [](double rmse, double reference) {
+    return reference > 0.0 ? Format("%+.1f %%", 100.0 * (1.0 - rmse / reference))
+                           : std::string("n/a");
+  };
+  return Format(
+      "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d time folds, %d "
+      "regime folds, %d range folds; structure: %s (best held-out: %s); held-out RMSE %.4g "
+      "(against the constant %s, the static cubic %s; on held-out regimes %s and %s); "
+      "cross-validated RMSE %.4g (constant %.4g), %s, condition %.2g; hysteresis term %s",
+      duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
+      span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells, folds,
+      regime_folds, range_folds, kLevelNames[std::clamp(level, 0, 5)],
+      kLevelNames[std::clamp(best_level, 0, 5)], held_out_rmse,
+      gain(held_out_rmse, held_out_rmse_constant).c_str(),
+      gain(held_out_rmse, held_out_rmse_static).c_str(),
+      gain(regime_rmse, regime_rmse_constant).c_str(),
+      gain(regime_rmse, regime_rmse_static).c_str(), cv_rmse,
+      cv_rmse_constant, skill_text.c_str(), condition, hysteresis_tried ? "tried" : "not tried") +
+         (std::isnan(cv_rmse_nonlinear)
+              ? std::string()
+              : nonlinear_units > 0
+                    ? Format("; nonlinear correction %d units, C %g (cross-validated RMSE %.4g)",
+                             nonlinear_units, nonlinear_ridge_c, cv_rmse_nonlinear)
+                    : Format("; no nonlinear correction (best cross-validated RMSE %.4g)",
+                             cv_rmse_nonlinear));
+}
+
+}  // namespace gyrodrift::drift

@@ -1,0 +1,306 @@
+// The structure search of the thermal identification: fold moments, held-out scores, the nested
+// ladder and the one-standard-error rule (thermal_search.h).
+#include "thermal_search.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace gyrodrift::drift::internal {
+namespace {
+
+constexpr double kRelativeRidge = 1e-10;  // on the unit-diagonal Gram of a subset
+
+// Calls f(begin, length) for every run of logged rows (weight > 0) within [begin, end).
+template <typename F>
+void ForLoggedRuns(const Eigen::VectorXd& weight, Eigen::Index begin, Eigen::Index end, F&& f) {
+  Eigen::Index i = begin;
+  while (i < end) {
+    while (i < end && weight[i] <= 0.0) ++i;
+    const Eigen::Index start = i;
+    while (i < end && weight[i] > 0.0) ++i;
+    if (i > start) f(start, i - start);
+  }
+}
+
+// Least squares on the columns `cols` of Gram G and moment b, solved with unit-diagonal scaling
+// and a tiny ridge (the subsets' columns can be close to collinear).
+Eigen::VectorXd SolveSubset(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
+                            const std::vector<int>& cols) {
+  const Eigen::Index m = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd a(m, m);
+  Eigen::VectorXd rhs(m), d(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    d[i] = 1.0 / std::sqrt(std::max(g(cols[i], cols[i]), std::numeric_limits<double>::min()));
+  }
+  for (Eigen::Index i = 0; i < m; ++i) {
+    rhs[i] = b[cols[i]] * d[i];
+    for (Eigen::Index j = 0; j < m; ++j) a(i, j) = g(cols[i], cols[j]) * d[i] * d[j];
+    a(i, i) += kRelativeRidge;
+  }
+  Eigen::VectorXd w = a.ldlt().solve(rhs);
+  return w.cwiseProduct(d);
+}
+
+// Condition number of the unit-diagonal Gram of the columns `cols`.
+double Condition(const Eigen::MatrixXd& g, const std::vector<int>& cols) {
+  const Eigen::Index m = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd a(m, m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = 0; j < m; ++j) {
+      a(i, j) = g(cols[i], cols[j]) /
+                std::sqrt(std::max(g(cols[i], cols[i]) * g(cols[j], cols[j]),
+                                   std::numeric_limits<double>::min()));
+    }
+  }
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a).eigenvalues();
+  return ev[0] > 0.0 ? ev[m - 1] / ev[0] : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+FoldScores::FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
+                       const Eigen::VectorXd& weight, const std::vector<FoldRows>& folds,
+                       unsigned scored)
+    : x_(x), yc_(yc), weight_(weight) {
+  const Eigen::Index m = x.cols();
+  g_total_ = Eigen::MatrixXd::Zero(m, m);
+  b_total_ = Eigen::VectorXd::Zero(m);
+  std::array<int, kSchemes> per_scheme{};
+  for (const FoldRows& rows : folds) {
+    Fold f;
+    f.scheme = rows.scheme;
+    f.ranges = rows.ranges;
+    f.g = Eigen::MatrixXd::Zero(m, m);
+    f.b = Eigen::VectorXd::Zero(m);
+    for (const auto& [begin, end] : rows.ranges) {
+      ForLoggedRuns(weight, begin, end, [&](Eigen::Index start, Eigen::Index length) {
+        const auto xu = x.middleRows(start, length);
+        f.g.selfadjointView<Eigen::Lower>().rankUpdate(xu.transpose());
+        f.b += xu.transpose() * yc.segment(start, length);
+        f.yy += yc.segment(start, length).squaredNorm();
+        f.logged += static_cast<double>(length);
+      });
+    }
+    f.g = f.g.selfadjointView<Eigen::Lower>();
+    if (f.scheme == kTimeBlocks) {
+      g_total_ += f.g;
+      b_total_ += f.b;
+    }
+    if (scored & (1u << f.scheme)) ++per_scheme[f.scheme];
+    folds_.push_back(std::move(f));
+  }
+  const int schemes =
+      static_cast<int>(std::count_if(per_scheme.begin(), per_scheme.end(), [](int c) { return c > 0; }));
+  for (Fold& f : folds_) {
+    f.g_train = g_total_ - f.g;
+    f.b_train = b_total_ - f.b;
+    f.weight = per_scheme[f.scheme] > 0 ? 1.0 / (schemes * per_scheme[f.scheme]) : 0.0;
+  }
+}
+
+Eigen::VectorXd FoldScores::Weights(const Fold& f, const std::vector<int>& cols) const {
+  return SolveSubset(f.g_train, f.b_train, cols);
+}
+
+Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols) const {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(folds_.size()));
+  for (size_t k = 0; k < folds_.size(); ++k) {
+    const Fold& f = folds_[k];
+    const Eigen::VectorXd w = Weights(f, cols);
+    double e = f.yy;
+    for (size_t i = 0; i < cols.size(); ++i) {
+      const double wi = w[static_cast<Eigen::Index>(i)];
+      e -= 2.0 * wi * f.b[cols[i]];
+      for (size_t j = 0; j < cols.size(); ++j) {
+        e += wi * f.g(cols[i], cols[j]) * w[static_cast<Eigen::Index>(j)];
+      }
+    }
+    out[static_cast<Eigen::Index>(k)] = std::max(0.0, e) / std::max(1.0, f.logged);
+  }
+  return out;
+}
+
+double FoldScores::Mean(const Eigen::VectorXd& per_fold) const {
+  double sum = 0.0;
+  for (size_t k = 0; k < folds_.size(); ++k) {
+    sum += folds_[k].weight * per_fold[static_cast<Eigen::Index>(k)];
+  }
+  return sum;
+}
+
+double FoldScores::SchemeMean(const Eigen::VectorXd& per_fold, FoldScheme scheme) const {
+  double sum = 0.0;
+  int count = 0;
+  for (size_t k = 0; k < folds_.size(); ++k) {
+    if (folds_[k].scheme != scheme) continue;
+    sum += per_fold[static_cast<Eigen::Index>(k)];
+    ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+double FoldScores::StandardError(const Eigen::VectorXd& per_fold) const {
+  // Each scheme's mean has variance s^2 / n; the schemes weigh equally in the mean.
+  double variance = 0.0;
+  int schemes = 0;
+  for (int s = 0; s < kSchemes; ++s) {
+    double sum = 0.0, sum2 = 0.0;
+    int n = 0;
+    for (size_t k = 0; k < folds_.size(); ++k) {
+      if (folds_[k].scheme != s || folds_[k].weight == 0.0) continue;
+      const double v = per_fold[static_cast<Eigen::Index>(k)];
+      sum += v;
+      sum2 += v * v;
+      ++n;
+    }
+    if (n == 0) continue;
+    ++schemes;
+    if (n > 1) {
+      const double mean = sum / n;
+      variance += std::max(0.0, (sum2 - n * mean * mean) / (n - 1)) / n;
+    }
+  }
+  return schemes > 0 ? std::sqrt(variance) / schemes : 0.0;
+}
+
+double FoldScores::TimeMse(const std::vector<int>& cols) const {
+  const Eigen::VectorXd s = Scores(cols);
+  double sse = 0.0, logged = 0.0;
+  for (size_t k = 0; k < folds_.size(); ++k) {
+    if (folds_[k].scheme != kTimeBlocks) continue;
+    sse += s[static_cast<Eigen::Index>(k)] * std::max(1.0, folds_[k].logged);
+    logged += folds_[k].logged;
+  }
+  return logged > 0.0 ? sse / logged : 0.0;
+}
+
+Eigen::VectorXd FoldScores::TimeResidual(const std::vector<int>& cols) const {
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(yc_.size());
+  for (const Fold& f : folds_) {
+    if (f.scheme != kTimeBlocks) continue;
+    const Eigen::VectorXd w = Weights(f, cols);
+    for (const auto& [begin, end] : f.ranges) {
+      for (size_t i = 0; i < cols.size(); ++i) {
+        r.segment(begin, end - begin) -=
+            w[static_cast<Eigen::Index>(i)] * x_.col(cols[i]).segment(begin, end - begin);
+      }
+      r.segment(begin, end - begin) += yc_.segment(begin, end - begin);
+      r.segment(begin, end - begin).array() *= weight_.segment(begin, end - begin).array();
+    }
+  }
+  return r;
+}
+
+SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layout,
+                             const SearchRules& rules) {
+  constexpr int kLevels = CalibrationReport::kHysteresis + 1;
+  std::array<Subset, kLevels> best{};
+  auto consider = [&](Subset s) {
+    s.fold_scores = scores.Scores(s.cols);
+    s.score = scores.Mean(s.fold_scores);
+    if (s.score < best[static_cast<size_t>(s.level)].score) best[static_cast<size_t>(s.level)] = s;
+    return s;
+  };
+  SearchResult result;
+  // The constant, then static powers of every channel.
+  Subset constant;
+  result.constant = consider(constant);
+  for (int p = 1; p <= layout.static_powers; ++p) {
+    Subset s;
+    s.level = CalibrationReport::kStatic;
+    s.static_power = p;
+    for (int c = 0; c < layout.channels; ++c) {
+      for (int q = 1; q <= p; ++q) s.cols.push_back(layout.StaticColumn(c, q));
+    }
+    const Subset scored = consider(std::move(s));
+    if (p == layout.static_powers) result.static_cubic = scored;
+  }
+  // One lag state's level powers; one or two lag states with their rates; each with or without
+  // the linear static term; with the hysteresis term of one of their states.
+  const int max_states = std::min(rules.max_states, layout.candidates);
+  std::vector<int> chosen;
+  auto visit = [&](auto&& self, int next) -> void {
+    if (!chosen.empty()) {
+      for (int with_linear : {0, 1}) {
+       for (bool rates : {false, true}) {
+        if (!rates && chosen.size() > 1) continue;
+        if (rules.one_direction && (chosen.size() > 1 || with_linear)) continue;
+        Subset s;
+        s.states = chosen;
+        s.static_power = with_linear;
+        s.rates = rates;
+        s.level = !rates ? CalibrationReport::kLag : chosen.size() == 1 ? CalibrationReport::kOneState : CalibrationReport::kTwoStates;
+        for (int c = 0; with_linear && c < layout.channels; ++c) {
+          s.cols.push_back(layout.StaticColumn(c, 1));
+        }
+        for (int j : chosen) {
+          for (int p = 0; p < layout.state_columns - (rates ? 0 : 1); ++p) {
+            s.cols.push_back(layout.StateColumn(j, p));
+          }
+        }
+        if (Condition(scores.gram(), s.cols) > rules.max_condition) continue;
+        consider(s);
+        if (!rates) continue;
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          for (int w = 0; w < layout.widths; ++w) {
+            Subset h = s;
+            h.level = CalibrationReport::kHysteresis;
+            h.hysteresis_state = static_cast<int>(k);
+            h.hysteresis_width = w;
+            h.cols.push_back(layout.WidthColumn(chosen[k], w));
+            consider(std::move(h));
+          }
+        }
+       }
+      }
+    }
+    if (static_cast<int>(chosen.size()) == max_states) return;
+    for (int j = next; j < layout.candidates; ++j) {
+      chosen.push_back(j);
+      self(self, j + 1);
+      chosen.pop_back();
+    }
+  };
+  visit(visit, 0);
+
+  std::array<bool, kLevels> eligible{};
+  for (int l = 0; l < kLevels; ++l) {
+    eligible[static_cast<size_t>(l)] = std::isfinite(best[static_cast<size_t>(l)].score);
+  }
+  int b = 0;
+  for (int l = 1; l < kLevels; ++l) {
+    if (eligible[static_cast<size_t>(l)] &&
+        best[static_cast<size_t>(l)].score < best[static_cast<size_t>(b)].score) {
+      b = l;
+    }
+  }
+  result.best_level = b;
+  result.best_score = best[static_cast<size_t>(b)].score;
+  // The one-standard-error rule: the simplest level not clearly worse than the best.
+  const Subset& top = best[static_cast<size_t>(b)];
+  int pick = b;
+  for (int l = 0; l < b; ++l) {
+    if (!eligible[static_cast<size_t>(l)]) continue;
+    const Eigen::VectorXd d = best[static_cast<size_t>(l)].fold_scores - top.fold_scores;
+    if (scores.Mean(d) <= rules.standard_errors * scores.StandardError(d)) {
+      pick = l;
+      break;
+    }
+  }
+  result.chosen = best[static_cast<size_t>(pick)];
+  // The guarantee: a structure that does not beat the constant by a standard error is the
+  // constant.
+  if (pick > 0) {
+    const Eigen::VectorXd d = result.chosen.fold_scores - result.constant.fold_scores;
+    if (!(scores.Mean(d) < -rules.standard_errors * scores.StandardError(d))) {
+      result.chosen = result.constant;
+      result.fell_back_to_constant = true;
+    }
+  }
+  return result;
+}
+
+}  // namespace gyrodrift::drift::internal
