@@ -159,7 +159,7 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
                                o.features.rate_hz, o.thermal, !o.linear_compensation,
-                               SubModelSeed(o, g), record_starts));  // LOGGED_PENDING
+                               SubModelSeed(o, g), record_starts, logged));
     }
     return;
   }
