@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "gyrodrift/allan/allan.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -137,7 +138,7 @@ TEST_F(GapsCli, EveryCommandTakesTheFourModesAndSpellsTheFlagAsTyped) {
     for (const auto& [command, who] :
          std::vector<std::pair<std::string, std::string>>{
              {"decompose " + Path("holed.csv") + " -c rate_dph -o " + Path("d.csv"), "decompose"},
-             {"evaluate " + Path("holed.csv") + " -t rate_dph -T temperature_c --mode compensate",
+             {"evaluate " + Path("holed.csv") + " -t rate_dph -T temperature_c --mode compensate -o " + Path("d.csv"),
               "evaluate"}}) {
       r = test::RunCli(command + gaps);
       test::ExpectCleanFailure(r, 2, "--gaps " + std::string(mode) + ": " + who +

@@ -39,7 +39,7 @@ std::string WriteBursts(const io::CsvTable& table, double on_s, double period_s,
     if (std::fmod(t[i] - t[0], period_s) < on_s) rows.push_back(i);
   }
   std::vector<io::CsvColumn> columns;
-  for (const std::string& name : {"time_s", "rate_dph", "temperature_c"}) {
+  for (const char* name : {"time_s", "rate_dph", "temperature_c"}) {
     const Eigen::VectorXd all = table.Column(name);
     Eigen::VectorXd kept(static_cast<Eigen::Index>(rows.size()));
     for (size_t k = 0; k < rows.size(); ++k) kept[static_cast<Eigen::Index>(k)] = all[rows[k]];
