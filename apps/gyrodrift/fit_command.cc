@@ -99,6 +99,8 @@ void Run(const FitArgs& a) {
     Eigen::MatrixXd block(table.rows(), targets.values.cols() + temperature.values.cols());
     block.leftCols(targets.values.cols()) = targets.values;
     if (temperature.values.cols() > 0) block.rightCols(temperature.values.cols()) = temperature.values;
+    // interpolate fits on the made-up rows as data; only carry keeps the fit to the logged ones.
+    if (a.log.gaps != "carry") logged.clear();
     run.Append(block, starts, logged);
     sources += (sources.empty() ? "" : ",") + input;
   }

@@ -78,6 +78,14 @@ TEST_F(GapsCli, CarryFitsOnTheLoggedRowsAndCompensateLeavesTheMadeUpRowsOut) {
   EXPECT_NE(r.out.find("--gaps carry fits, scores and reports on the 500 logged rows only"),
             std::string::npos)
       << r.out;
+  // ... and fits on them: the library's fit of the filled log without a mask.
+  const io::LoadedModel interp = io::ReadModelFile(Dir() + "/interp.json");
+  const drift::DriftModel unmasked = drift::FitDriftModel(
+      filled.Column("rate_dph"), filled.Column("temperature_c"), interp.model.options);
+  EXPECT_EQ(drift::EstimateDrift(interp.model, filled.Column("temperature_c")),
+            drift::EstimateDrift(unmasked, filled.Column("temperature_c")));
+  EXPECT_NE(drift::EstimateDrift(interp.model, filled.Column("temperature_c")),
+            drift::EstimateDrift(carry.model, filled.Column("temperature_c")));
   // A decomposition would run across the made-up rows: refused, naming the method.
   r = test::RunCli("fit " + Path("bursts.csv") + " -t rate_dph -T temperature_c --mode compensate " +
                    "-m ms-elm --gaps carry -o " + Path("ms.json"));
