@@ -197,6 +197,49 @@ TEST_F(CalibrateCli, SeveralCalibrationLogsAndASplitVerification) {
             std::string::npos);
 }
 
+// A duty-cycled calibration log (60 s of every 300 s) under gaps = "carry": the model `fit
+// --gaps carry` gives; a verification log with made-up rows is refused (its block means and
+// Allan deviation need logged rows).
+TEST_F(CalibrateCli, ADutyCycledCalibrationIsFittedOnItsLoggedRows) {
+  const io::CsvTable cal = io::CsvTable::Read(Dir() + "/logs/SN1_cal.csv");
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < cal.rows(); ++i) {
+    if (i % 300 < 60) keep.push_back(i);
+  }
+  std::vector<io::CsvColumn> bursts;
+  for (const std::string& name : cal.header()) {
+    const Eigen::VectorXd all = cal.Column(name);
+    Eigen::VectorXd kept(static_cast<Eigen::Index>(keep.size()));
+    for (size_t k = 0; k < keep.size(); ++k) kept[static_cast<Eigen::Index>(k)] = all[keep[k]];
+    bursts.push_back({name, kept});
+  }
+  io::WriteCsv(Dir() + "/logs/D_cal.csv", bursts);
+  const std::string manifest = Dir() + "/carry.toml";
+  io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
+                                        "\n[[unit]]\nserial = \"D1\"\ncalibration = "
+                                        "\"logs/D_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n");
+  const std::string out = Dir() + "/out_carry";
+  auto r = test::RunCli("calibrate '" + manifest + "' -o '" + out + "' -q");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = test::RunCli("fit '" + Dir() + "/logs/D_cal.csv' -t gyro_x -T temp_x --mode compensate " +
+                   "--gaps carry -q -o '" + Dir() + "/d.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto axes = io::ReadModelFileAxes(out + "/D1/model.json");
+  const io::LoadedModel fitted = io::ReadModelFile(Dir() + "/d.json");
+  ASSERT_TRUE(axes[0].model.sub_models.front().thermal);
+  EXPECT_EQ(axes[0].model.sub_models.front().thermal->coefficients,
+            fitted.model.sub_models.front().thermal->coefficients);
+  // The same bursts as the verification: refused, naming the log.
+  io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
+                                        "\n[[unit]]\nserial = \"D2\"\ncalibration = "
+                                        "\"logs/SN1_cal.csv\"\nverification = \"logs/D_cal.csv\"\n");
+  r = test::RunCli("calibrate '" + manifest + "' -o '" + Dir() + "/out_carry2'");
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_NE((r.out + r.err).find("D_cal.csv: gaps = 'carry' fills this verification log's gaps"),
+            std::string::npos)
+      << r.out << r.err;
+}
+
 TEST_F(CalibrateCli, AFailingUnitIsReportedAndTheOthersGoOn) {
   // SN1's verification log loses a value; the limit is one no unit meets.
   fs::create_directories(Dir() + "/bad");
