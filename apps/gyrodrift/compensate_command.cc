@@ -1,6 +1,7 @@
 // gyrodrift compensate: remove the drift a saved compensate-mode model estimates from temperature.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,6 +10,7 @@
 #include "command.h"
 #include "drift_cli.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -26,9 +28,8 @@ struct CompensateArgs {
   bool quiet = false;
 };
 
-double Rms(const Eigen::VectorXd& v) {
-  const Eigen::VectorXd centred = v.array() - v.mean();
-  return std::sqrt(centred.squaredNorm() / static_cast<double>(v.size()));
+nlohmann::json SummaryJson(const drift::SignalSummary& s) {
+  return {{"mean", s.mean}, {"rms", s.rms}, {"std", s.std}, {"slow_variation", s.slow}};
 }
 
 // One axis compensated: the columns it adds, its part of the sidecar, its console lines.
@@ -74,16 +75,25 @@ AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& tab
                 {"temperature_column", loaded.info.temperature_column},
                 {"seed", model.options.seed},
                 {"tool_version", loaded.info.tool_version}};
+  // The mean, RMS, std and slow variation before and after (a calibration mostly moves the
+  // bias, which the std alone hides), blocks timed at the model's sample rate.
+  const drift::CompensationSummary summary =
+      drift::SummariseCompensation(y, compensated, model.options.features.rate_hz);
   j["samples"] = y.size();
-  j["std_before"] = Rms(y);
-  j["std_after"] = Rms(compensated);
-  // Files before format 4 did not record the unit.
-  const std::string unit = loaded.info.rate_unit.empty() ? "" : " " + loaded.info.rate_unit;
-  const std::string made_up =
-      logged.empty() ? "" : fmt::format(", logged rows only: {} made up left out", logged.size() - y.size());
-  r.text = fmt::format("{}\n{}: std {:.6g}{} before, {:.6g}{} after compensation ({} samples{})\n",
-                       model.Summary(), loaded.info.target_column, Rms(y), unit, Rms(compensated),
-                       unit, y.size(), made_up);
+  j["std_before"] = summary.before.std;
+  j["std_after"] = summary.after.std;
+  j["before"] = SummaryJson(summary.before);
+  j["after"] = SummaryJson(summary.after);
+  j["slow_variation_block_s"] = summary.block_s;
+  j["slow_variation_blocks"] = summary.blocks;
+  // Files before format 4 did not record the unit: the table then names none.
+  r.text = model.Summary() + "\n" + summary.Table(loaded.info.target_column, loaded.info.rate_unit);
+  // Filled gaps: the figures above leave the made-up rows out (the slow variation's blocks then
+  // hold consecutive logged samples, which span more time).
+  if (!logged.empty()) {
+    r.text += fmt::format("{}: statistics over the {} logged rows ({} made up left out)\n",
+                          loaded.info.target_column, y.size(), logged.size() - static_cast<size_t>(y.size()));
+  }
   // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
   // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
   if (truth.size() > 0) {
@@ -137,6 +147,18 @@ void Run(const CompensateArgs& a) {
   std::vector<bool> logged;  // --gaps interpolate or carry: the rows that were logged
   const io::CsvTable table = ReadLog(a.input, a.log, &text, &record_starts, {}, &logged);
   for (const io::LoadedModel& axis : axes) RequireModelColumns(axis, table);
+  // Before the work: a temperature that does not look like degC (each column once).
+  std::vector<std::string> temperature_columns;
+  for (const io::LoadedModel& axis : axes) {
+    if (!axis.model.uses_temperature()) continue;
+    for (const std::string& c : SplitColumns(axis.info.temperature_column)) {
+      if (std::find(temperature_columns.begin(), temperature_columns.end(), c) ==
+          temperature_columns.end()) {
+        temperature_columns.push_back(c);
+      }
+    }
+  }
+  if (!a.quiet) fmt::print("{}", InputWarnings(a.input, "", table, temperature_columns));
   std::vector<std::string> suffixes;
   for (const io::LoadedModel& axis : axes) {
     suffixes.push_back(axes.size() == 1 ? "" : "_" + axis.info.target_column);

@@ -49,6 +49,14 @@ drift::FitSettings Settings(const DriftArgs& args, const std::string& method);
 // median step is not positive.
 double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::string* how);
 
+// The warnings to print before the work on a log `path`: its sample rate assumed (`rate_how` as
+// ResolveRateHz returns it, "default"; "" = the command takes no rate) and each of its
+// `temperature_columns` that does not look like degC (drift::TemperatureWarning). Each line
+// "warning: ...\n"; "" when there is nothing to say.
+std::string InputWarnings(const std::string& path, const std::string& rate_how,
+                          const io::CsvTable& table,
+                          const std::vector<std::string>& temperature_columns);
+
 // Throws DataError "model needs column 'X' (trained with --target X); IN.csv has: a, b" unless
 // the table has the model's target column and, when the model uses it, its temperature column.
 void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);

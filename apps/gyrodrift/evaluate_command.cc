@@ -2,6 +2,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -79,10 +80,17 @@ void Run(const EvaluateArgs& a) {
   Eigen::MatrixXd temperature;
   Eigen::VectorXd truth;
   std::string temperature_column, truth_column;
+  std::vector<std::string> temperature_names;
   if (!a.temperature.empty()) {
     SelectedColumns t = ReadColumns(table, a.temperature, "--temperature");
     temperature_column = t.joined;
     temperature = std::move(t.values);
+    temperature_names = std::move(t.names);
+  }
+  // Before the work: an assumed sample rate, a temperature that does not look like degC.
+  if (!a.quiet) {
+    fmt::print("{}", InputWarnings(a.inputs.front(), rate_how, table, temperature_names));
+    std::fflush(stdout);
   }
   if (!a.truth.empty()) {
     truth_column = ColumnName(table, a.truth);

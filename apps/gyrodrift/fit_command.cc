@@ -2,13 +2,16 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "cli_util.h"
 #include "command.h"
 #include "drift_cli.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
 #include "progress.h"
@@ -16,17 +19,40 @@
 namespace gyrodrift::cli {
 namespace {
 
-// The chosen regressors (named by the temperature columns) with their coefficients, the
-// calibration report and its warnings.
+// The chosen regressors (named by the temperature columns) with their coefficients in physical
+// units around the reference temperature (drift::PhysicalCoefficients), the calibration report
+// and its warnings.
 void PrintThermalModel(const std::string& name, const drift::ThermalRegression& t,
-                       const std::vector<std::string>& channels) {
+                       const std::vector<std::string>& channels, std::optional<double> reference_c,
+                       const std::string& unit) {
   fmt::print("  {:<8} {}\n", name, t.Summary());
-  const std::vector<std::string> names = t.RegressorNames(channels);
-  for (size_t i = 0; i < names.size(); ++i) {
-    const std::string& label = names[i];
-    const auto k = static_cast<Eigen::Index>(i);
-    fmt::print("           {:<40} {:>12.6g} +- {:.2g}\n", label, t.coefficients[k],
-               std::sqrt(t.covariance(k, k)));
+  const drift::ThermalCoefficients c = drift::PhysicalCoefficients(t, reference_c, channels);
+  std::string around;
+  if (reference_c) {
+    around = fmt::format("{:.6g} degC (--reference-temperature)", *reference_c);
+  } else if (c.reference_c.size() == 1) {
+    around = fmt::format("{:.6g} degC (the calibration's mean)", c.reference_c[0]);
+  } else {
+    for (size_t i = 0; i < c.reference_c.size(); ++i) {
+      around += fmt::format("{}{} {:.6g}", i ? ", " : "",
+                            channels.size() == c.reference_c.size() ? channels[i]
+                                                                     : fmt::format("T{}", i + 1),
+                            c.reference_c[i]);
+    }
+    around += " degC (the calibration's means)";
+  }
+  fmt::print("           coefficients per K^k of (temperature or state level - reference), "
+             "around {}:\n", around);
+  for (const drift::PhysicalCoefficient& term : c.terms) {
+    std::string note;
+    // A state's first power: the level's calibration range, where the powers are polynomials.
+    if (term.state >= 0 && term.unit == "/K") {
+      const auto& range = c.state_range_c[static_cast<size_t>(term.state)];
+      note = fmt::format("  (level {:.4g}..{:.4g} degC in calibration)", range.first,
+                         range.second);
+    }
+    fmt::print("           {:<40} {:>12.6g} +- {:<8.2g} {}{}{}\n", term.term, term.value, term.sd,
+               unit, term.unit, note);
   }
   fmt::print("           calibration: {}\n", t.report.Summary());
   for (const std::string& w : t.report.warnings) {
@@ -53,7 +79,7 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
   const std::vector<std::string> channels = SplitColumns(axis.info.temperature_column);
   for (const auto& sub : model.sub_models) {
     if (sub.thermal) {
-      PrintThermalModel(sub.name, *sub.thermal, channels);
+      PrintThermalModel(sub.name, *sub.thermal, channels, o.reference_c, axis.info.rate_unit);
       continue;
     }
     fmt::print(
@@ -77,7 +103,7 @@ void Run(const FitArgs& a) {
 
   // Several calibration logs (or one split at its gaps) become one run of several records: the
   // targets' columns, then the temperatures', of every log one after the other.
-  std::string notes, rate_how, sources;
+  std::string notes, rate_how, sources, warnings;
   SelectedColumns targets, temperature;
   drift::RecordRows run;
   for (const std::string& input : a.inputs) {
@@ -90,6 +116,7 @@ void Run(const FitArgs& a) {
     if (!time_note.empty()) notes += (a.inputs.size() > 1 ? input + ": " : "") + time_note + "\n";
     targets = ReadColumns(table, a.target, "--target");
     if (!a.temperature.empty()) temperature = ReadColumns(table, a.temperature, "--temperature");
+    warnings += InputWarnings(input, how, table, temperature.names);
     if (sources.empty()) {
       o.features.rate_hz = rate_hz;
       rate_how = how;
@@ -128,6 +155,12 @@ void Run(const FitArgs& a) {
         o.mode == drift::Mode::kCompensate ? "a decomposition runs across the made-up rows"
                                            : "a prediction from the output's past reads made-up "
                                              "rows"));
+  }
+  // What the user must know before waiting for the fit: an assumed rate, a temperature that
+  // does not look like degC.
+  if (!a.quiet && !warnings.empty()) {
+    fmt::print("{}", warnings);
+    std::fflush(stdout);
   }
   const auto axes = static_cast<int>(targets.names.size());
   std::vector<io::LoadedModel> fitted;

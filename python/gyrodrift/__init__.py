@@ -23,7 +23,7 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "noise_terms", "select_modes", "simulate",
+    "decompose", "evaluate", "noise_terms", "select_modes", "simulate", "temperature_warning",
 ]
 
 
@@ -186,6 +186,27 @@ class DriftModel:
         ``gyrodrift compensate``."""
         return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
+    def compensation_summary(self, temperature, y, *, record_starts=()):
+        """Compensate mode: what compensating ``y`` does to it, the figures ``gyrodrift
+        compensate`` prints and keeps in its sidecar. Returns a dict: ``before`` and ``after``
+        (each ``mean``, ``rms`` about zero, ``std`` about the mean and ``slow_variation``, the RMS
+        about their mean of 10-min block means, NaN on a log shorter than two blocks),
+        ``samples``, ``slow_variation_block_s``, ``slow_variation_blocks`` and ``table`` (the
+        printed lines). The blocks are timed at the model's sample rate (docs/drift.md 1.5)."""
+        return self._core.compensation_summary(temperature, y, record_starts=list(record_starts))
+
+    def coefficients(self, *, reference_temperature=None):
+        """The thermal sub-models' coefficients in physical units, as ``gyrodrift fit`` prints
+        them: per sub-model a dict of ``sub_model``, ``reference_c`` (per channel: the given
+        ``reference_temperature``, else the model's, else the calibration's mean), ``terms``
+        (each ``term``, ``power``, ``state``, ``unit`` such as "dph/K", "dph/K^2",
+        "dph/(K/min)", ``value`` and ``sd``: the bias at the reference, then per K^k of
+        (temperature or state level - reference), per K/min of a state's rate, the hysteresis
+        term in target units) and ``state_range_c`` (each state's level range in calibration,
+        where its powers are polynomials). Empty for models without identified thermal
+        sub-models (docs/drift.md 1.5)."""
+        return self._core.coefficients(reference_temperature=reference_temperature)
+
     def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=512,
                 threads=0, progress=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
@@ -240,6 +261,21 @@ class DriftModel:
 
     def __repr__(self):
         return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"
+
+
+def temperature_warning(temperature, name="temperature"):
+    """The warning ``gyrodrift fit`` prints before the work for a temperature column that does
+    not look like degC (outside -80..200 degC, or whole numbers only, as raw ADC counts step),
+    saying what is assumed; "" when it looks like degC. ``DriftModel.fit`` issues it as a
+    UserWarning.
+
+    >>> import gyrodrift as gd
+    >>> gd.temperature_warning([25.1, 25.2, 25.4])
+    ''
+    >>> gd.temperature_warning([64000.0, 64012.0, 64100.0], "temp").split(";")[0]
+    "temperature column 'temp' runs from 64000 to 64100, outside -80..200 degC"
+    """
+    return _gyrodrift.temperature_warning(temperature, name)
 
 
 def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisations=100,

@@ -37,9 +37,12 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/drift/temperature_check.h"
+#include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
 #include "gyrodrift/io/model_file.h"
@@ -626,6 +629,13 @@ class PyDriftModel {
       throw UsageError("temperature_columns: " + std::to_string(names.size()) + " names for " +
                        std::to_string(temperature.cols()) + " temperature columns");
     }
+    // Before the work, as `gyrodrift fit`: a temperature that does not look like degC.
+    for (Eigen::Index c = 0; c < temperature.cols(); ++c) {
+      const std::string w = drift::TemperatureWarning(temperature.col(c), names[static_cast<size_t>(c)]);
+      if (!w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) {
+        throw py::error_already_set();
+      }
+    }
     io::LoadedModel loaded;
     loaded.info.source = source;
     loaded.info.target_column = target;
@@ -681,6 +691,75 @@ class PyDriftModel {
       compensated = y - e.col(0);
     }
     return ToArray(compensated);
+  }
+
+  // The figures `gyrodrift compensate` prints and keeps in its sidecar for y compensated by this
+  // model (drift::SummariseCompensation at the model's sample rate).
+  py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
+                               const std::vector<Eigen::Index>& record_starts) const {
+    RequireMode(drift::Mode::kCompensate, "compensation_summary");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    if (y.size() != t.rows()) {
+      throw DataError("compensation_summary: y has " + std::to_string(y.size()) +
+                      " samples, temperature " + std::to_string(t.rows()));
+    }
+    drift::CompensationSummary s;
+    {
+      py::gil_scoped_release release;
+      const Eigen::VectorXd compensated =
+          y - drift::EstimateDriftWithSd(Loaded().model, t, record_starts).col(0);
+      s = drift::SummariseCompensation(y, compensated, Loaded().model.options.features.rate_hz);
+    }
+    auto figures = [](const drift::SignalSummary& f) {
+      py::dict d;
+      d["mean"] = f.mean;
+      d["rms"] = f.rms;
+      d["std"] = f.std;
+      d["slow_variation"] = f.slow;
+      return d;
+    };
+    py::dict d;
+    d["samples"] = s.samples;
+    d["before"] = figures(s.before);
+    d["after"] = figures(s.after);
+    d["slow_variation_block_s"] = s.block_s;
+    d["slow_variation_blocks"] = s.blocks;
+    d["table"] = s.Table(Loaded().info.target_column, Loaded().info.rate_unit);
+    return d;
+  }
+
+  // The thermal sub-models' coefficients in physical units around `reference_temperature`, else
+  // the model's reference temperature, else the calibration's means (as `gyrodrift fit` prints).
+  py::list Coefficients(std::optional<double> reference_temperature) const {
+    const io::LoadedModel& l = Loaded();
+    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    const std::optional<double> reference =
+        reference_temperature ? reference_temperature : l.model.options.reference_c;
+    py::list out;
+    for (const drift::SubModel& sub : l.model.sub_models) {
+      if (!sub.thermal) continue;
+      const drift::ThermalCoefficients c =
+          drift::PhysicalCoefficients(*sub.thermal, reference, channels);
+      py::list terms;
+      for (const drift::PhysicalCoefficient& t : c.terms) {
+        py::dict d;
+        d["term"] = t.term;
+        d["power"] = t.power;
+        d["state"] = t.state;
+        d["unit"] = l.info.rate_unit + t.unit;
+        d["value"] = t.value;
+        d["sd"] = t.sd;
+        terms.append(d);
+      }
+      py::dict d;
+      d["sub_model"] = sub.name;
+      d["reference_c"] = c.reference_c;
+      d["terms"] = terms;
+      d["state_range_c"] = c.state_range_c;
+      out.append(d);
+    }
+    return out;
   }
 
   // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
@@ -1084,6 +1163,10 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"),
            py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
+           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
+           arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal", arg("window") = 512,
            arg("threads") = 0, arg("progress") = py::none())
@@ -1111,6 +1194,9 @@ PYBIND11_MODULE(_gyrodrift, m) {
                               d.Loaded().model.temperature_max_c);
       });
 
+  m.def("temperature_warning", [](const gp::Array& t, const std::string& name) {
+    return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
+  }, arg("temperature"), arg("name") = "temperature");
   m.def("select_modes", &gp::SelectModesPy, arg("x"), arg("imfs"), arg("residue"), py::kw_only(),
         arg("criterion") = "pdf", arg("distance") = "l2", arg("realisations") = 100,
         arg("confidence") = 0.99, arg("seed") = 1, arg("band") = 0.99, arg("threads") = 0);

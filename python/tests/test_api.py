@@ -125,3 +125,14 @@ def test_select_modes_groups_a_decomposition_into_series_that_add_up():
     assert s["noise_level_seed"] == 3 and "noise{" in s["summary"]
     with pytest.raises(gd.UsageError, match="criterion"):
         gd.select_modes(x, imfs, residue, criterion="nope")
+
+
+def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():
+    sim = gd.simulate(duration=3600, seed=3)
+    counts = np.round(sim["temperature_c"] * 512.0)  # a die-temperature register, not degC
+    with pytest.warns(UserWarning, match=r"^temperature column 'temp_raw' runs from .* outside "
+                                         r"-80\.\.200 degC; whole numbers only: raw ADC counts\?"):
+        gd.DriftModel().fit(sim["rate_dph"], counts, mode="compensate",
+                            temperature_columns=["temp_raw"])
+    assert gd.temperature_warning(sim["temperature_c"]) == ""
+    assert "whole numbers only" in gd.temperature_warning(counts, "temp_raw")

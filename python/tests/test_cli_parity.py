@@ -117,6 +117,27 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     assert len(thermal["regressors"]) == len(thermal["coefficients"]) == len(thermal["sd"])
     assert any("temperature_c" in name for name in thermal["regressors"])
     assert np.all(np.isfinite(thermal["sd"]))
+    # What compensation did, as the CLI printed and kept it (drift::SummariseCompensation).
+    side = read_json(tmp_path / "comp.csv.json")
+    summary = loaded.compensation_summary(temperature, y)
+    for when in ("before", "after"):
+        for figure in ("mean", "rms", "std", "slow_variation"):
+            assert summary[when][figure] == side[when][figure], (when, figure)
+    assert summary["slow_variation_blocks"] == side["slow_variation_blocks"] == 12
+    printed = cli("compensate", tmp_path / "cli_model.json", sim_csv, "-o",
+                  tmp_path / "comp2.csv").stdout
+    assert summary["table"] in printed
+    # The coefficients in physical units, as `fit` prints them.
+    printed = cli("fit", sim_csv, "--target", "rate_dph", "--temperature", "temperature_c",
+                  "--mode", "compensate", "--seed", "3", "-o", tmp_path / "m2.json").stdout
+    (coefficients,) = loaded.coefficients()
+    assert coefficients["reference_c"][0] == pytest.approx(np.mean(temperature), abs=1e-9)
+    for term in coefficients["terms"]:
+        assert f"{term['term']:<40} {term['value']:>12.6g} +- " in printed, term
+        assert term["unit"].startswith("dph")
+    (at_20,) = loaded.coefficients(reference_temperature=20.0)
+    assert at_20["reference_c"] == [20.0]
+    assert at_20["terms"][0]["term"] == "bias"
 
 
 def test_fit_settings_map_as_the_cli_flags(cli, sim_csv, tmp_path):

@@ -14,7 +14,9 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/statistics.h"
+#include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/temperature_check.h"
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -32,21 +34,6 @@ constexpr const char* kSummaryFile = "summary.json";
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-double RmsAboutMean(const Eigen::Ref<const Eigen::VectorXd>& v) {
-  if (v.size() == 0) return std::numeric_limits<double>::quiet_NaN();
-  return std::sqrt((v.array() - v.mean()).square().mean());
-}
-
-// Means of consecutive blocks of `block` samples (a last partial block is dropped unless it is
-// the only one).
-Eigen::VectorXd BlockMeans(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Index block) {
-  const Eigen::Index blocks = std::max<Eigen::Index>(1, v.size() / block);
-  const Eigen::Index len = std::min(block, v.size());
-  Eigen::VectorXd out(blocks);
-  for (Eigen::Index b = 0; b < blocks; ++b) out[b] = v.segment(b * len, len).mean();
-  return out;
 }
 
 // The first sample and length of the longest record.
@@ -79,8 +66,11 @@ std::string Fmt(double v) { return std::isnan(v) ? "" : io::FormatDouble(v); }
 std::vector<std::string> Failures(const Limits& limits, const VerificationResult& v) {
   std::vector<std::string> out;
   if (!std::isnan(limits.residual_drift_rms) && !(v.drift_rms_after <= limits.residual_drift_rms)) {
-    out.push_back(fmt::format("residual drift {:.4g} > {:.4g}", v.drift_rms_after,
-                              limits.residual_drift_rms));
+    out.push_back(std::isnan(v.drift_rms_after)
+                      ? std::string("residual drift not measured (the log is shorter than two "
+                                    "drift_window_s blocks)")
+                      : fmt::format("residual drift {:.4g} > {:.4g}", v.drift_rms_after,
+                                    limits.residual_drift_rms));
   }
   if (!std::isnan(limits.bias_instability_dph)) {
     // Unidentified, B is reported as 0; what bounds it is the curve's flattest point read by the
@@ -107,7 +97,31 @@ struct Log {
   double rate_hz = 1.0;
   std::vector<Eigen::Index> record_starts;  // gaps = split: where the log's records start
   std::vector<bool> logged;  // gaps = carry: the rows that were logged (empty: every row)
+  std::vector<std::string> warnings;        // about its inputs (InputWarnings)
 };
+
+// What the user must know about a log's inputs: an assumed sample rate, temperature columns of
+// the axes that do not look like degC (drift::TemperatureWarning), each naming the log's file.
+std::vector<std::string> InputWarnings(const Manifest& m, const std::string& path,
+                                       const io::CsvTable& table, const std::string& rate_how) {
+  std::vector<std::string> out;
+  const std::string name = fs::path(path).filename().string();
+  if (rate_how == "default") {
+    out.push_back(name +
+                  ": no time_s column: its sample rate is taken as 1 Hz (set rate_hz in the "
+                  "manifest if it is not)");
+  }
+  std::vector<std::string> seen;
+  for (const AxisSpec& axis : m.axes) {
+    for (const std::string& column : axis.temperature) {
+      if (std::find(seen.begin(), seen.end(), column) != seen.end()) continue;
+      seen.push_back(column);
+      const std::string w = drift::TemperatureWarning(table.Column(column), column);
+      if (!w.empty()) out.push_back(name + ": " + w);
+    }
+  }
+  return out;
+}
 
 Log ReadUnitLog(const Manifest& m, const std::string& path) {
   Log log;
@@ -116,6 +130,7 @@ Log ReadUnitLog(const Manifest& m, const std::string& path) {
                           m.log.gaps == io::GapPolicy::kCarry ? &log.logged : nullptr);
   std::string how;
   log.rate_hz = io::ResolveSampleRate(log.table, m.rate_hz, &how);
+  log.warnings = InputWarnings(m, path, log.table, how);
   return log;
 }
 
@@ -182,7 +197,12 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
         a.cv_rmse = t.report.cv_rmse;
         a.skill = t.report.skill;
       }
+      // A warning of the calibration report: the run could not identify this sub-model.
+      a.identified = a.identified.value_or(true) && t.report.warnings.empty();
       for (const std::string& w : t.report.warnings) a.warnings.push_back(sub.name + ": " + w);
+    }
+    for (const Log& log : cal) {
+      a.warnings.insert(a.warnings.end(), log.warnings.begin(), log.warnings.end());
     }
     r.axes.push_back(std::move(a));
     models.push_back(std::move(model));
@@ -201,6 +221,9 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
           "continuous log",
           unit.verification[k], ver.table.rows() - drift::CountLogged(ver.logged, ver.table.rows()),
           ver.table.rows()));
+    }
+    for (AxisResult& a : r.axes) {
+      a.warnings.insert(a.warnings.end(), ver.warnings.begin(), ver.warnings.end());
     }
     std::vector<io::CsvColumn> columns;
     for (int c = 0; c < static_cast<int>(ver.table.header().size()); ++c) {
@@ -226,21 +249,26 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
       v.log = unit.verification[k];
       v.samples = y.size();
       v.rate_hz = ver.rate_hz;
-      v.std_before = RmsAboutMean(y);
-      v.std_after = RmsAboutMean(compensated);
-      v.output_means = BlockMeans(y, block);
-      v.compensated_means = BlockMeans(compensated, block);
-      v.estimate_means = BlockMeans(estimate, block);
+      // The figures `gyrodrift compensate` reports, the slow variation over drift_window_s.
+      const drift::CompensationSummary summary =
+          drift::SummariseCompensation(y, compensated, ver.rate_hz, m.drift_window_s);
+      v.mean_before = summary.before.mean;
+      v.mean_after = summary.after.mean;
+      v.std_before = summary.before.std;
+      v.std_after = summary.after.std;
+      v.output_means = drift::BlockMeans(y, block);
+      v.compensated_means = drift::BlockMeans(compensated, block);
+      v.estimate_means = drift::BlockMeans(estimate, block);
       v.block_hours.resize(v.output_means.size());
       for (Eigen::Index b = 0; b < v.block_hours.size(); ++b) {
         v.block_hours[b] = (static_cast<double>(b) + 0.5) * static_cast<double>(block) /
                            ver.rate_hz / 3600.0;
       }
-      v.drift_rms_before = RmsAboutMean(v.output_means);
-      v.drift_rms_after = RmsAboutMean(v.compensated_means);
+      v.drift_rms_before = summary.before.slow;
+      v.drift_rms_after = summary.after.slow;
       if (!axis.truth.empty()) {
         const Eigen::VectorXd truth = ver.table.Column(axis.truth);
-        v.truth_means = BlockMeans(truth, block);
+        v.truth_means = drift::BlockMeans(truth, block);
         const double truth_rms = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
         const double residual =
             std::sqrt((truth - estimate).squaredNorm() / static_cast<double>(truth.size()));
@@ -396,7 +424,8 @@ const std::vector<std::string>& FleetColumns() {
       "std_before", "std_after", "drift_rms_before", "drift_rms_after", "drift_removed",
       "truth_removed", "arw_before_dpsh", "arw_after_dpsh", "bias_instability_before_dph",
       "bias_instability_after_dph", "rrw_before_dphpsh", "rrw_after_dphpsh", "bias", "cv_rmse",
-      "skill", "regressors", "warnings", "outside_share", "unit_seconds"};
+      "skill", "regressors", "warnings", "identified", "outside_share", "mean_before",
+      "mean_after", "unit_seconds"};
   return kColumns;
 }
 
@@ -449,7 +478,10 @@ std::vector<FleetRow> Rows(const UnitResult& unit) {
                                Fmt(a.skill),
                                regressors,
                                warnings,
+                               !a.identified ? "" : *a.identified ? "yes" : "no",
                                Fmt(v.outside_share),
+                               Fmt(v.mean_before),
+                               Fmt(v.mean_after),
                                seconds}});
     }
   }

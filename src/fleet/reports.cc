@@ -80,18 +80,23 @@ std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const Unit
     for (size_t i = 0; i < a.regressors.size(); ++i) model += (i ? ", " : "") + a.regressors[i];
     if (!std::isnan(a.bias)) model += fmt::format("\nintercept (repeatable bias): {:.6g} {}", a.bias, unit_name);
     if (!std::isnan(a.cv_rmse)) model += fmt::format("\ncross-validated RMSE {:.4g} {}, skill {:.3f}", a.cv_rmse, unit_name, a.skill);
+    if (a.identified && !*a.identified) {
+      model += "\nnot identified: the calibration run could not identify this model (warnings below)";
+    }
     for (const std::string& w : a.warnings) model += "\nwarning: " + w;
     report.AddPreformatted(model);
     io::ReportTable table;
     table.title = "Verification of " + a.target;
-    table.header = {"log", "samples", "std before", "std after", "residual drift before",
+    table.header = {"log", "samples", "mean before", "mean after", "std before", "std after",
+                    "residual drift before",
                     "residual drift after", "true drift removed", "ARW after (deg/rt h)",
                     "B before (deg/h)", "B after (deg/h)", "outside cal. range", "limits broken"};
     for (const VerificationResult& v : a.verification) {
       std::string failures;
       for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
       table.rows.push_back({std::filesystem::path(v.log).filename().string(),
-                            std::to_string(v.samples), Num(v.std_before), Num(v.std_after),
+                            std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
+                            Num(v.std_before), Num(v.std_after),
                             Num(v.drift_rms_before), Num(v.drift_rms_after),
                             Percent(v.truth_removed), Num(v.noise_after.n_dpsh.value),
                             Num(v.noise_before.b_dph.value), Num(v.noise_after.b_dph.value),
@@ -154,6 +159,24 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
     if (!Text(row, "outliers").empty()) {
       outliers.push_back(fmt::format("{} {} ({})", row.cells[0], Text(row, "axis"), Text(row, "outliers")));
     }
+  }
+  // Units whose calibration run could not identify their model (fleet.csv's identified = no):
+  // their compensation rests on a model the data did not support.
+  std::vector<std::string> unidentified;
+  for (const FleetRow& row : fleet.rows) {
+    if (Text(row, "identified") != "no") continue;
+    const std::string entry = fmt::format("{} {}", row.cells[0], Text(row, "axis"));
+    if (std::find(unidentified.begin(), unidentified.end(), entry) == unidentified.end()) {
+      unidentified.push_back(entry);
+    }
+  }
+  if (!unidentified.empty()) {
+    std::string list;
+    for (const std::string& u : unidentified) list += (list.empty() ? "" : "; ") + u;
+    report.AddParagraph(fmt::format(
+        "Not identified ({} unit axes, marked \"not identified\" in the table below): the "
+        "calibration run could not identify the model (see the warnings on the unit's page): {}.",
+        unidentified.size(), list));
   }
   report.AddParagraph(outliers.empty()
                           ? "No outliers: every unit's figures lie within 3.5 robust standard "
@@ -228,7 +251,7 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
   table.title = "Every unit, axis and verification log (fleet.csv)";
   table.header = {"#", "serial", "axis", "log", "status", "residual drift before",
                   "residual drift after", "true drift removed", "B after (deg/h)",
-                  "ARW after (deg/rt h)", "bias", "outliers", "limits broken / error"};
+                  "ARW after (deg/rt h)", "bias", "model", "outliers", "limits broken / error"};
   for (const FleetRow& row : fleet.rows) {
     const auto i = std::find(serials.begin(), serials.end(), row.cells[0]) - serials.begin();
     const bool error = Text(row, "status") == "error";
@@ -238,13 +261,16 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
                           Percent(Cell(row, "truth_removed")),
                           Num(Cell(row, "bias_instability_after_dph")),
                           Num(Cell(row, "arw_after_dpsh")), Num(Cell(row, "bias")),
+                          Text(row, "identified") == "no" ? "not identified" : "",
                           Text(row, "outliers"), Text(row, "failures")});
     std::vector<std::string> links(table.header.size());
     if (!error) links[1] = row.cells[0] + "/report.html";
     table.links.push_back(links);
   }
   table.caption = "Click a serial for the unit's page (its models, figures and files are in its "
-                  "folder). Residual drift in " + unit_name + ".";
+                  "folder). Residual drift in " + unit_name + ". Model: \"not identified\" where "
+                  "the calibration run could not identify the thermal model (its warnings are on "
+                  "the unit's page and in fleet.csv).";
   report.AddTable(table);
   return report.Render(assets);
 }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -117,6 +118,73 @@ TEST_F(CompensateCli, TruthColumnGivesTheShareOfTheDriftRemoved) {
   char line[64];
   std::snprintf(line, sizeof line, "(%.1f %% removed)", removed);
   EXPECT_NE(r.out.find(line), std::string::npos) << r.out;
+}
+
+// What compensation did to the output: mean, RMS, std and slow variation before and after, in
+// the console and the sidecar, the library's figures (drift::SummariseCompensation).
+TEST_F(CompensateCli, ReportsMeanRmsAndSlowVariationBeforeAndAfter) {
+  // 30 min at 1 Hz: three 10-min blocks.
+  io::WriteFileAtomically(Dir() + "/long.csv", test::ThermalLogCsv(1800, 3));
+  const std::string out = Dir() + "/long_out.csv";
+  const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() + "/long.csv' -o '" +
+                              out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto table = io::CsvTable::Read(out);
+  const drift::CompensationSummary s = drift::SummariseCompensation(
+      table.Column("rate_dph"), table.Column("compensated"), 1.0);
+  ASSERT_EQ(s.blocks, 3);
+  EXPECT_NE(r.out.find("rate_dph (dph), 1800 samples:\n"), std::string::npos) << r.out;
+  char line[160];
+  std::snprintf(line, sizeof line, "  %-16s %14.6g %14.6g\n", "mean", s.before.mean, s.after.mean);
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out << line;
+  std::snprintf(line, sizeof line, "  %-16s %14.6g %14.6g  (RMS about their mean of 3 means of "
+                "600-s blocks)\n", "slow variation", s.before.slow, s.after.slow);
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out << line;
+  EXPECT_NE(r.out.find("  RMS "), std::string::npos) << r.out;
+  const auto json = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(json["before"]["mean"].get<double>(), s.before.mean);
+  EXPECT_EQ(json["after"]["mean"].get<double>(), s.after.mean);
+  EXPECT_EQ(json["before"]["rms"].get<double>(), s.before.rms);
+  EXPECT_EQ(json["after"]["std"].get<double>(), s.after.std);
+  EXPECT_EQ(json["std_after"].get<double>(), s.after.std);
+  EXPECT_EQ(json["before"]["slow_variation"].get<double>(), s.before.slow);
+  EXPECT_EQ(json["after"]["slow_variation"].get<double>(), s.after.slow);
+  EXPECT_EQ(json["slow_variation_block_s"].get<double>(), 600.0);
+  EXPECT_EQ(json["slow_variation_blocks"].get<int>(), 3);
+  // The compensation removes slow drift here.
+  EXPECT_LT(s.after.slow, s.before.slow);
+
+  // A 10-min log has one block: the slow variation is not measured, and says so.
+  const std::string short_out = Dir() + "/short_out.csv";
+  const auto short_run = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                                      "/test.csv' -o '" + short_out + "'");
+  ASSERT_EQ(short_run.exit_code, 0) << short_run.err;
+  EXPECT_NE(short_run.out.find("n/a"), std::string::npos) << short_run.out;
+  EXPECT_NE(short_run.out.find("not measured: the log is shorter than 2 blocks of 600 s"),
+            std::string::npos)
+      << short_run.out;
+  const auto short_json = nlohmann::json::parse(io::ReadTextFile(short_out + ".json"));
+  EXPECT_TRUE(short_json["before"]["slow_variation"].is_null());
+}
+
+// A temperature in ADC counts is named before the work, with what the tool assumes.
+TEST_F(CompensateCli, WarnsUpFrontOfATemperatureInCounts) {
+  const auto input = io::CsvTable::Read(Dir() + "/test.csv");
+  const Eigen::VectorXd counts = (input.Column("temperature_c").array() * 512.0 + 52000.0).round();
+  io::WriteCsv(Dir() + "/counts.csv",
+               {{"rate_dph", input.Column("rate_dph")}, {"temperature_c", counts}});
+  const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                              "/counts.csv' -o '" + Dir() + "/counts_out.csv'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string warning = "warning: " + Dir() + "/counts.csv: temperature column "
+                              "'temperature_c' runs from ";
+  EXPECT_EQ(r.out.rfind(warning, 0), 0u) << r.out;  // the first line
+  EXPECT_NE(r.out.find("raw ADC counts?; it is taken as degC as given"), std::string::npos)
+      << r.out;
+  // A degC log has no such warning.
+  const auto clean = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                                  "/test.csv' -o '" + Dir() + "/clean_out.csv'");
+  EXPECT_EQ(clean.out.find("warning: " + Dir() + "/test.csv"), std::string::npos) << clean.out;
 }
 
 TEST_F(CompensateCli, RunsOnALogWithOnlyTheModelsColumns) {
@@ -278,7 +346,7 @@ TEST(CompensateCliAxes, SeveralTargetsFitOneFileAndCompensateEveryAxis) {
     for (const char* column : {"drift_est_", "drift_sd_", "compensated_"}) {
       EXPECT_TRUE(out.HasColumn(std::string(column) + axis)) << column << axis;
     }
-    EXPECT_NE(r.out.find(std::string(axis) + ": std"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(std::string(axis) + " (dph), "), std::string::npos) << r.out;
   }
   // The three-axis file estimates gyro_y as the one-axis model does.
   r = test::RunCli("compensate '" + dir + "/y.json' '" + dir + "/imu.csv' -o '" + dir +

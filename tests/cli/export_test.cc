@@ -188,7 +188,7 @@ TEST_F(ExportCli, TheCasesExerciseWhatTheyClaim) {
   EXPECT_TRUE(beyond) << thermal.model.Summary();
   const io::LoadedModel two = io::ReadModelFile(Dir() + "/two.json");
   const auto& t2 = *two.model.sub_models[0].thermal;
-  EXPECT_TRUE(t2.linear[1] || std::any_of(t2.states.begin(), t2.states.end(),
+  EXPECT_TRUE(t2.static_power[1] > 0 || std::any_of(t2.states.begin(), t2.states.end(),
                                           [](const auto& s) { return s.channel == 1; }))
       << t2.Summary();
   EXPECT_GE(io::ReadModelFile(Dir() + "/ms.json").model.sub_models.size(), 2u);

@@ -2,8 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <optional>
 #include <nlohmann/json.hpp>
 
+#include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
@@ -39,7 +42,7 @@ TEST_F(FitCli, MsElmCompensateWritesAModelThatLoads) {
   EXPECT_NE(r.out.find("wrote " + model), std::string::npos) << r.out;
   const auto json = nlohmann::json::parse(io::ReadTextFile(model));
   EXPECT_EQ(json["format"], "gyrodrift-model");
-  EXPECT_EQ(json["format_version"], 6);
+  EXPECT_EQ(json["format_version"], io::kModelFormatVersion);
   EXPECT_EQ(json["training"]["target_column"], "rate_dph");
   EXPECT_EQ(json["training"]["temperature_column"], "temperature_c");
   EXPECT_EQ(json["training"]["samples"], 400);
@@ -169,6 +172,71 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   r = Fit("-t rate_dph --mode predict -m poly", dir_ + "/u.json");  // the uniform log
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.find("not uniform"), std::string::npos) << r.out;
+}
+
+// The thermal model's coefficients in physical units around the reference temperature, the
+// library's figures (drift::PhysicalCoefficients).
+TEST_F(FitCli, PrintsTheCoefficientsInPhysicalUnits) {
+  const std::string model = dir_ + "/m.json";
+  auto r = Fit("-t rate_dph -T temperature_c --mode compensate", model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::LoadedModel loaded = io::ReadModelFile(model);
+  const drift::ThermalRegression& t = *loaded.model.sub_models.at(0).thermal;
+  drift::ThermalCoefficients c = drift::PhysicalCoefficients(t, std::nullopt, {"temperature_c"});
+  char line[200];
+  std::snprintf(line, sizeof line, "around %.6g degC (the calibration's mean):", t.centre_c[0]);
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out << line;
+  for (const drift::PhysicalCoefficient& term : c.terms) {
+    std::snprintf(line, sizeof line, "%-40s %12.6g +- ", term.term.c_str(), term.value);
+    EXPECT_NE(r.out.find(line), std::string::npos) << r.out << line;
+    EXPECT_NE(r.out.find("dph" + term.unit), std::string::npos) << r.out << term.unit;
+  }
+  // Around a stated reference: the bias there.
+  r = Fit("-t rate_dph -T temperature_c --mode compensate --reference-temperature 20", model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("around 20 degC (--reference-temperature):"), std::string::npos) << r.out;
+  c = drift::PhysicalCoefficients(*io::ReadModelFile(model).model.sub_models.at(0).thermal, 20.0);
+  std::snprintf(line, sizeof line, "%-40s %12.6g +- ", "bias", c.terms[0].value);
+  EXPECT_NE(r.out.find(line), std::string::npos) << r.out << line;
+}
+
+// Before the work: a sample rate assumed for a log without time_s, and a temperature that does
+// not look like degC, each with what the tool assumes.
+TEST_F(FitCli, WarnsUpFrontOfAnAssumedRateAndATemperatureInCounts) {
+  const auto input = io::CsvTable::Read(input_);
+  const std::string untimed = dir_ + "/untimed.csv";
+  io::WriteCsv(untimed, {{"rate_dph", input.Column("rate_dph")},
+                         {"temperature_c", input.Column("temperature_c")},
+                         {"counts", (input.Column("temperature_c").array() * 512.0).round().eval()}});
+  const std::string model = dir_ + "/m.json";
+  const std::string rate_warning = "warning: " + untimed +
+                                   " has no time_s column: its sample rate is taken as 1 Hz "
+                                   "(give --rate-hz if it is not)\n";
+  auto r = test::RunCli("fit '" + untimed + "' -t rate_dph -T temperature_c --mode compensate "
+                        "-o '" + model + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind(rate_warning, 0), 0u) << r.out;  // the first line, before the model
+  EXPECT_NE(r.out.find("sample rate: 1 Hz (default)"), std::string::npos) << r.out;
+  // Given, the rate is no assumption.
+  r = test::RunCli("fit '" + untimed + "' -t rate_dph -T temperature_c --mode compensate "
+                   "--rate-hz 1 -o '" + model + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("warning: " + untimed), std::string::npos) << r.out;
+  // A temperature in counts: named up front, the fit goes on as degC.
+  r = test::RunCli("fit '" + untimed + "' -t rate_dph -T counts --mode compensate --rate-hz 1 "
+                   "-o '" + model + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("warning: " + untimed + ": temperature column 'counts' runs from ", 0),
+            0u)
+      << r.out;
+  EXPECT_NE(r.out.find("whole numbers only: raw ADC counts?; it is taken as degC as given"),
+            std::string::npos)
+      << r.out;
+  // Quiet means quiet.
+  r = test::RunCli("fit '" + untimed + "' -t rate_dph -T counts --mode compensate -q -o '" +
+                   model + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 TEST_F(FitCli, EveryBaselineFits) {

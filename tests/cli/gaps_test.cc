@@ -98,7 +98,7 @@ TEST_F(GapsCli, CarryFitsOnTheLoggedRowsAndCompensateLeavesTheMadeUpRowsOut) {
   r = test::RunCli("compensate " + Path("carry.json") + " " + Path("bursts.csv") +
                    " --gaps carry --truth drift_dph -o " + Path("c_carry.csv"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("(500 samples, logged rows only: 2450 made up left out)"), std::string::npos)
+  EXPECT_NE(r.out.find("rate_dph: statistics over the 500 logged rows (2450 made up left out)"), std::string::npos)
       << r.out;
   const io::CsvTable out_carry = io::CsvTable::Read(Dir() + "/c_carry.csv");
   EXPECT_EQ(out_carry.rows(), 500);

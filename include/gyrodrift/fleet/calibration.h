@@ -3,8 +3,10 @@
 // Per unit and axis: fit the compensate-mode drift model on the calibration log (exactly what
 // `gyrodrift fit --target <every axis> --mode compensate` writes, seed and options alike),
 // compensate each verification log, and measure before and after compensation:
+//   - the mean (the bias the compensation moves) and the standard deviation;
 //   - the residual drift: RMS, about their mean, of the output's means over drift_window_s
-//     blocks (the slow part the compensation is for; white noise averages out of it);
+//     blocks (the slow part the compensation is for; white noise averages out of it), as
+//     drift::SummariseCompensation computes it for `gyrodrift compensate`;
 //   - the Allan deviation (overlapping, octave taus) and its IEEE 952 terms N, B, K;
 //   - with a true-drift column: the share of its RMS removed, 1 - RMS(truth - estimate) /
 //     RMS(truth), as `compensate --truth` reports it;
@@ -16,12 +18,14 @@
 // summary.json holds the same fingerprint (manifest settings and the logs' bytes: UnitFingerprint)
 // unless `force`. A unit that fails (unreadable log, a fit that cannot run) is reported with its
 // one-line error and the others go on. OUT/fleet.csv (one row per unit, axis and verification log)
-// and OUT/fleet.html (distributions across the fleet, outliers flagged, links to each unit's page)
-// are written at the end.
+// and OUT/fleet.html (distributions across the fleet, outliers flagged, units whose calibration
+// could not identify their model marked, links to each unit's page) are written at the end.
 #pragma once
 
 #include <Eigen/Core>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,8 +41,11 @@ struct VerificationResult {
   std::string log;  // path
   Eigen::Index samples = 0;
   double rate_hz = 0.0;
+  double mean_before = 0.0, mean_after = 0.0;              // rate unit: the bias moved
   double std_before = 0.0, std_after = 0.0;                // rate unit
-  double drift_rms_before = 0.0, drift_rms_after = 0.0;    // rate unit (drift_window_s means)
+  // Rate unit: drift::SummariseCompensation's slow variation over drift_window_s blocks (NaN for
+  // a log shorter than two blocks: not measured, so a residual drift limit is broken).
+  double drift_rms_before = 0.0, drift_rms_after = 0.0;
   double truth_removed = std::numeric_limits<double>::quiet_NaN();  // share, NaN: no truth
   double outside_share = 0.0;  // samples beyond the calibration's temperature range
   allan::NoiseTerms noise_before, noise_after;
@@ -56,7 +63,14 @@ struct AxisResult {
   double bias = std::numeric_limits<double>::quiet_NaN();  // intercept, rate unit (thermal)
   double cv_rmse = std::numeric_limits<double>::quiet_NaN();
   double skill = std::numeric_limits<double>::quiet_NaN();
-  std::vector<std::string> warnings;  // calibration-run warnings
+  // The calibration-run warnings of its thermal sub-models ("<sub-model>: ..."), then those on
+  // its logs' inputs ("<log file>: ...": an assumed sample rate, a temperature that does not
+  // look like degC).
+  std::vector<std::string> warnings;
+  // Whether the calibration run identified the model: false when a thermal sub-model's
+  // calibration report has warnings (it says what the run could not identify, or that the model
+  // fell back to a constant); unset for a method without identified thermal sub-models.
+  std::optional<bool> identified;
   std::vector<VerificationResult> verification;
   bool pass() const;
 };

@@ -231,7 +231,7 @@ TEST(ThermalModel, PowersContinueAlongTheirTangentBeyondTheCalibrationRange) {
   const Eigen::MatrixXd x = m.Regressors(Eigen::VectorXd::Constant(10, hot));
   const double z = (hot - m.centre_c[0]) / m.scale_k[0];
   ASSERT_GT(z, st.level_max);
-  const Eigen::Index first = m.linear[0] ? 2 : 1;
+  const Eigen::Index first = 1 + m.static_power[0];
   EXPECT_NEAR(x(9, first), z, 1e-12);
   EXPECT_NEAR(x(9, first + 1), st.level_max * st.level_max + 2 * st.level_max * (z - st.level_max),
               1e-9);
@@ -273,6 +273,125 @@ TEST(ThermalModel, ARunWithoutCoolingOrDwellsIsFlaggedAndBadInputRefused) {
   Eigen::VectorXd with_nan = y;
   with_nan[100] = std::nan("");
   EXPECT_THROW(IdentifyThermalModel(t, with_nan, 1.0, ThermalModelOptions{}), DataError);
+}
+
+// A heat-up calibration (cold soak, one ramp up at 0.6 K/min, a hold) of a gyro whose drift
+// follows a lagged level, a gradient (sensor less coil: a lag difference, whose sign follows the
+// direction of the change) and a Shupe rate term.
+struct HeatUp {
+  Eigen::VectorXd t, drift;
+};
+HeatUp HeatUpRun(const Eigen::VectorXd& t) {
+  const Eigen::VectorXd coil = State(t, 600.0);
+  Eigen::VectorXd a(t.size());
+  FirstOrderLag(t, 600.0, 1.0, a);
+  HeatUp h{t, Eigen::VectorXd(t.size())};
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double d = coil[i] - 20.0;
+    h.drift[i] = 0.1 + 3e-3 * d + 5e-5 * d * d + 0.01 * (t[i] - coil[i]) +
+                 60.0 * (a[i] - coil[i]) / 600.0;
+  }
+  return h;
+}
+
+// What a one-way calibration cannot identify stays out: no lag difference (two states, or a state
+// beside the static term), and a rate of the sign it never saw (cooling) is held at the edge of
+// the rates it did see, with the standard deviation widened by what the hold left out. The run
+// gets its advice. On a mission that cools, the estimate is no worse than doing nothing.
+TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHoldsCoolingRates) {
+  const Eigen::Index n = 8 * 3600;
+  Eigen::VectorXd cal(n);
+  for (Eigen::Index i = 0; i < n; ++i) cal[i] = std::min(60.0, -20.0 + 0.01 * std::max<Eigen::Index>(0, i - 2700));
+  const HeatUp h = HeatUpRun(cal);
+  Rng rng(8, 0);
+  Eigen::VectorXd y(n);
+  for (Eigen::Index i = 0; i < n; ++i) y[i] = h.drift[i] + 0.2 * rng.Normal();
+  const ThermalRegression m = IdentifyThermalModel(cal, y, 1.0, ThermalModelOptions{});
+  EXPECT_LE(m.states.size(), 1u) << m.Summary();
+  EXPECT_FALSE(!m.states.empty() && m.static_power[0] > 0) << m.Summary();
+  std::string advice;
+  for (const std::string& a : m.report.advice) advice += a + "\n";
+  EXPECT_NE(advice.find("no cooling: add a ramp down"), std::string::npos) << advice;
+  for (const ThermalState& s : m.states) {
+    EXPECT_TRUE(std::isfinite(s.rate_min)) << "cooling was never seen";
+    EXPECT_TRUE(std::isinf(s.rate_max)) << "heating was";
+  }
+  // A mission between the calibration's ends that heats and cools at 1 K/min.
+  const Eigen::VectorXd mission = Programme(8.0).array() * 0.5 + 10.0;
+  const Eigen::VectorXd truth = HeatUpRun(mission).drift;
+  const Eigen::MatrixXd e = m.EstimateWithSd(mission);
+  const double none = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
+  const double after = std::sqrt((e.col(0) - truth).squaredNorm() / static_cast<double>(truth.size()));
+  EXPECT_LT(after, none) << m.Summary();
+  if (!m.states.empty() && m.coefficients[m.coefficients.size() - 1] != 0.0) {
+    // Where the mission cools, the rate column sits at the calibration's edge.
+    const Eigen::MatrixXd x = m.Regressors(mission);
+    EXPECT_GE(x.col(x.cols() - 1).minCoeff(), m.states[0].rate_min);
+  }
+}
+
+// The guarantee: a gyro without temperature dependence gets the constant, whatever the
+// temperature did; the report says so.
+TEST(ThermalModel, NoTemperatureDependenceGivesTheConstant) {
+  const Eigen::VectorXd t = Programme(8.0);
+  Rng rng(9, 0);
+  Eigen::VectorXd y(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) y[i] = 0.3 + 0.2 * rng.Normal();
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  EXPECT_EQ(m.report.level, CalibrationReport::kConstant) << m.report.Summary();
+  EXPECT_TRUE(m.states.empty());
+  EXPECT_EQ(m.static_power[0], 0);
+  ASSERT_EQ(m.coefficients.size(), 1);
+  EXPECT_NEAR(m.coefficients[0], 0.3, 0.01);
+  EXPECT_NE(m.report.Summary().find("structure: the constant"), std::string::npos)
+      << m.report.Summary();
+}
+
+// A gyro with a plain static cubic gets static powers of T, not lag states.
+TEST(ThermalModel, AStaticDriftGetsStaticPowers) {
+  const Eigen::VectorXd t = Programme(8.0);
+  Rng rng(10, 0);
+  Eigen::VectorXd y(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    const double d = t[i] - 20.0;
+    y[i] = 0.1 + 4e-3 * d + 1e-4 * d * d + 0.05 * rng.Normal();
+  }
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  EXPECT_EQ(m.report.level, CalibrationReport::kStatic) << m.report.Summary();
+  EXPECT_GE(m.static_power[0], 2);
+  EXPECT_EQ(m.RegressorNames()[2], "T1^2");
+}
+
+// A duty-cycled log: 5 s of every 300 s logged, the rest made up across the gaps. Samples not
+// logged never reach the fit (garbage there changes nothing), and the model is the continuous
+// log's to within its noise.
+TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
+  const Eigen::VectorXd t = Programme(8.0);
+  const Eigen::VectorXd s = State(t, 480.0);
+  Rng rng(11, 0);
+  Eigen::VectorXd drift(t.size()), y(t.size());
+  std::vector<bool> logged(static_cast<size_t>(t.size()));
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    drift[i] = 0.1 + 3e-3 * (s[i] - 20.0);
+    y[i] = drift[i] + 0.02 * rng.Normal();
+    logged[static_cast<size_t>(i)] = i % 300 < 5;
+  }
+  const ThermalRegression m =
+      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {}, logged);
+  Eigen::VectorXd garbage = y;
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    if (!logged[static_cast<size_t>(i)]) garbage[i] = 1e3;
+  }
+  const ThermalRegression g =
+      IdentifyThermalModel(t, garbage, 1.0, ThermalModelOptions{}, false, 1, {}, logged);
+  EXPECT_EQ(g.coefficients, m.coefficients);
+  const double rms =
+      std::sqrt((m.Estimate(t) - drift).squaredNorm() / static_cast<double>(t.size()));
+  EXPECT_LT(rms, 0.02) << m.Summary();
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, true, 1, {}, logged),
+               UsageError);
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {}, {true}),
+               DataError);
 }
 
 TEST(ThermalModel, GridFollowsTheRunLength) {

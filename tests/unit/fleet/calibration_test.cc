@@ -169,6 +169,11 @@ TEST_F(FleetCalibration, AVerificationIsMeasuredAsDocumented) {
   EXPECT_EQ(v.rate_hz, 1.0);
   EXPECT_DOUBLE_EQ(v.std_before, RmsAboutMean(y));
   EXPECT_DOUBLE_EQ(v.std_after, RmsAboutMean(compensated));
+  EXPECT_DOUBLE_EQ(v.mean_before, y.mean());
+  EXPECT_DOUBLE_EQ(v.mean_after, compensated.mean());
+  // The calibration warnings decide whether the model counts as identified.
+  ASSERT_TRUE(a.identified.has_value());
+  EXPECT_EQ(*a.identified, a.warnings.empty()) << a.warnings.size();
   // 100-s block means: 72 whole blocks, the last 50 samples dropped.
   ASSERT_EQ(v.output_means.size(), kVerSamples / 100);
   Eigen::VectorXd means(kVerSamples / 100), comp_means(kVerSamples / 100);
@@ -271,6 +276,19 @@ TEST_F(FleetCalibration, ALimitIsNeverPassedOnAFigureThatWasNotMeasured) {
   // Without the limit the same log passes: only a set limit needs its figure.
   const Manifest zero_free = Make("", {{"SNZ", "SN2_cal.csv", "SNZ_ver.csv"}});
   EXPECT_TRUE(CalibrateUnit(zero_free, zero_free.units[0], test::FakeDygraphs()).result.pass());
+
+  // A verification log shorter than two drift_window_s blocks has no residual drift to measure:
+  // an empty cell, and a set limit broken, named so.
+  Manifest long_window = Fleet("residual_drift_rms = 1e6\n");
+  long_window.drift_window_s = static_cast<double>(kVerSamples);
+  const UnitResult w =
+      CalibrateUnit(long_window, long_window.units[1], test::FakeDygraphs()).result;
+  ASSERT_EQ(w.error, "");
+  EXPECT_TRUE(std::isnan(w.axes[0].verification[0].drift_rms_after));
+  ASSERT_EQ(w.axes[0].verification[0].failures.size(), 1u);
+  EXPECT_EQ(w.axes[0].verification[0].failures[0],
+            "residual drift not measured (the log is shorter than two drift_window_s blocks)");
+  EXPECT_EQ(Cell(Rows(w).at(0), "drift_rms_after"), "");
 }
 
 TEST_F(FleetCalibration, AUnitsOwnErrorIsItsResultNotAnException) {
@@ -302,9 +320,12 @@ TEST(Rows, EveryCellComesFromTheResult) {
   a.cv_rmse = 0.0625;
   a.skill = 0.875;
   a.warnings = {"no dwell", "narrow span"};
+  a.identified = false;
   VerificationResult v;
   v.log = "/data/logs/SN7_ver.csv";
   v.samples = 1234;
+  v.mean_before = 1.5;
+  v.mean_after = -0.125;
   v.std_before = 0.5;
   v.std_after = 0.25;
   v.drift_rms_before = 0.2;
@@ -351,7 +372,10 @@ TEST(Rows, EveryCellComesFromTheResult) {
       {"skill", "0.875"},
       {"regressors", "T; dT/dt"},
       {"warnings", "no dwell; narrow span"},
+      {"identified", "no"},  // the calibration run could not identify the model
       {"outside_share", "0.1"},
+      {"mean_before", "1.5"},
+      {"mean_after", "-0.125"},
       {"unit_seconds", "0.25"}};
   ASSERT_EQ(expected.size(), FleetColumns().size());
   for (size_t i = 0; i < expected.size(); ++i) {

@@ -116,6 +116,8 @@ VerificationResult Verification(const std::string& log, double drift_after, doub
   v.log = log;
   v.samples = 7250;
   v.rate_hz = 1.0;
+  v.mean_before = 1.5;
+  v.mean_after = -0.25;
   v.std_before = 0.123456;
   v.std_after = 0.0123456;
   v.drift_rms_before = 0.25;
@@ -152,6 +154,7 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   x.cv_rmse = 0.0123456;
   x.skill = 0.875;
   x.warnings = {"narrow span"};
+  x.identified = false;  // the warning: the run could not identify the model
   x.verification = {Verification("/data/logs/SN7_ver.csv", 0.0123456, 0.95123),
                     Verification("/data/logs/SN7_ver2.csv", 0.0625, kNan)};
   x.verification[1].failures = {"residual drift 0.0625 > 0.05", "second"};
@@ -160,6 +163,7 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   y.target = "gyro_y";
   y.bias = kNan;  // not an identified thermal model: no intercept, no CV line
   y.cv_rmse = kNan;
+  y.identified.reset();
   y.verification[1].failures.clear();
   unit.axes = {x, y};
 
@@ -179,6 +183,8 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   EXPECT_NE(Unescape(html).find("thermal: level and rate\nregressors: temp_x, d temp_x/dt\n"
                                 "intercept (repeatable bias): 0.125 dph\n"
                                 "cross-validated RMSE 0.01235 dph, skill 0.875\n"
+                                "not identified: the calibration run could not identify this "
+                                "model (warnings below)\n"
                                 "warning: narrow span</pre>"),
             std::string::npos);
   EXPECT_NE(Unescape(html).find("thermal: level and rate\nregressors: temp_x, d temp_x/dt\n"
@@ -188,11 +194,12 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   const auto rows = TableRows(html, "Verification of gyro_x");
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(Texts(rows[0]),
-            (std::vector<std::string>{"SN7_ver.csv", "7250", "0.1235", "0.01235", "0.25", "0.01235",
-                                      "95.1 %", "0.00458", "0.5", "0.0125", "12.5 %", "none"}));
-  EXPECT_EQ(Texts(rows[1])[6], "-");  // no truth
-  EXPECT_EQ(Texts(rows[1])[11], "residual drift 0.0625 > 0.05; second");
-  EXPECT_EQ(Texts(TableRows(html, "Verification of gyro_y")[1])[11], "none");
+            (std::vector<std::string>{"SN7_ver.csv", "7250", "1.5", "-0.25", "0.1235", "0.01235",
+                                      "0.25", "0.01235", "95.1 %", "0.00458", "0.5", "0.0125",
+                                      "12.5 %", "none"}));
+  EXPECT_EQ(Texts(rows[1])[8], "-");  // no truth
+  EXPECT_EQ(Texts(rows[1])[13], "residual drift 0.0625 > 0.05; second");
+  EXPECT_EQ(Texts(TableRows(html, "Verification of gyro_y")[1])[13], "none");
 
   // Two figures per axis and log: the block means and the Allan deviation.
   const std::vector<nlohmann::json> figures = Figures(html);
@@ -227,6 +234,11 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   EXPECT_NE(
       RenderUnitReport(open, spec, unit, test::FakeDygraphs()).find("Limits: no limits set. Result: PASS."),
       std::string::npos);
+}
+
+size_t FleetColumnIndex(const std::string& name) {
+  const auto& c = FleetColumns();
+  return static_cast<size_t>(std::find(c.begin(), c.end(), name) - c.begin());
 }
 
 // A fleet.csv row with the figures the fleet page reads.
@@ -268,6 +280,10 @@ TEST(FleetReport, PlotsEachUnitsWorstLogAndLinksTheCalibratedUnits) {
                 Row("SN3", "gyro_x", "a.csv", "pass", 0.03125, 0.7),
                 Row("SN3", "gyro_y", "a.csv", "pass", 0.0375, 0.85)};
   fleet.rows[4].cells[5] = "drift_rms_after bias";  // flagged by FinishFleet
+  for (const size_t r : {0, 1, 2, 5}) {
+    fleet.rows[r].cells[FleetColumnIndex("identified")] = "yes";
+  }
+  fleet.rows[4].cells[FleetColumnIndex("identified")] = "no";  // SN3 gyro_x
   fleet.rows[3].cells[4] = "log.csv: data row 2 is 'nan'";
 
   const std::string html = RenderFleetReport(m, fleet, test::FakeDygraphs());
@@ -277,6 +293,11 @@ TEST(FleetReport, PlotsEachUnitsWorstLogAndLinksTheCalibratedUnits) {
                                                   "removed >= 75.0 %."),
             std::string::npos);
   EXPECT_NE(Unescape(html).find("fleet median): SN3 gyro_x (drift_rms_after bias)."),
+            std::string::npos);
+  // Units whose calibration could not identify their model: named, and marked in the table.
+  EXPECT_NE(Unescape(html).find("Not identified (1 unit axes, marked \"not identified\" in the "
+                                "table below): the calibration run could not identify the model "
+                                "(see the warnings on the unit's page): SN3 gyro_x."),
             std::string::npos);
 
   // One point per unit (x = its number in the table) and axis: a unit's worst log, the highest
@@ -311,13 +332,14 @@ TEST(FleetReport, PlotsEachUnitsWorstLogAndLinksTheCalibratedUnits) {
   ASSERT_EQ(rows.size(), fleet.rows.size());
   EXPECT_EQ(Texts(rows[1]),
             (std::vector<std::string>{"1", "SN1", "gyro_x", "b.csv", "fail", "0.25", "0.0625",
-                                      "80.0 %", "0.0125", "0.00458", "0.5", "", ""}));
+                                      "80.0 %", "0.0125", "0.00458", "0.5", "", "", ""}));
   EXPECT_EQ(rows[1][1].link, "SN1/report.html");
   EXPECT_EQ(Texts(rows[3]),
             (std::vector<std::string>{"2", "SN2", "", "", "error", "-", "-", "-", "-", "-", "-", "",
-                                      "log.csv: data row 2 is 'nan'"}));
+                                      "", "log.csv: data row 2 is 'nan'"}));
   EXPECT_EQ(rows[3][1].link, "");
   EXPECT_EQ(Texts(rows[4])[0], "3");
+  EXPECT_EQ(Texts(rows[4])[11], "not identified");
   EXPECT_EQ(rows[4][1].link, "SN3/report.html");
 }
 

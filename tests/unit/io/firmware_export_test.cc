@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -79,8 +80,9 @@ LoadedModel Fit(const Log& log, drift::DriftOptions o, int channels = 1,
 }
 
 // The estimate of every axis from the coefficients JSON, with the equation of docs/firmware.md:
-// per sub-model b0 + sum a_c z_c + sum_j [sum_p g_jp P_p(zs_j) + r_j ds_j/dt] + h H_w(s_k)
-// - reference_estimate.
+// per sub-model b0 + sum_c sum_p a_cp P_p(z_c) + sum_j [sum_p g_jp P_p(zs_j) + r_j R(ds_j/dt)]
+// + h H_w(s_k) - reference_estimate, P_p the power continued along its tangent beyond the range and
+// R the rate held within [rate_min, rate_max] (null: unbounded).
 Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& temperature_c) {
   const Eigen::Index n = temperature_c.rows();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(j["axes"].size()));
@@ -89,12 +91,27 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
     for (const json& sub : axis["sub_models"]) {
       if (sub["zero"].get<bool>()) continue;
       Eigen::VectorXd e = Eigen::VectorXd::Constant(n, sub["intercept"].get<double>());
-      for (const json& l : sub["linear"]) {
+      auto tangent_powers = [](const std::vector<double>& powers, double z, double lo, double hi) {
+        const double edge = std::clamp(z, lo, hi);
+        double sum = 0.0;
+        for (size_t p = 1; p <= powers.size(); ++p) {
+          const double pp = static_cast<double>(p);
+          sum += powers[p - 1] * (p == 1 ? z : std::pow(edge, pp) + pp * std::pow(edge, pp - 1) * (z - edge));
+        }
+        return sum;
+      };
+      auto bound = [](const json& v, double otherwise) {
+        return v.is_null() ? otherwise : v.get<double>();
+      };
+      constexpr double kInf = std::numeric_limits<double>::infinity();
+      for (const json& l : sub["static"]) {
         const auto c = l["channel"].get<Eigen::Index>();
-        e += l["coefficient"].get<double>() *
-             ((temperature_c.col(c).array() - l["centre_c"].get<double>()) /
-              l["scale_k"].get<double>())
-                 .matrix();
+        const std::vector<double> powers = l["powers"].get<std::vector<double>>();
+        const double lo = bound(l["level_min"], -kInf), hi = bound(l["level_max"], kInf);
+        for (Eigen::Index t = 0; t < n; ++t) {
+          const double z = (temperature_c(t, c) - l["centre_c"].get<double>()) / l["scale_k"].get<double>();
+          e[t] += tangent_powers(powers, z, lo, hi);
+        }
       }
       std::vector<Eigen::VectorXd> levels;  // of each state, degC
       for (const json& s : sub["states"]) {
@@ -113,13 +130,9 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
           }
           level[t] = input;
           const double z = (input - s["centre_c"].get<double>()) / s["scale_k"].get<double>();
-          const double edge = std::clamp(z, lo, hi);
-          double sum = 0.0;
-          for (size_t p = 1; p <= powers.size(); ++p) {
-            const double pp = static_cast<double>(p);
-            sum += powers[p - 1] * (std::pow(edge, pp) + pp * std::pow(edge, pp - 1) * (z - edge));
-          }
-          e[t] += sum + s["rate"].get<double>() * (before_last - input) / tau;
+          const double rate = std::clamp((before_last - input) / tau, bound(s["rate_min"], -kInf),
+                                         bound(s["rate_max"], kInf));
+          e[t] += tangent_powers(powers, z, lo, hi) + s["rate"].get<double>() * rate;
         }
       }
       if (!sub["hysteresis"].is_null()) {
@@ -196,7 +209,7 @@ TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
   for (const LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_}) {
     const json j = json::parse(RenderCoefficientsJson({*m}, kJson));
     EXPECT_EQ(j["format"], "gyrodrift-coefficients");
-    EXPECT_EQ(j["format_version"], 2);
+    EXPECT_EQ(j["format_version"], 3);
     EXPECT_EQ(j["rate_hz"], 1.0);
     const int channels = m->model.temperature_channels();
     const Eigen::MatrixXd t = test.temperature.leftCols(channels);
@@ -217,7 +230,7 @@ TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
   EXPECT_TRUE(beyond);
   // The two-channel model uses the board channel, so the channel mapping is exercised.
   const auto& t2 = *two_->model.sub_models[0].thermal;
-  EXPECT_TRUE(t2.linear[1] || std::any_of(t2.states.begin(), t2.states.end(),
+  EXPECT_TRUE(t2.static_power[1] > 0 || std::any_of(t2.states.begin(), t2.states.end(),
                                           [](const auto& s) { return s.channel == 1; }))
       << t2.Summary();
   // The reference: the estimate is zero for a record in equilibrium at it.

@@ -381,9 +381,11 @@ TEST_F(Refusal, OtherFormatsAndVersions) {
   j["format"] = "gyrodrift-imfs";
   ExpectRefused(Reseal(j), "not a gyrodrift model file");
   j = Json();
-  j["format_version"] = 7;
-  ExpectRefused(Reseal(j),
-                "format_version 7 is not supported (this gyrodrift reads versions 1 to 6)");
+  const int next = kModelFormatVersion + 1;
+  j["format_version"] = next;
+  ExpectRefused(Reseal(j), "format_version " + std::to_string(next) +
+                               " is not supported (this gyrodrift reads versions 1 to " +
+                               std::to_string(kModelFormatVersion) + ")");
   j["format_version"] = 0;
   ExpectRefused(Reseal(j), "format_version 0 is not supported");
   // A version-1 file (before the feature set, the limit flag and the range were stored) loads,

@@ -1,0 +1,97 @@
+#include "gyrodrift/drift/compensation_summary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+double RmsAboutMean(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return std::sqrt((x.array() - x.mean()).square().mean());
+}
+
+// A figure of the table: %.6g, "n/a" for NaN (a slow variation not measured).
+std::string Cell(double v) {
+  if (std::isnan(v)) return "n/a";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.6g", v);
+  return buffer;
+}
+
+}  // namespace
+
+Eigen::VectorXd BlockMeans(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block) {
+  block = std::max<Eigen::Index>(1, block);
+  const Eigen::Index blocks = std::max<Eigen::Index>(1, x.size() / block);
+  const Eigen::Index length = std::min(block, x.size());
+  Eigen::VectorXd out(blocks);
+  for (Eigen::Index b = 0; b < blocks; ++b) out[b] = x.segment(b * length, length).mean();
+  return out;
+}
+
+SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block) {
+  RequireFiniteSignal("signal", x, 1);
+  SignalSummary s;
+  s.mean = x.mean();
+  s.std = RmsAboutMean(x);
+  s.rms = std::sqrt(x.squaredNorm() / static_cast<double>(x.size()));
+  s.slow = x.size() / std::max<Eigen::Index>(1, block) >= 2
+               ? RmsAboutMean(BlockMeans(x, block))
+               : std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+
+CompensationSummary SummariseCompensation(const Eigen::Ref<const Eigen::VectorXd>& y,
+                                          const Eigen::Ref<const Eigen::VectorXd>& compensated,
+                                          double rate_hz, double block_s) {
+  RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
+  RequireInRange("block_s", block_s, 1e-6, 1e9);
+  RequireFiniteSignal("output", y, 1);
+  RequireFiniteSignal("compensated output", compensated, 1);
+  if (compensated.size() != y.size()) {
+    throw DataError("compensation summary: the output has " + std::to_string(y.size()) +
+                    " samples, the compensated output " + std::to_string(compensated.size()));
+  }
+  CompensationSummary s;
+  s.samples = y.size();
+  s.block_s = block_s;
+  s.block = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(block_s * rate_hz)));
+  s.blocks = y.size() / s.block;
+  s.before = Summarise(y, s.block);
+  s.after = Summarise(compensated, s.block);
+  return s;
+}
+
+std::string CompensationSummary::Table(const std::string& target, const std::string& unit) const {
+  char line[256];
+  // The names are the user's, of any length: not through the fixed buffer.
+  std::string out = target + (unit.empty() ? "" : " (" + unit + ")") + ", " +
+                    std::to_string(samples) + " samples:\n";
+  std::snprintf(line, sizeof(line), "  %-16s %14s %14s\n", "", "before", "after");
+  out += line;
+  auto row = [&](const char* name, double b, double a, const std::string& note) {
+    std::snprintf(line, sizeof(line), "  %-16s %14s %14s%s\n", name, Cell(b).c_str(),
+                  Cell(a).c_str(), note.c_str());
+    out += line;
+  };
+  row("mean", before.mean, after.mean, "");
+  row("RMS", before.rms, after.rms, "  (about zero)");
+  row("std", before.std, after.std, "  (about the mean)");
+  char note[160];
+  if (blocks >= 2) {
+    std::snprintf(note, sizeof(note), "  (RMS about their mean of %lld means of %g-s blocks)",
+                  static_cast<long long>(blocks), block_s);
+  } else {
+    std::snprintf(note, sizeof(note), "  (not measured: the log is shorter than 2 blocks of %g s)",
+                  block_s);
+  }
+  row("slow variation", before.slow, after.slow, note);
+  return out;
+}
+
+}  // namespace gyrodrift::drift
