@@ -63,16 +63,26 @@ ThermalCoefficients PhysicalCoefficients(const ThermalRegression& model,
   a(0, 0) = 1.0;
   term(0, 0, "");
   out.terms[0].term = "bias";
+  static constexpr const char* kPowerUnits[] = {"", "/K", "/K^2", "/K^3"};
   Eigen::Index col = 1;
+  // A block of powers 1..powers of a standardised level (a channel's, or a state's) about z0:
+  // the bias row takes their values at z0, the row of u^k their k-th Taylor coefficients per K^k.
+  auto powers_block = [&](int powers, double z0_level, double scale, double lo, double hi,
+                          int state) {
+    for (int p = 1; p <= powers; ++p) a(0, col + p - 1) = TaylorOfPower(p, 0, z0_level, lo, hi);
+    for (int k = 1; k <= powers; ++k) {
+      for (int p = k; p <= powers; ++p) {
+        a(col + k - 1, col + p - 1) = TaylorOfPower(p, k, z0_level, lo, hi) / std::pow(scale, k);
+      }
+      term(col + k - 1, k, kPowerUnits[k], state);
+    }
+    col += powers;
+  };
   for (int c = 0; c < channels; ++c) {
     const auto i = static_cast<size_t>(c);
-    if (!model.linear[i]) continue;
-    a(0, col) = z0[i];
-    a(col, col) = 1.0 / model.scale_k[i];
-    term(col, 1, "/K");
-    ++col;
+    powers_block(model.static_power[i], z0[i], model.scale_k[i], model.static_min[i],
+                 model.static_max[i], -1);
   }
-  static constexpr const char* kPowerUnits[] = {"", "/K", "/K^2", "/K^3"};
   const int powers = model.max_power;
   for (size_t j = 0; j < model.states.size(); ++j) {
     const ThermalState& s = model.states[j];
@@ -81,18 +91,7 @@ ThermalCoefficients PhysicalCoefficients(const ThermalRegression& model,
     const double scale = model.scale_k[i];
     out.state_range_c.emplace_back(model.centre_c[i] + scale * s.level_min,
                                    model.centre_c[i] + scale * s.level_max);
-    for (int p = 1; p <= powers; ++p) {
-      a(0, col + p - 1) = TaylorOfPower(p, 0, z0[i], s.level_min, s.level_max);
-    }
-    // Row of u^k: every power p >= k contributes its k-th Taylor coefficient, per K^k.
-    for (int k = 1; k <= powers; ++k) {
-      for (int p = k; p <= powers; ++p) {
-        a(col + k - 1, col + p - 1) =
-            TaylorOfPower(p, k, z0[i], s.level_min, s.level_max) / std::pow(scale, k);
-      }
-      term(col + k - 1, k, kPowerUnits[k], state);
-    }
-    col += powers;
+    powers_block(powers, z0[i], scale, s.level_min, s.level_max, state);
     a(col, col) = 1.0 / 60.0;  // K/s to K/min
     term(col, 1, "/(K/min)", state);
     ++col;

@@ -4,11 +4,13 @@
 //
 // Around reference temperatures T0 (one per channel; by default the calibration's means), with
 // u = T - T0 of a channel's temperature or a state's level (K), the model reads
-//   drift = bias(T0) + sum_c a_c u_c + sum_j [ sum_{k=1..P} c_jk u_j^k + r_j ds_j/dt ] [ + h H ]
+//   drift = bias(T0) + sum_c sum_{k=1..Q} a_ck u_c^k + sum_j [ sum_{k=1..P} c_jk u_j^k
+//           + r_j ds_j/dt ] [ + h H ]
 // where bias(T0) is the estimate with every state in equilibrium at T0 (no rate, no hysteresis),
-// c_jk the k-th Taylor coefficient of the state's power terms at T0 (target units per K^k),
+// a_ck and c_jk the k-th Taylor coefficients of a channel's static powers and of a state's powers
+// at T0 (target units per K^k),
 // r_j in target units per K/min and h in target units (H in [-1, 1]). The expansion is exact
-// while each state's level stays on one side of the edges of its calibration range (inside it:
+// while each level stays on one side of the edges of its calibration range (inside it:
 // the polynomial; beyond an edge the powers >= 2 continue along their tangent, so about a T0
 // beyond an edge the terms of order >= 2 are zero and the expansion holds on that side).
 // A nonlinear correction (ThermalRegression::correction) is not part of the coefficients.

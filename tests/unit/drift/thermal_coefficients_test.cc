@@ -42,10 +42,12 @@ Eigen::VectorXd Rebuild(const ThermalRegression& m, const ThermalCoefficients& c
   Eigen::VectorXd out = Eigen::VectorXd::Constant(x.rows(), c.terms[0].value);
   Eigen::Index col = 1;
   for (int ch = 0; ch < m.channels(); ++ch) {
-    if (!m.linear[static_cast<size_t>(ch)]) continue;
-    out += c.terms[static_cast<size_t>(col)].value *
-           (temperature.col(ch).array() - c.reference_c[static_cast<size_t>(ch)]).matrix();
-    ++col;
+    const Eigen::ArrayXd u =
+        temperature.col(ch).array() - c.reference_c[static_cast<size_t>(ch)];
+    for (int k = 1; k <= m.static_power[static_cast<size_t>(ch)]; ++k) {
+      out += (c.terms[static_cast<size_t>(col)].value * u.pow(k)).matrix();
+      ++col;
+    }
   }
   for (const ThermalState& s : m.states) {
     const auto ch = static_cast<size_t>(s.channel);
@@ -96,9 +98,10 @@ TEST(ThermalCoefficients, RebuildTheEstimateOfAFittedModel) {
   }
   // The units follow the terms: a state's powers per K^k, its rate per K/min.
   const ThermalCoefficients c = PhysicalCoefficients(m, 20.0, {"temp"});
-  EXPECT_EQ(c.terms[1 + (m.linear[0] ? 1 : 0)].unit, "/K");
-  EXPECT_EQ(c.terms[1 + (m.linear[0] ? 1 : 0)].state, 0);
-  EXPECT_EQ(c.terms[static_cast<size_t>(m.max_power + (m.linear[0] ? 2 : 1))].unit, "/(K/min)");
+  const size_t first = 1 + static_cast<size_t>(m.static_power[0]);
+  EXPECT_EQ(c.terms[first].unit, "/K");
+  EXPECT_EQ(c.terms[first].state, 0);
+  EXPECT_EQ(c.terms[first + static_cast<size_t>(m.max_power)].unit, "/(K/min)");
   EXPECT_NE(c.terms[1].term.find("temp"), std::string::npos);
   ASSERT_EQ(c.state_range_c.size(), m.states.size());
   EXPECT_GT(c.state_range_c[0].second - c.state_range_c[0].first, 60.0);
@@ -114,7 +117,9 @@ ThermalRegression HandMade() {
   m.max_power = 3;
   m.centre_c = {25.0};
   m.scale_k = {10.0};
-  m.linear = {false};
+  m.static_power = {0};
+  m.static_min = {0.0};
+  m.static_max = {0.0};
   m.states = {{0, 100.0, -2.0, 2.0}};
   m.coefficients = Eigen::Vector<double, 5>(2.0, 3.0, 0.5, -0.1, 120.0);
   m.covariance = Eigen::VectorXd::Constant(5, 0.04).asDiagonal();
