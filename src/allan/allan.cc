@@ -1,8 +1,6 @@
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/edf.h"
 
-#include <fmt/core.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -458,10 +456,10 @@ AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>
   for (size_t k = 0; k < ms.size(); ++k) {
     if (terms[k] == 0) {
       if (options.grid == TauGrid::kList) {
-        throw DataError(fmt::format(
-            "tau {:g} s has no cluster pair of logged samples: {} needs {} logged samples in a "
-            "row, the longest run is {}",
-            static_cast<double>(ms[k]) * tau0, ToString(dev), order * ms[k], run_length));
+        throw DataError("tau " + FormatValue(static_cast<double>(ms[k]) * tau0) +
+                        " s has no cluster pair of logged samples: " + ToString(dev) + " needs " +
+                        std::to_string(order * ms[k]) + " logged samples in a row, the longest "
+                        "run is " + std::to_string(run_length));
       }
       continue;
     }
@@ -488,10 +486,9 @@ AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>
     result.points.push_back(p);
   }
   if (result.points.empty()) {
-    throw DataError(fmt::format(
-        "{} of a record with gaps: no tau has a cluster pair of logged samples ({} logged samples "
-        "in a row needed at the shortest tau, the longest run is {})",
-        ToString(dev), order, run_length));
+    throw DataError(ToString(dev) + " of a record with gaps: no tau has a cluster pair of logged "
+                    "samples (" + std::to_string(order) + " logged samples in a row needed at the "
+                    "shortest tau, the longest run is " + std::to_string(run_length) + ")");
   }
   return result;
 }
