@@ -201,19 +201,23 @@ TEST_F(CalibrateCli, SeveralCalibrationLogsAndASplitVerification) {
 // --gaps carry` gives; a verification log with made-up rows is refused (its block means and
 // Allan deviation need logged rows).
 TEST_F(CalibrateCli, ADutyCycledCalibrationIsFittedOnItsLoggedRows) {
-  const io::CsvTable cal = io::CsvTable::Read(Dir() + "/logs/SN1_cal.csv");
-  std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < cal.rows(); ++i) {
-    if (i % 300 < 60) keep.push_back(i);
-  }
-  std::vector<io::CsvColumn> bursts;
-  for (const std::string& name : cal.header()) {
-    const Eigen::VectorXd all = cal.Column(name);
-    Eigen::VectorXd kept(static_cast<Eigen::Index>(keep.size()));
-    for (size_t k = 0; k < keep.size(); ++k) kept[static_cast<Eigen::Index>(k)] = all[keep[k]];
-    bursts.push_back({name, kept});
-  }
-  io::WriteCsv(Dir() + "/logs/D_cal.csv", bursts);
+  auto write_bursts = [](const std::string& from, const std::string& to) {
+    const io::CsvTable log = io::CsvTable::Read(from);
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = 0; i < log.rows(); ++i) {
+      if (i % 300 < 60) keep.push_back(i);
+    }
+    std::vector<io::CsvColumn> bursts;
+    for (const std::string& name : log.header()) {
+      const Eigen::VectorXd all = log.Column(name);
+      Eigen::VectorXd kept(static_cast<Eigen::Index>(keep.size()));
+      for (size_t k = 0; k < keep.size(); ++k) kept[static_cast<Eigen::Index>(k)] = all[keep[k]];
+      bursts.push_back({name, kept});
+    }
+    io::WriteCsv(to, bursts);
+  };
+  write_bursts(Dir() + "/logs/SN1_cal.csv", Dir() + "/logs/D_cal.csv");
+  write_bursts(Dir() + "/logs/SN1_ver.csv", Dir() + "/logs/D_ver.csv");
   const std::string manifest = Dir() + "/carry.toml";
   io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
                                         "\n[[unit]]\nserial = \"D1\"\ncalibration = "
@@ -229,13 +233,13 @@ TEST_F(CalibrateCli, ADutyCycledCalibrationIsFittedOnItsLoggedRows) {
   ASSERT_TRUE(axes[0].model.sub_models.front().thermal);
   EXPECT_EQ(axes[0].model.sub_models.front().thermal->coefficients,
             fitted.model.sub_models.front().thermal->coefficients);
-  // The same bursts as the verification: refused, naming the log.
+  // A verification logged in bursts: refused, naming the log.
   io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
                                         "\n[[unit]]\nserial = \"D2\"\ncalibration = "
-                                        "\"logs/SN1_cal.csv\"\nverification = \"logs/D_cal.csv\"\n");
+                                        "\"logs/SN1_cal.csv\"\nverification = \"logs/D_ver.csv\"\n");
   r = test::RunCli("calibrate '" + manifest + "' -o '" + Dir() + "/out_carry2'");
   EXPECT_NE(r.exit_code, 0) << r.out;
-  EXPECT_NE((r.out + r.err).find("D_cal.csv: gaps = 'carry' fills this verification log's gaps"),
+  EXPECT_NE((r.out + r.err).find("D_ver.csv: gaps = 'carry' fills this verification log's gaps"),
             std::string::npos)
       << r.out << r.err;
 }
