@@ -2,6 +2,7 @@
 // IEEE 952 noise terms.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -117,15 +118,39 @@ void Run(const AllanArgs& a) {
   // phase: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
   // worked out while time_s is there, and printed at the end.
   std::string notes, time_note;
+  // A log with gaps (--gaps split or carry) is analysed on its time grid with the gaps as
+  // missing samples (allan::ComputeWithGaps): carry marks the rows it made up, and split's records
+  // are joined with one missing sample between them, so no cluster pair spans a break.
+  std::vector<bool> logged;
   const Eigen::VectorXd data = [&] {
-    io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
+    std::vector<Eigen::Index> starts;
+    io::CsvTable table = ReadLog(a.input, a.log, &notes, &starts, {a.column}, &logged);
     if (!a.quiet) time_note = NonUniformTimeNote(table);
     Eigen::VectorXd column = table.TakeColumn(a.column);
     RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", column,
                          "its Allan deviation is zero at every tau (a logging fault?)");
-    return column;
+    if (a.log.gaps == "carry" || starts.empty()) return column;
+    Eigen::VectorXd joined(column.size() + static_cast<Eigen::Index>(starts.size()));
+    logged.assign(static_cast<size_t>(joined.size()), true);
+    Eigen::Index from = 0, to = 0;
+    for (size_t r = 0; r <= starts.size(); ++r) {
+      const Eigen::Index end = r < starts.size() ? starts[r] : column.size();
+      joined.segment(to, end - from) = column.segment(from, end - from);
+      to += end - from;
+      if (r < starts.size()) {
+        joined[to] = 0.0;  // never read: a break between records
+        logged[static_cast<size_t>(to++)] = false;
+      }
+      from = end;
+    }
+    return joined;
   }();
-  const al::AllanResult r = al::Compute(data, o, execution);
+  if (a.log.gaps == "interpolate") logged.clear();  // the made-up rows are analysed as data
+  auto compute = [&](const al::AllanOptions& options) {
+    return logged.empty() ? al::Compute(data, options, execution)
+                          : al::ComputeWithGaps(data, logged, options, execution);
+  };
+  const al::AllanResult r = compute(o);
 
   // Noise terms need an Allan-variance curve; for the other estimators fit an OADEV on the same
   // grid.
@@ -142,7 +167,7 @@ void Run(const AllanArgs& a) {
       al::AllanOptions oa = o;
       oa.deviation = al::Deviation::kOadev;
       fit_source = "oadev";
-      terms = al::IdentifyNoise(al::Compute(data, oa, execution), fit_options);
+      terms = al::IdentifyNoise(compute(oa), fit_options);
     }
   } catch (const DataError& e) {
     fit_error = e.what();  // too few points to fit: the deviations are still the result
@@ -193,6 +218,14 @@ void Run(const AllanArgs& a) {
                                                              : nlohmann::json("inf")},
       {"seed", nullptr}};
   sidecar["samples"] = r.n_samples;
+  sidecar["options"]["gaps"] = a.log.gaps;
+  // The analysed grid: with gaps skipped, how many of its samples were logged.
+  if (!logged.empty()) {
+    sidecar["logged_samples"] = std::count(logged.begin(), logged.end(), true);
+    sidecar["gaps_method"] =
+        "overlapping estimator over the cluster pairs whose samples are all logged (made-up "
+        "samples and record breaks skipped); EDF of a gap-free record with as many terms";
+  }
   sidecar["summary"] = r.Summary();
   sidecar["dev_unit"] = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
   sidecar["edf_method"] =
@@ -267,7 +300,7 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
       ->required();
   BindSetting(cmd->add_option("--type", args->type, "rate (gyro output) | angle (integrated)")
                   ->capture_default_str(),
-              {"type"});
+              {"type", "data_type"});
   BindSetting(cmd->add_option("--dev", args->dev, "oadev|adev|mdev|hdev|ohdev|tdev|totdev")
                   ->capture_default_str(),
               {"dev", "deviation"});
@@ -291,7 +324,7 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
               {"tau_min_s"});
   BindSetting(cmd->add_option("--fit-tau-max", args->fit_tau_max_s, "noise fit: largest tau in s"),
               {"tau_max_s"});
-  AddLogOptions(cmd, &args->log, /*split=*/false);
+  AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -128,19 +128,26 @@ double ParseDuration(const std::string& text) {
 }
 
 io::LogOptions LogArgs::Options() const {
-  return {io::GapPolicyFromString(gaps), io::DelimiterFromString(delimiter)};
+  return {io::GapPolicyFromString(gaps), io::DelimiterFromString(delimiter), "--gaps"};
 }
 
-void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split) {
-  std::string help =
-      "a time_s step of 1.5 median steps or more (missing samples): error (refuse, naming the "
-      "row) | interpolate (fill every column linearly; the rows are kept in the outputs)";
-  std::vector<std::string> choices{"error", "interpolate"};
-  if (split) {
-    help += " | split (keep the rows; the thermal model's lag states restart after each gap)";
-    choices.push_back("split");
-  }
-  cmd->add_option("--gaps", log->gaps, help)->check(CLI::IsMember(choices))->capture_default_str();
+void LogArgs::RequireOneRecord(std::string_view who, std::string_view why) const {
+  if (gaps != "split" && gaps != "carry") return;
+  throw UsageError(fmt::format("--gaps {}: {} needs one uniform record ({}): use --gaps "
+                               "interpolate (the made-up rows then count as data) or --gaps error",
+                               gaps, who, why));
+}
+
+void AddLogOptions(CLI::App* cmd, LogArgs* log) {
+  cmd->add_option("--gaps", log->gaps,
+                  "a time_s step of 1.5 median steps or more (missing samples): error (refuse, "
+                  "naming the row) | interpolate (fill every column linearly; the made-up rows "
+                  "count as data and are marked in the outputs) | split (keep the rows; the "
+                  "thermal model's lag states restart after each gap) | carry (fill as "
+                  "interpolate; the lag states run across the gaps, fits, scores and reports use "
+                  "the logged rows only). docs/cli.md says what each command does with each")
+      ->check(CLI::IsMember({"error", "interpolate", "split", "carry"}))
+      ->capture_default_str();
   cmd->add_option("--delimiter", log->delimiter,
                   "cell delimiter: auto (a comma where the header has one, else a tab, else a "
                   "semicolon) | comma | tab | semicolon")
@@ -150,9 +157,9 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split) {
 
 io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
                      std::vector<Eigen::Index>* record_starts,
-                     const std::vector<std::string>& columns) {
+                     const std::vector<std::string>& columns, std::vector<bool>* logged) {
   std::string note;
-  io::CsvTable table = io::ReadLog(path, log.Options(), &note, record_starts, columns);
+  io::CsvTable table = io::ReadLog(path, log.Options(), &note, record_starts, columns, logged);
   if (!note.empty()) *notes += note + "\n";
   return table;
 }

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
@@ -58,18 +59,23 @@ using io::ResolveSampleRate;
 struct LogArgs {
   std::string gaps = "error";
   std::string delimiter = "auto";
-  io::LogOptions Options() const;
+  io::LogOptions Options() const;  // messages spell the setting as the flag, --gaps
   bool Given() const { return gaps != "error" || delimiter != "auto"; }
+  // A command that analyses one uniform record (`who`, e.g. "decompose") refuses --gaps split
+  // and carry with a one-line UsageError saying `why`.
+  void RequireOneRecord(std::string_view who, std::string_view why) const;
 };
-// --gaps error|interpolate, and split where the command takes several records (`split`), and
+// --gaps error|interpolate|split|carry (every command takes the same modes; one that cannot
+// honour split or carry refuses it, LogArgs::RequireOneRecord) and
 // --delimiter auto|comma|tab|semicolon.
-void AddLogOptions(CLI::App* cmd, LogArgs* log, bool split);
+void AddLogOptions(CLI::App* cmd, LogArgs* log);
 // ReadLog under those choices; the note on filled or split gaps, if any, is appended (with a
-// newline) to *notes; record_starts and columns (the only ones kept, with time_s; empty = all) as
-// io::ReadLog's.
+// newline) to *notes; record_starts, columns (the only ones kept, with time_s; empty = all) and
+// logged as io::ReadLog's.
 io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
                      std::vector<Eigen::Index>* record_starts = nullptr,
-                     const std::vector<std::string>& columns = {});
+                     const std::vector<std::string>& columns = {},
+                     std::vector<bool>* logged = nullptr);
 
 // Binds `flag` to the names under which the library refers to what it sets (a
 // drift::FitSettings setting such as "lags", an options field such as "ensemble_size"), where

@@ -40,23 +40,32 @@ struct AxisResult {
 };
 
 // `suffix` is "" for a one-axis model (drift_est, drift_sd, compensated), "_<target>" otherwise.
+// The estimate runs over every row (the thermal states across filled gaps); the statistics use
+// the logged rows only (`logged`, empty = every row).
 AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& table,
                           const std::vector<Eigen::Index>& record_starts,
-                          const Eigen::VectorXd& truth, const std::string& truth_column,
-                          const std::string& suffix) {
+                          const std::vector<bool>& logged, const Eigen::VectorXd& truth_all,
+                          const std::string& truth_column, const std::string& suffix) {
   const drift::DriftModel& model = loaded.model;
-  const Eigen::VectorXd y = table.Column(loaded.info.target_column);
-  const Eigen::MatrixXd temperature =
+  const Eigen::VectorXd y_all = table.Column(loaded.info.target_column);
+  const Eigen::MatrixXd temperature_all =
       ReadColumns(table, loaded.info.temperature_column, "--temperature").values;
-  const Eigen::MatrixXd estimate_sd = drift::EstimateDriftWithSd(model, temperature, record_starts);
-  const Eigen::VectorXd estimate = estimate_sd.col(0);
-  const Eigen::VectorXd compensated = y - estimate;
+  const Eigen::MatrixXd estimate_sd =
+      drift::EstimateDriftWithSd(model, temperature_all, record_starts);
+  const Eigen::VectorXd estimate_all = estimate_sd.col(0);
+  const Eigen::VectorXd compensated_all = y_all - estimate_all;
 
   AxisResult r;
-  r.columns.push_back({"drift_est" + suffix, estimate});
+  r.columns.push_back({"drift_est" + suffix, estimate_all});
   // Identified models give each estimate a standard deviation (thermal_model.h).
   if (model.identified()) r.columns.push_back({"drift_sd" + suffix, estimate_sd.col(1)});
-  r.columns.push_back({"compensated" + suffix, compensated});
+  r.columns.push_back({"compensated" + suffix, compensated_all});
+  const Eigen::VectorXd y = drift::LoggedRows(y_all, logged);
+  const Eigen::VectorXd estimate = drift::LoggedRows(estimate_all, logged);
+  const Eigen::VectorXd compensated = drift::LoggedRows(compensated_all, logged);
+  const Eigen::VectorXd truth = drift::LoggedRows(truth_all, truth_all.size() ? logged
+                                                                               : std::vector<bool>{});
+  const Eigen::MatrixXd temperature = drift::LoggedRows(temperature_all, logged);
 
   nlohmann::json& j = r.sidecar;
   j["model"] = {{"summary", model.Summary()},
@@ -79,6 +88,12 @@ AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& tab
   j["slow_variation_blocks"] = summary.blocks;
   // Files before format 4 did not record the unit: the table then names none.
   r.text = model.Summary() + "\n" + summary.Table(loaded.info.target_column, loaded.info.rate_unit);
+  // Filled gaps: the figures above leave the made-up rows out (the slow variation's blocks then
+  // hold consecutive logged samples, which span more time).
+  if (!logged.empty()) {
+    r.text += fmt::format("{}: statistics over the {} logged rows ({} made up left out)\n",
+                          loaded.info.target_column, y.size(), logged.size() - static_cast<size_t>(y.size()));
+  }
   // Against a known drift (the simulator's drift_dph): how much of its RMS the estimate removes,
   // 1 - RMS(truth - estimate) / RMS(truth), RMS about zero (the drift's offset is part of it).
   if (truth.size() > 0) {
@@ -113,7 +128,7 @@ AxisResult CompensateAxis(const io::LoadedModel& loaded, const io::CsvTable& tab
       r.text += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
     }
   }
-  if (model.identified()) j["drift_sd_mean"] = estimate_sd.col(1).mean();
+  if (model.identified()) j["drift_sd_mean"] = drift::LoggedRows(estimate_sd.col(1), logged).mean();
   return r;
 }
 
@@ -129,7 +144,8 @@ void Run(const CompensateArgs& a) {
   }
   std::string text;  // the console report, notes first
   std::vector<Eigen::Index> record_starts;  // --gaps split: the estimate restarts after each gap
-  const io::CsvTable table = ReadLog(a.input, a.log, &text, &record_starts);
+  std::vector<bool> logged;  // --gaps interpolate or carry: the rows that were logged
+  const io::CsvTable table = ReadLog(a.input, a.log, &text, &record_starts, {}, &logged);
   for (const io::LoadedModel& axis : axes) RequireModelColumns(axis, table);
   // Before the work: a temperature that does not look like degC (each column once).
   std::vector<std::string> temperature_columns;
@@ -153,6 +169,11 @@ void Run(const CompensateArgs& a) {
       }
     }
   }
+  const bool mark_made_up = !logged.empty() && a.log.gaps != "carry";  // column `interpolated`
+  if (mark_made_up && table.HasColumn("interpolated")) {
+    throw DataError(a.input + " already has a column 'interpolated': --gaps interpolate marks the "
+                    "rows it makes up in one (rename it, or use --gaps carry)");
+  }
   Eigen::VectorXd truth;  // read before the work, so a misspelt column fails fast
   std::string truth_column;
   if (!a.truth.empty()) {
@@ -171,8 +192,16 @@ void Run(const CompensateArgs& a) {
   }
   nlohmann::json sidecar = SidecarHeader("compensate");
   sidecar["options"] = {{"model", a.model}, {"input", a.input}, {"gaps", a.log.gaps}, {"records", record_starts.size() + 1}};
+  // Made-up rows: the statistics leave them out; the output marks them (interpolate) or leaves
+  // them out too (carry: one output row per logged row, as for a log without gaps).
+  const Eigen::Index logged_rows = drift::CountLogged(logged, table.rows());
+  sidecar["rows"] = {{"logged", logged_rows},
+                     {"made_up", table.rows() - logged_rows},
+                     {"written", a.log.gaps == "carry" ? logged_rows : table.rows()},
+                     {"statistics_over", "logged rows"}};
   for (size_t i = 0; i < axes.size(); ++i) {
-    AxisResult r = CompensateAxis(axes[i], table, record_starts, truth, truth_column, suffixes[i]);
+    AxisResult r =
+        CompensateAxis(axes[i], table, record_starts, logged, truth, truth_column, suffixes[i]);
     for (io::CsvColumn& column : r.columns) columns.push_back(std::move(column));
     // One axis: its fields at the top level (the layout of one-axis models); several: "axes".
     if (axes.size() == 1) {
@@ -181,6 +210,14 @@ void Run(const CompensateArgs& a) {
       sidecar["axes"].push_back(std::move(r.sidecar));
     }
     text += r.text;
+  }
+  if (!logged.empty() && a.log.gaps == "carry") {
+    for (io::CsvColumn& column : columns) column.values = drift::LoggedRows(column.values, logged);
+  } else if (mark_made_up) {
+    Eigen::VectorXd flag(table.rows());
+    for (Eigen::Index k = 0; k < flag.size(); ++k) flag[k] = logged[static_cast<size_t>(k)] ? 0.0 : 1.0;
+    columns.insert(columns.begin() + static_cast<std::ptrdiff_t>(table.header().size()),
+                   {"interpolated", flag});
   }
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
@@ -205,7 +242,11 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       "drift_sd_<target> and compensated_<target> for each.\n"
       "With --truth drift_dph (a simulated log) it also reports how much of the true drift's\n"
       "RMS the estimate removes: 1 - RMS(truth - drift_est) / RMS(truth).\n"
-      "test.csv needs the columns the model was trained with (here rate_dph and temperature_c).");
+      "test.csv needs the columns the model was trained with (here rate_dph and temperature_c).\n"
+      "A log with gaps: --gaps interpolate fills them and marks the made-up rows in a column\n"
+      "interpolated (1 = made up); --gaps carry runs the estimate across them on the interpolated\n"
+      "temperature and writes the logged rows only. Either way the std and the truth share are\n"
+      "over the logged rows.");
   cmd->add_option("model", args->model, "model file written by 'gyrodrift fit --mode compensate'")
       ->required()
       ->check(kInputFile);
@@ -217,7 +258,7 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
   cmd->add_option("--truth", args->truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "
                   "share of its RMS the estimate removes");
-  AddLogOptions(cmd, &args->log, /*split=*/true);
+  AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -106,6 +106,7 @@ void Run(const DecomposeArgs& a) {
   context.execution.Validate();
 
   // Only the column (and time_s) is read, and the table is dropped once the column is out.
+  a.log.RequireOneRecord("decompose", "a decomposition runs across the gaps");
   std::string notes;
   const Eigen::VectorXd x = [&] {
     io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
@@ -246,7 +247,7 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--noise-file", args->noise_file,
                   "CSV of white-noise realisations (one per column) to use instead of drawing")
       ->check(kInputFile);
-  AddLogOptions(cmd, &args->log, /*split=*/false);
+  AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

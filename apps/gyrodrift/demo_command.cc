@@ -83,6 +83,7 @@ study::StudyOptions MakeStudyOptions(const DemoArgs& a) {
 
 study::StudyLog ReadStudyLog(const DemoArgs& a) {
   const auto start = Clock::now();
+  a.log.RequireOneRecord("demo", "the study decomposes and splits one record");
   std::string notes;
   const io::CsvTable table = ReadLog(a.input, a.log, &notes);
   study::StudyLog log;
@@ -230,7 +231,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
                   ->capture_default_str(),
               {"threads"});
-  AddLogOptions(cmd, &args->log, /*split=*/false);
+  AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
   BindSetting(
       cmd->add_option("--duration", args->duration,

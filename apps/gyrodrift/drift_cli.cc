@@ -113,7 +113,7 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
                               "worker threads (0 = all cores); results do not depend on it")
                   ->capture_default_str(),
               {"threads"});
-  AddLogOptions(cmd, &a->log, split_records);
+  AddLogOptions(cmd, &a->log);
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 

@@ -33,7 +33,7 @@ struct DriftArgs {
   bool quiet = false;
 };
 
-// Adds the input(s) (several with `split_records`: fit's calibration logs, and --gaps split),
+// Adds the input(s) (several with `split_records`: fit's calibration logs),
 // --target, --temperature, --reference-temperature, --nonlinear, --hysteresis, --mode,
 // --decomposition, --lags, --hidden, --rate-hz, --thermal-features, --time-constants,
 // --ensemble, --realisations, --seed, --threads, --gaps, --delimiter and --quiet to cmd, each

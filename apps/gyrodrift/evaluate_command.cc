@@ -72,6 +72,8 @@ void Run(const EvaluateArgs& a) {
                      ": evaluate scores one axis at a time (fit takes several targets)");
   }
 
+  a.log.RequireOneRecord("evaluate", "it splits one record chronologically and scores every "
+                         "method on it; fit --gaps " + a.log.gaps + " and compensate take records");
   std::string gap_note;
   const io::CsvTable table = ReadLog(a.inputs.front(), a.log, &gap_note);
   std::string rate_how;

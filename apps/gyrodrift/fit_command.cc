@@ -119,7 +119,8 @@ void Run(const FitArgs& a) {
   drift::RecordRows run;
   for (const std::string& input : a.inputs) {
     std::vector<Eigen::Index> starts;
-    const io::CsvTable table = ReadLog(input, a.log, &notes, &starts);
+    std::vector<bool> logged;  // --gaps carry: the rows that were logged
+    const io::CsvTable table = ReadLog(input, a.log, &notes, &starts, {}, &logged);
     std::string how;
     const double rate_hz = ResolveRateHz(a, table, &how);
     const std::string time_note = NonUniformTimeNote(table);
@@ -136,7 +137,9 @@ void Run(const FitArgs& a) {
     Eigen::MatrixXd block(table.rows(), targets.values.cols() + temperature.values.cols());
     block.leftCols(targets.values.cols()) = targets.values;
     if (temperature.values.cols() > 0) block.rightCols(temperature.values.cols()) = temperature.values;
-    run.Append(block, starts);
+    // interpolate fits on the made-up rows as data; only carry keeps the fit to the logged ones.
+    if (a.log.gaps != "carry") logged.clear();
+    run.Append(block, starts, logged);
     sources += (sources.empty() ? "" : ",") + input;
   }
   targets.values = run.rows.leftCols(targets.values.cols());
@@ -154,6 +157,15 @@ void Run(const FitArgs& a) {
         "--method {}: several records ({}) are fitted by --method thermal only (a decomposition "
         "or lags would run across the breaks)",
         drift::ToString(method), a.inputs.size() > 1 ? "several input logs" : "--gaps split"));
+  }
+  if (!run.logged.empty() && (o.mode != drift::Mode::kCompensate || drift::UsesDecomposition(method))) {
+    throw UsageError(fmt::format(
+        "--gaps carry: the fit uses the logged rows only, which --mode {} --method {} cannot do "
+        "({}): use --method thermal or poly in compensate mode, or --gaps interpolate",
+        drift::ToString(o.mode), drift::ToString(method),
+        o.mode == drift::Mode::kCompensate ? "a decomposition runs across the made-up rows"
+                                           : "a prediction from the output's past reads made-up "
+                                             "rows"));
   }
   // What the user must know before waiting for the fit: an assumed rate, a temperature that
   // does not look like degC.
@@ -179,7 +191,7 @@ void Run(const FitArgs& a) {
         progress.Update(fraction, label + ": " + std::string(step));
       };
       axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, o, record_starts,
-                                        execution);
+                                        execution, run.logged);
       fitted.push_back(std::move(axis));
     }
   }
@@ -215,7 +227,9 @@ const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {
       "one by one with the same options into one model file, one model per axis.\n"
       "Several calibration logs (fit day1.csv day2.csv ...), or one split at its gaps\n"
       "(--gaps split), are fitted by the thermal method as records of one calibration: its\n"
-      "lag states restart at the start of each.\n"
+      "lag states restart at the start of each. A duty-cycled log (5 s of every 300 s) is fitted\n"
+      "with --gaps carry: the lag states run across the gaps on the interpolated temperature,\n"
+      "the fit uses the logged rows only (compensate mode, thermal or a single learner).\n"
       "See docs/cli.md and docs/drift.md.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/true);
   BindSetting(cmd->add_option("--method,-m", args->method,

@@ -48,6 +48,7 @@ void Run(const PredictArgs& a) {
                      "needs a model fitted with --mode predict)");
   }
 
+  a.log.RequireOneRecord("predict", "a prediction from the output's own past runs across the gaps");
   std::string notes;
   const io::CsvTable table = ReadLog(a.input, a.log, &notes);
   RequireModelColumns(loaded, table);
@@ -154,7 +155,7 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
   BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
                   ->capture_default_str(),
               {"threads"});
-  AddLogOptions(cmd, &args->log, /*split=*/false);
+  AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -58,11 +58,14 @@ def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, s
 
 
 def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", confidence=0.683,
-          threads=0, fit_tau_min=0.0, fit_tau_max=float("inf")):
+          threads=0, fit_tau_min=0.0, fit_tau_max=float("inf"), logged=None):
     """Allan-family deviation with confidence intervals and the IEEE 952 noise terms.
 
     As ``gyrodrift allan``. ``taus`` is "all", "octave", "decade" or a sequence of averaging
-    times in s (each rounded to a whole number of samples by the library).
+    times in s (each rounded to a whole number of samples by the library). ``logged``: one bool
+    per sample of a record with gaps on its time grid, False where the sample is missing (its
+    value, NaN or a filled one, is not used): as ``gyrodrift allan --gaps carry``, the
+    overlapping estimators (oadev, ohdev) skip the cluster pairs that hold a missing sample.
 
     Returns a dict: ``tau_s``, ``m``, ``dev``, ``dev_lo``, ``dev_hi``, ``n_terms``, ``edf``,
     ``alpha``, ``alpha_identified`` (arrays, one entry per tau), ``dev_unit``, ``summary`` and
@@ -76,7 +79,8 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
     """
     return _gyrodrift.allan(x, rate_hz=rate_hz, type=type, dev=dev, taus=taus, units=units,
                             confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
-                            fit_tau_max=fit_tau_max)
+                            fit_tau_max=fit_tau_max,
+                            logged=[] if logged is None else [bool(v) for v in logged])
 
 
 def noise_terms(tau_s, adev_dph, edf, *, fit_tau_min=0.0, fit_tau_max=float("inf"),
@@ -137,7 +141,7 @@ class DriftModel:
             thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
             threads=0, nonlinear=False, reference_temperature=None, hysteresis="auto",
             target="rate_dph", temperature_columns=None, source="python", record_starts=(),
-            progress=None):
+            logged=None, progress=None):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
         Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
@@ -152,7 +156,11 @@ class DriftModel:
         Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
         one after the other with ``record_starts`` the first sample of each run after the first:
         the thermal model's lag states restart there (``fit A.csv B.csv``; method thermal in
-        compensate mode only). ``progress``: a callable given the fraction of the fit done, as for
+        compensate mode only). ``logged``: one bool per sample, False on rows made up across a
+        gap (``--gaps carry``: a duty-cycled log filled on its time grid); the thermal states run
+        over every row, the fit uses the logged ones only (compensate mode, a method without a
+        decomposition; ``y`` on the made-up rows is ignored and may be NaN). Score and report on
+        the logged rows too. ``progress``: a callable given the fraction of the fit done, as for
         ``decompose`` (Ctrl-C stops the fit at its next report). Returns self.
         """
         self._core.fit(y, temperature, mode=mode, method=method, decomposition=decomposition,
@@ -162,7 +170,9 @@ class DriftModel:
                        nonlinear=nonlinear, reference_temperature=reference_temperature,
                        hysteresis=hysteresis, target=target,
                        temperature_columns=temperature_columns, source=source,
-                       record_starts=list(record_starts), progress=progress)
+                       record_starts=list(record_starts),
+                       logged=[] if logged is None else [bool(v) for v in logged],
+                       progress=progress)
         return self
 
     def estimate(self, temperature, *, record_starts=()):

@@ -33,6 +33,7 @@ def allan(
     taus: Literal["all", "octave", "decade"] | Sequence[float] = ...,
     units: Literal["dph", "dps", "rads"] = ..., confidence: float = ..., threads: int = ...,
     fit_tau_min: float = ..., fit_tau_max: float = ...,
+    logged: Sequence[bool] | None = ...,
 ) -> dict[str, Any]: ...
 
 def noise_terms(
@@ -63,6 +64,7 @@ class DriftModel:
         reference_temperature: float | None = ..., target: str = ...,
         temperature_columns: Sequence[str] | None = ..., source: str = ...,
         record_starts: Sequence[int] = ...,
+        logged: Sequence[bool] | None = ...,
         progress: Callable[[float], object] | None = ...,
     ) -> DriftModel: ...
     def estimate(

@@ -354,7 +354,7 @@ void SetTaus(const std::variant<std::string, std::vector<double>>& taus, al::All
 py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const std::string& dev,
                const std::variant<std::string, std::vector<double>>& taus,
                const std::string& units, double confidence, int threads, double fit_tau_min,
-               double fit_tau_max) {
+               double fit_tau_max, const std::vector<bool>& logged) {
   al::AllanOptions o;
   o.rate_hz = rate_hz;
   o.data_type = al::DataTypeFromString(type);
@@ -374,7 +374,12 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
   std::string fit_error, fit_source = al::ToString(o.deviation);
   {
     py::gil_scoped_release release;
-    r = al::Compute(data, o, execution);
+    // As `gyrodrift allan --gaps carry`: made-up samples (logged false) are skipped.
+    auto compute = [&](const al::AllanOptions& options) {
+      return logged.empty() ? al::Compute(data, options, execution)
+                            : al::ComputeWithGaps(data, logged, options, execution);
+    };
+    r = compute(o);
     // As `gyrodrift allan`: the noise terms need an Allan-variance curve; for the other
     // estimators an OADEV on the same grid is fitted.
     const bool allan_curve = o.deviation == al::Deviation::kAdev ||
@@ -387,7 +392,7 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
         al::AllanOptions oa = o;
         oa.deviation = al::Deviation::kOadev;
         fit_source = "oadev";
-        terms = al::IdentifyNoise(al::Compute(data, oa, execution), fit_options);
+        terms = al::IdentifyNoise(compute(oa), fit_options);
       }
     } catch (const DataError& e) {
       fit_error = e.what();  // too few points to fit: the deviations are still the result
@@ -600,7 +605,7 @@ class PyDriftModel {
            const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
-           const py::object& progress) {
+           const std::vector<bool>& logged, const py::object& progress) {
     LongCall call(progress);
     const drift::DriftOptions o =
         MakeDriftOptions({mode, method, decomposition, lags, hidden, rate_hz, thermal_features,
@@ -639,7 +644,7 @@ class PyDriftModel {
         loaded.info.temperature_column += (c ? "," : "") + names[c];
     }
     call.Run(
-        [&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution); });
+        [&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution, logged); });
     loaded_ = std::move(loaded);
     fitted_ = true;
   }
@@ -1138,7 +1143,8 @@ PYBIND11_MODULE(_gyrodrift, m) {
   m.def("allan", &gp::Allan, arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = "rate",
         arg("dev") = "oadev", arg("taus") = "octave", arg("units") = "dph",
         arg("confidence") = 0.683, arg("threads") = 0, arg("fit_tau_min") = 0.0,
-        arg("fit_tau_max") = std::numeric_limits<double>::infinity());
+        arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
+        arg("logged") = std::vector<bool>{});
   m.def("noise_terms", &gp::NoiseTerms, arg("tau_s"), arg("adev_dph"), arg("edf"), py::kw_only(),
         arg("fit_tau_min") = 0.0, arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
         arg("min_share") = 0.1, arg("significance") = 0.05, arg("sample_period_s") = 0.0);
@@ -1158,7 +1164,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
            arg("hysteresis") = "auto", arg("target") = "rate_dph",
            arg("temperature_columns") = py::none(),
            arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
-           arg("progress") = py::none())
+           arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"),

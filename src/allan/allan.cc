@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "allan/kernels.h"
 #include "common/enum_names.h"
@@ -350,6 +351,144 @@ AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options,
     }
     p.edf = EquivalentDof(dev, p.alpha, m, n);
     ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
+  }
+  return result;
+}
+
+namespace {
+
+// First sample and length of the longest run of logged samples.
+std::pair<Eigen::Index, Eigen::Index> LongestLoggedRun(const std::vector<bool>& logged) {
+  Eigen::Index best_begin = 0, best = 0, begin = 0;
+  for (Eigen::Index i = 0; i <= static_cast<Eigen::Index>(logged.size()); ++i) {
+    if (i < static_cast<Eigen::Index>(logged.size()) && logged[static_cast<size_t>(i)]) continue;
+    if (i - begin > best) {
+      best = i - begin;
+      best_begin = begin;
+    }
+    begin = i + 1;
+  }
+  return {best_begin, best};
+}
+
+}  // namespace
+
+AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>& logged,
+                            const AllanOptions& options, const Execution& execution) {
+  options.Validate();
+  execution.Validate();
+  const Deviation dev = options.deviation;
+  if (dev != Deviation::kOadev && dev != Deviation::kOhdev) {
+    ThrowOption("deviation", ToString(dev),
+                "oadev or ohdev for a record with gaps (the overlapping estimators skip the "
+                "cluster pairs that hold a made-up sample)");
+  }
+  if (options.data_type != DataType::kRate) {
+    ThrowOption("data_type", ToString(options.data_type),
+                "rate for a record with gaps (a made-up rate sample spoils the spans over it)");
+  }
+  if (static_cast<Eigen::Index>(logged.size()) != data.size()) {
+    throw DataError("the mask of logged samples has " + std::to_string(logged.size()) +
+                    " flags for " + std::to_string(data.size()) + " samples: they must match");
+  }
+  Eigen::VectorXd kept(data.size());
+  Eigen::Index count = 0;
+  for (Eigen::Index i = 0; i < data.size(); ++i) {
+    if (logged[static_cast<size_t>(i)]) kept[count++] = data[i];
+  }
+  RequireFiniteSignal("input (logged samples)", kept.head(count), 2);
+  // The missing values are never used: they become the logged mean, which adds nothing to the
+  // phase, so a NaN gap is as good as a filled one.
+  const double mean = kept.head(count).mean();
+  Eigen::VectorXd y = data;
+  for (Eigen::Index i = 0; i < y.size(); ++i) {
+    if (!logged[static_cast<size_t>(i)]) y[i] = mean;
+  }
+  const std::vector<double> x = InternalPhase(y, options);
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  // made_up[k]: made-up samples among the first k; the span of phase points i..i+d*m is clean
+  // when made_up[i + d*m] == made_up[i].
+  std::vector<std::int64_t> made_up(static_cast<size_t>(n), 0);
+  for (std::int64_t k = 1; k < n; ++k) {
+    made_up[static_cast<size_t>(k)] =
+        made_up[static_cast<size_t>(k - 1)] + (logged[static_cast<size_t>(k - 1)] ? 0 : 1);
+  }
+  const int order = DifferenceOrder(dev);
+  const std::vector<std::int64_t> ms = AveragingFactors(options, n);
+  const double tau0 = options.tau0_s();
+  std::vector<double> variance(ms.size(), 0.0);
+  std::vector<std::int64_t> terms(ms.size(), 0);
+  ParallelFor(static_cast<int>(ms.size()), execution.threads, [&](int k, int) {
+    const std::int64_t m = ms[static_cast<size_t>(k)];
+    double acc = 0.0;
+    std::int64_t used = 0;
+    const double* p = x.data();
+    for (std::int64_t i = 0; i + order * m < n; ++i) {
+      if (made_up[static_cast<size_t>(i + order * m)] != made_up[static_cast<size_t>(i)]) continue;
+      const double d = order == 2 ? p[i + 2 * m] - 2.0 * p[i + m] + p[i]
+                                  : p[i + 3 * m] - 3.0 * p[i + 2 * m] + 3.0 * p[i + m] - p[i];
+      acc += d * d;
+      ++used;
+    }
+    const double tau = static_cast<double>(m) * tau0;
+    terms[static_cast<size_t>(k)] = used;
+    if (used > 0) variance[static_cast<size_t>(k)] = acc / ((order == 2 ? 2.0 : 6.0) *
+                                                            static_cast<double>(used) * tau * tau);
+  });
+  const auto [run_begin, run_length] = LongestLoggedRun(logged);
+  AllanResult result;
+  result.options = options;
+  result.n_samples = data.size();
+  result.n_phase = n;
+  const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
+  const Eigen::Map<const Eigen::VectorXd> run_phase(x.data() + run_begin, run_length + 1);
+  std::vector<std::optional<int>> alpha(ms.size());
+  int carried = 0;  // as Compute: the first identified type stands in before it
+  bool found = false;
+  for (size_t k = 0; k < ms.size() && want_alpha; ++k) {
+    if (terms[k] == 0) continue;
+    alpha[k] = IdentifyAlpha(run_phase, ms[k], options.data_type, order);
+    if (alpha[k] && !found) {
+      carried = *alpha[k];
+      found = true;
+    }
+  }
+  for (size_t k = 0; k < ms.size(); ++k) {
+    if (terms[k] == 0) {
+      if (options.grid == TauGrid::kList) {
+        throw DataError("tau " + FormatValue(static_cast<double>(ms[k]) * tau0) +
+                        " s has no cluster pair of logged samples: " + ToString(dev) + " needs " +
+                        std::to_string(order * ms[k]) + " logged samples in a row, the longest "
+                        "run is " + std::to_string(run_length));
+      }
+      continue;
+    }
+    AllanPoint p;
+    p.m = ms[k];
+    p.tau_s = static_cast<double>(p.m) * tau0;
+    p.dev = std::sqrt(std::max(0.0, variance[k]));
+    p.n_terms = terms[k];
+    if (!options.confidence_intervals) {
+      p.edf = p.dev_lo = p.dev_hi = std::numeric_limits<double>::quiet_NaN();
+      result.points.push_back(p);
+      continue;
+    }
+    if (options.forced_alpha) {
+      p.alpha = *options.forced_alpha;
+    } else if (alpha[k]) {
+      p.alpha = carried = *alpha[k];
+      p.alpha_identified = true;
+    } else {
+      p.alpha = carried;
+    }
+    p.edf = EquivalentDof(dev, p.alpha, p.m, static_cast<Eigen::Index>(p.n_terms + order * p.m));
+    ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
+    result.points.push_back(p);
+  }
+  if (result.points.empty()) {
+    throw DataError(ToString(dev) + " of a record with gaps: no tau has a cluster pair of logged "
+                    "samples (" + std::to_string(order) + " logged samples in a row needed at the "
+                    "shortest tau, the longest run is " + std::to_string(run_length) + ")");
   }
   return result;
 }

@@ -183,8 +183,11 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
                  const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                 const std::vector<Eigen::Index>& record_starts, int threads) {
+                 const std::vector<Eigen::Index>& record_starts, int threads,
+                 const std::vector<bool>& logged) {
   const DriftOptions& o = model.options;
+  assert(logged.empty() || (o.mode == Mode::kCompensate &&
+                            static_cast<Eigen::Index>(logged.size()) == fit_end));
   const Execution learners{.threads = threads};
   model.training_samples = fit_end;
   const size_t groups = model.sub_models.size();
@@ -196,13 +199,16 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
                                o.features.rate_hz, o.thermal, !o.linear_compensation,
-                               SubModelSeed(o, g), record_starts));
+                               SubModelSeed(o, g), record_starts, logged));
     }
     return;
   }
   if (o.mode == Mode::kCompensate) {  // a single learner on the thermal features
-    model.sub_models.front().learner = FitLearner(
-        thermal.topRows(fit_end), series.col(0).head(fit_end), SubModelLearner(o, 0), learners);
+    // The features ran over every row (made-up ones too); the fit sees the logged rows only.
+    model.sub_models.front().learner =
+        FitLearner(LoggedRows(thermal.topRows(fit_end), logged),
+                   LoggedRows(series.col(0).head(fit_end), logged), SubModelLearner(o, 0),
+                   learners);
     return;
   }
   auto fit_with_lags = [&](int p, Eigen::Index end) {
@@ -252,9 +258,18 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options,
                          const std::vector<Eigen::Index>& record_starts,
-                         const Execution& execution) {
+                         const Execution& execution, const std::vector<bool>& logged) {
   options.Validate();
   execution.Validate();
+  if (!logged.empty() && (options.mode != Mode::kCompensate || UsesDecomposition(options.method))) {
+    throw UsageError(
+        "a log whose gaps were filled, fitted on its logged rows only, needs compensate mode and a "
+        "method without a decomposition (thermal, poly, elm, svr, bp): method " +
+        std::string(ToString(options.method)) + " in " + std::string(ToString(options.mode)) +
+        " mode would " +
+        (options.mode == Mode::kCompensate ? "decompose across the made-up rows"
+                                           : "predict from made-up rows"));
+  }
   if (!record_starts.empty() &&
       !(options.mode == Mode::kCompensate && options.method == Method::kThermal)) {
     throw UsageError(
@@ -263,9 +278,11 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
         " in " + std::string(ToString(options.mode)) +
         " mode needs one uniform record (decompositions and lags run across a break)");
   }
-  RequireFiniteSignal("target", y, 32);
+  CheckLogged(logged, y.size());
+  const Eigen::VectorXd y_logged = LoggedRows(y, logged);
+  RequireFiniteSignal("target", y_logged, 32);
   CheckRecordStarts(record_starts, y.size());
-  RequireVaryingSignal("target", y, "there is nothing to model");
+  RequireVaryingSignal("target", y_logged, "there is nothing to model");
   if (options.uses_temperature()) {
     // Checked before the decomposition, which is the slow part.
     internal::RequireTemperatureFor(temperature_c, y.size());
@@ -297,7 +314,7 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
   const bool decomposed = UsesDecomposition(options.method);
   execution.Report(decomposed ? internal::kGroupsDoneShare : 0.0, "fit sub-models");
   internal::FitLearners(prepared.model, prepared.series, y, thermal, y.size(), temperature_c,
-                        record_starts, execution.threads);
+                        record_starts, execution.threads, logged);
   if (prepared.model.uses_temperature()) {
     prepared.model.temperature_min_c = temperature_c.col(0).minCoeff();
     prepared.model.temperature_max_c = temperature_c.col(0).maxCoeff();

@@ -41,11 +41,13 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
 
 // Fits every sub-model on rows t < fit_end of the series (and thermal features, N x F or empty;
 // identified sub-models read the temperature channels, N x C, instead, as records: features.h).
-// Learners run on `threads` workers (Execution::threads).
+// Learners run on `threads` workers (Execution::threads). `logged` (features.h; empty = every
+// row, else fit_end flags) keeps the fit to the logged rows: compensate mode only.
 void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
                  const Eigen::Ref<const Eigen::VectorXd>& y,
                  const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
                  const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                 const std::vector<Eigen::Index>& record_starts, int threads);
+                 const std::vector<Eigen::Index>& record_starts, int threads,
+                 const std::vector<bool>& logged = {});
 
 }  // namespace gyrodrift::drift::internal

@@ -96,6 +96,7 @@ struct Log {
   io::CsvTable table;
   double rate_hz = 1.0;
   std::vector<Eigen::Index> record_starts;  // gaps = split: where the log's records start
+  std::vector<bool> logged;  // gaps = carry: the rows that were logged (empty: every row)
   std::vector<std::string> warnings;        // about its inputs (InputWarnings)
 };
 
@@ -125,7 +126,8 @@ std::vector<std::string> InputWarnings(const Manifest& m, const std::string& pat
 Log ReadUnitLog(const Manifest& m, const std::string& path) {
   Log log;
   log.table = io::ReadLog(path, m.log, nullptr,
-                          m.log.gaps == io::GapPolicy::kSplit ? &log.record_starts : nullptr);
+                          m.log.gaps == io::GapPolicy::kSplit ? &log.record_starts : nullptr, {},
+                          m.log.gaps == io::GapPolicy::kCarry ? &log.logged : nullptr);
   std::string how;
   log.rate_hz = io::ResolveSampleRate(log.table, m.rate_hz, &how);
   log.warnings = InputWarnings(m, path, log.table, how);
@@ -173,7 +175,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
     for (const Log& log : cal) {
       Eigen::MatrixXd block(log.table.rows(), 1 + static_cast<Eigen::Index>(axis.temperature.size()));
       block << log.table.Column(axis.target), Temperatures(log.table, axis);
-      run.Append(block, log.record_starts);
+      run.Append(block, log.record_starts, log.logged);
     }
     io::LoadedModel model;
     model.info.target_column = axis.target;
@@ -181,7 +183,7 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
     model.info.source = Joined(unit.calibration);
     model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
     model.model = drift::FitDriftModel(run.rows.col(0), run.rows.rightCols(run.rows.cols() - 1),
-                                       options, run.record_starts, one_thread);
+                                       options, run.record_starts, one_thread, run.logged);
     AxisResult a;
     a.target = axis.target;
     a.temperature = model.info.temperature_column;
@@ -211,6 +213,16 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   std::vector<io::CsvColumn> allan_columns;
   for (size_t k = 0; k < unit.verification.size(); ++k) {
     const Log ver = ReadUnitLog(m, unit.verification[k]);
+    // Block means and the Allan analysis of the verification need the time grid of a log with
+    // no made-up rows; carry serves duty-cycled calibration logs.
+    if (!ver.logged.empty()) {
+      throw DataError(fmt::format(
+          "{}: gaps = 'carry' fills this verification log's gaps ({} of {} rows made up), but the "
+          "verification's block means and Allan deviation need logged rows: verify on a "
+          "continuous log",
+          unit.verification[k], ver.table.rows() - drift::CountLogged(ver.logged, ver.table.rows()),
+          ver.table.rows()));
+    }
     for (AxisResult& a : r.axes) {
       a.warnings.insert(a.warnings.end(), ver.warnings.begin(), ver.warnings.end());
     }

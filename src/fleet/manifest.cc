@@ -216,6 +216,12 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
                                             "decomposition would run across the gaps)",
                                             drift::ToString(m.method)));
     }
+    if (m.log.gaps == io::GapPolicy::kCarry && drift::UsesDecomposition(m.method)) {
+      c.Fail(*top.Find("gaps"), fmt::format("gaps = 'carry' needs a method that fits on the logged "
+                                            "rows only (thermal or poly), not '{}' (a "
+                                            "decomposition would run across the made-up rows)",
+                                            drift::ToString(m.method)));
+    }
   }
   if (top.Find("delimiter")) m.log.delimiter = top.Enum("delimiter", io::DelimiterFromString);
   if (const toml::node* n = top.Find("seed")) {

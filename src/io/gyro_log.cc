@@ -15,10 +15,11 @@
 namespace gyrodrift::io {
 namespace {
 
-constexpr gyrodrift::internal::EnumNames<GapPolicy, 3> kGapPolicies{{
+constexpr gyrodrift::internal::EnumNames<GapPolicy, 4> kGapPolicies{{
     {GapPolicy::kError, "error"},
     {GapPolicy::kInterpolate, "interpolate"},
     {GapPolicy::kSplit, "split"},
+    {GapPolicy::kCarry, "carry"},
 }};
 
 }  // namespace
@@ -31,15 +32,32 @@ GapPolicy GapPolicyFromString(std::string_view text) {
   return gyrodrift::internal::EnumFromName(text, "gaps", kGapPolicies);
 }
 
+std::string SpellGaps(const LogOptions& options, GapPolicy policy) {
+  if (options.gaps_name.rfind("--", 0) == 0) {
+    return options.gaps_name + " " + std::string(ToString(policy));
+  }
+  return fmt::format("{} = '{}'", options.gaps_name, ToString(policy));
+}
+
 CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,
-                 std::vector<Eigen::Index>* record_starts, const std::vector<std::string>& columns) {
+                 std::vector<Eigen::Index>* record_starts, const std::vector<std::string>& columns,
+                 std::vector<bool>* logged) {
   const GapPolicy gaps = options.gaps;
+  auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
   if (gap_note) gap_note->clear();
   if (record_starts) record_starts->clear();
+  if (logged) logged->clear();
   if (gaps == GapPolicy::kSplit && record_starts == nullptr) {
-    throw UsageError(path + ": gaps = split needs a caller that takes several records (a thermal "
-                     "model's fit or compensation); a decomposition or an Allan analysis needs "
-                     "one uniform record: fill the gaps by interpolation or split the file");
+    throw UsageError(path + ": " + spell(gaps) +
+                     " needs a caller that takes several records (a thermal model's fit or "
+                     "compensation); this one needs one uniform record: use " +
+                     spell(GapPolicy::kInterpolate) + ", or split the file");
+  }
+  if (gaps == GapPolicy::kCarry && logged == nullptr) {
+    throw UsageError(path + ": " + spell(gaps) +
+                     " needs a caller that fits and scores on the logged rows only (a thermal "
+                     "model's fit or compensation); this one would use the made-up rows as "
+                     "data: use " + spell(GapPolicy::kInterpolate) + " to say so");
   }
   CsvReadOptions read{.delimiter = options.delimiter, .columns = columns};
   if (!columns.empty()) read.columns.push_back("time_s");
@@ -81,9 +99,12 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
           "{:g} s): {}",
           path, step, i + 2, samples, median,
           gaps == GapPolicy::kError
-              ? "fill gaps by linear interpolation or split the log into records at its gaps "
-                "(gaps = interpolate or split)"
-              : "too long to fill by interpolation: split the log at its gaps (gaps = split)"));
+              ? fmt::format("fill gaps by linear interpolation ({}, or {} to fit on the logged "
+                            "rows only) or split the log into records at its gaps ({})",
+                            spell(GapPolicy::kInterpolate), spell(GapPolicy::kCarry),
+                            spell(GapPolicy::kSplit))
+              : fmt::format("too long to fill by interpolation: split the log at its gaps ({})",
+                            spell(GapPolicy::kSplit))));
     }
     insert.push_back({i, static_cast<int>(samples)});
     missing += static_cast<long>(samples);
@@ -92,19 +113,45 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
     if (gap_note && !record_starts->empty()) {
       *gap_note = fmt::format(
           "note: time_s has {} gap{} (median step {:g} s, {} samples missing): the log is split "
-          "into {} records, and the thermal model's lag states restart after each gap (gaps = "
-          "split)",
+          "into {} records, and the thermal model's lag states restart after each gap ({})",
           record_starts->size(), record_starts->size() == 1 ? "" : "s", median, missing,
-          record_starts->size() + 1);
+          record_starts->size() + 1, spell(gaps));
     }
     return table;
   }
   if (insert.empty()) return table;
-  if (gap_note) {
+  const long rows = static_cast<long>(t.size()) + missing;
+  const double made_up = static_cast<double>(missing) / static_cast<double>(rows);
+  if (gap_note && gaps == GapPolicy::kCarry) {
+    *gap_note = fmt::format(
+        "note: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) filled by "
+        "linear interpolation for the thermal states to run across; fits, scores and reports use "
+        "the {} logged rows only ({})",
+        insert.size(), insert.size() == 1 ? "" : "s", median, missing, rows, 100.0 * made_up,
+        t.size(), spell(gaps));
+  } else if (gap_note && made_up > kMostlyMadeUpShare) {
+    *gap_note = fmt::format(
+        "warning: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) are made up "
+        "by linear interpolation ({}), and they count as data wherever the rows are used; {} "
+        "fits, scores and reports on the {} logged rows only",
+        insert.size(), insert.size() == 1 ? "" : "s", median, missing, rows, 100.0 * made_up,
+        spell(gaps), spell(GapPolicy::kCarry), t.size());
+  } else if (gap_note) {
     *gap_note = fmt::format(
         "note: time_s has {} gap{} (median step {:g} s): {} samples filled by linear "
-        "interpolation (gaps = interpolate)",
-        insert.size(), insert.size() == 1 ? "" : "s", median, missing);
+        "interpolation ({})",
+        insert.size(), insert.size() == 1 ? "" : "s", median, missing, spell(gaps));
+  }
+  if (logged) {
+    logged->reserve(static_cast<size_t>(rows));
+    size_t next = 0;
+    for (Eigen::Index i = 0; i < t.size(); ++i) {
+      logged->push_back(true);
+      if (next < insert.size() && insert[next].first == i) {
+        logged->insert(logged->end(), static_cast<size_t>(insert[next].second), false);
+        ++next;
+      }
+    }
   }
   return table.WithInterpolatedRows(insert);
 }

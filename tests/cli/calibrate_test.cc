@@ -197,6 +197,53 @@ TEST_F(CalibrateCli, SeveralCalibrationLogsAndASplitVerification) {
             std::string::npos);
 }
 
+// A duty-cycled calibration log (60 s of every 300 s) under gaps = "carry": the model `fit
+// --gaps carry` gives; a verification log with made-up rows is refused (its block means and
+// Allan deviation need logged rows).
+TEST_F(CalibrateCli, ADutyCycledCalibrationIsFittedOnItsLoggedRows) {
+  auto write_bursts = [](const std::string& from, const std::string& to) {
+    const io::CsvTable log = io::CsvTable::Read(from);
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = 0; i < log.rows(); ++i) {
+      if (i % 300 < 60) keep.push_back(i);
+    }
+    std::vector<io::CsvColumn> bursts;
+    for (const std::string& name : log.header()) {
+      const Eigen::VectorXd all = log.Column(name);
+      Eigen::VectorXd kept(static_cast<Eigen::Index>(keep.size()));
+      for (size_t k = 0; k < keep.size(); ++k) kept[static_cast<Eigen::Index>(k)] = all[keep[k]];
+      bursts.push_back({name, kept});
+    }
+    io::WriteCsv(to, bursts);
+  };
+  write_bursts(Dir() + "/logs/SN1_cal.csv", Dir() + "/logs/D_cal.csv");
+  write_bursts(Dir() + "/logs/SN1_ver.csv", Dir() + "/logs/D_ver.csv");
+  const std::string manifest = Dir() + "/carry.toml";
+  io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
+                                        "\n[[unit]]\nserial = \"D1\"\ncalibration = "
+                                        "\"logs/D_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n");
+  const std::string out = Dir() + "/out_carry";
+  auto r = test::RunCli("calibrate '" + manifest + "' -o '" + out + "' -q");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  r = test::RunCli("fit '" + Dir() + "/logs/D_cal.csv' -t gyro_x -T temp_x --mode compensate " +
+                   "--gaps carry -q -o '" + Dir() + "/d.json'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto axes = io::ReadModelFileAxes(out + "/D1/model.json");
+  const io::LoadedModel fitted = io::ReadModelFile(Dir() + "/d.json");
+  ASSERT_TRUE(axes[0].model.sub_models.front().thermal);
+  EXPECT_EQ(axes[0].model.sub_models.front().thermal->coefficients,
+            fitted.model.sub_models.front().thermal->coefficients);
+  // A verification logged in bursts: refused, naming the log.
+  io::WriteFileAtomically(manifest, std::string("gaps = \"carry\"\n") + kAxes +
+                                        "\n[[unit]]\nserial = \"D2\"\ncalibration = "
+                                        "\"logs/SN1_cal.csv\"\nverification = \"logs/D_ver.csv\"\n");
+  r = test::RunCli("calibrate '" + manifest + "' -o '" + Dir() + "/out_carry2'");
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_NE((r.out + r.err).find("D_ver.csv: gaps = 'carry' fills this verification log's gaps"),
+            std::string::npos)
+      << r.out << r.err;
+}
+
 TEST_F(CalibrateCli, AFailingUnitIsReportedAndTheOthersGoOn) {
   // SN1's verification log loses a value; the limit is one no unit meets.
   fs::create_directories(Dir() + "/bad");
@@ -250,6 +297,8 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
        "bad.toml:15: several calibration logs need method = 'thermal', not 'ms-elm'"},
       {"split, not thermal", "method = \"ms-elm\"\ngaps = \"split\"\n" + std::string(kAxes) + unit,
        "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
+      {"carry, decomposition", "method = \"ms-elm\"\ngaps = \"carry\"\n" + std::string(kAxes) + unit,
+       "bad.toml:2: gaps = 'carry' needs a method that fits on the logged rows only"},
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
       {"bad hysteresis", "hysteresis = \"sometimes\"\n" + std::string(kAxes) + unit,

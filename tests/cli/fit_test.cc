@@ -131,8 +131,9 @@ TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   auto r = test::RunCli(fit + "-o '" + dir_ + "/g.json'");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("time_s jumps by 301 s before data row 101 (300 missing samples at the "
-                       "median step 1 s): fill gaps by linear interpolation or split the log into "
-                       "records at its gaps (gaps = interpolate or split"),
+                       "median step 1 s): fill gaps by linear interpolation (--gaps interpolate, "
+                       "or --gaps carry to fit on the logged rows only) or split the log into "
+                       "records at its gaps (--gaps split)"),
             std::string::npos)
       << r.err;
   EXPECT_FALSE(test::FileExists(dir_ + "/g.json"));

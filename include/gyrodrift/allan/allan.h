@@ -148,6 +148,19 @@ struct AllanResult {
 AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options,
                     const Execution& execution = {});
 
+// A record with gaps (a duty-cycled or interrupted log) on its uniform time grid: `logged` holds
+// one flag per sample, false where the sample was made up (io::GapPolicy::kCarry) or is a break
+// between records; the made-up values are never used. The overlapping estimators (oadev, ohdev;
+// rate data) then sum only the cluster pairs (triples) whose 2m (3m) samples are all logged, as
+// allantools does with NaN gaps, and divide by how many there are: n_terms counts them, a tau
+// without one is left out, and the EDF is that of a gap-free record giving as many terms (an
+// approximation: the terms of a gapped record are less correlated, so the interval is wider than
+// it need be). The noise type per tau is identified on the longest run of logged samples. With
+// every flag set it gives Compute's values (to rounding: a plain sum, not Compute's blocked one). Throws UsageError for another estimator or angle data,
+// DataError when the mask does not match the data or no tau has a term (naming the longest run).
+AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>& logged,
+                            const AllanOptions& options, const Execution& execution = {});
+
 // ---- Building blocks (exposed for tests and other modules) --------------------------------------
 
 // Largest averaging factor the estimator accepts for n_phase phase points (at least one term;

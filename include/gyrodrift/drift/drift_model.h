@@ -177,12 +177,16 @@ bool IdentifiesThermalModel(const DriftOptions& options);
 // Method::kThermal only (IdentifyThermalModel restarts its lag states there), UsageError
 // otherwise. Runs on execution.threads workers and reports its progress there: the fraction of
 // the whole fit and the step, "decompose" (the grouping included) then "fit sub-models". The model
-// is the same bits for any execution. Throws UsageError / DataError.
+// is the same bits for any execution. `logged` (features.h CheckLogged; empty = every row): a log
+// whose gaps were filled (io::GapPolicy::kCarry); the thermal states run over every row, the fit
+// uses the logged rows only (y elsewhere is ignored). Compensate mode with a method without a
+// decomposition only (thermal, poly, elm, svr, bp), UsageError otherwise. Throws UsageError /
+// DataError.
 DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
                          const DriftOptions& options,
                          const std::vector<Eigen::Index>& record_starts = {},
-                         const Execution& execution = {});
+                         const Execution& execution = {}, const std::vector<bool>& logged = {});
 
 // Share of temperature samples outside [min_c, max_c] (0 when the range is NaN: no temperature),
 // e.g. a model's training range: where a thermal model extrapolates.

@@ -91,13 +91,26 @@ void ForEachRecord(Eigen::Index n, const std::vector<Eigen::Index>& record_start
 
 // Records appended one after another: each block of rows (N_i x C, the same C) below the earlier
 // ones, record_starts gaining the block's first row (after the first block) and its own record
-// starts shifted into place (the gaps of a log split at them).
+// starts shifted into place (the gaps of a log split at them), and logged its mask of logged rows
+// (empty: every row; logged stays empty while every block's is).
 struct RecordRows {
   Eigen::MatrixXd rows;
   std::vector<Eigen::Index> record_starts;
+  std::vector<bool> logged;
   void Append(const Eigen::Ref<const Eigen::MatrixXd>& block,
-              const std::vector<Eigen::Index>& block_starts = {});
+              const std::vector<Eigen::Index>& block_starts = {},
+              const std::vector<bool>& block_logged = {});
 };
+
+// Which rows of a record were logged (a log whose gaps were filled, io::GapPolicy::kCarry): one
+// flag per row, true where the row was logged; empty = every row. The thermal states run over
+// every row; fits and scores use the logged ones. CheckLogged throws DataError unless the mask is
+// empty or has n flags with at least one set; LoggedRows keeps the rows of m where it is set.
+void CheckLogged(const std::vector<bool>& logged, Eigen::Index n);
+Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,
+                           const std::vector<bool>& logged);
+// Rows logged: n when the mask is empty.
+Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n);
 
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,

@@ -5,8 +5,10 @@
 //   method = "thermal"            # fit --method of every axis (compensate mode); default thermal
 //   rate_unit = "dph"             # unit of the gyro columns: dph | dps | rads (allan --units)
 //   rate_hz = 1.0                 # optional; default: from each log's time_s, else 1 Hz
-//   gaps = "error"                # optional: error | interpolate | split (io::GapPolicy; split:
-//                                 # the thermal method only)
+//   gaps = "error"                # optional: error | interpolate | split | carry (io::GapPolicy;
+//                                 # split: the thermal method only; carry: a method without a
+//                                 # decomposition, and calibration logs only: a verification
+//                                 # log with made-up rows is refused)
 //   delimiter = "auto"            # optional: auto | comma | tab | semicolon (io::Delimiter)
 //   seed = 1                      # optional
 //   nonlinear = false             # optional, fit --nonlinear

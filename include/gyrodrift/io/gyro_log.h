@@ -19,9 +19,15 @@ namespace gyrodrift::io {
 //   split:       keep the rows as they are and cut the log into records at its gaps (the caller
 //                gets where each record starts): a thermal model's lag states restart after a
 //                gap instead of running across it, for a logger that stopped for a while. Only
-//                where the caller can use records (record_starts given); a decomposition or an
-//                Allan analysis needs one uniform record.
-enum class GapPolicy { kError, kInterpolate, kSplit };
+//                where the caller can use records (record_starts given).
+//   carry:       fill the gaps as interpolate does, and tell the caller which rows were logged
+//                (*logged): a thermal model's lag states run across each gap on the interpolated
+//                temperature, while fitting, scoring and reporting use the logged rows only (a
+//                duty-cycled logger: 5 s of every 300 s). Only where the caller honours the mask
+//                (logged given).
+// Where rows were made up (interpolate or carry) and the caller passed `logged`, it receives the
+// mask; a caller that shows the made-up rows marks them.
+enum class GapPolicy { kError, kInterpolate, kSplit, kCarry };
 std::string_view ToString(GapPolicy policy);
 GapPolicy GapPolicyFromString(std::string_view text);  // UsageError naming the choices
 
@@ -29,22 +35,36 @@ GapPolicy GapPolicyFromString(std::string_view text);  // UsageError naming the 
 struct LogOptions {
   GapPolicy gaps = GapPolicy::kError;
   Delimiter delimiter = Delimiter::kAuto;
+  // How the caller's user spells the gaps setting, so that every message names it as typed:
+  // "gaps" (a manifest key: gaps = 'split') or a flag such as "--gaps" (--gaps split).
+  std::string gaps_name = "gaps";
   bool operator==(const LogOptions&) const = default;
 };
+
+// `policy` spelt as the user sets it under options.gaps_name: "--gaps split" or "gaps = 'split'".
+std::string SpellGaps(const LogOptions& options, GapPolicy policy);
+
+// Share of made-up rows above which interpolate warns (the models would fit and score mostly on
+// rows nobody logged) and suggests carry.
+constexpr double kMostlyMadeUpShare = 0.5;
 
 // Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
 // increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row
 // (the log was merged, sorted wrongly or its clock jumped; every model and the Allan analysis
 // would otherwise take the samples as equally spaced, silently). Gaps are handled by
 // options.gaps; when rows were interpolated or the log was split, *gap_note (if given) says so,
-// else it is cleared. With kSplit, *record_starts receives the first row (0-based) of every
-// record after the first (empty: no gap); kSplit without record_starts is a UsageError. Shorter
+// else it is cleared (with interpolate, when more than kMostlyMadeUpShare of the rows are made up,
+// the note is a warning that suggests carry). With kSplit, *record_starts receives the first row
+// (0-based) of every record after the first (empty: no gap); kSplit without record_starts is a
+// UsageError. *logged (if given) receives one flag per returned row, true where the row was
+// logged, or stays empty when every row was; kCarry without logged is a UsageError. Shorter
 // irregular steps stay a note (NonUniformTimeNote). `columns`: the columns the caller needs
 // (CsvReadOptions::columns; time_s is kept with them); empty = every column.
 CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
                  std::string* gap_note = nullptr,
                  std::vector<Eigen::Index>* record_starts = nullptr,
-                 const std::vector<std::string>& columns = {});
+                 const std::vector<std::string>& columns = {},
+                 std::vector<bool>* logged = nullptr);
 
 // The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
 // column, which the table must have kept) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when

@@ -141,5 +141,92 @@ TEST(AllanCompute, ResultsDoNotDependOnThreadCountOrGrouping) {
   EXPECT_EQ(some.points[2].dev, one.points[4999].dev);
 }
 
+
+// ComputeWithGaps: the overlapping estimators over the cluster pairs of logged samples only.
+namespace gaps {
+
+// y = 1 3 2 _ 5 1 4 at 1 Hz, the fourth sample missing (NaN: never read).
+Eigen::VectorXd HandRecord() {
+  Eigen::VectorXd y(7);
+  y << 1, 3, 2, std::numeric_limits<double>::quiet_NaN(), 5, 1, 4;
+  return y;
+}
+const std::vector<bool> kHandLogged{true, true, true, false, true, true, true};
+
+TEST(AllanGaps, OverlappingAdevSkipsThePairsThatHoldAMissingSample) {
+  const AllanResult r = ComputeWithGaps(HandRecord(), kHandLogged, {});
+  // m = 1: pairs (1,3) (3,2) (5,1) (1,4), differences 2 -1 -4 3: AVAR = 30 / (2 * 4). m = 2 needs
+  // four logged samples in a row and has none: left out.
+  ASSERT_EQ(r.points.size(), 1U);
+  EXPECT_EQ(r.points[0].m, 1);
+  EXPECT_EQ(r.points[0].n_terms, 4);
+  EXPECT_NEAR(r.points[0].dev, std::sqrt(30.0 / 8.0), 1e-12);
+  EXPECT_TRUE(r.points[0].dev_lo < r.points[0].dev && r.points[0].dev < r.points[0].dev_hi);
+  // Overlapping Hadamard: triples (1,3,2) and (5,1,4), second differences -3 and 7.
+  const AllanResult h = ComputeWithGaps(HandRecord(), kHandLogged, {.deviation = Deviation::kOhdev});
+  ASSERT_EQ(h.points.size(), 1U);
+  EXPECT_EQ(h.points[0].n_terms, 2);
+  EXPECT_NEAR(h.points[0].dev, std::sqrt(58.0 / 12.0), 1e-12);
+}
+
+TEST(AllanGaps, EveryFlagSetIsComputeAndALongGapOnlyLosesTerms) {
+  const Eigen::VectorXd y = WhiteNoise(2000, 1.0, 3);
+  const AllanResult plain = Compute(y, {});
+  const AllanResult masked = ComputeWithGaps(y, std::vector<bool>(2000, true), {});
+  ASSERT_EQ(plain.points.size(), masked.points.size());
+  for (size_t k = 0; k < plain.points.size(); ++k) {
+    EXPECT_NEAR(masked.points[k].dev, plain.points[k].dev, 1e-12 * plain.points[k].dev);
+    EXPECT_EQ(masked.points[k].n_terms, plain.points[k].n_terms);
+    EXPECT_EQ(masked.points[k].alpha, plain.points[k].alpha);
+    EXPECT_NEAR(masked.points[k].edf, plain.points[k].edf, 1e-9 * plain.points[k].edf);
+  }
+  // The samples 800..1199 missing: the estimate is that of the two runs pooled, whatever the
+  // filled values were (here garbage).
+  Eigen::VectorXd holed = y;
+  std::vector<bool> logged(2000, true);
+  for (int i = 800; i < 1200; ++i) {
+    holed[i] = 1e6;
+    logged[static_cast<size_t>(i)] = false;
+  }
+  const AllanResult r = ComputeWithGaps(holed, logged, {.grid = TauGrid::kList, .tau_list_s = {4.0}});
+  double sum = 0.0;
+  std::int64_t terms = 0;
+  for (const auto& [begin, end] : {std::pair{0, 800}, std::pair{1200, 2000}}) {
+    for (int i = begin; i + 8 <= end; ++i) {
+      const double d = y.segment(i + 4, 4).sum() - y.segment(i, 4).sum();
+      sum += d * d;
+      ++terms;
+    }
+  }
+  ASSERT_EQ(r.points.size(), 1U);
+  EXPECT_EQ(r.points[0].n_terms, terms);
+  EXPECT_NEAR(r.points[0].dev, std::sqrt(sum / (2.0 * static_cast<double>(terms) * 16.0)),
+              1e-12);
+  // A white-noise record keeps its level: within 10 % of the gap-free one at the short taus.
+  const AllanResult gapped = ComputeWithGaps(holed, logged, {});
+  for (const AllanPoint& p : gapped.points) {
+    for (const AllanPoint& q : plain.points) {
+      if (q.m == p.m && p.m <= 16) EXPECT_NEAR(p.dev / q.dev, 1.0, 0.1) << "m = " << p.m;
+    }
+  }
+}
+
+TEST(AllanGaps, RefusesWhatItCannotDoHonestly) {
+  EXPECT_THROW(ComputeWithGaps(HandRecord(), kHandLogged, {.deviation = Deviation::kAdev}),
+               UsageError);
+  EXPECT_THROW(ComputeWithGaps(HandRecord(), kHandLogged, {.data_type = DataType::kAngle}),
+               UsageError);
+  EXPECT_THROW(ComputeWithGaps(HandRecord(), {true, false}, {}), DataError);
+  try {
+    ComputeWithGaps(HandRecord(), kHandLogged, {.grid = TauGrid::kList, .tau_list_s = {2.0}});
+    ADD_FAILURE() << "a tau without a term was computed";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("needs 4 logged samples in a row, the longest run is 3"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace gaps
 }  // namespace
 }  // namespace gyrodrift::allan

@@ -196,6 +196,48 @@ TEST(DriftModel, SeveralRecordsAreFittedByTheThermalMethodOnly) {
       UsageError);
 }
 
+// A log whose gaps were filled (io::GapPolicy::kCarry): the thermal features run over every row,
+// the fit uses the logged rows only, whatever the made-up rows hold.
+TEST(DriftModel, AMaskOfLoggedRowsKeepsTheFitToThem) {
+  const Log log = MakeLog(3000, 11);
+  std::vector<bool> logged(3000, false);
+  for (size_t i = 0; i < logged.size(); i += 100) {
+    for (size_t k = 0; k < 10; ++k) logged[i + k] = true;  // 10 of every 100 rows
+  }
+  const DriftOptions o = Fast(Mode::kCompensate, Method::kPoly);
+  Eigen::VectorXd spoiled = log.rate;
+  for (Eigen::Index i = 0; i < spoiled.size(); ++i) {
+    if (!logged[static_cast<size_t>(i)]) spoiled[i] = std::nan("");
+  }
+  const DriftModel masked = FitDriftModel(spoiled, log.temperature, o, {}, {}, logged);
+  // The same learner fitted by hand on the logged rows of the full-record features.
+  const DriftModel full = FitDriftModel(log.rate, log.temperature, o);
+  const FeatureOptions features = EffectiveFeatures(full.options);
+  const Eigen::MatrixXd x = ThermalFeatures(log.temperature, features);
+  const DriftModel refit = [&] {
+    DriftModel m = full;
+    m.sub_models.front().learner =
+        FitLearner(LoggedRows(x, logged), LoggedRows(log.rate, logged), [&] {
+          LearnerOptions l = full.options.learner;
+          l.kind = LearnerKind::kPoly;
+          l.seed = SeedFor(full.options.seed, "sub-model", 0);
+          return l;
+        }());
+    return m;
+  }();
+  EXPECT_EQ(EstimateDrift(masked, log.temperature), EstimateDrift(refit, log.temperature));
+  EXPECT_NE(EstimateDrift(masked, log.temperature), EstimateDrift(full, log.temperature));
+  // A decomposition (or a prediction from the output's past) would read the made-up rows.
+  EXPECT_THROW(FitDriftModel(log.rate, log.temperature, Fast(Mode::kCompensate, Method::kMsElm),
+                             {}, {}, logged),
+               UsageError);
+  EXPECT_THROW(FitDriftModel(log.rate, Eigen::VectorXd(), Fast(Mode::kPredict, Method::kPoly), {},
+                             {}, logged),
+               UsageError);
+  EXPECT_THROW(FitDriftModel(log.rate, log.temperature, o, {}, {}, std::vector<bool>(10, true)),
+               DataError);
+}
+
 // Options are plain values: a model holds the options it was fitted with (the thermal time
 // constants limited to the record, as FitDriftModel does), whatever execution ran the fit, and
 // the same options compare equal (reference_c unset included).

@@ -124,5 +124,29 @@ TEST(Records, AppendedBlocksShiftTheirOwnStarts) {
   EXPECT_THROW(CheckRecordStarts({9}, 9), DataError);
 }
 
+TEST(LoggedRows, AMaskKeepsTheLoggedRowsAndRecordsCarryIt) {
+  Eigen::MatrixXd m(4, 2);
+  m << 1, 10, 2, 20, 3, 30, 4, 40;
+  const std::vector<bool> logged{true, false, false, true};
+  const Eigen::MatrixXd kept = LoggedRows(m, logged);
+  ASSERT_EQ(kept.rows(), 2);
+  EXPECT_EQ(kept(1, 1), 40.0);
+  EXPECT_EQ(LoggedRows(m, {}), m);  // empty: every row
+  EXPECT_EQ(CountLogged(logged, 4), 2);
+  EXPECT_EQ(CountLogged({}, 4), 4);
+  EXPECT_THROW(CheckLogged({true, false}, 4), DataError);
+  EXPECT_THROW(CheckLogged({false, false}, 2), DataError);
+
+  // A block without a mask after one with a mask counts as logged, and the other way round.
+  RecordRows run;
+  run.Append(Eigen::MatrixXd::Zero(2, 1));
+  EXPECT_TRUE(run.logged.empty());
+  run.Append(Eigen::MatrixXd::Zero(3, 1), {}, {true, false, true});
+  run.Append(Eigen::MatrixXd::Zero(1, 1));
+  EXPECT_EQ(run.logged, (std::vector<bool>{true, true, true, false, true, true}));
+  EXPECT_EQ(run.record_starts, (std::vector<Eigen::Index>{2, 5}));
+  EXPECT_THROW(run.Append(Eigen::MatrixXd::Zero(2, 1), {}, {true}), DataError);
+}
+
 }  // namespace
 }  // namespace gyrodrift::drift

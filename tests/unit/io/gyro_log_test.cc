@@ -38,7 +38,7 @@ TEST(GyroLog, GapsAreRefusedByDefaultAndFilledLinearlyOnRequest) {
   EXPECT_DOUBLE_EQ(t.Column("rate")[4], 5.0);
   EXPECT_DOUBLE_EQ(t.Column("rate")[7], 9.0);
   EXPECT_EQ(note, "note: time_s has 2 gaps (median step 1 s): 3 samples filled by linear "
-                  "interpolation (gaps = interpolate)");
+                  "interpolation (gaps = 'interpolate')");
   // A bad cell is still named by its row in the file.
   try {
     t.Column("status");
@@ -86,6 +86,69 @@ TEST(GyroLog, SplitKeepsTheRowsAndSaysWhereRecordsStart) {
   EXPECT_TRUE(note.empty());
   // A caller that cannot take records cannot ask for a split.
   EXPECT_THROW(ReadLog(path, {GapPolicy::kSplit}), UsageError);
+}
+
+TEST(GyroLog, CarryFillsTheGapsAndSaysWhichRowsWereLogged) {
+  // As the interpolate case: 1-s steps, two samples missing after row 3, one after row 5.
+  const std::string path =
+      Write("carry.csv", "time_s,rate,temp\n0,1,10\n1,2,11\n2,3,12\n5,6,18\n6,8,20\n8,10,24\n9,11,26\n");
+  std::string note;
+  std::vector<bool> logged{false};  // stale: cleared
+  const CsvTable t = ReadLog(path, {GapPolicy::kCarry}, &note, nullptr, {}, &logged);
+  ASSERT_EQ(t.rows(), 10);
+  EXPECT_EQ(logged, (std::vector<bool>{true, true, true, false, false, true, true, false, true,
+                                       true}));
+  // The made-up rows are the interpolate policy's: every column linear across the gap.
+  EXPECT_DOUBLE_EQ(t.Column("temp")[3], 14.0);
+  EXPECT_DOUBLE_EQ(t.Column("temp")[4], 16.0);
+  EXPECT_DOUBLE_EQ(t.Column("temp")[7], 22.0);
+  EXPECT_DOUBLE_EQ(t.Column("rate")[7], 9.0);
+  EXPECT_NE(note.find("3 of 10 rows (30.0 %) filled by linear interpolation"), std::string::npos)
+      << note;
+  EXPECT_NE(note.find("the 7 logged rows only (gaps = 'carry')"), std::string::npos) << note;
+  // Interpolate hands out the same mask to a caller that marks the made-up rows.
+  std::vector<bool> filled;
+  ReadLog(path, {GapPolicy::kInterpolate}, nullptr, nullptr, {}, &filled);
+  EXPECT_EQ(filled, logged);
+  // No gap: an empty mask (every row logged).
+  ReadLog(Write("u3.csv", "time_s,r\n0,1\n1,2\n2,3\n"), {GapPolicy::kCarry}, &note, nullptr, {},
+          &logged);
+  EXPECT_TRUE(logged.empty());
+  EXPECT_TRUE(note.empty());
+  // A caller that would use the made-up rows as data cannot ask for carry.
+  EXPECT_THROW(ReadLog(path, {GapPolicy::kCarry}), UsageError);
+  EXPECT_EQ(GapPolicyFromString("carry"), GapPolicy::kCarry);
+}
+
+TEST(GyroLog, MostlyMadeUpRowsAreAWarningThatSuggestsCarry) {
+  // A duty-cycled logger: 2 samples of every 10 s, so 8 of every 10 rows would be made up.
+  std::string text = "time_s,r\n";
+  for (int burst = 0; burst < 5; ++burst) {
+    for (int k = 0; k < 2; ++k) text += std::to_string(10 * burst + k) + "," + std::to_string(k) + "\n";
+  }
+  const std::string path = Write("bursts.csv", text);
+  std::string note;
+  const CsvTable t = ReadLog(path, {GapPolicy::kInterpolate, Delimiter::kAuto, "--gaps"}, &note);
+  EXPECT_EQ(t.rows(), 42);
+  EXPECT_EQ(note.rfind("warning: ", 0), 0U) << note;
+  EXPECT_NE(note.find("32 of 42 rows (76.2 %) are made up"), std::string::npos) << note;
+  // Spelt as the caller's user sets it: a flag here.
+  EXPECT_NE(note.find("(--gaps interpolate)"), std::string::npos) << note;
+  EXPECT_NE(note.find("--gaps carry fits, scores and reports on the 10 logged rows only"),
+            std::string::npos)
+      << note;
+  // The error policy names the choices the same way.
+  try {
+    ReadLog(path, {GapPolicy::kError, Delimiter::kAuto, "--gaps"});
+    ADD_FAILURE() << "a gap was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("(--gaps interpolate, or --gaps carry to fit on the "
+                                         "logged rows only)"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("(--gaps split)"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(SpellGaps({}, GapPolicy::kSplit), "gaps = 'split'");
 }
 
 TEST(GyroLog, TheDelimiterCanBeNamed) {
