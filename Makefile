@@ -2,6 +2,13 @@
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?= -DCMAKE_BUILD_TYPE=Release
+# A compiler cache where one is installed (scripts/setup-deps.sh installs ccache): a rebuild, or a
+# fresh clone of sources built before on this machine, reuses the objects. CCACHE_BASEDIR makes
+# the paths it hashes relative to the checkout, wherever the clone is.
+CCACHE := $(shell command -v ccache 2>/dev/null)
+LAUNCHER := $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE) -DCMAKE_C_COMPILER_LAUNCHER=$(CCACHE))
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_DIR ?= $(if $(HOME),$(HOME)/.cache/ccache,$(CURDIR)/.ccache)
 
 .PHONY: deps configure build demo test test-sanitize fuzz bench clean
 
@@ -9,7 +16,7 @@ deps:
 	@./scripts/setup-deps.sh
 
 configure: deps
-	@cmake -S . -B $(BUILD) -G Ninja $(CMAKE_FLAGS) -DGYRODRIFT_BUILD_TESTS=ON -DGYRODRIFT_BUILD_BENCH=ON >/dev/null
+	@cmake -S . -B $(BUILD) -G Ninja $(CMAKE_FLAGS) $(LAUNCHER) -DGYRODRIFT_BUILD_TESTS=ON -DGYRODRIFT_BUILD_BENCH=ON >/dev/null
 
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
@@ -30,7 +37,7 @@ SANITIZE_FLAGS = -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fn
 SANITIZE_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GYRODRIFT_SANITIZE=1
 test-sanitize: deps
-	@CC=clang CXX=clang++ cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug \
+	@CC=clang CXX=clang++ cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug $(LAUNCHER) \
 		"-DCMAKE_CXX_FLAGS_DEBUG=$(SANITIZE_FLAGS)" -DGYRODRIFT_BUILD_TESTS=ON \
 		-DGYRODRIFT_BUILD_PYTHON=OFF >/dev/null
 	@cmake --build build-sanitize -j $(JOBS)
@@ -43,7 +50,7 @@ FUZZ_SECONDS ?= 30
 FUZZ_SEED ?= 1
 FUZZ_FLAGS = -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 fuzz: deps
-	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE= \
+	@CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE= $(LAUNCHER) \
 		-DGYRODRIFT_BUILD_TESTS=OFF -DGYRODRIFT_BUILD_APPS=OFF -DGYRODRIFT_BUILD_FUZZ=ON \
 		-DGYRODRIFT_BUILD_PYTHON=OFF \
 		"-DCMAKE_CXX_FLAGS=$(FUZZ_FLAGS)" >/dev/null

@@ -2,7 +2,7 @@
 # Installs the Debian packages gyrodrift builds against. Idempotent and quiet when all is there.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config ccache
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libsvm-dev libfann-dev libjs-dygraphs
