@@ -9,6 +9,8 @@ CCACHE := $(shell command -v ccache 2>/dev/null)
 LAUNCHER := $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE) -DCMAKE_C_COMPILER_LAUNCHER=$(CCACHE))
 export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_DIR ?= $(if $(HOME),$(HOME)/.cache/ccache,$(CURDIR)/.ccache)
+# The sanitized and fuzz builds carry -g: without this, ccache would hash the build directory too.
+export CCACHE_NOHASHDIR := 1
 
 .PHONY: deps configure build demo test test-sanitize fuzz bench clean
 
