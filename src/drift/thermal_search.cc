@@ -243,7 +243,8 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
         }
         if (Condition(scores.gram(), s.cols) > rules.max_condition) continue;
         consider(s);
-        if (!rates) continue;
+        // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
+        if (!rates || rules.one_direction) continue;
         for (size_t k = 0; k < chosen.size(); ++k) {
           for (int w = 0; w < layout.widths; ++w) {
             Subset h = s;

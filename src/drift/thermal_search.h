@@ -110,7 +110,8 @@ struct SearchRules {
   double max_condition = 1e8;
   double standard_errors = 1.0;
   // The run showed one direction of temperature change only: no structure holds a lag difference
-  // (two states, or a state beside the static term), whose sign follows the direction.
+  // (two states, or a state beside the static term), whose sign follows the direction, nor a
+  // hysteresis term, which tells the directions apart.
   bool one_direction = false;
 };
 
