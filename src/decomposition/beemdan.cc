@@ -29,6 +29,19 @@ NoiseStagePolicy FixedStages(const DecompositionOptions& o) {
   };
 }
 
+// The probe outside the band ends the noise assistance: it is kept as the first IMF of the plain
+// EMD that finishes the decomposition, and the report says why.
+void KeepProbe(const char* reason, const SiftOutcome& probe, const Eigen::VectorXd& imf,
+               Eigen::VectorXd& r, std::vector<Eigen::VectorXd>& modes,
+               DecompositionReport& report) {
+  report.stop_reason = reason;
+  r -= imf;
+  modes.push_back(imf);
+  report.sifts_per_imf.push_back(probe.sifts);
+  report.sift_cap_hit.push_back(probe.cap_hit);
+  report.sift_cap_hits += probe.cap_hit;
+}
+
 // Ends the noise assistance at the first mode outside the white-noise energy band, whose band is
 // set by mode 1 (modes[0], noise-assisted).
 NoiseStagePolicy EnergyBandExit(const DecompositionOptions& o) {
@@ -51,12 +64,7 @@ NoiseStagePolicy EnergyBandExit(const DecompositionOptions& o) {
                   "mode %d energy 2^%.2f above the %g%% white-noise band (2^%.2f); plain EMD for "
                   "the rest",
                   k, log2_energy, 100 * band.confidence, upper);
-    report.stop_reason = text;
-    r -= imf;
-    modes.push_back(imf);
-    report.sifts_per_imf.push_back(probe.sifts);
-    report.sift_cap_hit.push_back(probe.cap_hit);
-    report.sift_cap_hits += probe.cap_hit;
+    KeepProbe(text, probe, imf, r, modes, report);
     return false;
   };
 }
@@ -125,12 +133,7 @@ NoiseStagePolicy EnsembleBandExit(const DecompositionOptions& o) {
                     "the rest",
                     k);
     }
-    report.stop_reason = text;
-    r -= imf;
-    modes.push_back(imf);
-    report.sifts_per_imf.push_back(probe.sifts);
-    report.sift_cap_hit.push_back(probe.cap_hit);
-    report.sift_cap_hits += probe.cap_hit;
+    KeepProbe(text, probe, imf, r, modes, report);
     return false;
   };
 }

@@ -5,13 +5,13 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "../common/format.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -22,14 +22,22 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kLongestWindow = 4096;
 
-// printf into a string (the core links no formatting library).
-std::string Format(const char* format, ...) {
-  char buffer[256];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof(buffer), format, args);
-  va_end(args);
-  return buffer;
+using gyrodrift::internal::Format;
+
+// The candidate of least one-step RMSE (the first of equal ones: the grids run from the smaller
+// window and the larger constant); `criterion` receives its RMSE.
+template <class T, class F>
+T BestOnGrid(const std::vector<T>& candidates, F rmse_of, double& criterion) {
+  T best = candidates.front();
+  criterion = std::numeric_limits<double>::infinity();
+  for (const T& c : candidates) {
+    const double rmse = rmse_of(c);
+    if (rmse < criterion) {
+      criterion = rmse;
+      best = c;
+    }
+  }
+  return best;
 }
 
 bool IsKalman(Method m) { return m == Method::kKalmanLevel || m == Method::kKalmanTrend; }
@@ -273,30 +281,22 @@ Baseline FitBaseline(Method method, const Eigen::Ref<const Eigen::VectorXd>& y) 
       b.constant = y.mean();
       break;
     case Method::kTrailingMean: {
-      double best = std::numeric_limits<double>::infinity();
+      std::vector<int> windows;
       for (int k = 0; k <= 16; ++k) {
         const int w = static_cast<int>(std::lround(16.0 * std::pow(2.0, k / 2.0)));
         if (w > n && k > 0) break;
-        const double rmse = OneStepRmse(y, TrailingMeans(y, n, w));
-        if (rmse < best) {
-          best = rmse;
-          b.window = w;
-        }
+        windows.push_back(w);
       }
-      b.criterion = best;
+      b.window = BestOnGrid(windows, [&](int w) { return OneStepRmse(y, TrailingMeans(y, n, w)); },
+                            b.criterion);
       break;
     }
     case Method::kExpSmoothing: {
-      double best = std::numeric_limits<double>::infinity();
-      for (int k = 0; k <= 28; ++k) {
-        const double alpha = std::pow(2.0, -k / 2.0);
-        const double rmse = OneStepRmse(y, SmoothedLevels(y, n, alpha));
-        if (rmse < best) {
-          best = rmse;
-          b.alpha = alpha;
-        }
-      }
-      b.criterion = best;
+      std::vector<double> alphas;
+      for (int k = 0; k <= 28; ++k) alphas.push_back(std::pow(2.0, -k / 2.0));
+      b.alpha = BestOnGrid(
+          alphas, [&](double alpha) { return OneStepRmse(y, SmoothedLevels(y, n, alpha)); },
+          b.criterion);
       break;
     }
     case Method::kKalmanLevel:

@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 #include <limits>
 #include <numeric>
 
@@ -684,10 +682,11 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   report.held_out_rmse_best = std::sqrt(search.best_score);
   if (report.regime_folds + report.range_folds > 0) {
     auto regimes = [&](const internal::Subset& subset) {
+      const Eigen::VectorXd every = scores.Scores(subset.cols, /*every_fold=*/true);
       const int r = report.regime_folds > 0, e = report.range_folds > 0;
-      return std::sqrt(
-          (scores.SchemeMean(subset.fold_scores, internal::kRegimes) * r +
-           scores.SchemeMean(subset.fold_scores, internal::kRangeEnds) * e) / (r + e));
+      return std::sqrt((scores.SchemeMean(every, internal::kRegimes) * r +
+                        scores.SchemeMean(every, internal::kRangeEnds) * e) /
+                       (r + e));
     };
     report.regime_rmse = regimes(best);
     report.regime_rmse_constant = regimes(search.constant);

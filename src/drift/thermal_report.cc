@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 
 #include "gyrodrift/drift/features.h"
 
@@ -29,22 +27,13 @@ constexpr double kSlowLagS = 1800.0;
 
 namespace internal {
 
-std::string Format(const char* format, ...) {
-  char buffer[512];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof(buffer), format, args);
-  va_end(args);
-  return buffer;
-}
-
 std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                                            double rate_hz, double ramp_rate_k_per_min,
                                            const std::vector<Eigen::Index>& record_starts) {
   std::vector<ThermalSegment> all;
   ForEachRecord(temperature_c.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
-    for (ThermalSegment s : Segments(temperature_c.segment(begin, length), rate_hz,
-                                     ramp_rate_k_per_min)) {
+    for (ThermalSegment s :
+         Segments(temperature_c.segment(begin, length), rate_hz, ramp_rate_k_per_min)) {
       s.begin += begin;
       s.end += begin;
       all.push_back(s);
@@ -82,11 +71,13 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
   auto& w = report.warnings;
   auto& advice = report.advice;
   if (report.duration_s < kShortestCalibrationS) {
-    w.push_back(Format("a log of %.3g min is not a calibration run: nothing of its thermal "
-                       "response can be held out and checked",
-                       report.duration_s / 60.0));
-    advice.push_back("log a calibration run of at least 8 h: ramps up and down at 0.5-2 K/min "
-                     "and dwells of 30 min or more at 3 or more temperatures");
+    w.push_back(
+        Format("a log of %.3g min is not a calibration run: nothing of its thermal "
+               "response can be held out and checked",
+               report.duration_s / 60.0));
+    advice.push_back(
+        "log a calibration run of at least 8 h: ramps up and down at 0.5-2 K/min "
+        "and dwells of 30 min or more at 3 or more temperatures");
   }
   const int channels = model.channels();
   for (int c = 0; c < channels; ++c) {
@@ -94,8 +85,10 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
       w.push_back(Format("temperature %sspans only %.3g K: the model is not identified beyond it",
                          channels > 1 ? Format("T%d ", c + 1).c_str() : "",
                          report.span_k[static_cast<size_t>(c)]));
-      advice.push_back(Format("narrow range: cover at least %.0f K, ideally the whole operating "
-                              "range", kShortestSpanK));
+      advice.push_back(
+          Format("narrow range: cover at least %.0f K, ideally the whole operating "
+                 "range",
+                 kShortestSpanK));
     }
   }
   if (report.max_heating_k_per_min < 2.0 * options.ramp_rate_k_per_min) {
@@ -111,8 +104,10 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
         "no dwell of 10 min or more: the level response cannot be told from the rate response");
   }
   if (report.dwells < 3) {
-    advice.push_back(Format("%d dwell%s: hold 30 min or more at 3 or more temperatures across the "
-                            "range", report.dwells, report.dwells == 1 ? "" : "s"));
+    advice.push_back(
+        Format("%d dwell%s: hold 30 min or more at 3 or more temperatures across the "
+               "range",
+               report.dwells, report.dwells == 1 ? "" : "s"));
   }
   if (report.ramps + report.dwells < 3) {
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
@@ -125,16 +120,16 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
         "thermal states could lag the sensor by at most %.0f s (time constants up to %g of the "
         "run): a gyro whose coil lags its sensor by more needs a longer calibration run",
         longest_delay, options.longest_tau_share));
-    advice.push_back(Format(
-        "short run: %.3g h lets states lag by %.0f s at most; %.3g h reaches %.0f s",
-        report.duration_s / 3600.0, longest_delay,
-        kSlowLagS / (options.state_order * options.longest_tau_share) / 3600.0, kSlowLagS));
+    advice.push_back(
+        Format("short run: %.3g h lets states lag by %.0f s at most; %.3g h reaches %.0f s",
+               report.duration_s / 3600.0, longest_delay,
+               kSlowLagS / (options.state_order * options.longest_tau_share) / 3600.0, kSlowLagS));
   }
   double slowest = 0.0;
   for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);
   if (slowest > 0.0 && report.duration_s < 8.0 * slowest) {
-    w.push_back(Format("the run is shorter than 8 times the slowest chosen time constant (%g s)",
-                       slowest));
+    w.push_back(
+        Format("the run is shorter than 8 times the slowest chosen time constant (%g s)", slowest));
   }
   if (fell_back_to_constant) {
     w.push_back(Format(
@@ -154,8 +149,8 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
         report.regime_rmse, report.regime_rmse_constant));
   }
   if (report.condition > kLargestCondition) {
-    w.push_back(Format("the chosen regressors are nearly collinear (condition %.2g)",
-                       report.condition));
+    w.push_back(
+        Format("the chosen regressors are nearly collinear (condition %.2g)", report.condition));
   }
 }
 
@@ -210,26 +205,25 @@ std::string CalibrationReport::Summary() const {
                            : std::string("n/a");
   };
   return Format(
-      "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d time folds, %d "
-      "regime folds, %d range folds; structure: %s (best held-out: %s); held-out RMSE %.4g "
-      "(against the constant %s, the static cubic %s; on held-out regimes %s and %s); "
-      "cross-validated RMSE %.4g (constant %.4g), %s, condition %.2g; hysteresis term %s",
-      duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
-      span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells, folds,
-      regime_folds, range_folds, kLevelNames[std::clamp(level, 0, 5)],
-      kLevelNames[std::clamp(best_level, 0, 5)], held_out_rmse,
-      gain(held_out_rmse, held_out_rmse_constant).c_str(),
-      gain(held_out_rmse, held_out_rmse_static).c_str(),
-      gain(regime_rmse, regime_rmse_constant).c_str(),
-      gain(regime_rmse, regime_rmse_static).c_str(), cv_rmse,
-      cv_rmse_constant, skill_text.c_str(), condition, hysteresis_tried ? "tried" : "not tried") +
-         (std::isnan(cv_rmse_nonlinear)
-              ? std::string()
-              : nonlinear_units > 0
-                    ? Format("; nonlinear correction %d units, C %g (cross-validated RMSE %.4g)",
-                             nonlinear_units, nonlinear_ridge_c, cv_rmse_nonlinear)
-                    : Format("; no nonlinear correction (best cross-validated RMSE %.4g)",
-                             cv_rmse_nonlinear));
+             "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d time folds, %d "
+             "regime folds, %d range folds; structure: %s (best held-out: %s); held-out RMSE %.4g "
+             "(against the constant %s, the static cubic %s; on held-out regimes %s and %s); "
+             "cross-validated RMSE %.4g (constant %.4g), %s, condition %.2g; hysteresis term %s",
+             duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
+             span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells, folds,
+             regime_folds, range_folds, kLevelNames[std::clamp(level, 0, 5)],
+             kLevelNames[std::clamp(best_level, 0, 5)], held_out_rmse,
+             gain(held_out_rmse, held_out_rmse_constant).c_str(),
+             gain(held_out_rmse, held_out_rmse_static).c_str(),
+             gain(regime_rmse, regime_rmse_constant).c_str(),
+             gain(regime_rmse, regime_rmse_static).c_str(), cv_rmse, cv_rmse_constant,
+             skill_text.c_str(), condition, hysteresis_tried ? "tried" : "not tried") +
+         (std::isnan(cv_rmse_nonlinear) ? std::string()
+          : nonlinear_units > 0
+              ? Format("; nonlinear correction %d units, C %g (cross-validated RMSE %.4g)",
+                       nonlinear_units, nonlinear_ridge_c, cv_rmse_nonlinear)
+              : Format("; no nonlinear correction (best cross-validated RMSE %.4g)",
+                       cv_rmse_nonlinear));
 }
 
 }  // namespace gyrodrift::drift

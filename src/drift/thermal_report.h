@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "../common/format.h"
 #include "gyrodrift/drift/thermal_model.h"
 
 namespace gyrodrift::drift::internal {
 
-// printf-style formatting for the report's texts (the core library has no fmt dependency).
-std::string Format(const char* format, ...);
+using gyrodrift::internal::Format;
 
 // Ramps and dwells of every record, one after the other (a regime never spans two records).
 std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,

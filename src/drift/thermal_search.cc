@@ -50,9 +50,8 @@ double Condition(const Eigen::MatrixXd& g, const std::vector<int>& cols) {
   Eigen::MatrixXd a(m, m);
   for (Eigen::Index i = 0; i < m; ++i) {
     for (Eigen::Index j = 0; j < m; ++j) {
-      a(i, j) = g(cols[i], cols[j]) /
-                std::sqrt(std::max(g(cols[i], cols[i]) * g(cols[j], cols[j]),
-                                   std::numeric_limits<double>::min()));
+      a(i, j) = g(cols[i], cols[j]) / std::sqrt(std::max(g(cols[i], cols[i]) * g(cols[j], cols[j]),
+                                                         std::numeric_limits<double>::min()));
     }
   }
   const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a).eigenvalues();
@@ -92,8 +91,8 @@ FoldScores::FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
     if (scored & (1u << f.scheme)) ++per_scheme[f.scheme];
     folds_.push_back(std::move(f));
   }
-  const int schemes =
-      static_cast<int>(std::count_if(per_scheme.begin(), per_scheme.end(), [](int c) { return c > 0; }));
+  const int schemes = static_cast<int>(
+      std::count_if(per_scheme.begin(), per_scheme.end(), [](int c) { return c > 0; }));
   for (Fold& f : folds_) {
     f.g_train = g_total_ - f.g;
     f.b_train = b_total_ - f.b;
@@ -105,10 +104,12 @@ Eigen::VectorXd FoldScores::Weights(const Fold& f, const std::vector<int>& cols)
   return SolveSubset(f.g_train, f.b_train, cols);
 }
 
-Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols) const {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(folds_.size()));
+Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols, bool every_fold) const {
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(folds_.size()),
+                                                  std::numeric_limits<double>::quiet_NaN());
   for (size_t k = 0; k < folds_.size(); ++k) {
     const Fold& f = folds_[k];
+    if (f.weight == 0.0 && !every_fold) continue;
     const Eigen::VectorXd w = Weights(f, cols);
     double e = f.yy;
     for (size_t i = 0; i < cols.size(); ++i) {
@@ -126,7 +127,7 @@ Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols) const {
 double FoldScores::Mean(const Eigen::VectorXd& per_fold) const {
   double sum = 0.0;
   for (size_t k = 0; k < folds_.size(); ++k) {
-    sum += folds_[k].weight * per_fold[static_cast<Eigen::Index>(k)];
+    if (folds_[k].weight > 0.0) sum += folds_[k].weight * per_fold[static_cast<Eigen::Index>(k)];
   }
   return sum;
 }
@@ -167,7 +168,7 @@ double FoldScores::StandardError(const Eigen::VectorXd& per_fold) const {
 }
 
 double FoldScores::TimeMse(const std::vector<int>& cols) const {
-  const Eigen::VectorXd s = Scores(cols);
+  const Eigen::VectorXd s = Scores(cols, /*every_fold=*/true);
   double sse = 0.0, logged = 0.0;
   for (size_t k = 0; k < folds_.size(); ++k) {
     if (folds_[k].scheme != kTimeBlocks) continue;
@@ -225,37 +226,39 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
   auto visit = [&](auto&& self, int next) -> void {
     if (!chosen.empty()) {
       for (int with_linear : {0, 1}) {
-       for (bool rates : {false, true}) {
-        if (!rates && chosen.size() > 1) continue;
-        if (rules.one_direction && (chosen.size() > 1 || with_linear)) continue;
-        Subset s;
-        s.states = chosen;
-        s.static_power = with_linear;
-        s.rates = rates;
-        s.level = !rates ? CalibrationReport::kLag : chosen.size() == 1 ? CalibrationReport::kOneState : CalibrationReport::kTwoStates;
-        for (int c = 0; with_linear && c < layout.channels; ++c) {
-          s.cols.push_back(layout.StaticColumn(c, 1));
-        }
-        for (int j : chosen) {
-          for (int p = 0; p < layout.state_columns - (rates ? 0 : 1); ++p) {
-            s.cols.push_back(layout.StateColumn(j, p));
+        for (bool rates : {false, true}) {
+          if (!rates && chosen.size() > 1) continue;
+          if (rules.one_direction && (chosen.size() > 1 || with_linear)) continue;
+          Subset s;
+          s.states = chosen;
+          s.static_power = with_linear;
+          s.rates = rates;
+          s.level = !rates               ? CalibrationReport::kLag
+                    : chosen.size() == 1 ? CalibrationReport::kOneState
+                                         : CalibrationReport::kTwoStates;
+          for (int c = 0; with_linear && c < layout.channels; ++c) {
+            s.cols.push_back(layout.StaticColumn(c, 1));
+          }
+          for (int j : chosen) {
+            for (int p = 0; p < layout.state_columns - (rates ? 0 : 1); ++p) {
+              s.cols.push_back(layout.StateColumn(j, p));
+            }
+          }
+          if (Condition(scores.gram(), s.cols) > rules.max_condition) continue;
+          consider(s);
+          // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
+          if (!rates || rules.one_direction) continue;
+          for (size_t k = 0; k < chosen.size(); ++k) {
+            for (int w = 0; w < layout.widths; ++w) {
+              Subset h = s;
+              h.level = CalibrationReport::kHysteresis;
+              h.hysteresis_state = static_cast<int>(k);
+              h.hysteresis_width = w;
+              h.cols.push_back(layout.WidthColumn(chosen[k], w));
+              consider(std::move(h));
+            }
           }
         }
-        if (Condition(scores.gram(), s.cols) > rules.max_condition) continue;
-        consider(s);
-        // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
-        if (!rates || rules.one_direction) continue;
-        for (size_t k = 0; k < chosen.size(); ++k) {
-          for (int w = 0; w < layout.widths; ++w) {
-            Subset h = s;
-            h.level = CalibrationReport::kHysteresis;
-            h.hysteresis_state = static_cast<int>(k);
-            h.hysteresis_width = w;
-            h.cols.push_back(layout.WidthColumn(chosen[k], w));
-            consider(std::move(h));
-          }
-        }
-       }
       }
     }
     if (static_cast<int>(chosen.size()) == max_states) return;

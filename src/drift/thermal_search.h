@@ -46,8 +46,9 @@ class FoldScores {
   const Eigen::MatrixXd& gram() const { return g_total_; }  // of every logged row
   // The training part's least-squares weights of fold f on the columns `cols`.
   Eigen::VectorXd Weights(const Fold& f, const std::vector<int>& cols) const;
-  // Held-out mean square error of every fold.
-  Eigen::VectorXd Scores(const std::vector<int>& cols) const;
+  // Held-out mean square error of every scored fold (NaN at the others, which `every_fold`
+  // scores too: the search needs the scored folds only, the report the rest for three subsets).
+  Eigen::VectorXd Scores(const std::vector<int>& cols, bool every_fold = false) const;
   // The fold-weighted mean of per-fold values (scores or their differences), over every fold or
   // over the folds of one scheme.
   double Mean(const Eigen::VectorXd& per_fold) const;

@@ -323,11 +323,14 @@ TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHoldsCoolingRates) {
   const double none = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
   const double after = std::sqrt((e.col(0) - truth).squaredNorm() / static_cast<double>(truth.size()));
   EXPECT_LT(after, none) << m.Summary();
-  if (!m.states.empty() && m.coefficients[m.coefficients.size() - 1] != 0.0) {
-    // Where the mission cools, the rate column sits at the calibration's edge.
-    const Eigen::MatrixXd x = m.Regressors(mission);
-    EXPECT_GE(x.col(x.cols() - 1).minCoeff(), m.states[0].rate_min);
-  }
+  // Where the mission cools, the state's rate column sits at the calibration's edge, and the
+  // unheld rates would have gone below it.
+  ASSERT_EQ(m.states.size(), 1u) << m.Summary();
+  const Eigen::Index rate = 1 + m.static_power[0] + m.max_power;
+  const Eigen::MatrixXd held = m.Regressors(mission);
+  const Eigen::MatrixXd free = m.Regressors(mission, {}, /*within_support=*/false);
+  EXPECT_DOUBLE_EQ(held.col(rate).minCoeff(), m.states[0].rate_min);
+  EXPECT_LT(free.col(rate).minCoeff(), m.states[0].rate_min);
 }
 
 // The guarantee: a gyro without temperature dependence gets the constant, whatever the

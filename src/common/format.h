@@ -1,0 +1,12 @@
+// Private: printf-style formatting into a string, for the messages and report lines of the core
+// library, which links no formatting library.
+#pragma once
+
+#include <string>
+
+namespace gyrodrift::internal {
+
+// The text of `format` with its arguments, cut at 511 characters.
+std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
+
+}  // namespace gyrodrift::internal
