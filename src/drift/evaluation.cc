@@ -129,14 +129,9 @@ double SlowVariation(const Eigen::Ref<const Eigen::VectorXd>& x, double rate_hz,
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e9);
   RequireInRange("block_s", block_s, 1e-9, 1e12);
   const auto block = std::max<Eigen::Index>(1, std::llround(block_s * rate_hz));
-  const Eigen::Index blocks = x.size() / block;
-  if (blocks == 0) return std::numeric_limits<double>::quiet_NaN();
-  double sum = 0.0;
-  for (Eigen::Index b = 0; b < blocks; ++b) {
-    const double mean = x.segment(b * block, block).mean();
-    sum += mean * mean;
-  }
-  return std::sqrt(sum / static_cast<double>(blocks));
+  if (x.size() < block) return std::numeric_limits<double>::quiet_NaN();
+  const Eigen::VectorXd means = BlockMeans(x, block);  // compensation_summary.h
+  return std::sqrt(means.squaredNorm() / static_cast<double>(means.size()));
 }
 
 double SlowVariationRemoved(const Eigen::Ref<const Eigen::VectorXd>& reference,
