@@ -134,12 +134,15 @@ void TakeLog(const StudyOptions& a, const StudyLog& log, StudyResult& s) {
 
 void DecomposeStep(StudyResult& s) {
   const StudyOptions& a = s.options;
+  // One seed for both, as FitDriftModel seeds them: the selection's white-noise level draws its
+  // own realisations when the ensemble is smaller than the Monte-Carlo (issue 25).
   dec::DecompositionOptions dopt = s.drift_options.decomposition;
   dopt.seed = a.seed;
+  sel::SelectionOptions sopt = s.drift_options.selection;
+  sopt.monte_carlo.seed = a.seed;
   dec::DecompositionContext context;
   context.execution.threads = s.threads;
-  sel::GroupedDecomposition grouped =
-      sel::DecomposeAndSelect(s.output, dopt, s.drift_options.selection, context);
+  sel::GroupedDecomposition grouped = sel::DecomposeAndSelect(s.output, dopt, sopt, context);
   if (!grouped.selection) {
     throw DataError(s.target_name +
                     " has fewer than 3 extrema: there is nothing to decompose or to model");

@@ -209,5 +209,23 @@ TEST(Study, ShortSimulationComparesRunsAAndB) {
   EXPECT_TRUE(names.count("models/thermal_compensate.json"));
 }
 
+TEST(Study, GroupingUsesTheStudysSeed) {
+  // Issue 25: with fewer ensemble members than Monte-Carlo realisations the selection's white-noise
+  // level draws its own realisations; they must come from the study's seed, not the default 1.
+  StudyOptions o = Quick({drift::Method::kPoly});
+  o.seed = 2;
+  const StudyResult s = RunStudy(o, {.threads = 2});
+  EXPECT_EQ(s.selection.noise_level_seed, 2u);
+  // The same grouping as the selection of that decomposition with seed 2 throughout.
+  selection::SelectionOptions sopt = s.drift_options.selection;
+  sopt.monte_carlo.seed = 2;
+  const selection::SelectionResult again = selection::SelectModes(s.output, s.decomposition, sopt);
+  ASSERT_EQ(again.groups.size(), s.selection.groups.size());
+  for (size_t g = 0; g < again.groups.size(); ++g) {
+    EXPECT_EQ(again.groups[g].imfs, s.selection.groups[g].imfs);
+  }
+  EXPECT_EQ(again.Summary(), s.selection.Summary());
+}
+
 }  // namespace
 }  // namespace gyrodrift::study
