@@ -164,29 +164,4 @@ io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* n
   return table;
 }
 
-// "all" | "octave" | "decade" | "1,10,100" (seconds).
-void ParseTaus(const std::string& text, allan::AllanOptions* o) {
-  if (text == "all" || text == "octave" || text == "decade") {
-    o->grid = allan::TauGridFromString(text);
-    return;
-  }
-  o->grid = allan::TauGrid::kList;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    const bool blank_tail =
-        end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
-    if (!blank_tail || !(v > 0.0) || !std::isfinite(v)) {
-      ThrowOption(
-          "--taus", text,
-          "all, octave, decade or a comma-separated list of positive taus in s (bad item '" + item +
-              "')");
-    }
-    o->tau_list_s.push_back(v);
-  }
-  if (o->tau_list_s.empty()) ThrowOption("--taus", text, "all, octave, decade or a list of taus");
-}
-
 }  // namespace gyrodrift::cli

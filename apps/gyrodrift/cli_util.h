@@ -46,10 +46,6 @@ bool IsTerminal();
 // value that is not positive and finite, is a UsageError naming --duration.
 double ParseDuration(const std::string& text);
 
-// --taus: "all" | "octave" | "decade" | "1,10,100" (seconds) into o->grid and o->tau_list_s.
-// Throws OptionError naming --taus and the bad item.
-void ParseTaus(const std::string& text, allan::AllanOptions* o);
-
 // The log rules every command shares (io/gyro_log.h).
 using io::NonUniformTimeNote;
 using io::ReadLog;

@@ -61,8 +61,9 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
           threads=0, fit_tau_min=0.0, fit_tau_max=float("inf"), logged=None):
     """Allan-family deviation with confidence intervals and the IEEE 952 noise terms.
 
-    As ``gyrodrift allan``. ``taus`` is "all", "octave", "decade" or a sequence of averaging
-    times in s (each rounded to a whole number of samples by the library). ``logged``: one bool
+    As ``gyrodrift allan`` (both call the library's one allan operation, tasks::RunAllan).
+    ``taus`` is "all", "octave", "decade", a comma-separated list or a sequence of averaging
+    times in s, each a whole number of sample periods (another is refused, naming the nearest). ``logged``: one bool
     per sample of a record with gaps on its time grid, False where the sample is missing (its
     value, NaN or a filled one, is not used): as ``gyrodrift allan --gaps carry``, the
     overlapping estimators (oadev, ohdev) skip the cluster pairs that hold a missing sample.

@@ -13,6 +13,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <nlohmann/json.hpp>
+
 #include <signal.h>
 
 #include <Eigen/Core>
@@ -50,6 +52,7 @@
 #include "gyrodrift/selection/selection.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/allan_task.h"
 
 namespace py = pybind11;
 
@@ -304,100 +307,45 @@ py::tuple Decompose(const Array& x_in, const std::string& method, const std::str
 
 // ---- allan ----------------------------------------------------------------------------------
 
-py::dict TermDict(const al::NoiseTerm& t, const char* unit) {
-  py::dict d;
-  d["unit"] = unit;
-  d["identified"] = t.identified;
-  d["value"] = t.value;
-  d["sigma"] = t.sigma;
-  d["tau_lo_s"] = t.tau_lo_s;
-  d["tau_hi_s"] = t.tau_hi_s;
-  d["slope_reading"] = t.slope_reading;
-  d["slope_tau_s"] = t.slope_tau_s;
-  d["evidence_chi2"] = t.evidence_chi2;
-  return d;
-}
-
-// The keys of the `noise_terms` object of `gyrodrift allan`'s sidecar.
-py::dict TermsDict(const al::NoiseTerms& t) {
-  py::dict d;
-  d["critical_chi2"] = t.critical_chi2;
-  d["points_used"] = t.points_used;
-  d["tau_min_s"] = t.tau_min_s;
-  d["tau_max_s"] = t.tau_max_s;
-  d["chi2_per_dof"] = t.chi2_per_dof;
-  d["min_dev_dph"] = t.min_dev_dph;
-  d["min_dev_tau_s"] = t.min_dev_tau_s;
-  d["Q"] = TermDict(t.q_urad, "urad");
-  d["Q_arcsec"] = t.q_urad.value * 0.206264806247;
-  d["N"] = TermDict(t.n_dpsh, "deg/sqrt(h)");
-  d["B"] = TermDict(t.b_dph, "deg/h");
-  d["K"] = TermDict(t.k_dphpsh, "deg/h/sqrt(h)");
-  d["R"] = TermDict(t.r_dphph, "deg/h/h");
-  d["summary"] = t.Summary();
-  return d;
-}
-
-// `taus`: "all", "octave", "decade", or a sequence of averaging times in s.
-void SetTaus(const std::variant<std::string, std::vector<double>>& taus, al::AllanOptions* o) {
-  if (const auto* grid = std::get_if<std::string>(&taus)) {
-    o->grid = al::TauGridFromString(*grid);
-    if (o->grid == al::TauGrid::kList) {
-      throw OptionError("taus", "'" + *grid + "'", "all, octave, decade or a sequence of taus in s");
+// A record of the task layer as Python objects: the dict the sidecar's JSON object would load as,
+// but with NaN kept as NaN (the JSON file writes null).
+py::object ToPython(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::object: {
+      py::dict d;
+      for (const auto& [key, value] : j.items()) d[py::str(key)] = ToPython(value);
+      return d;
     }
-  } else {
-    o->grid = al::TauGrid::kList;
-    o->tau_list_s = std::get<std::vector<double>>(taus);
+    case nlohmann::json::value_t::array: {
+      py::list l;
+      for (const auto& value : j) l.append(ToPython(value));
+      return l;
+    }
+    case nlohmann::json::value_t::string:
+      return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::boolean:
+      return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+      return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned:
+      return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float:
+      return py::float_(j.get<double>());
+    default:
+      return py::none();
   }
 }
 
-py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const std::string& dev,
-               const std::variant<std::string, std::vector<double>>& taus,
-               const std::string& units, double confidence, int threads, double fit_tau_min,
-               double fit_tau_max, const std::vector<bool>& logged) {
-  al::AllanOptions o;
-  o.rate_hz = rate_hz;
-  o.data_type = al::DataTypeFromString(type);
-  o.deviation = al::DeviationFromString(dev);
-  o.units = al::RateUnitFromString(units);
-  o.confidence = confidence;
-  SetTaus(taus, &o);
-  o.Validate();
-  const Execution execution{.threads = threads};
-  execution.Validate();
-  const al::NoiseFitOptions fit_options{.tau_min_s = fit_tau_min, .tau_max_s = fit_tau_max};
-  fit_options.Validate();
+py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings,
+               const std::vector<bool>& logged) {
+  settings.Validate();
   const Eigen::VectorXd data = ToVector(x_in, "x");
-
-  al::AllanResult r;
-  std::optional<al::NoiseTerms> terms;
-  std::string fit_error, fit_source = al::ToString(o.deviation);
+  tasks::AllanRun run;
   {
     py::gil_scoped_release release;
-    // As `gyrodrift allan --gaps carry`: made-up samples (logged false) are skipped.
-    auto compute = [&](const al::AllanOptions& options) {
-      return logged.empty() ? al::Compute(data, options, execution)
-                            : al::ComputeWithGaps(data, logged, options, execution);
-    };
-    r = compute(o);
-    // As `gyrodrift allan`: the noise terms need an Allan-variance curve; for the other
-    // estimators an OADEV on the same grid is fitted.
-    const bool allan_curve = o.deviation == al::Deviation::kAdev ||
-                             o.deviation == al::Deviation::kOadev ||
-                             o.deviation == al::Deviation::kTotdev;
-    try {
-      if (allan_curve) {
-        terms = al::IdentifyNoise(r, fit_options);
-      } else {
-        al::AllanOptions oa = o;
-        oa.deviation = al::Deviation::kOadev;
-        fit_source = "oadev";
-        terms = al::IdentifyNoise(compute(oa), fit_options);
-      }
-    } catch (const DataError& e) {
-      fit_error = e.what();  // too few points to fit: the deviations are still the result
-    }
+    run = tasks::RunAllan(data, logged, settings);
   }
+  const al::AllanResult& r = run.curve;
   const auto n = static_cast<Eigen::Index>(r.points.size());
   Eigen::VectorXd tau(n), devs(n), lo(n), hi(n), edf(n);
   py::array_t<std::int64_t> m(n), n_terms(n), alpha(n);
@@ -424,16 +372,11 @@ py::dict Allan(const Array& x_in, double rate_hz, const std::string& type, const
   d["edf"] = ToArray(edf);
   d["alpha"] = alpha;
   d["alpha_identified"] = identified;
-  d["dev_unit"] = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
+  d["dev_unit"] = run.dev_unit;
   d["samples"] = r.n_samples;
   d["summary"] = r.Summary();
-  if (terms) {
-    py::dict t = TermsDict(*terms);
-    t["source_dev"] = fit_source;
-    d["noise_terms"] = t;
-  } else {
-    d["noise_terms"] = py::dict(py::arg("error") = fit_error);
-  }
+  // The sidecar's record of the terms (`gyrodrift allan`): the same keys and numbers.
+  d["noise_terms"] = ToPython(tasks::AllanRecord(run, settings, logged)["noise_terms"]);
   return d;
 }
 
@@ -453,7 +396,7 @@ py::dict NoiseTerms(const Array& tau_s, const Array& adev_dph, const Array& edf,
     py::gil_scoped_release release;
     terms = al::IdentifyNoise(t, a, e, o);
   }
-  return TermsDict(terms);
+  return ToPython(tasks::NoiseTermsRecord(terms));
 }
 
 // ---- simulate -------------------------------------------------------------------------------
@@ -1140,11 +1083,36 @@ PYBIND11_MODULE(_gyrodrift, m) {
         arg("fixed_sifts") = 10, arg("sd") = 0.2, arg("noise_scaling") = "colominas2014",
         arg("bound") = "ensemble", arg("band") = 0.99, arg("noise_stages") = 3,
         arg("noise_realisations") = py::none(), arg("progress") = py::none());
-  m.def("allan", &gp::Allan, arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = "rate",
-        arg("dev") = "oadev", arg("taus") = "octave", arg("units") = "dph",
-        arg("confidence") = 0.683, arg("threads") = 0, arg("fit_tau_min") = 0.0,
-        arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
-        arg("logged") = std::vector<bool>{});
+  // Defaults from a default-constructed AllanSettings, their one home (python/tests/
+  // test_defaults.py checks that __init__.py and __init__.pyi show the same).
+  const gyrodrift::tasks::AllanSettings allan_defaults;
+  m.def(
+      "allan",
+      [](const gp::Array& x, double rate_hz, const std::string& type, const std::string& dev,
+         const std::variant<std::string, std::vector<double>>& taus, const std::string& units,
+         double confidence, int threads, double fit_tau_min, double fit_tau_max,
+         const std::vector<bool>& logged) {
+        gyrodrift::tasks::AllanSettings s{.rate_hz = rate_hz,
+                                          .type = type,
+                                          .dev = dev,
+                                          .units = units,
+                                          .confidence = confidence,
+                                          .threads = threads,
+                                          .fit_tau_min_s = fit_tau_min,
+                                          .fit_tau_max_s = fit_tau_max};
+        if (const auto* grid = std::get_if<std::string>(&taus)) {
+          s.taus = *grid;
+        } else {
+          s.tau_list_s = std::get<std::vector<double>>(taus);
+          if (s.tau_list_s.empty()) throw gyrodrift::OptionError("taus", "[]", "a non-empty sequence");
+        }
+        return gp::Allan(x, s, logged);
+      },
+      arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = allan_defaults.type,
+      arg("dev") = allan_defaults.dev, arg("taus") = allan_defaults.taus,
+      arg("units") = allan_defaults.units, arg("confidence") = allan_defaults.confidence,
+      arg("threads") = allan_defaults.threads, arg("fit_tau_min") = allan_defaults.fit_tau_min_s,
+      arg("fit_tau_max") = allan_defaults.fit_tau_max_s, arg("logged") = std::vector<bool>{});
   m.def("noise_terms", &gp::NoiseTerms, arg("tau_s"), arg("adev_dph"), arg("edf"), py::kw_only(),
         arg("fit_tau_min") = 0.0, arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
         arg("min_share") = 0.1, arg("significance") = 0.05, arg("sample_period_s") = 0.0);

@@ -1,0 +1,227 @@
+#include "gyrodrift/tasks/allan_task.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::tasks {
+namespace {
+
+namespace al = gyrodrift::allan;
+
+// Arc-seconds per microradian: Q is also given in arcsec, the unit of many datasheets.
+constexpr double kArcsecPerUrad = 0.206264806247;
+
+void ParseTaus(const std::string& text, al::AllanOptions* o) {
+  if (text == "all" || text == "octave" || text == "decade") {
+    o->grid = al::TauGridFromString(text);
+    return;
+  }
+  o->grid = al::TauGrid::kList;
+  std::stringstream s(text);
+  std::string item;
+  while (std::getline(s, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    const bool blank_tail =
+        end != item.c_str() && std::string(end).find_first_not_of(" \t") == std::string::npos;
+    if (!blank_tail || !(v > 0.0) || !std::isfinite(v)) {
+      ThrowOption(
+          "taus", text,
+          "all, octave, decade or a comma-separated list of positive taus in s (bad item '" + item +
+              "')");
+    }
+    o->tau_list_s.push_back(v);
+  }
+  if (o->tau_list_s.empty()) ThrowOption("taus", text, "all, octave, decade or a list of taus");
+}
+
+// Averages span whole samples: a tau between two is not silently moved to the nearer one.
+void RequireWholeSamples(const std::vector<double>& taus, double rate_hz) {
+  for (double tau : taus) {
+    const double m = tau * rate_hz;
+    // Absolute in samples (a relative test would let half a sample through at large factors),
+    // loose enough for decimal taus such as 0.1 s at 10 Hz.
+    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 + 1e-12 * m) {
+      ThrowOption("taus", fmt::format("{:g}", tau),
+                  fmt::format("a whole number of sample periods at {:g} Hz (nearest: {:g} s)",
+                              rate_hz, std::max(1.0, std::round(m)) / rate_hz));
+    }
+  }
+}
+
+// The noise terms need an Allan-variance curve.
+bool AllanCurve(al::Deviation d) {
+  return d == al::Deviation::kAdev || d == al::Deviation::kOadev || d == al::Deviation::kTotdev;
+}
+
+nlohmann::json TermJson(const al::NoiseTerm& t, const char* unit) {
+  return {{"unit", unit},
+          {"identified", t.identified},
+          {"value", t.value},
+          {"sigma", t.sigma},
+          {"tau_lo_s", t.tau_lo_s},
+          {"tau_hi_s", t.tau_hi_s},
+          {"slope_reading", t.slope_reading},
+          {"slope_tau_s", t.slope_tau_s},
+          {"evidence_chi2", t.evidence_chi2}};
+}
+
+nlohmann::json PointsRecord(const al::AllanResult& r) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& p : r.points) {
+    points.push_back({{"tau_s", p.tau_s},
+                      {"m", p.m},
+                      {"dev", p.dev},
+                      {"dev_lo", p.dev_lo},
+                      {"dev_hi", p.dev_hi},
+                      {"n_terms", p.n_terms},
+                      {"edf", p.edf},
+                      {"alpha", p.alpha},
+                      {"noise_type", al::NoiseTypeName(p.alpha)},
+                      {"alpha_identified", p.alpha_identified}});
+  }
+  return points;
+}
+
+}  // namespace
+
+al::AllanOptions AllanSettings::Options() const {
+  // Beyond this range the averages under- or overflow (1e308 Hz gave all-zero deviations).
+  RequireInRange("rate_hz", rate_hz, 1e-9, 1e9);
+  al::AllanOptions o;
+  o.rate_hz = rate_hz;
+  o.data_type = al::DataTypeFromString(type);
+  o.deviation = al::DeviationFromString(dev);
+  o.units = al::RateUnitFromString(units);
+  o.confidence = confidence;
+  if (tau_list_s.empty()) {
+    ParseTaus(taus, &o);
+  } else {
+    o.grid = al::TauGrid::kList;
+    o.tau_list_s = tau_list_s;
+  }
+  RequireWholeSamples(o.tau_list_s, rate_hz);
+  o.Validate();
+  return o;
+}
+
+al::NoiseFitOptions AllanSettings::FitOptions() const {
+  const al::NoiseFitOptions o{.tau_min_s = fit_tau_min_s, .tau_max_s = fit_tau_max_s};
+  o.Validate();
+  return o;
+}
+
+Execution AllanSettings::MakeExecution() const {
+  const Execution execution{.threads = threads};
+  execution.Validate();
+  return execution;
+}
+
+void AllanSettings::Validate() const {
+  Options();
+  MakeExecution();
+  FitOptions();
+}
+
+AllanRun RunAllan(const Eigen::VectorXd& data, const std::vector<bool>& logged,
+                  const AllanSettings& settings) {
+  const al::AllanOptions o = settings.Options();
+  const Execution execution = settings.MakeExecution();
+  const al::NoiseFitOptions fit_options = settings.FitOptions();
+  auto compute = [&](const al::AllanOptions& options) {
+    return logged.empty() ? al::Compute(data, options, execution)
+                          : al::ComputeWithGaps(data, logged, options, execution);
+  };
+  AllanRun run;
+  run.curve = compute(o);
+  run.dev_unit = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
+  run.fit_source = al::ToString(o.deviation);
+  try {
+    if (AllanCurve(o.deviation)) {
+      run.terms = al::IdentifyNoise(run.curve, fit_options);
+    } else {
+      al::AllanOptions oa = o;
+      oa.deviation = al::Deviation::kOadev;
+      run.fit_source = "oadev";
+      run.terms = al::IdentifyNoise(compute(oa), fit_options);
+    }
+  } catch (const DataError& e) {
+    run.fit_error = e.what();  // too few points to fit: the deviations are still the result
+  }
+  return run;
+}
+
+nlohmann::json NoiseTermsRecord(const al::NoiseTerms& t) {
+  return {{"critical_chi2", t.critical_chi2},
+          {"points_used", t.points_used},
+          {"tau_min_s", t.tau_min_s},
+          {"tau_max_s", t.tau_max_s},
+          {"chi2_per_dof", t.chi2_per_dof},
+          {"min_dev_dph", t.min_dev_dph},
+          {"min_dev_tau_s", t.min_dev_tau_s},
+          {"Q", TermJson(t.q_urad, "urad")},
+          {"Q_arcsec", t.q_urad.value * kArcsecPerUrad},
+          {"N", TermJson(t.n_dpsh, "deg/sqrt(h)")},
+          {"B", TermJson(t.b_dph, "deg/h")},
+          {"K", TermJson(t.k_dphpsh, "deg/h/sqrt(h)")},
+          {"R", TermJson(t.r_dphph, "deg/h/h")},
+          {"summary", t.Summary()}};
+}
+
+nlohmann::json AllanRecord(const AllanRun& run, const AllanSettings& settings,
+                           const std::vector<bool>& logged) {
+  const al::AllanOptions o = settings.Options();
+  const al::NoiseFitOptions fit = settings.FitOptions();
+  nlohmann::json record;
+  record["options"] = {
+      {"rate_hz", o.rate_hz},
+      {"tau0_s", o.tau0_s()},
+      {"type", al::ToString(o.data_type)},
+      {"dev", al::ToString(o.deviation)},
+      {"taus", settings.taus},
+      {"tau_grid", al::ToString(o.grid)},
+      {"tau_list_s", o.tau_list_s},
+      {"units", al::ToString(o.units)},
+      {"confidence", o.confidence},
+      {"threads", settings.threads},
+      {"fit_tau_min_s", fit.tau_min_s},
+      {"fit_tau_max_s",
+       std::isfinite(fit.tau_max_s) ? nlohmann::json(fit.tau_max_s) : nlohmann::json("inf")},
+      {"seed", nullptr}};
+  record["samples"] = run.curve.n_samples;
+  // The analysed grid: with gaps skipped, how many of its samples were logged.
+  if (!logged.empty()) {
+    record["logged_samples"] = std::count(logged.begin(), logged.end(), true);
+    record["gaps_method"] =
+        "overlapping estimator over the cluster pairs whose samples are all logged (made-up "
+        "samples and record breaks skipped); EDF of a gap-free record with as many terms";
+  }
+  record["summary"] = run.curve.Summary();
+  record["dev_unit"] = run.dev_unit;
+  record["edf_method"] =
+      "Greenhall & Riley 2003 (TOTDEV: NIST SP 1065 table 7); noise type per tau by lag-1 "
+      "autocorrelation, carried forward below 30 points";
+  record["points"] = PointsRecord(run.curve);
+  if (run.terms) {
+    nlohmann::json terms = NoiseTermsRecord(*run.terms);
+    terms["source_dev"] = run.fit_source;
+    terms["method"] =
+        "IEEE 952 model fitted in log variance (weights from the EDF); terms removed steepest "
+        "first (R, Q, K, N, B) while a nested chi-square test at the significance level, "
+        "corrected for the correlated overlapping points, finds them unnecessary, or while they "
+        "stay below 10 % of the model at every tau; uncertainties from the correlated points "
+        "(docs/allan.md)";
+    record["noise_terms"] = terms;
+  } else {
+    record["noise_terms"] = {{"error", run.fit_error}};
+  }
+  return record;
+}
+
+}  // namespace gyrodrift::tasks
