@@ -13,6 +13,7 @@
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
+#include "gyrodrift/tasks/decompose_task.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -24,50 +25,11 @@ struct DecomposeArgs {
   std::string input;
   std::string column;
   std::string output;
-  std::string method = "beemdan";
-  std::string stop = "rilling";
-  int ensemble = 100;
-  double noise = 0.2;
-  std::uint64_t seed = 1;
-  int threads = 0;
-  int max_imfs = 0;
-  int max_sifts = 0;
-  int s_number = 4;
-  int fixed_sifts = 10;
-  double sd = 0.2;
-  std::string scaling = "colominas2014";
-  std::string bound{dec::ToString(dec::DecompositionOptions{}.beemdan_bound)};
-  double band = 0.99;
-  int noise_stages = 3;
+  tasks::DecomposeSettings settings;  // the defaults are the library's
   std::string noise_file;
   LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
-
-nlohmann::json OptionsJson(const DecomposeArgs& a, const dec::DecompositionOptions& o) {
-  return {
-      {"input", a.input},
-      {"column", a.column},
-      {"method", dec::ToString(o.method)},
-      {"stop_rule", dec::ToString(o.sifting.stop_rule)},
-      {"rilling_thresholds",
-       {o.sifting.rilling_threshold1, o.sifting.rilling_threshold2, o.sifting.rilling_tolerance}},
-      {"s_number", o.sifting.s_number},
-      {"fixed_sifts", o.sifting.fixed_sifts},
-      {"sd_threshold", o.sifting.sd_threshold},
-      {"max_sifts", o.sifting.EffectiveMaxSifts()},
-      {"max_imfs", o.max_imfs},
-      {"ensemble_size", o.ensemble_size},
-      {"noise_strength", o.noise_strength},
-      {"seed", o.seed},
-      {"threads", a.threads},
-      {"noise_scaling", dec::ToString(o.noise_scaling)},
-      {"beemdan_bound", dec::ToString(o.beemdan_bound)},
-      {"band_confidence", o.band_confidence},
-      {"noise_stages", o.noise_stages},
-      {"noise_file", a.noise_file},
-  };
-}
 
 // Beyond this many samples a decomposition does not fit in the memory of a workstation: the
 // IMFs alone are 8 bytes x samples x (about log2(samples) modes), and sifting keeps a dozen
@@ -85,25 +47,9 @@ void RequireDecomposableSize(const std::string& name, Eigen::Index samples) {
 
 void Run(const DecomposeArgs& a) {
   RequireOutputsAreNotInputs({a.input, a.noise_file}, {a.output, SidecarPath(a.output)});
-  dec::DecompositionOptions o;
-  o.method = dec::MethodFromString(a.method);
-  o.sifting.stop_rule = dec::StopRuleFromString(a.stop);
-  o.sifting.max_sifts = a.max_sifts;
-  o.sifting.s_number = a.s_number;
-  o.sifting.fixed_sifts = a.fixed_sifts;
-  o.sifting.sd_threshold = a.sd;
-  o.max_imfs = a.max_imfs;
-  o.ensemble_size = a.ensemble;
-  o.noise_strength = a.noise;
-  o.seed = a.seed;
-  o.noise_scaling = dec::NoiseScalingFromString(a.scaling);
-  o.beemdan_bound = dec::BeemdanBoundFromString(a.bound);
-  o.band_confidence = a.band;
-  o.noise_stages = a.noise_stages;
-  o.Validate();  // option errors before any file is read
-  dec::DecompositionContext context;
-  context.execution.threads = a.threads;
-  context.execution.Validate();
+  const tasks::DecomposeSettings& settings = a.settings;
+  settings.Validate();  // option errors before any file is read
+  const dec::Method method = settings.Options().method;
 
   // Only the column (and time_s) is read, and the table is dropped once the column is out.
   a.log.RequireOneRecord("decompose", "a decomposition runs across the gaps");
@@ -117,25 +63,21 @@ void Run(const DecomposeArgs& a) {
     return column;
   }();
   Eigen::MatrixXd noise;  // --noise-file: one realisation per column
+  const std::string noise_name = "--noise-file = " + a.noise_file;
   if (!a.noise_file.empty()) {
-    if (o.method == dec::Method::kEmd) {
-      throw UsageError("--noise-file = " + a.noise_file + ": must not be given with --method emd");
-    }
+    tasks::RequireNoiseTaken(settings, noise_name);
     const io::CsvTable table = io::CsvTable::Read(a.noise_file);
     noise.resize(table.rows(), static_cast<Eigen::Index>(table.header().size()));
     for (int c = 0; c < static_cast<int>(table.header().size()); ++c)
       noise.col(c) = table.Column(c);
-    o.ensemble_size = static_cast<int>(noise.cols());
   }
   dec::Decomposition d;
   {
-    ProgressBar progress({1.0}, IsTerminal() && !a.quiet && o.method != dec::Method::kEmd);
-    progress.BeginStage(0, std::string(dec::ToString(o.method)));
-    context.execution.progress = [&progress](double fraction, std::string_view) {
-      progress.Update(fraction);
-    };
-    d = a.noise_file.empty() ? dec::Decompose(x, o, context)
-                             : dec::DecomposeWithNoise(x, noise, o, context);
+    ProgressBar progress({1.0}, IsTerminal() && !a.quiet && method != dec::Method::kEmd);
+    progress.BeginStage(0, std::string(dec::ToString(method)));
+    d = tasks::RunDecompose(
+        x, settings, noise,
+        [&progress](double fraction, std::string_view) { progress.Update(fraction); }, noise_name);
   }
 
   // Streamed from the decomposition itself: the text of 1e7 samples is gigabytes.
@@ -145,31 +87,20 @@ void Run(const DecomposeArgs& a) {
   }
   columns.push_back({"residue", d.residue.data(), d.residue.size()});
   nlohmann::json sidecar = SidecarHeader("decompose");
-  sidecar["options"] = OptionsJson(a, o);
+  sidecar["options"] = tasks::DecomposeOptionsRecord(settings, noise.cols());
+  sidecar["options"]["input"] = a.input;
+  sidecar["options"]["column"] = a.column;
+  sidecar["options"]["noise_file"] = a.noise_file;
   sidecar["samples"] = x.size();
-  sidecar["report"] = {
-      {"summary", d.report.Summary()},
-      {"imfs", d.num_imfs()},
-      {"sifts_per_imf", d.report.sifts_per_imf},
-      {"sift_cap_hit", d.report.sift_cap_hit},
-      {"sift_cap_hits", d.report.sift_cap_hits},
-      {"ensemble_size", d.report.ensemble_size},
-      {"seed", d.report.seed},
-      {"threads_used", d.report.threads},
-      {"supplied_noise", d.report.supplied_noise},
-      {"noise_assisted_stages", d.report.noise_assisted_stages},
-      {"stop_reason", d.report.stop_reason},
-      {"mode_log2_energy", d.report.mode_log2_energy},
-      {"noise_band_log2_upper", d.report.noise_band_log2_upper},
-  };
+  sidecar["report"] = tasks::DecomposeReportRecord(d);
   const std::string sidecar_text = sidecar.dump(2) + "\n";
-  io::WriteStreamedFilesAtomically({
-      {a.output, [&](std::FILE* out) { io::WriteCsvTo(out, columns); }},
-      {SidecarPath(a.output), [&](std::FILE* out) {
-         std::fwrite(sidecar_text.data(), 1, sidecar_text.size(), out);
-       }}});
+  io::WriteStreamedFilesAtomically(
+      {{a.output, [&](std::FILE* out) { io::WriteCsvTo(out, columns); }},
+       {SidecarPath(a.output),
+        [&](std::FILE* out) { std::fwrite(sidecar_text.data(), 1, sidecar_text.size(), out); }}});
   if (!a.quiet)
-    fmt::print("{}{}\nwrote {} and {}\n", notes, d.report.Summary(), a.output, SidecarPath(a.output));
+    fmt::print("{}{}\nwrote {} and {}\n", notes, d.report.Summary(), a.output,
+               SidecarPath(a.output));
 }
 
 const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
@@ -190,60 +121,65 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  BindSetting(cmd->add_option("--method,-m", args->method, "emd|eemd|ceemdan|iceemdan|beemdan")
-                  ->capture_default_str(),
-              {"method"});
-  BindSetting(cmd->add_option("--stop", args->stop, "sifting stop rule: rilling|snumber|fixed|sd")
-                  ->capture_default_str(),
-              {"stop_rule", "sifting.stop_rule"});
-  BindSetting(cmd->add_option("--max-sifts", args->max_sifts,
+  BindSetting(
+      cmd->add_option("--method,-m", args->settings.method, "emd|eemd|ceemdan|iceemdan|beemdan")
+          ->capture_default_str(),
+      {"method"});
+  BindSetting(
+      cmd->add_option("--stop", args->settings.stop, "sifting stop rule: rilling|snumber|fixed|sd")
+          ->capture_default_str(),
+      {"stop_rule", "sifting.stop_rule"});
+  BindSetting(cmd->add_option("--max-sifts", args->settings.max_sifts,
                               "sift cap per IMF (0 = rule default: 2000 rilling/sd, 50 snumber)")
                   ->capture_default_str(),
               {"sifting.max_sifts"});
-  BindSetting(cmd->add_option("--s-number", args->s_number, "S of the S-number rule")
+  BindSetting(cmd->add_option("--s-number", args->settings.s_number, "S of the S-number rule")
                   ->capture_default_str(),
               {"sifting.s_number"});
-  BindSetting(cmd->add_option("--fixed-sifts", args->fixed_sifts, "sifts per IMF for --stop fixed")
+  BindSetting(
+      cmd->add_option("--fixed-sifts", args->settings.fixed_sifts, "sifts per IMF for --stop fixed")
+          ->capture_default_str(),
+      {"sifting.fixed_sifts"});
+  BindSetting(cmd->add_option("--sd", args->settings.sd, "Cauchy SD threshold for --stop sd")
                   ->capture_default_str(),
-              {"sifting.fixed_sifts"});
-  BindSetting(
-      cmd->add_option("--sd", args->sd, "Cauchy SD threshold for --stop sd")->capture_default_str(),
-      {"sifting.sd_threshold"});
-  BindSetting(
-      cmd->add_option("--max-imfs", args->max_imfs, "IMF cap (0 = until the residue is monotone)")
-          ->capture_default_str(),
-      {"max_imfs"});
-  BindSetting(
-      cmd->add_option("--ensemble,-I", args->ensemble, "ensemble size (noise-assisted methods)")
-          ->capture_default_str(),
-      {"ensemble_size"});
-  BindSetting(
-      cmd->add_option("--noise", args->noise, "noise strength eps (relative to the signal's std)")
-          ->capture_default_str(),
-      {"noise_strength"});
-  cmd->add_option("--seed", args->seed, "seed; realisation i uses stream (seed, i)")
+              {"sifting.sd_threshold"});
+  BindSetting(cmd->add_option("--max-imfs", args->settings.max_imfs,
+                              "IMF cap (0 = until the residue is monotone)")
+                  ->capture_default_str(),
+              {"max_imfs"});
+  BindSetting(cmd->add_option("--ensemble,-I", args->settings.ensemble,
+                              "ensemble size (noise-assisted methods)")
+                  ->capture_default_str(),
+              {"ensemble_size"});
+  BindSetting(cmd->add_option("--noise", args->settings.noise,
+                              "noise strength eps (relative to the signal's std)")
+                  ->capture_default_str(),
+              {"noise_strength"});
+  cmd->add_option("--seed", args->settings.seed, "seed; realisation i uses stream (seed, i)")
       ->check(kSeed)
       ->capture_default_str();
-  BindSetting(cmd->add_option("--threads,-j", args->threads, "worker threads (0 = all cores)")
-                  ->capture_default_str(),
-              {"threads"});
-  BindSetting(cmd->add_option("--noise-scaling", args->scaling,
+  BindSetting(
+      cmd->add_option("--threads,-j", args->settings.threads, "worker threads (0 = all cores)")
+          ->capture_default_str(),
+      {"threads"});
+  BindSetting(cmd->add_option("--noise-scaling", args->settings.noise_scaling,
                               "ICEEMDAN/BEEMDAN noise scaling: colominas2014|constant-snr")
                   ->capture_default_str(),
               {"noise_scaling"});
   BindSetting(
-      cmd->add_option("--bound", args->bound,
+      cmd->add_option("--bound", args->settings.bound,
                       "BEEMDAN noise bound: ensemble (band of the ensemble's white-noise modes) | "
                       "energy (Flandrin et al.'s band) | stages | full (= ICEEMDAN)")
           ->capture_default_str(),
       {"beemdan_bound"});
-  BindSetting(cmd->add_option("--band", args->band, "BEEMDAN band confidence: 0.95 or 0.99")
-                  ->capture_default_str(),
-              {"band_confidence"});
   BindSetting(
-      cmd->add_option("--noise-stages", args->noise_stages, "BEEMDAN stages with --bound stages")
+      cmd->add_option("--band", args->settings.band, "BEEMDAN band confidence: 0.95 or 0.99")
           ->capture_default_str(),
-      {"noise_stages"});
+      {"band_confidence"});
+  BindSetting(cmd->add_option("--noise-stages", args->settings.noise_stages,
+                              "BEEMDAN stages with --bound stages")
+                  ->capture_default_str(),
+              {"noise_stages"});
   cmd->add_option("--noise-file", args->noise_file,
                   "CSV of white-noise realisations (one per column) to use instead of drawing")
       ->check(kInputFile);

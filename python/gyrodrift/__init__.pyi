@@ -61,7 +61,8 @@ class DriftModel:
         thermal_features: Literal["auto", "ladder", "classic", "lag-bank"] = ...,
         time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
         seed: int = ..., threads: int = ..., nonlinear: bool = ...,
-        reference_temperature: float | None = ..., target: str = ...,
+        reference_temperature: float | None = ...,
+        hysteresis: Literal["auto", "on", "off"] = ..., target: str = ...,
         temperature_columns: Sequence[str] | None = ..., source: str = ...,
         record_starts: Sequence[int] = ...,
         logged: Sequence[bool] | None = ...,
@@ -129,6 +130,7 @@ def evaluate(
     time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
     seed: int = ..., threads: int = ..., nonlinear: bool = ...,
     reference_temperature: float | None = ...,
+    hysteresis: Literal["auto", "on", "off"] = ...,
     progress: Callable[[float], object] | None = ...,
 ) -> dict[str, Any]: ...
 

@@ -53,6 +53,7 @@
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/decompose_task.h"
 
 namespace py = pybind11;
 
@@ -242,71 +243,6 @@ class LongCall {
   std::optional<py::error_already_set> error_;  // touched with the GIL only
 };
 
-// ---- decompose ------------------------------------------------------------------------------
-
-py::tuple Decompose(const Array& x_in, const std::string& method, const std::string& stop,
-                    int ensemble, double noise, std::uint64_t seed, int threads, int max_imfs,
-                    int max_sifts, int s_number, int fixed_sifts, double sd,
-                    const std::string& noise_scaling, const std::string& bound, double band,
-                    int noise_stages, std::optional<Array> noise_realisations,
-                    const py::object& progress) {
-  // The same option mapping as `gyrodrift decompose` (apps/gyrodrift/decompose_command.cc).
-  dec::DecompositionOptions o;
-  o.method = dec::MethodFromString(method);
-  o.sifting.stop_rule = dec::StopRuleFromString(stop);
-  o.sifting.max_sifts = max_sifts;
-  o.sifting.s_number = s_number;
-  o.sifting.fixed_sifts = fixed_sifts;
-  o.sifting.sd_threshold = sd;
-  o.max_imfs = max_imfs;
-  o.ensemble_size = ensemble;
-  o.noise_strength = noise;
-  o.seed = seed;
-  o.noise_scaling = dec::NoiseScalingFromString(noise_scaling);
-  o.beemdan_bound = dec::BeemdanBoundFromString(bound);
-  o.band_confidence = band;
-  o.noise_stages = noise_stages;
-  o.Validate();
-  dec::DecompositionContext context;
-  context.execution.threads = threads;
-  context.execution.Validate();
-  const Eigen::VectorXd x = ToVector(x_in, "x");
-  Eigen::MatrixXd supplied;  // noise_realisations, one per column
-  if (noise_realisations) {
-    if (o.method == dec::Method::kEmd) {
-      throw UsageError("noise_realisations: must not be given with method='emd'");
-    }
-    supplied = ToMatrix(*noise_realisations, "noise_realisations");
-    o.ensemble_size = static_cast<int>(supplied.cols());
-  }
-  LongCall call(progress);
-  context.execution.progress = call.Hook();
-  dec::Decomposition d;
-  call.Run([&] {
-    d = noise_realisations ? dec::DecomposeWithNoise(x, supplied, o, context)
-                           : dec::Decompose(x, o, context);
-  });
-  const dec::DecompositionReport& r = d.report;
-  py::dict report;
-  report["summary"] = r.Summary();
-  report["method"] = std::string(dec::ToString(r.method));
-  report["imfs"] = d.num_imfs();
-  report["sifts_per_imf"] = r.sifts_per_imf;
-  report["sift_cap_hit"] = r.sift_cap_hit;
-  report["sift_cap_hits"] = r.sift_cap_hits;
-  report["ensemble_size"] = r.ensemble_size;
-  report["seed"] = r.seed;
-  report["threads_used"] = r.threads;
-  report["supplied_noise"] = r.supplied_noise;
-  report["noise_assisted_stages"] = r.noise_assisted_stages;
-  report["stop_reason"] = r.stop_reason;
-  report["mode_log2_energy"] = r.mode_log2_energy;
-  report["noise_band_log2_upper"] = r.noise_band_log2_upper;
-  return py::make_tuple(ToArray(d.imfs), ToArray(d.residue), report);
-}
-
-// ---- allan ----------------------------------------------------------------------------------
-
 // A record of the task layer as Python objects: the dict the sidecar's JSON object would load as,
 // but with NaN kept as NaN (the JSON file writes null).
 py::object ToPython(const nlohmann::json& j) {
@@ -335,6 +271,27 @@ py::object ToPython(const nlohmann::json& j) {
       return py::none();
   }
 }
+
+// ---- decompose ------------------------------------------------------------------------------
+
+py::tuple Decompose(const Array& x_in, const tasks::DecomposeSettings& settings,
+                    std::optional<Array> noise_realisations, const py::object& progress) {
+  settings.Validate();
+  const Eigen::VectorXd x = ToVector(x_in, "x");
+  Eigen::MatrixXd supplied;  // noise_realisations, one per column
+  if (noise_realisations) {
+    tasks::RequireNoiseTaken(settings, "noise_realisations");
+    supplied = ToMatrix(*noise_realisations, "noise_realisations");
+  }
+  LongCall call(progress);
+  dec::Decomposition d;
+  call.Run([&] { d = tasks::RunDecompose(x, settings, supplied, call.Hook()); });
+  // The sidecar's report (`gyrodrift decompose`): the same keys and numbers.
+  return py::make_tuple(ToArray(d.imfs), ToArray(d.residue),
+                        ToPython(tasks::DecomposeReportRecord(d)));
+}
+
+// ---- allan ----------------------------------------------------------------------------------
 
 py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings,
                const std::vector<bool>& logged) {
@@ -1077,14 +1034,40 @@ PYBIND11_MODULE(_gyrodrift, m) {
     }
   });
 
-  m.def("decompose", &gp::Decompose, arg("x"), py::kw_only(), arg("method") = "beemdan",
-        arg("stop") = "rilling", arg("ensemble") = 100, arg("noise") = 0.2, arg("seed") = 1,
-        arg("threads") = 0, arg("max_imfs") = 0, arg("max_sifts") = 0, arg("s_number") = 4,
-        arg("fixed_sifts") = 10, arg("sd") = 0.2, arg("noise_scaling") = "colominas2014",
-        arg("bound") = "ensemble", arg("band") = 0.99, arg("noise_stages") = 3,
-        arg("noise_realisations") = py::none(), arg("progress") = py::none());
-  // Defaults from a default-constructed AllanSettings, their one home (python/tests/
-  // test_defaults.py checks that __init__.py and __init__.pyi show the same).
+  // Defaults from default-constructed settings of the task layer, their one home
+  // (python/tests/test_defaults.py checks that __init__.py and __init__.pyi show the same).
+  const gyrodrift::tasks::DecomposeSettings dd;
+  m.def(
+      "decompose",
+      [](const gp::Array& x, const std::string& method, const std::string& stop, int ensemble,
+         double noise, std::uint64_t seed, int threads, int max_imfs, int max_sifts, int s_number,
+         int fixed_sifts, double sd, const std::string& noise_scaling, const std::string& bound,
+         double band, int noise_stages, std::optional<gp::Array> noise_realisations,
+         const py::object& progress) {
+        const gyrodrift::tasks::DecomposeSettings s{.method = method,
+                                                    .stop = stop,
+                                                    .ensemble = ensemble,
+                                                    .noise = noise,
+                                                    .seed = seed,
+                                                    .threads = threads,
+                                                    .max_imfs = max_imfs,
+                                                    .max_sifts = max_sifts,
+                                                    .s_number = s_number,
+                                                    .fixed_sifts = fixed_sifts,
+                                                    .sd = sd,
+                                                    .noise_scaling = noise_scaling,
+                                                    .bound = bound,
+                                                    .band = band,
+                                                    .noise_stages = noise_stages};
+        return gp::Decompose(x, s, std::move(noise_realisations), progress);
+      },
+      arg("x"), py::kw_only(), arg("method") = dd.method, arg("stop") = dd.stop,
+      arg("ensemble") = dd.ensemble, arg("noise") = dd.noise, arg("seed") = dd.seed,
+      arg("threads") = dd.threads, arg("max_imfs") = dd.max_imfs, arg("max_sifts") = dd.max_sifts,
+      arg("s_number") = dd.s_number, arg("fixed_sifts") = dd.fixed_sifts, arg("sd") = dd.sd,
+      arg("noise_scaling") = dd.noise_scaling, arg("bound") = dd.bound, arg("band") = dd.band,
+      arg("noise_stages") = dd.noise_stages, arg("noise_realisations") = py::none(),
+      arg("progress") = py::none());
   const gyrodrift::tasks::AllanSettings allan_defaults;
   m.def(
       "allan",
