@@ -40,11 +40,11 @@ struct DemoArgs {
   std::string units = "dph";
   // Advanced: the size of the study. Defaults keep the full demo under 3 minutes on 2 cores.
   std::string duration = "8h";
-  int ensemble = 20;
-  int realisations = 20;
-  int window = 128;
+  int ensemble = study::StudyOptions{}.ensemble_size;
+  int realisations = study::StudyOptions{}.realisations;
+  int window = study::StudyOptions{}.causal_window;
   std::string methods = "all";
-  std::uint64_t seed = 1;
+  std::uint64_t seed = study::StudyOptions{}.seed;
   int threads = 0;
   LogArgs log;  // --gaps, --delimiter
   CLI::Option* units_option = nullptr;  // "--units given"

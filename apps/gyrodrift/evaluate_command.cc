@@ -25,11 +25,11 @@ namespace {
 struct EvaluateArgs : DriftArgs {
   std::string truth;
   std::string protocol = "both";
-  double split = 0.7;
+  double split = drift::EvaluationOptions{}.split;
   std::string methods = "all";
-  int repeats = 1;
-  int window = 512;
-  int horizon = 1;
+  int repeats = drift::EvaluationOptions{}.repeats;
+  int window = drift::CausalOptions{}.window;
+  int horizon = drift::EvaluationOptions{}.horizon;
   std::string output;
 };
 

@@ -26,7 +26,7 @@ struct PredictArgs {
   std::string input;
   std::string output;
   std::string protocol = "causal";
-  int window = 512;
+  int window = drift::CausalOptions{}.window;
   int horizon = 1;
   int threads = 0;
   LogArgs log;  // --gaps, --delimiter

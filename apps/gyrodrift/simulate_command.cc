@@ -24,12 +24,12 @@ struct SimulateArgs {
   std::string preset = "navigation";
   std::string profile = "chamber";
   std::string duration;  // empty: the programme's own length (8 h for the built-in ones)
-  double rate_hz = 1.0;
-  std::uint64_t seed = 1;
+  double rate_hz = simulation::SimulationOptions{}.rate_hz;
+  std::uint64_t seed = simulation::SimulationOptions{}.seed;
   std::string winding;              // empty: the preset's
   double asymmetry = 0.0;
   CLI::Option* asymmetry_option = nullptr;  // not given: the preset's
-  double input_rate_dph = 0.0;
+  double input_rate_dph = simulation::SimulationOptions{}.input_rate_dph;
   bool no_noise = false;
   std::string output;
   bool quiet = false;

@@ -12,9 +12,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <nlohmann/json.hpp>
-
 #include <signal.h>
 
 #include <Eigen/Core>
@@ -27,6 +24,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
@@ -35,14 +33,14 @@
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
-#include "gyrodrift/common/execution.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/execution.h"
 #include "gyrodrift/common/version.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
-#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/drift/temperature_check.h"
 #include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/fleet/calibration.h"
@@ -115,8 +113,8 @@ py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
 // KeyboardInterrupt pending as usual). The last call to end puts that handler back.
 std::atomic<unsigned> g_interrupts{0};
 std::mutex g_sigint_mutex;
-int g_running_calls = 0;            // guarded by g_sigint_mutex
-bool g_handler_installed = false;   // guarded by g_sigint_mutex
+int g_running_calls = 0;             // guarded by g_sigint_mutex
+bool g_handler_installed = false;    // guarded by g_sigint_mutex
 struct sigaction g_replaced_sigint;  // written before ours is installed, read by it
 
 extern "C" void InterruptHandler(int signal, siginfo_t* info, void* context) {
@@ -337,8 +335,8 @@ py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings,
   return d;
 }
 
-py::dict NoiseTerms(const Array& tau_s, const Array& adev_dph, const Array& edf,
-                    double fit_tau_min, double fit_tau_max, double min_share, double significance,
+py::dict NoiseTerms(const Array& tau_s, const Array& adev_dph, const Array& edf, double fit_tau_min,
+                    double fit_tau_max, double min_share, double significance,
                     double sample_period_s) {
   const al::NoiseFitOptions o{.tau_min_s = fit_tau_min,
                               .tau_max_s = fit_tau_max,
@@ -375,8 +373,9 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
     try {
       pair = profile.cast<std::pair<Array, Array>>();
     } catch (const py::cast_error&) {
-      throw UsageError("profile: must be chamber, chamber-b, sine or a pair of arrays "
-                       "(time_s, temperature_c)");
+      throw UsageError(
+          "profile: must be chamber, chamber-b, sine or a pair of arrays "
+          "(time_s, temperature_c)");
     }
     programme = sim::TemperatureProgramme::FromSamples(
         ToVector(pair.first, "profile time_s"), ToVector(pair.second, "profile temperature_c"),
@@ -389,9 +388,9 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   o.include_noise = noise;
   // As `gyrodrift simulate`: without a duration, the programme's own length (8 h for a sine).
   o.duration_s = duration ? *duration
-                          : programme->kind() == sim::TemperatureProgramme::Kind::kSine
-                                ? 8 * 3600.0
-                                : programme->NominalDuration();
+                 : programme->kind() == sim::TemperatureProgramme::Kind::kSine
+                     ? 8 * 3600.0
+                     : programme->NominalDuration();
   sim::SimulationResult r;
   {
     py::gil_scoped_release release;
@@ -437,48 +436,11 @@ std::vector<std::string> SplitColumns(const std::string& names) {
   size_t start = 0;
   while (true) {
     const size_t comma = names.find(',', start);
-    out.push_back(names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    out.push_back(
+        names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
     if (comma == std::string::npos) return out;
     start = comma + 1;
   }
-}
-
-// The model keywords of `DriftModel.fit` and `evaluate`: drift::FitSettings by name, as
-// `gyrodrift fit`'s flags (one mapping onto the options, drift::MakeDriftOptions).
-struct ModelArgs {
-  std::string mode, method, decomposition;
-  py::object lags, hidden;
-  double rate_hz = 1.0;
-  std::string thermal_features;
-  std::vector<double> time_constants;
-  int ensemble = 100, realisations = 100;
-  std::uint64_t seed = 1;
-  int threads = 0;
-  bool nonlinear = false;
-  std::optional<double> reference_temperature;
-  std::string hysteresis;
-  bool has_temperature = false;
-};
-
-drift::DriftOptions MakeDriftOptions(const ModelArgs& a) {
-  drift::FitSettings s;
-  s.mode = a.mode;
-  s.method = a.method;
-  s.decomposition = a.decomposition;
-  s.lags = AutoOrIntegerSetting("lags", a.lags);
-  s.hidden = AutoOrIntegerSetting("hidden", a.hidden);
-  s.rate_hz = a.rate_hz;
-  s.thermal_features = a.thermal_features;
-  s.time_constants = a.time_constants;
-  s.ensemble = a.ensemble;
-  s.realisations = a.realisations;
-  s.seed = a.seed;
-  s.threads = a.threads;
-  s.nonlinear = a.nonlinear;
-  s.reference_temperature = a.reference_temperature;
-  s.hysteresis = a.hysteresis;
-  s.has_temperature = a.has_temperature;
-  return drift::MakeDriftOptions(s);
 }
 
 // The Execution of a long call's `threads` keyword (as drift::MakeExecution maps it), reporting
@@ -496,22 +458,14 @@ class PyDriftModel {
   explicit PyDriftModel(io::LoadedModel loaded) : loaded_(std::move(loaded)), fitted_(true) {}
 
   // As `gyrodrift fit` (MakeDriftOptions above).
-  void Fit(const Array& y_in, const std::optional<Array>& temperature_in, const std::string& mode,
-           const std::string& method, const std::string& decomposition, const py::object& lags,
-           const py::object& hidden, double rate_hz, const std::string& thermal_features,
-           const std::vector<double>& time_constants, int ensemble, int realisations,
-           std::uint64_t seed, int threads, bool nonlinear,
-           std::optional<double> reference_temperature, const std::string& hysteresis,
-           const std::string& target,
+  void Fit(const Array& y_in, const std::optional<Array>& temperature_in,
+           const drift::FitSettings& settings, const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
            const std::vector<bool>& logged, const py::object& progress) {
     LongCall call(progress);
-    const drift::DriftOptions o =
-        MakeDriftOptions({mode, method, decomposition, lags, hidden, rate_hz, thermal_features,
-                          time_constants, ensemble, realisations, seed, threads, nonlinear,
-                          reference_temperature, hysteresis, temperature_in.has_value()});
-    const Execution execution = ExecutionOf(threads, call);
+    const drift::DriftOptions o = drift::MakeDriftOptions(settings);
+    const Execution execution = ExecutionOf(settings.threads, call);
 
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::MatrixXd temperature;
@@ -531,7 +485,8 @@ class PyDriftModel {
     }
     // Before the work, as `gyrodrift fit`: a temperature that does not look like degC.
     for (Eigen::Index c = 0; c < temperature.cols(); ++c) {
-      const std::string w = drift::TemperatureWarning(temperature.col(c), names[static_cast<size_t>(c)]);
+      const std::string w =
+          drift::TemperatureWarning(temperature.col(c), names[static_cast<size_t>(c)]);
       if (!w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) {
         throw py::error_already_set();
       }
@@ -543,8 +498,9 @@ class PyDriftModel {
       for (size_t c = 0; c < names.size(); ++c)
         loaded.info.temperature_column += (c ? "," : "") + names[c];
     }
-    call.Run(
-        [&] { loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution, logged); });
+    call.Run([&] {
+      loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution, logged);
+    });
     loaded_ = std::move(loaded);
     fitted_ = true;
   }
@@ -764,11 +720,11 @@ class PyDriftModel {
 
 // The grouping MS-ELM makes of a decomposition (docs/selection.md), with every curve it decided
 // on: the selection result of the library, as a dict.
-py::dict SelectModesPy(const Array& x_in, const py::array_t<double, py::array::f_style |
-                                                                     py::array::forcecast>& imfs_in,
-                       const Array& residue_in, const std::string& criterion,
-                       const std::string& distance, int realisations, double confidence,
-                       std::uint64_t seed, double band, int threads) {
+py::dict SelectModesPy(
+    const Array& x_in,
+    const py::array_t<double, py::array::f_style | py::array::forcecast>& imfs_in,
+    const Array& residue_in, const std::string& criterion, const std::string& distance,
+    int realisations, double confidence, std::uint64_t seed, double band, int threads) {
   LongCall call{py::none()};  // no progress reports: the GIL's release, Ctrl-C at the end
   selection::SelectionOptions o;
   o.criterion = selection::CriterionFromString(criterion);
@@ -782,8 +738,8 @@ py::dict SelectModesPy(const Array& x_in, const py::array_t<double, py::array::f
   execution.Validate();
   const Eigen::VectorXd x = ToVector(x_in, "x");
   if (imfs_in.ndim() != 2) throw UsageError("imfs: must be an (N, K) array, one IMF per column");
-  const Eigen::MatrixXd imfs = Eigen::Map<const Eigen::MatrixXd>(imfs_in.data(), imfs_in.shape(0),
-                                                                 imfs_in.shape(1));
+  const Eigen::MatrixXd imfs =
+      Eigen::Map<const Eigen::MatrixXd>(imfs_in.data(), imfs_in.shape(0), imfs_in.shape(1));
   const Eigen::VectorXd residue = ToVector(residue_in, "residue");
   selection::SelectionResult r;
   call.Run([&] { r = selection::SelectModes(x, imfs, residue, o, execution); });
@@ -844,20 +800,12 @@ std::vector<drift::Method> MethodList(const py::object& methods, drift::Mode mod
 
 // As `gyrodrift evaluate`: the same options (the model's as for fit), the rows as dicts.
 py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
-                  const std::optional<Array>& truth_in, const std::string& mode,
-                  const py::object& methods, const std::string& protocol, double split,
-                  int repeats, int horizon, int window, const std::string& decomposition,
-                  const py::object& lags, const py::object& hidden, double rate_hz,
-                  const std::string& thermal_features, const std::vector<double>& time_constants,
-                  int ensemble, int realisations, std::uint64_t seed, int threads,
-                  bool nonlinear, std::optional<double> reference_temperature,
-                  const std::string& hysteresis, const py::object& progress) {
+                  const std::optional<Array>& truth_in, const drift::FitSettings& settings,
+                  const py::object& methods, const std::string& protocol, double split, int repeats,
+                  int horizon, int window, const py::object& progress) {
   LongCall call(progress);
-  const drift::DriftOptions base = MakeDriftOptions(
-      {mode, "ms-elm", decomposition, lags, hidden, rate_hz, thermal_features, time_constants,
-       ensemble, realisations, seed, threads, nonlinear, reference_temperature, hysteresis,
-       temperature_in.has_value()});
-  const Execution execution = ExecutionOf(threads, call);
+  const drift::DriftOptions base = drift::MakeDriftOptions(settings);
+  const Execution execution = ExecutionOf(settings.threads, call);
   drift::EvaluationOptions e;
   e.split = split;
   e.repeats = repeats;
@@ -904,8 +852,8 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
   out["against_truth"] = result.against_truth;
   out["reference"] = ToArray(result.reference);
   out["rows"] = rows;
-  out["training_temperature_range_c"] = py::make_tuple(result.training_temperature_min_c,
-                                                       result.training_temperature_max_c);
+  out["training_temperature_range_c"] =
+      py::make_tuple(result.training_temperature_min_c, result.training_temperature_max_c);
   out["test_outside_training_temperature_share"] = result.test_outside_training_temperature_share;
   out["table"] = result.Table();
   return out;
@@ -917,7 +865,8 @@ py::list RowsList(const std::vector<fleet::FleetRow>& rows) {
   py::list out;
   for (const fleet::FleetRow& row : rows) {
     py::dict d;
-    for (size_t c = 0; c < row.cells.size(); ++c) d[py::str(fleet::FleetColumns()[c])] = row.cells[c];
+    for (size_t c = 0; c < row.cells.size(); ++c)
+      d[py::str(fleet::FleetColumns()[c])] = row.cells[c];
     out.append(d);
   }
   return out;
@@ -1087,7 +1036,8 @@ PYBIND11_MODULE(_gyrodrift, m) {
           s.taus = *grid;
         } else {
           s.tau_list_s = std::get<std::vector<double>>(taus);
-          if (s.tau_list_s.empty()) throw gyrodrift::OptionError("taus", "[]", "a non-empty sequence");
+          if (s.tau_list_s.empty())
+            throw gyrodrift::OptionError("taus", "[]", "a non-empty sequence");
         }
         return gp::Allan(x, s, logged);
       },
@@ -1096,85 +1046,169 @@ PYBIND11_MODULE(_gyrodrift, m) {
       arg("units") = allan_defaults.units, arg("confidence") = allan_defaults.confidence,
       arg("threads") = allan_defaults.threads, arg("fit_tau_min") = allan_defaults.fit_tau_min_s,
       arg("fit_tau_max") = allan_defaults.fit_tau_max_s, arg("logged") = std::vector<bool>{});
+  const gyrodrift::allan::NoiseFitOptions nd;
   m.def("noise_terms", &gp::NoiseTerms, arg("tau_s"), arg("adev_dph"), arg("edf"), py::kw_only(),
-        arg("fit_tau_min") = 0.0, arg("fit_tau_max") = std::numeric_limits<double>::infinity(),
-        arg("min_share") = 0.1, arg("significance") = 0.05, arg("sample_period_s") = 0.0);
+        arg("fit_tau_min") = nd.tau_min_s, arg("fit_tau_max") = nd.tau_max_s,
+        arg("min_share") = nd.min_share, arg("significance") = nd.significance,
+        arg("sample_period_s") = nd.sample_period_s);
+  const gyrodrift::simulation::SimulationOptions simd;
   m.def("simulate", &gp::Simulate, py::kw_only(), arg("duration") = py::none(),
-        arg("profile") = "chamber", arg("preset") = "navigation", arg("rate_hz") = 1.0,
-        arg("seed") = 1, arg("winding") = "", arg("asymmetry") = py::none(),
-        arg("input_rate_dph") = 0.0, arg("noise") = true);
+        arg("profile") = "chamber", arg("preset") = "navigation", arg("rate_hz") = simd.rate_hz,
+        arg("seed") = simd.seed, arg("winding") = "", arg("asymmetry") = py::none(),
+        arg("input_rate_dph") = simd.input_rate_dph, arg("noise") = simd.include_noise);
 
+  const gyrodrift::drift::FitSettings fd;
   py::class_<gp::PyDriftModel>(m, "DriftModel")
       .def(py::init<>())
-      .def("fit", &gp::PyDriftModel::Fit, arg("y"), arg("temperature") = py::none(), py::kw_only(),
-           arg("mode") = "compensate", arg("method") = "auto", arg("decomposition") = "beemdan",
-           arg("lags") = py::none(), arg("hidden") = "auto", arg("rate_hz") = 1.0,
-           arg("thermal_features") = "auto", arg("time_constants") = std::vector<double>{},
-           arg("ensemble") = 100, arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
-           arg("nonlinear") = false, arg("reference_temperature") = py::none(),
-           arg("hysteresis") = "auto", arg("target") = "rate_dph",
-           arg("temperature_columns") = py::none(),
-           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
-           arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
+      .def(
+          "fit",
+          [](gp::PyDriftModel& d, const gp::Array& y, const std::optional<gp::Array>& temperature,
+             const std::string& mode, const std::string& method, const std::string& decomposition,
+             const py::object& lags, const py::object& hidden, double rate_hz,
+             const std::string& thermal_features, const std::vector<double>& time_constants,
+             int ensemble, int realisations, std::uint64_t seed, int threads, bool nonlinear,
+             std::optional<double> reference_temperature, const std::string& hysteresis,
+             const std::string& target,
+             const std::optional<std::vector<std::string>>& temperature_columns,
+             const std::string& source, const std::vector<Eigen::Index>& record_starts,
+             const std::vector<bool>& logged, const py::object& progress) {
+            const gyrodrift::drift::FitSettings s{
+                .mode = mode,
+                .method = method,
+                .decomposition = decomposition,
+                .lags = gp::AutoOrIntegerSetting("lags", lags),
+                .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
+                .rate_hz = rate_hz,
+                .thermal_features = thermal_features,
+                .time_constants = time_constants,
+                .ensemble = ensemble,
+                .realisations = realisations,
+                .seed = seed,
+                .threads = threads,
+                .nonlinear = nonlinear,
+                .reference_temperature = reference_temperature,
+                .hysteresis = hysteresis,
+                .has_temperature = temperature.has_value()};
+            d.Fit(y, temperature, s, target, temperature_columns, source, record_starts, logged,
+                  progress);
+          },
+          arg("y"), arg("temperature") = py::none(), py::kw_only(), arg("mode") = "compensate",
+          arg("method") = fd.method, arg("decomposition") = fd.decomposition,
+          arg("lags") = py::none(), arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
+          arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
+          arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations,
+          arg("seed") = fd.seed, arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
+          arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
+          arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
+          arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
+          arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
-      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"),
-           py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
+           arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
            arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
-           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal", arg("window") = 512,
-           arg("threads") = 0, arg("progress") = py::none())
+           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal",
+           arg("window") = gyrodrift::drift::CausalOptions{}.window, arg("threads") = 0,
+           arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
       .def_property_readonly("fitted", [](const gp::PyDriftModel& d) { return d.fitted_; })
       .def_property_readonly("summary", &gp::PyDriftModel::Summary)
       .def_property_readonly("sub_models", &gp::PyDriftModel::SubModels)
-      .def_property_readonly("mode", [](const gp::PyDriftModel& d) {
-        return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.mode));
-      })
-      .def_property_readonly("method", [](const gp::PyDriftModel& d) {
-        return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.method));
-      })
-      .def_property_readonly("target", [](const gp::PyDriftModel& d) {
-        return d.Loaded().info.target_column;
-      })
-      .def_property_readonly("temperature_columns", [](const gp::PyDriftModel& d) {
-        const std::string& t = d.Loaded().info.temperature_column;
-        return t.empty() ? std::vector<std::string>{} : gp::SplitColumns(t);
-      })
+      .def_property_readonly(
+          "mode",
+          [](const gp::PyDriftModel& d) {
+            return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.mode));
+          })
+      .def_property_readonly(
+          "method",
+          [](const gp::PyDriftModel& d) {
+            return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.method));
+          })
+      .def_property_readonly(
+          "target", [](const gp::PyDriftModel& d) { return d.Loaded().info.target_column; })
+      .def_property_readonly("temperature_columns",
+                             [](const gp::PyDriftModel& d) {
+                               const std::string& t = d.Loaded().info.temperature_column;
+                               return t.empty() ? std::vector<std::string>{} : gp::SplitColumns(t);
+                             })
       .def_property_readonly("temperature_range_c", [](const gp::PyDriftModel& d) {
         return py::make_tuple(d.Loaded().model.temperature_min_c,
                               d.Loaded().model.temperature_max_c);
       });
 
-  m.def("temperature_warning", [](const gp::Array& t, const std::string& name) {
-    return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
-  }, arg("temperature"), arg("name") = "temperature");
+  m.def(
+      "temperature_warning",
+      [](const gp::Array& t, const std::string& name) {
+        return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
+      },
+      arg("temperature"), arg("name") = "temperature");
+  const gyrodrift::selection::SelectionOptions sd;
   m.def("select_modes", &gp::SelectModesPy, arg("x"), arg("imfs"), arg("residue"), py::kw_only(),
-        arg("criterion") = "pdf", arg("distance") = "l2", arg("realisations") = 100,
-        arg("confidence") = 0.99, arg("seed") = 1, arg("band") = 0.99, arg("threads") = 0);
-  m.def("evaluate", &gp::Evaluate, arg("y"), arg("temperature") = py::none(),
-        arg("truth") = py::none(), py::kw_only(), arg("mode") = "predict", arg("methods") = "all",
-        arg("protocol") = "both", arg("split") = 0.7, arg("repeats") = 1, arg("horizon") = 1,
-        arg("window") = 512, arg("decomposition") = "beemdan", arg("lags") = py::none(),
-        arg("hidden") = "auto", arg("rate_hz") = 1.0, arg("thermal_features") = "auto",
-        arg("time_constants") = std::vector<double>{}, arg("ensemble") = 100,
-        arg("realisations") = 100, arg("seed") = 1, arg("threads") = 0,
-        arg("nonlinear") = false, arg("reference_temperature") = py::none(),
-        arg("hysteresis") = "auto", arg("progress") = py::none());
+        arg("criterion") = std::string(gyrodrift::selection::ToString(sd.criterion)),
+        arg("distance") = std::string(gyrodrift::selection::ToString(sd.distance)),
+        arg("realisations") = sd.monte_carlo.realisations,
+        arg("confidence") = sd.monte_carlo.confidence, arg("seed") = sd.monte_carlo.seed,
+        arg("band") = sd.band_confidence, arg("threads") = 0);
+  const gyrodrift::drift::EvaluationOptions ed;
+  m.def(
+      "evaluate",
+      [](const gp::Array& y, const std::optional<gp::Array>& temperature,
+         const std::optional<gp::Array>& truth, const std::string& mode, const py::object& methods,
+         const std::string& protocol, double split, int repeats, int horizon, int window,
+         const std::string& decomposition, const py::object& lags, const py::object& hidden,
+         double rate_hz, const std::string& thermal_features,
+         const std::vector<double>& time_constants, int ensemble, int realisations,
+         std::uint64_t seed, int threads, bool nonlinear,
+         std::optional<double> reference_temperature, const std::string& hysteresis,
+         const py::object& progress) {
+        // The models' settings as fit's; the method is evaluate's list (ms-elm stands in).
+        const gyrodrift::drift::FitSettings s{.mode = mode,
+                                              .method = "ms-elm",
+                                              .decomposition = decomposition,
+                                              .lags = gp::AutoOrIntegerSetting("lags", lags),
+                                              .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
+                                              .rate_hz = rate_hz,
+                                              .thermal_features = thermal_features,
+                                              .time_constants = time_constants,
+                                              .ensemble = ensemble,
+                                              .realisations = realisations,
+                                              .seed = seed,
+                                              .threads = threads,
+                                              .nonlinear = nonlinear,
+                                              .reference_temperature = reference_temperature,
+                                              .hysteresis = hysteresis,
+                                              .has_temperature = temperature.has_value()};
+        return gp::Evaluate(y, temperature, truth, s, methods, protocol, split, repeats, horizon,
+                            window, progress);
+      },
+      arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
+      arg("mode") = "predict", arg("methods") = "all", arg("protocol") = "both",
+      arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
+      arg("window") = ed.causal.window, arg("decomposition") = fd.decomposition,
+      arg("lags") = py::none(), arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
+      arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
+      arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations, arg("seed") = fd.seed,
+      arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
+      arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
+      arg("progress") = py::none());
   m.def("calibrate", &gp::Calibrate, arg("manifest_path"), arg("output_dir"), py::kw_only(),
         arg("force") = false, arg("threads") = 0);
   m.def("_calibrate_unit", &gp::CalibrateUnit, arg("manifest_path"), arg("index"),
         arg("output_dir"), arg("force") = false);
   m.def("_finish_fleet", &gp::FinishFleet, arg("manifest_path"), arg("output_dir"), arg("units"),
         arg("seconds"));
-  m.def("_manifest_serials", [](const std::string& path) {
-    std::vector<std::string> serials;
-    for (const auto& u : gp::LoadManifest(path).units) serials.push_back(u.serial);
-    return serials;
-  }, arg("path"));
+  m.def(
+      "_manifest_serials",
+      [](const std::string& path) {
+        std::vector<std::string> serials;
+        for (const auto& u : gp::LoadManifest(path).units) serials.push_back(u.serial);
+        return serials;
+      },
+      arg("path"));
 }

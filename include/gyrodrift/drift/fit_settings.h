@@ -29,7 +29,7 @@ struct FitSettings {
   std::string lags;
   // The ELM methods: hidden units, "auto" (leave-one-out choice of L <= 50 and C) or L in
   // [1, 100000]; "" = not given (auto).
-  std::string hidden;
+  std::string hidden = "auto";
   double rate_hz = 1.0;                 // sample rate, Hz
   std::string thermal_features = "auto";  // a ThermalSet name (learners on thermal features)
   std::vector<double> time_constants;   // of those features, s; empty: the library's
