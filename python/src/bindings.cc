@@ -1,0 +1,116 @@
+// The shared helpers of the bindings (bindings.h).
+#include "bindings.h"
+
+namespace gyrodrift::python {
+
+// A 1-D float64 copy of any array-like (lists, float32, strided views), checked under the GIL so
+// the computation can run without it.
+Eigen::VectorXd ToVector(const Array& a, const char* name) {
+  if (a.ndim() != 1) {
+    throw UsageError(std::string(name) + ": must be a 1-D array (got " + std::to_string(a.ndim()) +
+                     " dimensions)");
+  }
+  Eigen::VectorXd v(a.shape(0));
+  std::copy(a.data(), a.data() + a.shape(0), v.data());
+  return v;
+}
+
+// N x C from a 1-D array (one column) or an (N, C) array.
+Eigen::MatrixXd ToMatrix(const Array& a, const char* name) {
+  if (a.ndim() == 1) return ToVector(a, name);
+  if (a.ndim() != 2) {
+    throw UsageError(std::string(name) + ": must be a 1-D or 2-D array (got " +
+                     std::to_string(a.ndim()) + " dimensions)");
+  }
+  Eigen::MatrixXd m(a.shape(0), a.shape(1));
+  auto r = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    for (py::ssize_t j = 0; j < a.shape(1); ++j) m(i, j) = r(i, j);
+  return m;
+}
+
+py::array_t<double> ToArray(const Eigen::VectorXd& v) {
+  py::array_t<double> a(v.size());
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
+// N x K as an (N, K) array in Eigen's column-major order (one memcpy; each IMF imfs[:, k] is
+// then contiguous).
+py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m) {
+  py::array_t<double, py::array::f_style> a({m.rows(), m.cols()});
+  std::copy(m.data(), m.data() + m.size(), a.mutable_data());
+  return a;
+}
+
+// ---- long calls: progress and Ctrl-C ---------------------------------------------------------
+
+// Ctrl-C during a long call: bindings.h.
+std::atomic<unsigned> g_interrupts{0};
+std::mutex g_sigint_mutex;
+int g_running_calls = 0;             // guarded by g_sigint_mutex
+bool g_handler_installed = false;    // guarded by g_sigint_mutex
+struct sigaction g_replaced_sigint;  // written before ours is installed, read by it
+
+extern "C" void InterruptHandler(int signal, siginfo_t* info, void* context) {
+  g_interrupts.fetch_add(1, std::memory_order_relaxed);
+  if (g_replaced_sigint.sa_flags & SA_SIGINFO) {
+    g_replaced_sigint.sa_sigaction(signal, info, context);
+  } else {
+    g_replaced_sigint.sa_handler(signal);
+  }
+}
+
+// A record of the task layer as Python objects: the dict the sidecar's JSON object would load as,
+// but with NaN kept as NaN (the JSON file writes null).
+py::object ToPython(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::object: {
+      py::dict d;
+      for (const auto& [key, value] : j.items()) d[py::str(key)] = ToPython(value);
+      return d;
+    }
+    case nlohmann::json::value_t::array: {
+      py::list l;
+      for (const auto& value : j) l.append(ToPython(value));
+      return l;
+    }
+    case nlohmann::json::value_t::string:
+      return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::boolean:
+      return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+      return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned:
+      return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float:
+      return py::float_(j.get<double>());
+    default:
+      return py::none();
+  }
+}
+
+// A setting that takes "auto" or an integer (lags, hidden), as FitSettings holds it: None is
+// "not given", ints and strings pass as text.
+std::string AutoOrIntegerSetting(const char* name, const py::object& value) {
+  if (value.is_none()) return "";
+  if (py::isinstance<py::str>(value) ||
+      (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value))) {
+    return py::str(value).cast<std::string>();
+  }
+  throw OptionError(name, py::repr(value).cast<std::string>(), "auto or an integer");
+}
+
+std::vector<std::string> SplitColumns(const std::string& names) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = names.find(',', start);
+    out.push_back(
+        names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
+}  // namespace gyrodrift::python

@@ -1,0 +1,393 @@
+// DriftModel: fit, estimate, compensate, predict, save and load (as the CLI's fit, compensate,
+// predict and export read a model file).
+#include "bindings.h"
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/compensation_summary.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/drift/fit_settings.h"
+#include "gyrodrift/drift/temperature_check.h"
+#include "gyrodrift/drift/thermal_coefficients.h"
+#include "gyrodrift/fleet/calibration.h"
+#include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/io/model_file.h"
+#include "gyrodrift/io/report.h"
+#include "gyrodrift/selection/selection.h"
+#include "gyrodrift/simulation/fog_simulator.h"
+#include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/decompose_task.h"
+
+namespace gyrodrift::python {
+namespace {
+
+namespace al = gyrodrift::allan;
+namespace dec = gyrodrift::decomposition;
+namespace sim = gyrodrift::simulation;
+namespace gp = gyrodrift::python;
+
+// One axis of a model file: the fitted model and the column names it was fitted on.
+class PyDriftModel {
+ public:
+  PyDriftModel() = default;
+  explicit PyDriftModel(io::LoadedModel loaded) : loaded_(std::move(loaded)), fitted_(true) {}
+
+  // As `gyrodrift fit` (MakeDriftOptions above).
+  void Fit(const Array& y_in, const std::optional<Array>& temperature_in,
+           const drift::FitSettings& settings, const std::string& target,
+           const std::optional<std::vector<std::string>>& temperature_columns,
+           const std::string& source, const std::vector<Eigen::Index>& record_starts,
+           const std::vector<bool>& logged, const py::object& progress) {
+    LongCall call(progress);
+    const drift::DriftOptions o = drift::MakeDriftOptions(settings);
+    const Execution execution = ExecutionOf(settings.threads, call);
+
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    Eigen::MatrixXd temperature;
+    if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
+    std::vector<std::string> names;
+    if (temperature_columns) {
+      names = *temperature_columns;
+    } else if (temperature.cols() == 1) {
+      names = {"temperature_c"};
+    } else {
+      for (Eigen::Index c = 0; c < temperature.cols(); ++c)
+        names.push_back("temperature_c" + std::to_string(c + 1));
+    }
+    if (temperature_in && static_cast<Eigen::Index>(names.size()) != temperature.cols()) {
+      throw UsageError("temperature_columns: " + std::to_string(names.size()) + " names for " +
+                       std::to_string(temperature.cols()) + " temperature columns");
+    }
+    // Before the work, as `gyrodrift fit`: a temperature that does not look like degC.
+    for (Eigen::Index c = 0; c < temperature.cols(); ++c) {
+      const std::string w =
+          drift::TemperatureWarning(temperature.col(c), names[static_cast<size_t>(c)]);
+      if (!w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) {
+        throw py::error_already_set();
+      }
+    }
+    io::LoadedModel loaded;
+    loaded.info.source = source;
+    loaded.info.target_column = target;
+    if (temperature_in) {
+      for (size_t c = 0; c < names.size(); ++c)
+        loaded.info.temperature_column += (c ? "," : "") + names[c];
+    }
+    call.Run([&] {
+      loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution, logged);
+    });
+    loaded_ = std::move(loaded);
+    fitted_ = true;
+  }
+
+  const io::LoadedModel& Loaded() const {
+    if (!fitted_) throw UsageError("DriftModel: not fitted (call fit() or DriftModel.load())");
+    return loaded_;
+  }
+
+  void RequireMode(drift::Mode mode, const char* what) const {
+    if (Loaded().model.options.mode != mode) {
+      throw UsageError(std::string(what) + ": needs a model fitted with mode '" +
+                       std::string(drift::ToString(mode)) + "', this one is '" +
+                       std::string(drift::ToString(Loaded().model.options.mode)) + "'");
+    }
+  }
+
+  py::tuple Estimate(const Array& temperature_in,
+                     const std::vector<Eigen::Index>& record_starts) const {
+    RequireMode(drift::Mode::kCompensate, "estimate");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    Eigen::MatrixXd e;
+    {
+      py::gil_scoped_release release;
+      e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
+    }
+    return py::make_tuple(ToArray(Eigen::VectorXd(e.col(0))), ToArray(Eigen::VectorXd(e.col(1))));
+  }
+
+  // y - estimate, as `gyrodrift compensate` writes it.
+  py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in,
+                                 const std::vector<Eigen::Index>& record_starts) const {
+    RequireMode(drift::Mode::kCompensate, "compensate");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    if (y.size() != t.rows()) {
+      throw DataError("compensate: y has " + std::to_string(y.size()) + " samples, temperature " +
+                      std::to_string(t.rows()));
+    }
+    Eigen::VectorXd compensated;
+    {
+      py::gil_scoped_release release;
+      const Eigen::MatrixXd e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
+      compensated = y - e.col(0);
+    }
+    return ToArray(compensated);
+  }
+
+  // The figures `gyrodrift compensate` prints and keeps in its sidecar for y compensated by this
+  // model (drift::SummariseCompensation at the model's sample rate).
+  py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
+                               const std::vector<Eigen::Index>& record_starts) const {
+    RequireMode(drift::Mode::kCompensate, "compensation_summary");
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    if (y.size() != t.rows()) {
+      throw DataError("compensation_summary: y has " + std::to_string(y.size()) +
+                      " samples, temperature " + std::to_string(t.rows()));
+    }
+    drift::CompensationSummary s;
+    {
+      py::gil_scoped_release release;
+      const Eigen::VectorXd compensated =
+          y - drift::EstimateDriftWithSd(Loaded().model, t, record_starts).col(0);
+      s = drift::SummariseCompensation(y, compensated, Loaded().model.options.features.rate_hz);
+    }
+    auto figures = [](const drift::SignalSummary& f) {
+      py::dict d;
+      d["mean"] = f.mean;
+      d["rms"] = f.rms;
+      d["std"] = f.std;
+      d["slow_variation"] = f.slow;
+      return d;
+    };
+    py::dict d;
+    d["samples"] = s.samples;
+    d["before"] = figures(s.before);
+    d["after"] = figures(s.after);
+    d["slow_variation_block_s"] = s.block_s;
+    d["slow_variation_blocks"] = s.blocks;
+    d["table"] = s.Table(Loaded().info.target_column, Loaded().info.rate_unit);
+    return d;
+  }
+
+  // The thermal sub-models' coefficients in physical units around `reference_temperature`, else
+  // the model's reference temperature, else the calibration's means (as `gyrodrift fit` prints).
+  py::list Coefficients(std::optional<double> reference_temperature) const {
+    const io::LoadedModel& l = Loaded();
+    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    const std::optional<double> reference =
+        reference_temperature ? reference_temperature : l.model.options.reference_c;
+    py::list out;
+    for (const drift::SubModel& sub : l.model.sub_models) {
+      if (!sub.thermal) continue;
+      const drift::ThermalCoefficients c =
+          drift::PhysicalCoefficients(*sub.thermal, reference, channels);
+      py::list terms;
+      for (const drift::PhysicalCoefficient& t : c.terms) {
+        py::dict d;
+        d["term"] = t.term;
+        d["power"] = t.power;
+        d["state"] = t.state;
+        d["unit"] = l.info.rate_unit + t.unit;
+        d["value"] = t.value;
+        d["sd"] = t.sd;
+        terms.append(d);
+      }
+      py::dict d;
+      d["sub_model"] = sub.name;
+      d["reference_c"] = c.reference_c;
+      d["terms"] = terms;
+      d["state_range_c"] = c.state_range_c;
+      out.append(d);
+    }
+    return out;
+  }
+
+  // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
+  py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
+                    const std::string& protocol_name, int window, int threads,
+                    const py::object& progress) const {
+    RequireMode(drift::Mode::kPredict, "predict");
+    LongCall call(progress);
+    const drift::Protocol protocol = drift::ProtocolFromString(protocol_name);
+    if (window < 16 || window > 1000000) {
+      throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
+    }
+    const drift::DriftModel& model = Loaded().model;
+    const Execution execution = ExecutionOf(threads, call);  // it never changes the result
+    const Eigen::VectorXd y = ToVector(y_in, "y");
+    Eigen::VectorXd temperature;
+    if (model.uses_temperature()) {
+      if (!temperature_in) throw UsageError("predict: this model needs temperature");
+      temperature = ToVector(*temperature_in, "temperature");
+    }
+    const Eigen::Index first = drift::FirstPredictable(model, protocol, horizon);
+    if (y.size() <= first) {
+      throw DataError("y has " + std::to_string(y.size()) + " samples: the model needs more than " +
+                      std::to_string(first) + " (its history) to predict any");
+    }
+    drift::CausalOptions causal;
+    causal.window = window;
+    Eigen::VectorXd prediction;
+    call.Run([&] {
+      prediction =
+          drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal, execution);
+    });
+    return py::make_tuple(first, ToArray(prediction));
+  }
+
+  void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
+
+  // One model file of several axes, as `gyrodrift fit --target a,b,c` writes it.
+  static void SaveAxes(const std::string& path, const std::vector<const PyDriftModel*>& models) {
+    if (models.empty()) throw UsageError("models: must hold at least one fitted model");
+    std::vector<io::LoadedModel> axes;
+    for (const PyDriftModel* m : models) axes.push_back(m->Loaded());
+    io::WriteModelFile(path, axes);
+  }
+
+  static std::vector<PyDriftModel> LoadAxes(const std::string& path) {
+    std::vector<PyDriftModel> out;
+    for (io::LoadedModel& axis : io::ReadModelFileAxes(path)) out.emplace_back(std::move(axis));
+    return out;
+  }
+
+  std::string Summary() const { return Loaded().model.Summary(); }
+
+  py::list SubModels() const {
+    const io::LoadedModel& l = Loaded();
+    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    py::list out;
+    for (const drift::SubModel& sub : l.model.sub_models) {
+      py::dict d;
+      d["name"] = sub.name;
+      d["imfs"] = sub.imfs;
+      d["has_residue"] = sub.has_residue;
+      d["learner"] = sub.learner ? py::cast(sub.learner->Summary()) : py::none();
+      d["mean"] = sub.mean ? py::cast(*sub.mean) : py::none();
+      d["baseline"] = sub.baseline ? py::cast(sub.baseline->Summary()) : py::none();
+      if (sub.thermal) {
+        const drift::ThermalRegression& t = *sub.thermal;
+        Eigen::VectorXd sd(t.coefficients.size());
+        for (Eigen::Index k = 0; k < sd.size(); ++k) sd[k] = std::sqrt(t.covariance(k, k));
+        py::dict th;
+        th["summary"] = t.Summary();
+        th["regressors"] = t.RegressorNames(channels);
+        th["coefficients"] = ToArray(t.coefficients);
+        th["sd"] = ToArray(sd);
+        th["calibration"] = t.report.Summary();
+        th["warnings"] = t.report.warnings;
+        th["advice"] = t.report.advice;
+        th["structure"] = t.report.level;  // CalibrationReport::Level: 0 the constant .. 5
+        if (t.has_hysteresis()) {
+          py::dict h;
+          h["tau_s"] = t.states[static_cast<size_t>(t.hysteresis_state)].tau_s;
+          h["width_k"] = t.hysteresis_width_k;
+          h["coefficient"] = t.coefficients[t.coefficients.size() - 1];
+          th["hysteresis"] = h;
+        } else {
+          th["hysteresis"] = py::none();
+        }
+        d["thermal"] = th;
+      } else {
+        d["thermal"] = py::none();
+      }
+      out.append(d);
+    }
+    return out;
+  }
+
+  io::LoadedModel loaded_;
+  bool fitted_ = false;
+};
+
+// DriftModel.fit's keywords as drift::FitSettings (their defaults: BindDriftModel).
+void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
+                 const std::optional<gp::Array>& temperature, const std::string& mode,
+                 const std::string& method, const std::string& decomposition,
+                 const py::object& lags, const py::object& hidden, double rate_hz,
+                 const std::string& thermal_features, const std::vector<double>& time_constants,
+                 int ensemble, int realisations, std::uint64_t seed, int threads, bool nonlinear,
+                 std::optional<double> reference_temperature, const std::string& hysteresis,
+                 const std::string& target,
+                 const std::optional<std::vector<std::string>>& temperature_columns,
+                 const std::string& source, const std::vector<Eigen::Index>& record_starts,
+                 const std::vector<bool>& logged, const py::object& progress) {
+  const gyrodrift::drift::FitSettings s{.mode = mode,
+                                        .method = method,
+                                        .decomposition = decomposition,
+                                        .lags = gp::AutoOrIntegerSetting("lags", lags),
+                                        .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
+                                        .rate_hz = rate_hz,
+                                        .thermal_features = thermal_features,
+                                        .time_constants = time_constants,
+                                        .ensemble = ensemble,
+                                        .realisations = realisations,
+                                        .seed = seed,
+                                        .threads = threads,
+                                        .nonlinear = nonlinear,
+                                        .reference_temperature = reference_temperature,
+                                        .hysteresis = hysteresis,
+                                        .has_temperature = temperature.has_value()};
+  d.Fit(y, temperature, s, target, temperature_columns, source, record_starts, logged, progress);
+}
+
+}  // namespace
+
+void BindDriftModel(py::module_& m) {
+  using py::arg;
+  const gyrodrift::drift::FitSettings fd;
+  py::class_<gp::PyDriftModel>(m, "DriftModel")
+      .def(py::init<>())
+      .def("fit", &FitKeywords, arg("y"), arg("temperature") = py::none(), py::kw_only(),
+           arg("mode") = "compensate", arg("method") = fd.method,
+           arg("decomposition") = fd.decomposition, arg("lags") = py::none(),
+           arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
+           arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
+           arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations,
+           arg("seed") = fd.seed, arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
+           arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
+           arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
+           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
+           arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
+      .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
+           arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
+           arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
+           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+      .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
+           arg("reference_temperature") = py::none())
+      .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
+           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal",
+           arg("window") = gyrodrift::drift::CausalOptions{}.window, arg("threads") = 0,
+           arg("progress") = py::none())
+      .def("save", &gp::PyDriftModel::Save, arg("path"))
+      .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
+      .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
+      .def_property_readonly("fitted", [](const gp::PyDriftModel& d) { return d.fitted_; })
+      .def_property_readonly("summary", &gp::PyDriftModel::Summary)
+      .def_property_readonly("sub_models", &gp::PyDriftModel::SubModels)
+      .def_property_readonly(
+          "mode",
+          [](const gp::PyDriftModel& d) {
+            return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.mode));
+          })
+      .def_property_readonly(
+          "method",
+          [](const gp::PyDriftModel& d) {
+            return std::string(gyrodrift::drift::ToString(d.Loaded().model.options.method));
+          })
+      .def_property_readonly(
+          "target", [](const gp::PyDriftModel& d) { return d.Loaded().info.target_column; })
+      .def_property_readonly("temperature_columns",
+                             [](const gp::PyDriftModel& d) {
+                               const std::string& t = d.Loaded().info.temperature_column;
+                               return t.empty() ? std::vector<std::string>{} : gp::SplitColumns(t);
+                             })
+      .def_property_readonly("temperature_range_c", [](const gp::PyDriftModel& d) {
+        return py::make_tuple(d.Loaded().model.temperature_min_c,
+                              d.Loaded().model.temperature_max_c);
+      });
+
+  m.def(
+      "temperature_warning",
+      [](const gp::Array& t, const std::string& name) {
+        return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
+      },
+      arg("temperature"), arg("name") = "temperature");
+}
+
+}  // namespace gyrodrift::python

@@ -1,0 +1,163 @@
+// evaluate: the methods compared on a chronological split, as `gyrodrift evaluate`.
+#include "bindings.h"
+#include "gyrodrift/allan/allan.h"
+#include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/decomposition/decomposition.h"
+#include "gyrodrift/drift/compensation_summary.h"
+#include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/evaluation.h"
+#include "gyrodrift/drift/fit_settings.h"
+#include "gyrodrift/drift/temperature_check.h"
+#include "gyrodrift/drift/thermal_coefficients.h"
+#include "gyrodrift/fleet/calibration.h"
+#include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/io/model_file.h"
+#include "gyrodrift/io/report.h"
+#include "gyrodrift/selection/selection.h"
+#include "gyrodrift/simulation/fog_simulator.h"
+#include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/decompose_task.h"
+
+namespace gyrodrift::python {
+namespace {
+
+namespace al = gyrodrift::allan;
+namespace dec = gyrodrift::decomposition;
+namespace sim = gyrodrift::simulation;
+namespace gp = gyrodrift::python;
+
+// ---- evaluate -------------------------------------------------------------------------------
+
+std::vector<drift::Method> MethodList(const py::object& methods, drift::Mode mode) {
+  std::vector<std::string> names;
+  if (py::isinstance<py::str>(methods)) {
+    const std::string text = methods.cast<std::string>();
+    if (text == "all") return drift::AllMethods(mode);
+    names = SplitColumns(text);
+  } else {
+    names = methods.cast<std::vector<std::string>>();
+  }
+  std::vector<drift::Method> out;
+  for (const std::string& name : names) {
+    const drift::Method m = drift::MethodFromString(name);
+    if (std::find(out.begin(), out.end(), m) != out.end()) {
+      throw OptionError("methods", "'" + name + "' twice", "a list without repeats");
+    }
+    out.push_back(m);
+  }
+  if (out.empty()) throw OptionError("methods", "(empty)", "at least one method");
+  return out;
+}
+
+// As `gyrodrift evaluate`: the same options (the model's as for fit), the rows as dicts.
+py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
+                  const std::optional<Array>& truth_in, const drift::FitSettings& settings,
+                  const py::object& methods, const std::string& protocol, double split, int repeats,
+                  int horizon, int window, const py::object& progress) {
+  LongCall call(progress);
+  const drift::DriftOptions base = drift::MakeDriftOptions(settings);
+  const Execution execution = ExecutionOf(settings.threads, call);
+  drift::EvaluationOptions e;
+  e.split = split;
+  e.repeats = repeats;
+  e.methods = MethodList(methods, base.mode);
+  if (protocol == "both") {
+    e.protocols = {drift::Protocol::kPaper, drift::Protocol::kCausal};
+  } else if (protocol == "paper" || protocol == "causal") {
+    e.protocols = {drift::ProtocolFromString(protocol)};
+  } else {
+    throw OptionError("protocol", "'" + protocol + "'", "paper, causal or both");
+  }
+  e.causal.window = window;
+  e.horizon = horizon;
+  e.Validate();
+  const Eigen::VectorXd y = ToVector(y_in, "y");
+  Eigen::MatrixXd temperature;
+  if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
+  Eigen::VectorXd truth;
+  if (truth_in) truth = ToVector(*truth_in, "truth");
+  drift::EvaluationResult result;
+  call.Run([&] { result = drift::Evaluate(y, temperature, truth, base, e, execution); });
+
+  py::list rows;
+  for (const drift::EvaluationRow& r : result.rows) {
+    py::dict row;
+    row["method"] = std::string(drift::ToString(r.method));
+    row["protocol"] = std::string(drift::ToString(r.protocol));
+    row["rmse"] = r.rmse;
+    row["rmse_std"] = r.rmse_std;
+    row["mae"] = r.mae;
+    row["max_abs"] = r.max_abs;
+    row["rmse_measured"] = r.rmse_measured;
+    row["slow_removed"] = r.slow_removed;
+    row["train_s"] = r.train_s;
+    row["predict_s"] = r.predict_s;
+    row["estimate"] = ToArray(r.estimate);
+    row["model_summary"] = r.model_summary;
+    row["notes"] = r.notes;
+    rows.append(row);
+  }
+  py::dict out;
+  out["mode"] = std::string(drift::ToString(result.mode));
+  out["first_test_sample"] = result.split_index;
+  out["against_truth"] = result.against_truth;
+  out["reference"] = ToArray(result.reference);
+  out["rows"] = rows;
+  out["training_temperature_range_c"] =
+      py::make_tuple(result.training_temperature_min_c, result.training_temperature_max_c);
+  out["test_outside_training_temperature_share"] = result.test_outside_training_temperature_share;
+  out["table"] = result.Table();
+  return out;
+}
+
+}  // namespace
+
+void BindEvaluate(py::module_& m) {
+  using py::arg;
+  const gyrodrift::drift::EvaluationOptions ed;
+  const gyrodrift::drift::FitSettings fd;
+  m.def(
+      "evaluate",
+      [](const gp::Array& y, const std::optional<gp::Array>& temperature,
+         const std::optional<gp::Array>& truth, const std::string& mode, const py::object& methods,
+         const std::string& protocol, double split, int repeats, int horizon, int window,
+         const std::string& decomposition, const py::object& lags, const py::object& hidden,
+         double rate_hz, const std::string& thermal_features,
+         const std::vector<double>& time_constants, int ensemble, int realisations,
+         std::uint64_t seed, int threads, bool nonlinear,
+         std::optional<double> reference_temperature, const std::string& hysteresis,
+         const py::object& progress) {
+        // The models' settings as fit's; the method is evaluate's list (ms-elm stands in).
+        const gyrodrift::drift::FitSettings s{.mode = mode,
+                                              .method = "ms-elm",
+                                              .decomposition = decomposition,
+                                              .lags = gp::AutoOrIntegerSetting("lags", lags),
+                                              .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
+                                              .rate_hz = rate_hz,
+                                              .thermal_features = thermal_features,
+                                              .time_constants = time_constants,
+                                              .ensemble = ensemble,
+                                              .realisations = realisations,
+                                              .seed = seed,
+                                              .threads = threads,
+                                              .nonlinear = nonlinear,
+                                              .reference_temperature = reference_temperature,
+                                              .hysteresis = hysteresis,
+                                              .has_temperature = temperature.has_value()};
+        return gp::Evaluate(y, temperature, truth, s, methods, protocol, split, repeats, horizon,
+                            window, progress);
+      },
+      arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
+      arg("mode") = "predict", arg("methods") = "all", arg("protocol") = "both",
+      arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
+      arg("window") = ed.causal.window, arg("decomposition") = fd.decomposition,
+      arg("lags") = py::none(), arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
+      arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
+      arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations, arg("seed") = fd.seed,
+      arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
+      arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
+      arg("progress") = py::none());
+}
+
+}  // namespace gyrodrift::python
