@@ -14,6 +14,7 @@
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/io/report.h"
 #include "regression/allan/allan_fixtures.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift {
@@ -127,10 +128,10 @@ TEST_F(CalibrateCli, CalibratesEveryUnitAndAxisAndMatchesFit) {
             drift::EstimateDrift(fitted.model, ver.Column("temp_x")));
   // Reports: structurally sound, the fleet page links each unit's page.
   const std::string fleet_html = io::ReadTextFile(out + "/fleet.html");
-  const io::ReportCheck check = io::CheckReportHtml(fleet_html);
+  const test::ReportCheck check = test::CheckReportHtml(fleet_html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_NE(fleet_html.find("href=\"SN3/report.html\""), std::string::npos);
-  EXPECT_TRUE(io::CheckReportHtml(io::ReadTextFile(out + "/SN1/report.html")).ok());
+  EXPECT_TRUE(test::CheckReportHtml(io::ReadTextFile(out + "/SN1/report.html")).ok());
 
   // A rerun skips every unit; --force redoes them with the same numbers; a changed log is redone.
   r = test::RunCli("calibrate '" + manifest + "' -o '" + out + "' -q");

@@ -11,6 +11,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/report.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift {
@@ -98,7 +99,7 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   EXPECT_EQ(io::CsvTable::Read(dir + "/predict_estimates.csv").rows(), 7200 - 5040);
   // The report: well formed, every figure has data, dygraphs inlined, nothing external.
   const std::string html = io::ReadTextFile(dir + "/report.html");
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_GE(check.figures, 12);
   EXPECT_GE(check.tables, 4);
@@ -129,7 +130,7 @@ TEST(DemoCli, UserLogStudy) {
                                    "poly/paper", "poly/causal"}));
   EXPECT_EQ(Pairs(work + "/out/predict_table.csv").size(), 20u);  // and the 5 filters
   const std::string html = io::ReadTextFile(work + "/out/report.html");
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   // The saved models name the log's own columns, so `gyrodrift compensate` applies them to it.
   const auto c = RunCli("compensate " + work + "/out/models/ms-elm_compensate.json " + work +

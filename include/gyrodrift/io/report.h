@@ -13,10 +13,7 @@
 //   points, so a report with a few dozen curves stays a few MB.
 //   Values are printed with 7 significant digits (plotting precision; the CSV files beside the
 //   report keep full precision); NaN and infinities become null (a gap).
-// CheckReportHtml: a structural check of a report file (balanced tags outside <script>/<style>,
-//   figure data present and non-empty, dygraphs inlined, no external resource; an <a href> may
-//   point to a relative path beside or below the report), used by the tests
-//   and available to anyone who post-processes a report.
+// The tests check a report's structure with tests/support/report_check.h.
 // Units: whatever the caller labels the axes with. Cost: O(total samples) to decimate and print.
 #pragma once
 
@@ -120,19 +117,8 @@ Decimated DecimateMinMax(const Eigen::Ref<const Eigen::VectorXd>& x,
                          const Eigen::Ref<const Eigen::MatrixXd>& lower,
                          const Eigen::Ref<const Eigen::MatrixXd>& upper, int max_points);
 
-// Result of CheckReportHtml.
-struct ReportCheck {
-  std::vector<std::string> problems;  // empty when the report passes
-  int figures = 0;                    // figure data blocks found
-  int tables = 0;
-  std::size_t bytes = 0;
-  bool ok() const { return problems.empty(); }
-  std::string Summary() const;  // one line
-};
-// Structural check of a report: every tag outside <script>/<style> is balanced (void elements
-// aside), attributes are quoted, each figure's JSON data block has non-empty x and series arrays
-// of equal length, the dygraphs library is inlined (no <script src>, no <link>), and no src/href
-// or CSS url() points outside the file.
-ReportCheck CheckReportHtml(const std::string& html);
+// A link to a file beside the report or below it (a fleet report's unit pages): no scheme, not
+// absolute, no "..". Such a link loads nothing when the report opens, so an <a href> may use it.
+bool IsLocalLink(const std::string& url);
 
 }  // namespace gyrodrift::io

@@ -23,6 +23,7 @@
 #include "gyrodrift/io/report.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift::fleet {
@@ -207,7 +208,7 @@ TEST_F(FleetCalibration, AVerificationIsMeasuredAsDocumented) {
   EXPECT_GE(v.tau_s.size(), 8);
   EXPECT_EQ(v.tau_s[0], 1.0);
   for (Eigen::Index i = 1; i < v.tau_s.size(); ++i) EXPECT_EQ(v.tau_s[i], 2.0 * v.tau_s[i - 1]);
-  EXPECT_TRUE(io::CheckReportHtml(out.files[3].second).ok());
+  EXPECT_TRUE(test::CheckReportHtml(out.files[3].second).ok());
 }
 
 TEST_F(FleetCalibration, LimitsFailStrictlyBeyondTheirValue) {
@@ -434,7 +435,7 @@ TEST_F(FleetCalibration, AFailingUnitIsReportedAndTheOthersGoOn) {
   EXPECT_EQ(csv.rfind(header + "\n", 0), 0u) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
   EXPECT_NE(csv.find("\nSNX,,,error,"), std::string::npos) << csv;
-  EXPECT_TRUE(io::CheckReportHtml(io::ReadTextFile(out + "/fleet.html")).ok());
+  EXPECT_TRUE(test::CheckReportHtml(io::ReadTextFile(out + "/fleet.html")).ok());
 }
 
 TEST_F(FleetCalibration, AFinishedUnitIsSkippedAndADamagedOneRedone) {

@@ -17,6 +17,7 @@
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/report.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift::fleet {
@@ -168,7 +169,7 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   unit.axes = {x, y};
 
   const std::string html = RenderUnitReport(m, spec, unit, test::FakeDygraphs());
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.tables, 2);
   EXPECT_NE(html.find("<h1>gyrodrift calibration: SN7</h1>"), std::string::npos);
@@ -287,7 +288,7 @@ TEST(FleetReport, PlotsEachUnitsWorstLogAndLinksTheCalibratedUnits) {
   fleet.rows[3].cells[4] = "log.csv: data row 2 is 'nan'";
 
   const std::string html = RenderFleetReport(m, fleet, test::FakeDygraphs());
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_NE(Unescape(html).find(fleet.Summary() + ". Limits: residual drift <= 0.05; true drift "
                                                   "removed >= 75.0 %."),
@@ -351,7 +352,7 @@ TEST(FleetReport, AFleetWithoutFiguresStillRenders) {
   fleet.errors = 1;
   fleet.rows = {Row("SN1", "", "", "error", kNan, kNan)};
   const std::string html = RenderFleetReport(m, fleet, test::FakeDygraphs());
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.figures, 0);
   EXPECT_NE(html.find("No outliers"), std::string::npos);

@@ -10,6 +10,7 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift::io {
@@ -61,7 +62,7 @@ HtmlReport SmallReport() {
 
 TEST(Report, SmallReportRendersAndPassesTheCheck) {
   const std::string html = SmallReport().Render(test::FakeDygraphs());
-  const ReportCheck check = CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.figures, 2);
   EXPECT_EQ(check.tables, 1);
@@ -80,7 +81,7 @@ TEST(Report, RealDygraphsIsInlinedWithoutItsSourceMap) {
   EXPECT_GT(assets.js.size(), 100000u);
   EXPECT_EQ(assets.js.find("sourceMappingURL"), std::string::npos);
   const std::string html = SmallReport().Render(assets);
-  const ReportCheck check = CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   const std::string out = test::TempDir("report_small") + "/small.html";
   WriteFileAtomically(out, html);  // for a look in a browser
@@ -97,13 +98,13 @@ TEST(Report, MissingDygraphsNamesThePackage) {
 
 TEST(Report, CheckCatchesBrokenReports) {
   const std::string good = SmallReport().Render(test::FakeDygraphs());
-  ASSERT_TRUE(CheckReportHtml(good).ok());
+  ASSERT_TRUE(test::CheckReportHtml(good).ok());
   auto broken = [&](std::string from, std::string to) {
     std::string html = good;
     const size_t at = html.find(from);
     EXPECT_NE(at, std::string::npos) << from;
     html.replace(at, from.size(), to);
-    return CheckReportHtml(html);
+    return test::CheckReportHtml(html);
   };
   EXPECT_FALSE(broken("</table>", "").ok());                                    // unclosed
   EXPECT_FALSE(broken("<h1>", "<h1><b>").ok());                                 // stray open tag
@@ -114,7 +115,7 @@ TEST(Report, CheckCatchesBrokenReports) {
   EXPECT_FALSE(broken("\"x\":[", "\"x\":[],\"old\":[").ok());                   // empty x
   EXPECT_FALSE(broken("var Dygraph", "var Other").ok());                        // not inlined
   EXPECT_FALSE(broken("<div class=\"fig\">", "<div class=fig>").ok());          // unquoted
-  EXPECT_FALSE(CheckReportHtml("<p>no html element</p>").ok());
+  EXPECT_FALSE(test::CheckReportHtml("<p>no html element</p>").ok());
 }
 
 TEST(Report, FigureErrorsAreDataErrors) {
@@ -177,7 +178,7 @@ TEST(HtmlReport, TableCellsLinkLocalPagesOnly) {
   report.AddTable(t);
   const std::string html = report.Render(LoadDygraphs());
   EXPECT_NE(html.find("<a href=\"SN%201/report.html\">SN 1</a>"), std::string::npos) << html;
-  const ReportCheck check = CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   for (const char* bad : {"../x.html", "/etc/passwd", "http://example.com/a.html", "a/../../b"}) {
     t.links[0][0] = bad;
@@ -186,8 +187,8 @@ TEST(HtmlReport, TableCellsLinkLocalPagesOnly) {
   t.links = {{"a.html", ""}};  // one row of links for two rows
   EXPECT_THROW(report.AddTable(t), DataError);
   // The check still refuses a link that leaves the folder, and any src.
-  EXPECT_FALSE(CheckReportHtml("<!DOCTYPE html><html><body><a href=\"../x.html\">x</a></body></html>").ok());
-  EXPECT_FALSE(CheckReportHtml("<!DOCTYPE html><html><body><img src=\"x.png\"/></body></html>").ok());
+  EXPECT_FALSE(test::CheckReportHtml("<!DOCTYPE html><html><body><a href=\"../x.html\">x</a></body></html>").ok());
+  EXPECT_FALSE(test::CheckReportHtml("<!DOCTYPE html><html><body><img src=\"x.png\"/></body></html>").ok());
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "gyrodrift/study/files.h"
 #include "gyrodrift/study/table.h"
 #include "unit/study/chamber_log.h"
+#include "support/report_check.h"
 #include "support/test_support.h"
 
 namespace gyrodrift::study {
@@ -170,7 +171,7 @@ TEST(Study, LogStudyGivesTablesFilesAndReport) {
         "5. Allan deviation", "6. Settings and timing", "Selection curves", "IMF 1 ("}) {
     EXPECT_NE(html.find(section), std::string::npos) << section;
   }
-  const io::ReportCheck check = io::CheckReportHtml(html);
+  const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   EXPECT_EQ(check.tables, 5);  // predict, compensate, noise terms, settings, timing
 
