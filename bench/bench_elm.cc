@@ -5,7 +5,7 @@
 // command and the load average of each run: docs/elm.md, "Speed".
 // Input: a drift-like series (random walk + two slow tones + white noise), seeded; inputs are
 // its 16 previous samples, the target the next one. The row kernels run with AVX2 + FMA when
-// the CPU has them (src/elm/kernels.h); the `kernels` label says which ran.
+// the CPU has them (src/elm/elm_kernels.h); the `kernels` label says which ran.
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -23,7 +23,7 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/report.h"
-#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/study_files.h"
 #include "gyrodrift/study/study.h"
 #include "progress.h"
 

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "common/enum_names.h"
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 #include "elm/training.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"

@@ -1,11 +1,11 @@
 // Hidden units, the streamed Gram matrix and the Cholesky ridge solver. The arithmetic over
-// rows runs in the dispatched kernels (kernels.h).
+// rows runs in the dispatched kernels (elm_kernels.h).
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 #include "elm/training.h"
 #include "gyrodrift/common/parallel.h"
 #include "gyrodrift/common/random.h"

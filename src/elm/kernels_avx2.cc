@@ -1,7 +1,7 @@
 // The ELM kernels for CPUs with AVX2 and FMA. The build compiles this file alone with
 // -mavx2 -mfma (CMakeLists.txt, x86-64 with GCC or Clang); elsewhere it provides no table.
 // Only ActiveKernels() (kernels.cc) calls into it, after checking the CPU.
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 
 #if defined(__AVX2__) && defined(__FMA__)
 

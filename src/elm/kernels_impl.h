@@ -1,4 +1,4 @@
-// Body of the ELM kernels (kernels.h), included once by kernels_baseline.cc and once by
+// Body of the ELM kernels (elm_kernels.h), included once by kernels_baseline.cc and once by
 // kernels_avx2.cc. Before including it a file defines
 //   Eigen                          a private name for Eigen's namespace in that file, so that
 //                                  its Eigen instantiations (built with that file's instruction
@@ -6,7 +6,7 @@
 //   GYRODRIFT_ELM_KERNEL_FMA       1 to use fused multiply-adds (the file is built with -mfma);
 //   GYRODRIFT_ELM_KERNEL_TABLE     the name of the function returning this file's table.
 // Everything else here has internal linkage. Do not include headers that define inline
-// functions used here from other files of the project (kernels.h is plain data only).
+// functions used here from other files of the project (elm_kernels.h is plain data only).
 //
 // The hidden-layer and output products are hand-written rather than Eigen products: a matrix
 // product library picks its summation order from the matrix shapes (a one-row product takes a
@@ -23,7 +23,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 #include "elm/training.h"
 #include "gyrodrift/common/parallel.h"
 

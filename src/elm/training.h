@@ -27,7 +27,7 @@ void DrawUnits(int inputs, int hidden, std::uint64_t seed, Eigen::MatrixXd* weig
 
 // out (rows x L) = g(xs A + b) for standardised inputs xs (rows x d); A is d x L, b has L
 // entries (RBF: g = exp(-b ||x - a||^2 / d)). `out` may be a block of a larger buffer. Each
-// entry is the same bits whatever the number of rows or the entry's position (kernels.h).
+// entry is the same bits whatever the number of rows or the entry's position (elm_kernels.h).
 void ComputeHidden(Activation activation, const Eigen::Ref<const Eigen::MatrixXd>& xs,
                    const Eigen::MatrixXd& weights, const Eigen::VectorXd& biases,
                    Eigen::Ref<Eigen::MatrixXd> out);

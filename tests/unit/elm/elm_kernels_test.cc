@@ -1,4 +1,4 @@
-// The ELM's dispatched row kernels (src/elm/kernels.h), each table on its own: the documented
+// The ELM's dispatched row kernels (src/elm/elm_kernels.h), each table on its own: the documented
 // order of operations to the bit, the vectorised exp against libm, row-position independence,
 // and agreement of the AVX2 + FMA and baseline builds to rounding.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/elm/elm.h"
 

@@ -1,4 +1,4 @@
-// The study's files (src/study/files.cc; named study_files_test, not files_test, because test
+// The study's files (src/study/study_files.cc; named study_files_test, not files_test, because test
 // targets are unit_<stem> and tests/unit/io/files_test.cc holds that name). From one small log
 // study: every CSV carries its result's numbers exactly (read back to the same doubles) under
 // the documented column names, in the order of the results; the record holds the run's stages;
@@ -16,7 +16,7 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/study_files.h"
 #include "gyrodrift/study/study.h"
 #include "unit/study/chamber_log.h"
 #include "study/study_steps.h"  // GroupOf, private to src/study

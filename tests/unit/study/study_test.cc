@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "gyrodrift/common/error.h"
-#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/study_files.h"
 #include "gyrodrift/study/table.h"
 #include "unit/study/chamber_log.h"
 #include "support/report_check.h"

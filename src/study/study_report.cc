@@ -6,7 +6,7 @@
 #include <string>
 
 #include "gyrodrift/simulation/gyro_noise.h"
-#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/study_files.h"
 #include "study_steps.h"
 
 namespace gyrodrift::study {

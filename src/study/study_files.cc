@@ -1,5 +1,5 @@
 // The study's files: CSV renderings of its data and tables, the record, and writing the set.
-#include "gyrodrift/study/files.h"
+#include "gyrodrift/study/study_files.h"
 
 #include <unistd.h>
 

@@ -1,5 +1,5 @@
 // Run-time choice of the ELM kernels (kernels.h).
-#include "elm/kernels.h"
+#include "elm/elm_kernels.h"
 
 namespace gyrodrift::elm::internal {
 
