@@ -312,6 +312,7 @@ struct Search {
   Eigen::VectorXd yc;  // the target centred on its logged mean, 0 where not logged
   std::unique_ptr<internal::FoldScores> scores;
   internal::SearchResult result;
+  internal::RunRegimes regimes;
 };
 
 // The calibration's description and folds in the report, then the structure search; the model
@@ -327,7 +328,8 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   report.records = static_cast<int>(run.record_starts.size()) + 1;
   const std::vector<ThermalSegment> segments = internal::RecordSegments(
       temperatures_c.col(0), model.rate_hz, options.ramp_rate_k_per_min, run.record_starts);
-  internal::DescribeRun(temperatures_c, model.rate_hz, segments, run.record_starts, report);
+  search.regimes =
+      internal::DescribeRun(temperatures_c, model.rate_hz, segments, run.record_starts, report);
   const std::vector<internal::FoldRows> folds =
       MakeFolds(temperatures_c.col(0), segments, weight, options);
   for (const internal::FoldRows& f : folds) {
@@ -541,7 +543,8 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
                                  .eigenvalues();
   model.report.condition =
       ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
-  internal::AddWarnings(model, options, search.result.fell_back_to_constant, model.report);
+  internal::AddWarnings(model, options, search.result.fell_back_to_constant, search.regimes,
+                        model.report);
   model.Validate();
   return model;
 }
