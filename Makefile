@@ -45,8 +45,8 @@ test-sanitize: deps
 	@cmake --build build-sanitize -j $(JOBS)
 	cd build-sanitize && $(SANITIZE_ENV) ctest --output-on-failure -j $(JOBS) -LE '^install$$'
 
-# libFuzzer on the CSV reader, the model-file loader, the option parsers and the calibration
-# manifest, FUZZ_SECONDS each,
+# libFuzzer on the CSV reader, the model-file loader, the option parsers, the calibration
+# manifest and the ULog reader, FUZZ_SECONDS each,
 # with AddressSanitizer and UndefinedBehaviorSanitizer; the corpora grow in build-fuzz/ (issue 14).
 FUZZ_SECONDS ?= 30
 FUZZ_SEED ?= 1
@@ -56,8 +56,8 @@ fuzz: deps
 		-DGYRODRIFT_BUILD_TESTS=OFF -DGYRODRIFT_BUILD_APPS=OFF -DGYRODRIFT_BUILD_FUZZ=ON \
 		-DGYRODRIFT_BUILD_PYTHON=OFF \
 		"-DCMAKE_CXX_FLAGS=$(FUZZ_FLAGS)" >/dev/null
-	@cmake --build build-fuzz -j $(JOBS) --target fuzz_csv fuzz_model_file fuzz_options fuzz_manifest
-	@for h in csv model_file options manifest; do \
+	@cmake --build build-fuzz -j $(JOBS) --target fuzz_csv fuzz_model_file fuzz_options fuzz_manifest fuzz_ulog
+	@for h in csv model_file options manifest ulog; do \
 		mkdir -p build-fuzz/corpus/$$h && cp tests/fuzz/corpus/$$h/* build-fuzz/corpus/$$h/ && \
 		./build-fuzz/tests/fuzz/fuzz_$$h -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -seed=$(FUZZ_SEED) -artifact_prefix=build-fuzz/ \
 			-print_final_stats=1 build-fuzz/corpus/$$h > build-fuzz/fuzz_$$h.log 2>&1 \

@@ -11,6 +11,8 @@ packages=(
   # The Python package (python/, docs/python.md): bindings, tests, the Dask fleet runner, examples.
   pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest
   python3-dask python3-distributed python3-matplotlib
+  # pip install . (pyproject.toml, setup.py): pip and the setuptools build backend.
+  python3-pip python3-setuptools
 )
 missing=()
 for p in "${packages[@]}"; do

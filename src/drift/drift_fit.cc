@@ -198,8 +198,11 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
       model.sub_models[g].thermal = std::make_shared<const ThermalRegression>(
           IdentifyThermalModel(temperature_c.topRows(fit_end),
                                series.col(static_cast<Eigen::Index>(g)).head(fit_end),
-                               o.features.rate_hz, o.thermal, !o.linear_compensation,
-                               SubModelSeed(o, g), record_starts, logged));
+                               o.features.rate_hz, o.thermal,
+                               {.record_starts = record_starts,
+                                .logged = logged,
+                                .nonlinear = !o.linear_compensation,
+                                .seed = SubModelSeed(o, g)}));
     }
     return;
   }

@@ -19,9 +19,14 @@ constexpr double kLeastSkill = 0.2;
 constexpr double kLargestCondition = 1e10;
 // Shorter than this, a log is not a calibration run: no regime can be held out.
 constexpr double kShortestCalibrationS = 3600.0;
-// A coil lags its case sensor by up to about an hour (our simulator: 40 min; the family's layer
-// chains: 10-60 min): a run whose slowest candidate state lags less cannot identify such a gyro.
-constexpr double kSlowLagS = 1800.0;
+
+// Adds v to `values` unless one of them is within `step` of it (a factor with `ratio`).
+void AddDistinct(double v, double step, bool ratio, std::vector<double>& values) {
+  for (double u : values) {
+    if (ratio ? std::max(u, v) < step * std::min(u, v) : std::abs(u - v) < step) return;
+  }
+  values.push_back(v);
+}
 
 }  // namespace
 
@@ -42,32 +47,50 @@ std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorX
   return all;
 }
 
-void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
-                 const std::vector<ThermalSegment>& segments,
-                 const std::vector<Eigen::Index>& record_starts, CalibrationReport& report) {
+RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
+                       const std::vector<ThermalSegment>& segments,
+                       const std::vector<Eigen::Index>& record_starts, CalibrationReport& report) {
   const double dt = 1.0 / rate_hz;
   for (Eigen::Index c = 0; c < temperatures_c.cols(); ++c) {
     report.span_k.push_back(temperatures_c.col(c).maxCoeff() - temperatures_c.col(c).minCoeff());
   }
-  for (const ThermalSegment& s : segments) {
-    if (s.ramp) {
-      ++report.ramps;
-    } else if (static_cast<double>(s.end - s.begin) * dt >= kShortestDwellS) {
-      ++report.dwells;
-    }
-  }
-  ForEachRecord(temperatures_c.rows(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
-    const auto t = temperatures_c.col(0).segment(begin, length);
+  // Channel 0's 60-s smoothed rate, K/min, restarting with every record.
+  const auto t0 = temperatures_c.col(0);
+  Eigen::VectorXd rate(t0.size());
+  ForEachRecord(t0.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    const auto t = t0.segment(begin, length);
     Eigen::VectorXd smooth(length);
     FirstOrderLag(t, kRateSmoothingS, dt, smooth);
-    const Eigen::VectorXd rate = (t - smooth) * (60.0 / kRateSmoothingS);
-    report.max_heating_k_per_min = std::max(report.max_heating_k_per_min, rate.maxCoeff());
-    report.max_cooling_k_per_min = std::max(report.max_cooling_k_per_min, -rate.minCoeff());
+    rate.segment(begin, length) = (t - smooth) * (60.0 / kRateSmoothingS);
   });
+  if (rate.size() > 0) {
+    report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
+    report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
+  }
+  // A ramp's rate is its steepest (the programme's; a sensor behind a case approaches the end of
+  // a ramp slowly), a dwell's level its mean.
+  RunRegimes regimes;
+  const double level_step = std::max(kDistinctLevelK, kDistinctLevelShare * report.span_k[0]);
+  for (const ThermalSegment& s : segments) {
+    const double length_s = static_cast<double>(s.end - s.begin) * dt;
+    if (s.ramp) {
+      ++report.ramps;
+      const auto r = rate.segment(s.begin, s.end - s.begin);
+      const bool heating = t0[s.end - 1] > t0[s.begin];
+      AddDistinct(heating ? r.maxCoeff() : -r.minCoeff(), kDistinctRateFactor, /*ratio=*/true,
+                  heating ? regimes.heating_k_per_min : regimes.cooling_k_per_min);
+    } else if (length_s >= kShortestDwellS) {
+      ++report.dwells;
+      AddDistinct(t0.segment(s.begin, s.end - s.begin).mean(), level_step, /*ratio=*/false,
+                  regimes.dwell_levels_c);
+    }
+  }
+  return regimes;
 }
 
 void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                 bool fell_back_to_constant, CalibrationReport& report) {
+                 bool fell_back_to_constant, const RunRegimes& regimes,
+                 CalibrationReport& report) {
   auto& w = report.warnings;
   auto& advice = report.advice;
   if (report.duration_s < kShortestCalibrationS) {
@@ -103,11 +126,20 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
     w.push_back(
         "no dwell of 10 min or more: the level response cannot be told from the rate response");
   }
-  if (report.dwells < 3) {
+  const int levels = static_cast<int>(regimes.dwell_levels_c.size());
+  if (levels < 3) {
     advice.push_back(
-        Format("%d dwell%s: hold 30 min or more at 3 or more temperatures across the "
-               "range",
-               report.dwells, report.dwells == 1 ? "" : "s"));
+        Format("dwells at %d temperature%s: hold 30 min or more at 3 or more temperatures across "
+               "the range",
+               levels, levels == 1 ? "" : "s"));
+  }
+  const std::pair<const std::vector<double>*, const char*> directions[] = {
+      {&regimes.heating_k_per_min, "heating"}, {&regimes.cooling_k_per_min, "cooling"}};
+  for (const auto& [rates, name] : directions) {
+    if (rates->size() != 1) continue;
+    advice.push_back(Format("%s at one rate (%.2g K/min): add a %s ramp at about half or twice "
+                            "it, so that the rate terms are told from the level",
+                            name, rates->front(), name));
   }
   if (report.ramps + report.dwells < 3) {
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");

@@ -19,13 +19,31 @@ std::vector<ThermalSegment> RecordSegments(const Eigen::Ref<const Eigen::VectorX
                                            double rate_hz, double ramp_rate_k_per_min,
                                            const std::vector<Eigen::Index>& record_starts);
 
-// Span of every channel, heating and cooling rates, ramps and dwells (channel 0 for the latter).
-void DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
-                 const std::vector<ThermalSegment>& segments,
-                 const std::vector<Eigen::Index>& record_starts, CalibrationReport& report);
+// A coil lags its case sensor by up to about an hour (our simulator: 40 min; the family's layer
+// chains: 10-60 min): a run whose slowest candidate state lags less cannot identify such a gyro.
+inline constexpr double kSlowLagS = 1800.0;
+// Two ramp rates of one direction differ by this factor or more to count as two rates (a plan's
+// rates r and r/2 reach a case sensor as about 1.1 and 0.76 K/min in the simulator), and two
+// dwells by this share of the span (at least kDistinctLevelK) to count as two levels.
+inline constexpr double kDistinctRateFactor = 1.25;
+inline constexpr double kDistinctLevelShare = 0.1;
+inline constexpr double kDistinctLevelK = 5.0;
+
+// The distinct regimes of a run, what a calibration plan asks for (gyrodrift plan): the mean
+// rates of its heating and cooling ramps (K/min, positive) and the levels of its dwells (degC).
+struct RunRegimes {
+  std::vector<double> heating_k_per_min, cooling_k_per_min, dwell_levels_c;
+};
+
+// Span of every channel, heating and cooling rates, ramps and dwells (channel 0 for the latter);
+// returns the distinct regimes.
+RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, double rate_hz,
+                       const std::vector<ThermalSegment>& segments,
+                       const std::vector<Eigen::Index>& record_starts, CalibrationReport& report);
 
 // The warnings of what the run cannot identify, and the advice of what to add.
 void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                 bool fell_back_to_constant, CalibrationReport& report);
+                 bool fell_back_to_constant, const RunRegimes& regimes,
+                 CalibrationReport& report);
 
 }  // namespace gyrodrift::drift::internal

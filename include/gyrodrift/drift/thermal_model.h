@@ -242,25 +242,32 @@ struct ThermalRegression {
   Eigen::VectorXd EstimateOf(const Eigen::Ref<const Eigen::MatrixXd>& regressors) const;
 };
 
-// Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz; with
-// `nonlinear`, also tries the correction above (its hidden weights drawn from a seed derived from
-// `seed` through the named stream "thermal-correction").
-// Several records (calibration runs, or one log split at its gaps) are given one after the other,
-// with record_starts the first sample of every record after the first (CheckRecordStarts): the
-// lag states restart at each (from the record's first temperature, as at the start of a run), so
-// no state runs across the break, and no ramp or dwell spans two records; the regressors of all
-// records are fitted together.
-// `logged` (empty, or one flag per sample): false marks a sample made up across a gap of a
-// duty-cycled log (interpolated temperature, so the lag states run across the gap); the fit, the
-// folds and every figure of the report use the logged samples only, and y is not read elsewhere.
-// Throws DataError for a record the cross-validation cannot split (fewer than 2 folds of at least
-// 16 logged samples) or non-finite samples; UsageError for bad options, or the nonlinear option
-// with samples made up.
+// How one identification runs, beside its options: the layout of the calibration's samples and
+// the optional nonlinear correction.
+struct ThermalIdentification {
+  // Several records (calibration runs, or one log split at its gaps) are given one after the
+  // other, with record_starts the first sample of every record after the first
+  // (CheckRecordStarts): the lag states restart at each (from the record's first temperature, as
+  // at the start of a run), so no state runs across the break, and no ramp or dwell spans two
+  // records; the regressors of all records are fitted together.
+  std::vector<Eigen::Index> record_starts;
+  // Empty, or one flag per sample: false marks a sample made up across a gap of a duty-cycled
+  // log (interpolated temperature, so the lag states run across the gap); the fit, the folds and
+  // every figure of the report use the logged samples only, and y is not read elsewhere.
+  std::vector<bool> logged;
+  // Also try the correction of the header comment, its hidden weights drawn from a seed derived
+  // from `seed` through the named stream "thermal-correction".
+  bool nonlinear = false;
+  std::uint64_t seed = 1;
+};
+
+// Identifies the model of y (N) from temperatures (N x C, degC) sampled at rate_hz
+// (thermal_identify.cc). Throws DataError for a record the cross-validation cannot split (fewer
+// than 2 folds of at least 16 logged samples) or non-finite samples; UsageError for bad options,
+// or the nonlinear option with samples made up.
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                                        const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
-                                       const ThermalModelOptions& options, bool nonlinear = false,
-                                       std::uint64_t seed = 1,
-                                       const std::vector<Eigen::Index>& record_starts = {},
-                                       const std::vector<bool>& logged = {});
+                                       const ThermalModelOptions& options,
+                                       const ThermalIdentification& run = {});
 
 }  // namespace gyrodrift::drift

@@ -94,7 +94,7 @@ TEST(ThermalModel, SeveralRecordsRestartTheirStates) {
   for (Eigen::Index i = 0; i < y.size(); ++i) y[i] = drift[i] + 0.2 * rng.Normal();
   const std::vector<Eigen::Index> starts{n};
 
-  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, starts);
+  const ThermalRegression m = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.record_starts = starts});
   EXPECT_EQ(m.report.records, 2);
   EXPECT_NE(m.report.Summary().find("in 2 records"), std::string::npos) << m.report.Summary();
   auto rms = [&](const Eigen::VectorXd& e) {
@@ -111,7 +111,7 @@ TEST(ThermalModel, SeveralRecordsRestartTheirStates) {
   EXPECT_EQ(joined.report.records, 1);
   EXPECT_GT(rms(joined.Estimate(t)), 2.0 * with_records) << joined.Summary();
   // Record starts out of order or out of range are refused.
-  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {n, n}),
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.record_starts = {n, n}}),
                DataError);
   EXPECT_THROW(m.Estimate(t, {0}), DataError);
   EXPECT_THROW(m.Estimate(t, {2 * n}), DataError);
@@ -380,20 +380,20 @@ TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
     logged[static_cast<size_t>(i)] = i % 300 < 5;
   }
   const ThermalRegression m =
-      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {}, logged);
+      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.logged = logged});
   Eigen::VectorXd garbage = y;
   for (Eigen::Index i = 0; i < t.size(); ++i) {
     if (!logged[static_cast<size_t>(i)]) garbage[i] = 1e3;
   }
   const ThermalRegression g =
-      IdentifyThermalModel(t, garbage, 1.0, ThermalModelOptions{}, false, 1, {}, logged);
+      IdentifyThermalModel(t, garbage, 1.0, ThermalModelOptions{}, {.logged = logged});
   EXPECT_EQ(g.coefficients, m.coefficients);
   const double rms =
       std::sqrt((m.Estimate(t) - drift).squaredNorm() / static_cast<double>(t.size()));
   EXPECT_LT(rms, 0.02) << m.Summary();
-  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, true, 1, {}, logged),
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.logged = logged, .nonlinear = true}),
                UsageError);
-  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, false, 1, {}, {true}),
+  EXPECT_THROW(IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.logged = {true}}),
                DataError);
 }
 

@@ -1,0 +1,552 @@
+// The identification of a thermal model from its calibration run (thermal_model.h): the candidate
+// design, the folds, the structure search (thermal_search.h), the refit of the chosen columns with
+// their uncertainty, the optional nonlinear correction and the calibration report
+// (thermal_report.h).
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numeric>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/random.h"
+#include "gyrodrift/drift/features.h"
+#include "gyrodrift/drift/thermal_model.h"
+#include "gyrodrift/elm/elm.h"
+#include "thermal_columns.h"
+#include "thermal_report.h"
+#include "thermal_search.h"
+
+namespace gyrodrift::drift {
+namespace {
+
+using internal::HysteresisColumns;
+using internal::StateColumns;
+using internal::StaticColumns;
+
+constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
+constexpr double kShortBlockS = 10.0;        // blocks that measure the residual's fast noise
+constexpr Eigen::Index kShortestFold = 16;   // logged samples
+// Held-out regimes beyond this many are grouped with their neighbours (the search's cost grows
+// with the folds).
+constexpr int kMostRegimeFolds = 24;
+// The range ends held out: the top and the bottom fifth of channel 0's span.
+constexpr double kRangeEndShare = 0.2;
+// The skill needs this many 10-min blocks of residual to tell slow error from noise.
+constexpr int kLeastSkillBlocks = 4;
+// Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
+constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
+constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
+
+// Standard deviation about the mean (population).
+double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  return std::sqrt((x.array() - x.mean()).square().mean());
+}
+
+// A partition of the run into folds: contiguous groups of whole units (regimes or time blocks),
+// cut at the unit boundaries nearest to i N / K, i = 1..K-1; each fold a range [first, last) of
+// unit indices. Fewer folds when units are few.
+std::vector<std::pair<int, int>> Partition(const std::vector<ThermalSegment>& segments,
+                                           Eigen::Index n, int k) {
+  std::vector<int> cuts{0};
+  const int count = static_cast<int>(segments.size());
+  for (int i = 1; i < k; ++i) {
+    const double ideal = static_cast<double>(n) * i / k;
+    int best = 0;
+    double best_distance = std::numeric_limits<double>::infinity();
+    for (int j = 1; j < count; ++j) {
+      const double d = std::abs(static_cast<double>(segments[static_cast<size_t>(j)].begin) - ideal);
+      if (d < best_distance) {
+        best_distance = d;
+        best = j;
+      }
+    }
+    if (best > cuts.back()) cuts.push_back(best);
+  }
+  cuts.push_back(count);
+  std::vector<std::pair<int, int>> folds;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) folds.emplace_back(cuts[i], cuts[i + 1]);
+  return folds;
+}
+
+// Equal time blocks as segments, for a run with too few regimes.
+std::vector<ThermalSegment> TimeBlocks(Eigen::Index n, int k) {
+  std::vector<ThermalSegment> blocks;
+  k = static_cast<int>(std::min<Eigen::Index>(k, n / kShortestFold));
+  for (int i = 0; i < k; ++i) blocks.push_back({n * i / k, n * (i + 1) / k, false});
+  return blocks;
+}
+
+// Mean of squares of the block means of x over blocks of `block` samples, each mean taken over the
+// block's logged samples (weight 1; 0 = made up across a gap), blocks without one left out.
+double BlockMeanSquare(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block,
+                       const Eigen::Ref<const Eigen::VectorXd>& weight,
+                       double* logged_per_block = nullptr) {
+  const Eigen::Index blocks = std::max<Eigen::Index>(1, x.size() / block);
+  if (x.size() < block) block = x.size();
+  double sum = 0.0;
+  int counted = 0;
+  for (Eigen::Index i = 0; i < blocks; ++i) {
+    const double w = weight.segment(i * block, block).sum();
+    if (w <= 0.0) continue;
+    const double m = x.segment(i * block, block).dot(weight.segment(i * block, block)) / w;
+    sum += m * m;
+    ++counted;
+  }
+  if (logged_per_block) *logged_per_block = counted > 0 ? weight.sum() / counted : 0.0;
+  return counted > 0 ? sum / counted : 0.0;
+}
+
+// Every candidate column (internal::DesignLayout): the intercept, per channel its static powers
+// 1..max_power, then per candidate state its powers, its rate and H_w for each of widths_k (each
+// candidate learning its ranges; the model its channels' static ranges).
+Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                double rate_hz, const std::vector<Eigen::Index>& record_starts,
+                                ThermalRegression& model, const internal::DesignLayout& layout,
+                                const std::vector<double>& widths_k, bool heating, bool cooling,
+                                std::vector<ThermalState>& candidates) {
+  const int channels = static_cast<int>(temperatures_c.cols());
+  Eigen::MatrixXd x(temperatures_c.rows(), layout.StateColumn(layout.candidates, 0));
+  Eigen::VectorXd level;
+  x.col(0).setOnes();
+  for (int c = 0; c < channels; ++c) {
+    const auto cu = static_cast<size_t>(c);
+    const Eigen::VectorXd z =
+        (temperatures_c.col(c).array() - model.centre_c[cu]) / model.scale_k[cu];
+    model.static_min.push_back(z.minCoeff());
+    model.static_max.push_back(z.maxCoeff());
+    StaticColumns(z, layout.static_powers, model.static_min[cu], model.static_max[cu],
+                  x.middleCols(layout.StaticColumn(c, 1), layout.static_powers));
+  }
+  for (size_t j = 0; j < candidates.size(); ++j) {
+    const auto c = static_cast<size_t>(candidates[j].channel);
+    StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
+                 model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
+                 /*learn_range=*/true, /*hold_rate=*/false, record_starts, widths_k,
+                 x.middleCols(layout.StateColumn(static_cast<int>(j), 0),
+                              layout.state_columns + layout.widths),
+                 level);
+    // The rates' support is their sign: a direction the run showed extrapolates (the Shupe and
+    // gradient terms are linear in the rates), one it never showed is held at the edge.
+    if (heating) candidates[j].rate_max = std::numeric_limits<double>::infinity();
+    if (cooling) candidates[j].rate_min = -std::numeric_limits<double>::infinity();
+  }
+  return x;
+}
+
+// The folds of thermal_model.h: equal time blocks (or groups of whole regimes with
+// folds_at_regimes), every regime held out in turn (neighbours grouped beyond kMostRegimeFolds),
+// the top and the bottom fifth of channel 0's range. Folds with fewer than kShortestFold logged
+// samples, or leaving fewer to train on, are dropped.
+std::vector<internal::FoldRows> MakeFolds(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                                          const std::vector<ThermalSegment>& segments,
+                                          const Eigen::VectorXd& weight,
+                                          const ThermalModelOptions& options) {
+  using internal::FoldRows;
+  const Eigen::Index n = temperature_c.size();
+  std::vector<FoldRows> folds;
+  std::vector<ThermalSegment> units = TimeBlocks(n, options.folds);
+  if (options.folds_at_regimes && Partition(segments, n, options.folds).size() >= 3) {
+    units = segments;
+  }
+  for (const auto& [first, last] : Partition(units, n, options.folds)) {
+    folds.push_back({internal::kTimeBlocks,
+                     {{units[static_cast<size_t>(first)].begin,
+                       units[static_cast<size_t>(last - 1)].end}}});
+  }
+  if (segments.size() >= 2) {
+    for (const auto& [first, last] : Partition(segments, n, kMostRegimeFolds)) {
+      folds.push_back({internal::kRegimes,
+                       {{segments[static_cast<size_t>(first)].begin,
+                         segments[static_cast<size_t>(last - 1)].end}}});
+    }
+  }
+  const double lo = temperature_c.minCoeff(), hi = temperature_c.maxCoeff();
+  const double edge = kRangeEndShare * (hi - lo);
+  for (bool top : {true, false}) {
+    FoldRows f{internal::kRangeEnds, {}};
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const bool in = top ? temperature_c[i] >= hi - edge : temperature_c[i] <= lo + edge;
+      if (!in) continue;
+      if (!f.ranges.empty() && f.ranges.back().second == i) {
+        f.ranges.back().second = i + 1;
+      } else {
+        f.ranges.emplace_back(i, i + 1);
+      }
+    }
+    folds.push_back(std::move(f));
+  }
+  const double total = weight.sum();
+  std::vector<FoldRows> kept;
+  for (FoldRows& f : folds) {
+    double logged = 0.0;
+    for (const auto& [begin, end] : f.ranges) logged += weight.segment(begin, end - begin).sum();
+    if (logged >= kShortestFold && total - logged >= kShortestFold) kept.push_back(std::move(f));
+  }
+  return kept;
+}
+
+// The nonlinear correction of the header comment: its candidates on one shared hidden layer of
+// the chosen regressors xs (intercept left out), scored against each fold's linear fit on the
+// time-block folds (each one range; every sample logged). Null when none lowers the
+// cross-validated error; the report says what was tried.
+std::shared_ptr<const Learner> FitCorrection(const internal::FoldScores& cv,
+                                             const Eigen::MatrixXd& xs, const Eigen::MatrixXd& z,
+                                             const Eigen::VectorXd& yc,
+                                             const internal::Subset& subset,
+                                             const Eigen::VectorXd& residual, std::uint64_t seed,
+                                             CalibrationReport& report) {
+  const Eigen::Index n = xs.rows();
+  elm::ElmOptions eo;
+  eo.hidden_units = kCorrectionUnits.back();
+  eo.ridge_c = 1.0;
+  eo.seed = SeedFor(seed, "thermal-correction");
+  const Execution one_thread{.threads = 1};
+  const elm::ElmFit widest = elm::Fit(z, yc, eo, one_thread);
+  const Eigen::MatrixXd h = elm::HiddenLayer(widest.model, z, 1);
+  const Eigen::MatrixXd hth = h.transpose() * h;
+  std::vector<double> error(kCorrectionUnits.size() * kCorrectionRidge.size(), 0.0);
+  double linear_error = 0.0;
+  for (const internal::FoldScores::Fold& f : cv.folds()) {
+    if (f.scheme != internal::kTimeBlocks) continue;
+    const auto [begin, end] = f.ranges.front();
+    const Eigen::VectorXd r = yc - xs * cv.Weights(f, subset.cols);
+    const Eigen::Index len = end - begin;
+    const auto r_fold = r.segment(begin, len);
+    // The network's target: the training part's residual, standardised as elm::Fit does.
+    const double mean = (r.sum() - r_fold.sum()) / static_cast<double>(n - len);
+    const double sd = std::sqrt(std::max(
+        ((r.array() - mean).square().sum() - (r_fold.array() - mean).square().sum()) /
+            static_cast<double>(n - len),
+        std::numeric_limits<double>::min()));
+    const Eigen::VectorXd t = (r.array() - mean) / sd;
+    const auto h_fold = h.middleRows(begin, len);
+    const Eigen::MatrixXd hth_train = hth - h_fold.transpose() * h_fold;
+    const Eigen::VectorXd ht_train =
+        h.transpose() * t - h_fold.transpose() * t.segment(begin, len);
+    linear_error += r_fold.squaredNorm();
+    size_t i = 0;
+    for (int units : kCorrectionUnits) {
+      for (double c : kCorrectionRidge) {
+        Eigen::MatrixXd a = hth_train.topLeftCorner(units, units);
+        a.diagonal().array() += 1.0 / c;
+        const Eigen::VectorXd beta = a.ldlt().solve(ht_train.head(units));
+        const Eigen::VectorXd predicted = (h_fold.leftCols(units) * beta).array() * sd + mean;
+        error[i++] += (r_fold - predicted).squaredNorm();
+      }
+    }
+  }
+  const size_t chosen =
+      static_cast<size_t>(std::min_element(error.begin(), error.end()) - error.begin());
+  report.cv_rmse_nonlinear = std::sqrt(error[chosen] / static_cast<double>(n));
+  if (!(error[chosen] < linear_error)) return nullptr;
+  LearnerOptions lo;
+  lo.kind = LearnerKind::kElm;
+  lo.elm.selection = elm::Selection::kFixed;
+  lo.elm.hidden_units = kCorrectionUnits[chosen / kCorrectionRidge.size()];
+  lo.elm.ridge_c = kCorrectionRidge[chosen % kCorrectionRidge.size()];
+  lo.seed = eo.seed;
+  report.nonlinear_units = lo.elm.hidden_units;
+  report.nonlinear_ridge_c = lo.elm.ridge_c;
+  return FitLearner(z, residual, lo, one_thread);
+}
+
+// Samples in a block of `seconds`, at least 1 and at most a quarter of the run.
+Eigen::Index BlockSamples(double seconds, double rate_hz, Eigen::Index n) {
+  return std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::round(seconds * rate_hz)), 1,
+                                  std::max<Eigen::Index>(1, n / 4));
+}
+
+// The logged-sample weights (1 logged, 0 made up across a gap), after checking the inputs.
+Eigen::VectorXd CheckedWeights(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                               const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
+                               const ThermalModelOptions& options,
+                               const ThermalIdentification& run) {
+  options.Validate();
+  RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
+  const Eigen::Index n = y.size();
+  const int channels = static_cast<int>(temperatures_c.cols());
+  if (channels < 1 || temperatures_c.rows() != n) {
+    throw DataError("thermal identification needs temperature columns of " + std::to_string(n) +
+                    " samples (the target's), got " + std::to_string(temperatures_c.rows()) +
+                    " x " + std::to_string(channels));
+  }
+  if (!run.logged.empty() && static_cast<Eigen::Index>(run.logged.size()) != n) {
+    throw DataError("thermal identification: " + std::to_string(run.logged.size()) +
+                    " logged-sample flags for " + std::to_string(n) + " samples");
+  }
+  Eigen::VectorXd weight = Eigen::VectorXd::Ones(n);
+  for (size_t i = 0; i < run.logged.size(); ++i) {
+    weight[static_cast<Eigen::Index>(i)] = run.logged[i];
+  }
+  const double n_logged = weight.sum();
+  RequireFiniteSignal("target", y, 2 * kShortestFold);
+  if (n_logged < 2 * kShortestFold) {
+    throw DataError("calibration run of " + std::to_string(static_cast<long>(n_logged)) +
+                    " logged samples is too short to cross-validate a thermal model (at least " +
+                    std::to_string(2 * kShortestFold) + " needed)");
+  }
+  if (run.nonlinear && n_logged < static_cast<double>(n)) {
+    throw UsageError("the nonlinear correction needs every sample logged (no gaps carried)");
+  }
+  CheckRecordStarts(run.record_starts, n);
+  for (int c = 0; c < channels; ++c) {
+    RequireFiniteSignal("temperature", temperatures_c.col(c), n);
+    RequireVaryingSignal("temperature", temperatures_c.col(c),
+                         "a thermal model needs a calibration run whose temperature changes");
+  }
+  return weight;
+}
+
+// One identification's working set: the candidate design and its fold scores.
+struct Search {
+  std::vector<ThermalState> candidates;
+  std::vector<double> widths_k;
+  internal::DesignLayout layout;
+  Eigen::MatrixXd x;
+  Eigen::VectorXd yc;  // the target centred on its logged mean, 0 where not logged
+  std::unique_ptr<internal::FoldScores> scores;
+  internal::SearchResult result;
+  internal::RunRegimes regimes;
+};
+
+// The calibration's description and folds in the report, then the structure search; the model
+// takes the chosen structure (its coefficients come from RefitChosen).
+void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                     const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::VectorXd& weight,
+                     const ThermalModelOptions& options, const ThermalIdentification& run,
+                     ThermalRegression& model, Search& search) {
+  const Eigen::Index n = y.size();
+  const int channels = static_cast<int>(temperatures_c.cols());
+  CalibrationReport& report = model.report;
+  report.duration_s = static_cast<double>(n) / model.rate_hz;
+  report.records = static_cast<int>(run.record_starts.size()) + 1;
+  const std::vector<ThermalSegment> segments = internal::RecordSegments(
+      temperatures_c.col(0), model.rate_hz, options.ramp_rate_k_per_min, run.record_starts);
+  search.regimes =
+      internal::DescribeRun(temperatures_c, model.rate_hz, segments, run.record_starts, report);
+  const std::vector<internal::FoldRows> folds =
+      MakeFolds(temperatures_c.col(0), segments, weight, options);
+  for (const internal::FoldRows& f : folds) {
+    report.folds += f.scheme == internal::kTimeBlocks;
+    report.regime_folds += f.scheme == internal::kRegimes;
+    report.range_folds += f.scheme == internal::kRangeEnds;
+  }
+  if (report.folds < 2) {
+    throw DataError("calibration run of " + std::to_string(n) +
+                    " samples is too short to cross-validate a thermal model (at least " +
+                    std::to_string(2 * kShortestFold) + " logged samples in each of 2 blocks)");
+  }
+  for (int c = 0; c < channels; ++c) {
+    for (double tau : options.Grid(report.duration_s)) search.candidates.push_back({c, tau});
+  }
+  report.hysteresis_tried = options.TriesHysteresis(report.duration_s);
+  if (report.hysteresis_tried) search.widths_k = options.hysteresis_widths_k;
+  search.layout = {channels, options.max_power, static_cast<int>(search.candidates.size()),
+                   options.max_power + 1, static_cast<int>(search.widths_k.size())};
+  const bool heating = report.max_heating_k_per_min >= 2.0 * options.ramp_rate_k_per_min;
+  const bool cooling = report.max_cooling_k_per_min >= 2.0 * options.ramp_rate_k_per_min;
+  search.x = CandidateDesign(temperatures_c, model.rate_hz, run.record_starts, model,
+                             search.layout, search.widths_k, heating, cooling, search.candidates);
+  const double mean = y.dot(weight) / weight.sum();
+  search.yc = ((y.array() - mean) * weight.array()).matrix();
+  // The choice is scored on the time blocks; the held-out regimes and range ends are reported
+  // (scoring or gating on them chose worse models on the family: docs/drift.md 4.8).
+  search.scores = std::make_unique<internal::FoldScores>(search.x, search.yc, weight, folds,
+                                                         1u << internal::kTimeBlocks);
+  search.result = internal::SearchStructure(
+      *search.scores, search.layout,
+      {options.max_states, options.max_condition, options.standard_errors, heating != cooling});
+  const internal::Subset& best = search.result.chosen;
+  model.static_power.assign(static_cast<size_t>(channels), best.static_power);
+  for (int j : best.states) model.states.push_back(search.candidates[static_cast<size_t>(j)]);
+  if (best.hysteresis_state >= 0) {
+    model.hysteresis_state = best.hysteresis_state;
+    model.hysteresis_width_k = search.widths_k[static_cast<size_t>(best.hysteresis_width)];
+  }
+}
+
+// The search's held-out errors in the report: the chosen structure's, the best level's and the
+// references', on the time blocks and on the held-out regimes and range ends.
+void ReportHeldOut(const Search& search, CalibrationReport& report) {
+  const internal::SearchResult& s = search.result;
+  report.level = s.chosen.level;
+  report.best_level = s.best_level;
+  report.held_out_rmse = std::sqrt(s.chosen.score);
+  report.held_out_rmse_constant = std::sqrt(s.constant.score);
+  report.held_out_rmse_static = std::sqrt(s.static_cubic.score);
+  report.held_out_rmse_best = std::sqrt(s.best_score);
+  if (report.regime_folds + report.range_folds == 0) return;
+  auto regimes = [&](const internal::Subset& subset) {
+    const Eigen::VectorXd every = search.scores->Scores(subset.cols, /*every_fold=*/true);
+    const int r = report.regime_folds > 0, e = report.range_folds > 0;
+    return std::sqrt((search.scores->SchemeMean(every, internal::kRegimes) * r +
+                      search.scores->SchemeMean(every, internal::kRangeEnds) * e) /
+                     (r + e));
+  };
+  report.regime_rmse = regimes(s.chosen);
+  report.regime_rmse_constant = regimes(s.constant);
+  report.regime_rmse_static = regimes(s.static_cubic);
+}
+
+// The chosen columns refitted on the logged samples (QR of the unit-scaled design), in the
+// model's coefficient slots (a state whose rate did not enter keeps a rate coefficient of 0), with
+// their covariance: the residual variance inflated by its correlation (batch means over
+// kBlockS). Returns the residual at every row (0 where not logged).
+Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
+                            const Eigen::VectorXd& weight, const Search& search,
+                            ThermalRegression& model, Eigen::MatrixXd& gram) {
+  const internal::Subset& best = search.result.chosen;
+  const Eigen::Index n = y.size();
+  const Eigen::Index p = static_cast<Eigen::Index>(best.cols.size());
+  const Eigen::Index rows = static_cast<Eigen::Index>(weight.sum());
+  Eigen::MatrixXd xs(rows, p);
+  Eigen::VectorXd ys(rows);
+  for (Eigen::Index i = 0, r = 0; i < n; ++i) {
+    if (weight[i] <= 0.0) continue;
+    for (Eigen::Index k = 0; k < p; ++k) xs(r, k) = search.x(i, best.cols[static_cast<size_t>(k)]);
+    ys[r++] = y[i];
+  }
+  Eigen::VectorXd scale(p);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    scale[i] = 1.0 / std::max(xs.col(i).norm(), std::numeric_limits<double>::min());
+  }
+  const Eigen::MatrixXd xn = xs * scale.asDiagonal();
+  const Eigen::VectorXd fitted =
+      scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xn).solve(ys);
+  // Where each fitted column sits among the model's m regressors.
+  std::vector<Eigen::Index> slot;
+  Eigen::Index k = 1 + best.static_power * model.channels();
+  for (Eigen::Index i = 0; i < k; ++i) slot.push_back(i);
+  for (size_t j = 0; j < best.states.size(); ++j, k += model.max_power + 1) {
+    for (int q = 0; q < model.max_power + (best.rates ? 1 : 0); ++q) slot.push_back(k + q);
+  }
+  if (best.hysteresis_state >= 0) slot.push_back(k++);
+  model.coefficients = Eigen::VectorXd::Zero(k);
+  for (Eigen::Index i = 0; i < p; ++i) model.coefficients[slot[static_cast<size_t>(i)]] = fitted[i];
+
+  Eigen::VectorXd residual = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd r = ys - xs * fitted;
+  const double r_mean = r.mean();
+  for (Eigen::Index i = 0, j = 0; i < n; ++i) {
+    if (weight[i] > 0.0) residual[i] = r[j++] - r_mean;
+  }
+  const double variance =
+      residual.squaredNorm() / std::max(1.0, static_cast<double>(rows - p));
+  double logged_per_block = 0.0;
+  const double block_ms =
+      BlockMeanSquare(residual, BlockSamples(kBlockS, model.rate_hz, n), weight, &logged_per_block);
+  const double inflation =
+      variance > 0.0 ? std::max(1.0, logged_per_block * block_ms / variance) : 1.0;
+  gram = xn.transpose() * xn;
+  const Eigen::MatrixXd covariance = scale.asDiagonal() *
+                                     gram.ldlt().solve(Eigen::MatrixXd::Identity(p, p)) *
+                                     scale.asDiagonal() * (variance * inflation);
+  model.covariance = Eigen::MatrixXd::Zero(k, k);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    for (Eigen::Index j = 0; j < p; ++j) {
+      model.covariance(slot[static_cast<size_t>(i)], slot[static_cast<size_t>(j)]) =
+          covariance(i, j);
+    }
+  }
+  return residual;
+}
+
+// The slow part of the cross-validated residual (model.cv_slow_sd) and the skill against the
+// constant on it: the block means' mean square less what the fast noise contributes to them,
+// from the means of kShortBlockS blocks scaled to a block's logged samples (exact for white
+// noise, and not fooled by the anti-correlated quantization noise that first differences would
+// count as white).
+void SlowErrorAndSkill(const Eigen::VectorXd& residual, const Eigen::VectorXd& weight,
+                       const Search& search, ThermalRegression& model) {
+  const Eigen::Index n = residual.size();
+  const Eigen::Index block = BlockSamples(kBlockS, model.rate_hz, n);
+  const Eigen::Index short_block =
+      std::min(block, BlockSamples(kShortBlockS, model.rate_hz, n));
+  double logged_per_block = 0.0, logged_per_short_block = 0.0;
+  BlockMeanSquare(residual, block, weight, &logged_per_block);
+  const double short_ms = BlockMeanSquare(residual, short_block, weight, &logged_per_short_block);
+  const double white_share =
+      logged_per_block > 0.0 ? short_ms * logged_per_short_block / logged_per_block : 0.0;
+  auto slow_ms = [&](const std::vector<int>& cols) {
+    return std::max(0.0, BlockMeanSquare(search.scores->TimeResidual(cols), block, weight) -
+                             white_share);
+  };
+  const double chosen_ms = slow_ms(search.result.chosen.cols);
+  const double constant_ms = slow_ms({0});
+  model.cv_slow_sd = std::sqrt(chosen_ms);
+  CalibrationReport& report = model.report;
+  report.cv_rmse = std::sqrt(search.scores->TimeMse(search.result.chosen.cols));
+  report.cv_rmse_constant = std::sqrt(search.scores->TimeMse({0}));
+  if (static_cast<double>(n) < kLeastSkillBlocks * kBlockS * model.rate_hz) {
+    report.skill = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    report.skill = constant_ms > 0.0 ? 1.0 - chosen_ms / constant_ms : 0.0;
+  }
+}
+
+// The nonlinear correction (header comment) on the chosen structure's residual. The network
+// sees every regressor of the model but the intercept (a rate that did not enter included: the
+// model's columns are what Estimate hands it).
+void AddCorrection(const Eigen::VectorXd& residual, std::uint64_t seed, const Search& search,
+                   ThermalRegression& model) {
+  const internal::Subset& best = search.result.chosen;
+  const internal::DesignLayout& layout = search.layout;
+  std::vector<int> model_cols;
+  for (int c = 0; c < model.channels(); ++c) {
+    for (int q = 1; q <= best.static_power; ++q) model_cols.push_back(layout.StaticColumn(c, q));
+  }
+  for (int j : best.states) {
+    for (int q = 0; q <= model.max_power; ++q) model_cols.push_back(layout.StateColumn(j, q));
+  }
+  if (best.hysteresis_state >= 0) {
+    model_cols.push_back(layout.WidthColumn(
+        best.states[static_cast<size_t>(best.hysteresis_state)], best.hysteresis_width));
+  }
+  model.correction =
+      FitCorrection(*search.scores, search.x(Eigen::all, best.cols),
+                    search.x(Eigen::all, model_cols), search.yc, best, residual, seed, model.report);
+}
+
+}  // namespace
+
+ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                                       const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
+                                       const ThermalModelOptions& options,
+                                       const ThermalIdentification& run) {
+  const Eigen::VectorXd weight = CheckedWeights(temperatures_c, y, rate_hz, options, run);
+  ThermalRegression model;
+  model.rate_hz = rate_hz;
+  model.order = options.state_order;
+  model.max_power = options.max_power;
+  for (int c = 0; c < temperatures_c.cols(); ++c) {
+    model.centre_c.push_back(temperatures_c.col(c).mean());
+    model.scale_k.push_back(Sd(temperatures_c.col(c)));
+  }
+  Search search;
+  ChooseStructure(temperatures_c, y, weight, options, run, model, search);
+  ReportHeldOut(search, model.report);
+  Eigen::MatrixXd gram;
+  const Eigen::VectorXd residual = RefitChosen(y, weight, search, model, gram);
+  SlowErrorAndSkill(residual, weight, search, model);
+  if (run.nonlinear && search.result.chosen.cols.size() > 1) {
+    AddCorrection(residual, run.seed, search, model);
+  }
+  const Eigen::VectorXd unit = gram.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                                 unit.asDiagonal() * gram * unit.asDiagonal())
+                                 .eigenvalues();
+  model.report.condition =
+      ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
+  internal::AddWarnings(model, options, search.result.fell_back_to_constant, search.regimes,
+                        model.report);
+  model.Validate();
+  return model;
+}
+
+}  // namespace gyrodrift::drift
