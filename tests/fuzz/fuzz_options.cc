@@ -12,6 +12,7 @@
 #include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/gyro_log.h"
+#include "gyrodrift/tasks/allan_task.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace cli = gyrodrift::cli;
@@ -21,8 +22,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const gyrodrift::Error&) {
   }
   try {
-    gyrodrift::allan::AllanOptions o;
-    cli::ParseTaus(text, &o);
+    // The tau list as `gyrodrift allan --taus` and Python's allan read it (the task layer).
+    (void)gyrodrift::tasks::AllanSettings{.rate_hz = 1.0, .taus = text}.Options();
   } catch (const gyrodrift::Error&) {
   }
   for (auto mode : {gyrodrift::drift::Mode::kPredict, gyrodrift::drift::Mode::kCompensate}) {
