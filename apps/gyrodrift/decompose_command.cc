@@ -103,18 +103,20 @@ void Run(const DecomposeArgs& a) {
                SidecarPath(a.output));
 }
 
+constexpr const char* kFooter =
+    "Example:\n"
+    "  gyrodrift simulate --duration 2h -o fog.csv\n"
+    "  gyrodrift decompose fog.csv --column rate_dph --method beemdan --seed 7 -o imfs.csv\n"
+    "writes imfs.csv (imf1..imfK,residue; one row per input sample) and imfs.csv.json (every\n"
+    "option, the seed and the report: sifts per IMF, noise-assisted stages and why they ended).\n"
+    "Defaults follow Rilling & Flandrin's emd.m (stop 0.05/0.5/0.05, 2000 sifts) and\n"
+    "Colominas et al. 2014 (eps 0.2); libeemd's rule is --stop snumber (S = 4, 50 sifts).";
+
 const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   auto args = std::make_shared<DecomposeArgs>();
   CLI::App* cmd = app.add_subcommand(
       "decompose", "Split a signal into IMFs + residue (EMD, EEMD, CEEMDAN, ICEEMDAN, BEEMDAN).");
-  cmd->footer(
-      "Example:\n"
-      "  gyrodrift simulate --duration 2h -o fog.csv\n"
-      "  gyrodrift decompose fog.csv --column rate_dph --method beemdan --seed 7 -o imfs.csv\n"
-      "writes imfs.csv (imf1..imfK,residue; one row per input sample) and imfs.csv.json (every\n"
-      "option, the seed and the report: sifts per IMF, noise-assisted stages and why they ended).\n"
-      "Defaults follow Rilling & Flandrin's emd.m (stop 0.05/0.5/0.05, 2000 sifts) and\n"
-      "Colominas et al. 2014 (eps 0.2); libeemd's rule is --stop snumber (S = 4, 50 sifts).");
+  cmd->footer(kFooter);
   cmd->add_option("input", args->input, "CSV file with a header row")
       ->required()
       ->check(kInputFile);

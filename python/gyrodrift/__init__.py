@@ -63,10 +63,11 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
 
     As ``gyrodrift allan`` (both call the library's one allan operation, tasks::RunAllan).
     ``taus`` is "all", "octave", "decade", a comma-separated list or a sequence of averaging
-    times in s, each a whole number of sample periods (another is refused, naming the nearest). ``logged``: one bool
-    per sample of a record with gaps on its time grid, False where the sample is missing (its
-    value, NaN or a filled one, is not used): as ``gyrodrift allan --gaps carry``, the
-    overlapping estimators (oadev, ohdev) skip the cluster pairs that hold a missing sample.
+    times in s, each a whole number of sample periods (another is refused, naming the nearest).
+    ``logged``: one bool per sample of a record with gaps on its time grid, False where the
+    sample is missing (its value, NaN or a filled one, is not used): as ``gyrodrift allan
+    --gaps carry``, the overlapping estimators (oadev, ohdev) skip the cluster pairs that hold a
+    missing sample.
 
     Returns a dict: ``tau_s``, ``m``, ``dev``, ``dev_lo``, ``dev_hi``, ``n_terms``, ``edf``,
     ``alpha``, ``alpha_identified`` (arrays, one entry per tau), ``dev_unit``, ``summary`` and
