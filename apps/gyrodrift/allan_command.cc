@@ -114,15 +114,15 @@ void Run(const AllanArgs& a) {
   fit_options.Validate();  // every option error before any file is read
 
   // Only the analysed column and time_s are read; the column is moved out of the table, and
-  // time_s is dropped with the table before the analysis, which needs as much again for the
-  // phase: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
+  // time_s is dropped with the table before the analysis, which builds the phase in the column's
+  // storage: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
   // worked out while time_s is there, and printed at the end.
   std::string notes, time_note;
   // A log with gaps (--gaps split or carry) is analysed on its time grid with the gaps as
   // missing samples (allan::ComputeWithGaps): carry marks the rows it made up, and split's records
   // are joined with one missing sample between them, so no cluster pair spans a break.
   std::vector<bool> logged;
-  const Eigen::VectorXd data = [&] {
+  Eigen::VectorXd data = [&] {
     std::vector<Eigen::Index> starts;
     io::CsvTable table = ReadLog(a.input, a.log, &notes, &starts, {a.column}, &logged);
     if (!a.quiet) time_note = NonUniformTimeNote(table);
@@ -146,17 +146,18 @@ void Run(const AllanArgs& a) {
     return joined;
   }();
   if (a.log.gaps == "interpolate") logged.clear();  // the made-up rows are analysed as data
-  auto compute = [&](const al::AllanOptions& options) {
-    return logged.empty() ? al::Compute(data, options, execution)
-                          : al::ComputeWithGaps(data, logged, options, execution);
-  };
-  const al::AllanResult r = compute(o);
-
   // Noise terms need an Allan-variance curve; for the other estimators fit an OADEV on the same
   // grid.
   const bool allan_curve = o.deviation == al::Deviation::kAdev ||
                            o.deviation == al::Deviation::kOadev ||
                            o.deviation == al::Deviation::kTotdev;
+  // The record's last use hands it over: the phase is built in its storage (no second copy).
+  auto compute = [&](const al::AllanOptions& options, bool last_use) {
+    if (!logged.empty()) return al::ComputeWithGaps(data, logged, options, execution);
+    return last_use ? al::Compute(std::move(data), options, execution)
+                    : al::Compute(data, options, execution);
+  };
+  const al::AllanResult r = compute(o, allan_curve);
   std::string fit_source = al::ToString(o.deviation);
   std::optional<al::NoiseTerms> terms;
   std::string fit_error;
@@ -167,7 +168,7 @@ void Run(const AllanArgs& a) {
       al::AllanOptions oa = o;
       oa.deviation = al::Deviation::kOadev;
       fit_source = "oadev";
-      terms = al::IdentifyNoise(compute(oa), fit_options);
+      terms = al::IdentifyNoise(compute(oa, true), fit_options);
     }
   } catch (const DataError& e) {
     fit_error = e.what();  // too few points to fit: the deviations are still the result
