@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <utility>
 
 #include "cli_util.h"
 #include "command.h"
@@ -91,12 +92,12 @@ void Run(const AllanArgs& a) {
   a.settings.Validate();  // every option error before any file is read
 
   // Only the analysed column and time_s are read; the column is moved out of the table, and
-  // time_s is dropped with the table before the analysis, which needs as much again for the
-  // phase: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
+  // time_s is dropped with the table before the analysis, which builds the phase in the column's
+  // storage: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
   // worked out while time_s is there, and printed at the end.
   std::string notes, time_note;
   std::vector<bool> logged;
-  const Eigen::VectorXd data = [&] {
+  Eigen::VectorXd data = [&] {
     std::vector<Eigen::Index> starts;
     io::CsvTable table = ReadLog(a.input, a.log, &notes, &starts, {a.column}, &logged);
     if (!a.quiet) time_note = NonUniformTimeNote(table);
@@ -107,7 +108,7 @@ void Run(const AllanArgs& a) {
     return JoinRecords(column, starts, &logged);
   }();
   if (a.log.gaps == "interpolate") logged.clear();  // the made-up rows are analysed as data
-  const tasks::AllanRun r = tasks::RunAllan(data, logged, a.settings);
+  const tasks::AllanRun r = tasks::RunAllan(std::move(data), logged, a.settings);
 
   std::vector<io::CsvColumn> columns(5);
   const char* names[] = {"tau_s", "dev", "dev_lo", "dev_hi", "n_terms"};

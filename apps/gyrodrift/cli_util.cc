@@ -128,7 +128,17 @@ double ParseDuration(const std::string& text) {
 }
 
 io::LogOptions LogArgs::Options() const {
-  return {io::GapPolicyFromString(gaps), io::DelimiterFromString(delimiter), "--gaps"};
+  if (no_header != !columns.empty()) {
+    throw UsageError(no_header ? "--no-header needs --columns naming the file's columns in order"
+                               : "--columns names the columns of a file without a header row: "
+                                 "add --no-header");
+  }
+  return {.gaps = io::GapPolicyFromString(gaps),
+          .delimiter = io::DelimiterFromString(delimiter),
+          .gaps_name = "--gaps",
+          .names = columns,
+          .skip_rows = skip_rows,
+          .bad_lines = io::BadLinesFromString(bad_lines)};
 }
 
 void LogArgs::RequireOneRecord(std::string_view who, std::string_view why) const {
@@ -152,6 +162,22 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log) {
                   "cell delimiter: auto (a comma where the header has one, else a tab, else a "
                   "semicolon) | comma | tab | semicolon")
       ->check(CLI::IsMember({"auto", "comma", "tab", "semicolon"}))
+      ->capture_default_str();
+  cmd->add_flag("--no-header", log->no_header,
+                "the file has no header row: --columns names its columns (a serial capture)");
+  cmd->add_option("--columns", log->columns,
+                  "with --no-header: the names of the file's columns, in order, comma-separated "
+                  "(e.g. temp_c,ax,ay,az,gx,gy,gz)")
+      ->delimiter(',');
+  cmd->add_option("--skip-rows", log->skip_rows,
+                  "lines skipped at the start of the file, before the header or the first row "
+                  "(a terminal program's banner); lines starting with # are skipped anyway")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  cmd->add_option("--bad-lines", log->bad_lines,
+                  "a row with another number of cells, or a cell that is not a number: error "
+                  "(refuse, naming the line) | skip (leave it out; the note lists the lines)")
+      ->check(CLI::IsMember({"error", "skip"}))
       ->capture_default_str();
 }
 

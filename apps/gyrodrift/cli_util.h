@@ -55,15 +55,22 @@ using io::ResolveSampleRate;
 struct LogArgs {
   std::string gaps = "error";
   std::string delimiter = "auto";
-  io::LogOptions Options() const;  // messages spell the setting as the flag, --gaps
-  bool Given() const { return gaps != "error" || delimiter != "auto"; }
+  // A serial capture: --no-header --columns a,b,c, --skip-rows N, --bad-lines error|skip.
+  bool no_header = false;
+  std::vector<std::string> columns;
+  int skip_rows = io::CsvReadOptions{}.skip_rows;
+  std::string bad_lines{io::ToString(io::CsvReadOptions{}.bad_lines)};
+  // Messages spell the settings as the flags (--gaps); UsageError for --columns without
+  // --no-header or the other way round.
+  io::LogOptions Options() const;
+  bool Given() const { return Options() != io::LogOptions{.gaps_name = "--gaps"}; }
   // A command that analyses one uniform record (`who`, e.g. "decompose") refuses --gaps split
   // and carry with a one-line UsageError saying `why`.
   void RequireOneRecord(std::string_view who, std::string_view why) const;
 };
 // --gaps error|interpolate|split|carry (every command takes the same modes; one that cannot
-// honour split or carry refuses it, LogArgs::RequireOneRecord) and
-// --delimiter auto|comma|tab|semicolon.
+// honour split or carry refuses it, LogArgs::RequireOneRecord),
+// --delimiter auto|comma|tab|semicolon, and the serial-capture flags of LogArgs.
 void AddLogOptions(CLI::App* cmd, LogArgs* log);
 // ReadLog under those choices; the note on filled or split gaps, if any, is appended (with a
 // newline) to *notes; record_starts, columns (the only ones kept, with time_s; empty = all) and

@@ -51,11 +51,11 @@ py::tuple Decompose(const Array& x_in, const tasks::DecomposeSettings& settings,
 py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings,
                const std::vector<bool>& logged) {
   settings.Validate();
-  const Eigen::VectorXd data = ToVector(x_in, "x");
+  Eigen::VectorXd data = ToVector(x_in, "x");
   tasks::AllanRun run;
   {
     py::gil_scoped_release release;
-    run = tasks::RunAllan(data, logged, settings);
+    run = tasks::RunAllan(std::move(data), logged, settings);
   }
   const al::AllanResult& r = run.curve;
   const auto n = static_cast<Eigen::Index>(r.points.size());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace gyrodrift::allan::internal {
 namespace {
@@ -82,34 +83,32 @@ double ReduceLanes(const double* acc) {
 
 void OverlappingSecondDifferenceSums(const double* x, std::int64_t n, const std::int64_t* ms,
                                      int count, double* out) {
-  int start = 0;
-  while (start < count) {
-    // Group consecutive factors that are close enough to share cache lines.
-    int stop = start + 1;
-    while (stop < count && stop - start < kOadevMaxGroup &&
-           ms[stop] - ms[start] <= kOadevMaxGroupSpan)
-      ++stop;
-    const int group = stop - start;
-    double acc[kOadevMaxGroup][kLanes] = {};
-    const std::int64_t longest = n - 2 * ms[start];
-    for (std::int64_t c = 0; c < longest; c += kChunk) {
-      for (int k = 0; k < group;) {
-        const std::int64_t m = ms[start + k];
-        // Four consecutive factors whose chunk is complete: one shared pass.
-        if (k + 4 <= group && ms[start + k + 3] == m + 3 && c + kChunk <= n - 2 * (m + 3)) {
-          AccumulateLanes4(x + c, x + c + m, x + c + 2 * m, kChunk, acc[k], acc[k + 1], acc[k + 2],
-                           acc[k + 3]);
-          k += 4;
-          continue;
-        }
-        const std::int64_t end = std::min(c + kChunk, n - 2 * m);
-        if (end > c) AccumulateLanes(x + c, x + c + m, x + c + 2 * m, end - c, acc[k]);
-        ++k;
+  if (count <= 0) return;
+  // One sweep over i for every factor: factor k's stream x[i + 2 m_k] is factor k+1's x[i + m]
+  // on an octave grid, and x[i] is everyone's, so a chunk of the phase comes from memory once for
+  // all the factors whose streams are within cache reach of each other, instead of three times
+  // per factor in a pass of its own (at 1e7 samples the per-factor passes ran from DRAM and cost
+  // 3x the octave sweep; docs/performance.md).
+  std::vector<double> acc(static_cast<size_t>(count) * kLanes, 0.0);
+  auto lanes = [&](int k) { return acc.data() + static_cast<size_t>(k) * kLanes; };
+  int active = count;  // factors with terms left in the current chunk (ms ascending)
+  for (std::int64_t c = 0; c < n - 2 * ms[0]; c += kChunk) {
+    while (c >= n - 2 * ms[active - 1]) --active;
+    for (int k = 0; k < active;) {
+      const std::int64_t m = ms[k];
+      // Four consecutive factors whose chunk is complete: one shared pass.
+      if (k + 4 <= active && ms[k + 3] == m + 3 && c + kChunk <= n - 2 * (m + 3)) {
+        AccumulateLanes4(x + c, x + c + m, x + c + 2 * m, kChunk, lanes(k), lanes(k + 1),
+                         lanes(k + 2), lanes(k + 3));
+        k += 4;
+        continue;
       }
+      const std::int64_t end = std::min(c + kChunk, n - 2 * m);
+      AccumulateLanes(x + c, x + c + m, x + c + 2 * m, end - c, lanes(k));
+      ++k;
     }
-    for (int k = 0; k < group; ++k) out[start + k] = ReduceLanes(acc[k]);
-    start = stop;
   }
+  for (int k = 0; k < count; ++k) out[k] = ReduceLanes(lanes(k));
 }
 
 double AdevVariance(const double* x, std::int64_t n, std::int64_t m, double tau_s) {

@@ -118,6 +118,13 @@ Sifter::Sifter(Eigen::Index n, const SiftingOptions& options)
   }
 }
 
+void Sifter::ReleaseNodeBuffers() {
+  lower_.ReleaseStorage();
+  upper_.ReleaseStorage();
+  ReleasePages(indmin_.data(), indmin_.size() * sizeof(int));
+  ReleasePages(indmax_.data(), indmax_.size() * sizeof(int));
+}
+
 void Sifter::Envelopes() {
   FitPair(lower_, upper_);
   lower_.Evaluate(n_, env_min_.data());

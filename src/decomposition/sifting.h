@@ -44,6 +44,12 @@ class Sifter {
   // returns extracted = false and leaves imf untouched.
   SiftOutcome ExtractImf(const double* x, double* imf);
 
+  // Gives back the memory of the per-node buffers (spline arrays, extrema indices), sized for the
+  // worst case and touched as far as the longest IMF so far reached: between IMFs of a long
+  // signal, so that the first IMF's nodes (a third of the samples each envelope, for noise) are
+  // not held through the rest of the decomposition. Results are unchanged.
+  void ReleaseNodeBuffers();
+
   // Rilling's first-sift envelope nodes, for the unit tests: false if emd.m would fail.
   bool EnvelopeNodes(const double* x, std::vector<double>* tmin, std::vector<double>* zmin,
                      std::vector<double>* tmax, std::vector<double>* zmax);

@@ -5,7 +5,30 @@
 #include <cassert>
 #include <cstdint>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 namespace gyrodrift::decomposition::internal {
+
+void ReleasePages(void* p, size_t bytes) {
+#if defined(__linux__) && defined(MADV_DONTNEED)
+  static const uintptr_t page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + page - 1) / page * page;
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) / page * page;
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+void EnvelopeSpline::ReleaseStorage() {
+  ReleasePages(t_.data(), t_.capacity() * sizeof(double));
+  ReleasePages(y_.data(), y_.capacity() * sizeof(double));
+  ReleasePages(storage_.data(), storage_.size() * sizeof(double));
+}
 
 EnvelopeSpline::EnvelopeSpline(Eigen::Index max_nodes, int phase) {
   const size_t size = static_cast<size_t>(max_nodes) + 1;

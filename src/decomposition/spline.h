@@ -41,6 +41,12 @@ struct UninitialisedAllocator : std::allocator<T> {
 template <class T>
 using UninitialisedVector = std::vector<T, UninitialisedAllocator<T>>;
 
+// Gives the whole pages inside [p, p + bytes) back to the system (Linux: madvise DONTNEED; they
+// read as zeros when next touched and cost no memory until then; elsewhere nothing happens).
+// For the worst-case buffers above once their contents are no longer needed: pages touched by a
+// long first IMF would otherwise stay resident through all the later, shorter ones.
+void ReleasePages(void* p, size_t bytes);
+
 class EnvelopeSpline {
  public:
   // phase 0 or 1 staggers this spline's arrays against another one's in the cache (see the .cc).
@@ -60,6 +66,8 @@ class EnvelopeSpline {
   // room for n + kPadding values (values past n are scratch).
   void EvaluateSift(Eigen::Index n, const double* lower, const double* h, double* next) const;
   static constexpr Eigen::Index kPadding = kSimdPadding;
+  // Gives back the pages of the node arrays (ReleasePages); the next fit rewrites what it reads.
+  void ReleaseStorage();
 
   friend void FitPair(EnvelopeSpline& a, EnvelopeSpline& b, size_t warm_up);
 

@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "common/enum_names.h"
+#include "common/enum_names.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
 
@@ -101,6 +102,28 @@ void CsvReadOptions::Validate() const {
   if (block_bytes < 1 || block_bytes > (size_t{1} << 30)) {
     throw OptionError("block_bytes", std::to_string(block_bytes), "an integer in [1, 1073741824]");
   }
+  if (skip_rows < 0 || skip_rows > 1000000) {
+    throw OptionError("skip_rows", std::to_string(skip_rows), "an integer in [0, 1000000]");
+  }
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i].empty() || std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(i),
+                                      names[i]) != names.begin() + static_cast<std::ptrdiff_t>(i)) {
+      throw OptionError("names", "'" + names[i] + "'", "non-empty column names, each once");
+    }
+  }
+}
+
+namespace {
+constexpr gyrodrift::internal::EnumNames<BadLines, 2> kBadLines{
+    {{BadLines::kError, "error"}, {BadLines::kSkip, "skip"}}};
+}  // namespace
+
+std::string_view ToString(BadLines bad_lines) {
+  return gyrodrift::internal::EnumName(bad_lines, kBadLines);
+}
+
+BadLines BadLinesFromString(std::string_view text) {
+  return gyrodrift::internal::EnumFromName(text, "bad_lines", kBadLines);
 }
 
 // Lines in, a table out. The text comes in blocks of any size (a whole string is one block); a
@@ -109,9 +132,13 @@ void CsvReadOptions::Validate() const {
 class CsvTable::Parser {
  public:
   // `size_hint`: the bytes to come (0 = unknown), to reserve the kept columns.
-  Parser(const std::string& source, Delimiter delimiter, const std::vector<std::string>& columns,
-         std::uint64_t size_hint)
-      : given_(delimiter), specs_(columns), size_hint_(size_hint) {
+  Parser(const std::string& source, const CsvReadOptions& options, std::uint64_t size_hint)
+      : given_(options.delimiter),
+        specs_(options.columns),
+        names_(options.names),
+        skip_rows_(options.skip_rows),
+        skip_bad_(options.bad_lines == BadLines::kSkip),
+        size_hint_(size_hint) {
     table_.source_ = source;
   }
 
@@ -178,17 +205,31 @@ class CsvTable::Parser {
   void Line(std::string_view line) {
     ++line_number_;
     parsed_bytes_ += line.size() + 1;
-    if (IsSkippable(line)) return;
+    if (line_number_ <= skip_rows_ || IsSkippable(line)) return;
     if (!have_header_) {
       Header(line);
-      return;
+      if (names_.empty()) return;  // else the line is the first data row
     }
     CsvTable& t = table_;
     SplitLine(line, delimiter_, cells_);
     if (cells_.size() != t.header_.size()) {
+      if (skip_bad_) {
+        t.skipped_lines_.push_back(line_number_);
+        return;
+      }
       throw DataError(t.source_ + ": line " + std::to_string(line_number_) + " has " +
                       std::to_string(cells_.size()) + " cells, the header has " +
-                      std::to_string(t.header_.size()));
+                      std::to_string(t.header_.size()) +
+                      (names_.empty() ? "" : " (the names given)"));
+    }
+    if (skip_bad_) {
+      for (const size_t c : kept_) {
+        double value;
+        if (!ParseDouble(cells_[c], value) || !std::isfinite(value)) {
+          t.skipped_lines_.push_back(line_number_);
+          return;
+        }
+      }
     }
     if (t.rows_ == capacity_) Reserve();
     const Eigen::Index row = t.rows_++;
@@ -211,7 +252,11 @@ class CsvTable::Parser {
                  : given_ == Delimiter::kSemicolon ? ';'
                                                    : DetectDelimiter(line);
     SplitLine(line, delimiter_, cells_);
-    for (auto cell : cells_) t.header_.emplace_back(Unquote(cell));
+    if (names_.empty()) {
+      for (auto cell : cells_) t.header_.emplace_back(Unquote(cell));
+    } else {
+      t.header_ = names_;
+    }
     for (size_t i = 0; i < t.header_.size(); ++i) {
       if (t.header_[i].empty()) {
         throw DataError(t.source_ + ": header column " + std::to_string(i + 1) + " has no name");
@@ -254,6 +299,9 @@ class CsvTable::Parser {
 
   const Delimiter given_;
   const std::vector<std::string> specs_;
+  const std::vector<std::string> names_;  // the header, when the file has none
+  const Eigen::Index skip_rows_;
+  const bool skip_bad_;
   const std::uint64_t size_hint_;
   CsvTable table_;
   bool started_ = false;
@@ -294,7 +342,7 @@ CsvTable CsvTable::Read(std::istream& in, const std::string& source,
     in.seekg(start);
   }
   in.clear();
-  Parser parser(source, options.delimiter, options.columns, size_hint);
+  Parser parser(source, options, size_hint);
   std::string block(options.block_bytes, '\0');
   while (in) {
     in.read(block.data(), static_cast<std::streamsize>(block.size()));
@@ -306,7 +354,7 @@ CsvTable CsvTable::Read(std::istream& in, const std::string& source,
 }
 
 CsvTable CsvTable::Parse(const std::string& text, const std::string& source, Delimiter delimiter) {
-  Parser parser(source, delimiter, {}, text.size());
+  Parser parser(source, CsvReadOptions{.delimiter = delimiter}, text.size());
   parser.Feed(text);
   return parser.Finish();
 }
@@ -369,6 +417,7 @@ CsvTable CsvTable::WithInterpolatedRows(
   out.header_ = header_;
   out.kept_ = kept_;
   out.first_bad_ = first_bad_;
+  out.skipped_lines_ = skipped_lines_;
   out.columns_.resize(columns_.size());
   // The rows the loop below adds: it takes the insertions in order, each at a row after the
   // previous one and before the last row (an insertion out of order stops it).

@@ -39,9 +39,46 @@ std::string SpellGaps(const LogOptions& options, GapPolicy policy) {
   return fmt::format("{} = '{}'", options.gaps_name, ToString(policy));
 }
 
+namespace {
+
+// "note: 3 damaged lines skipped (--bad-lines skip): lines 3, 5, 7", the first 10 lines named.
+std::string SkippedNote(const CsvTable& table, const LogOptions& options) {
+  const std::vector<Eigen::Index>& lines = table.skipped_lines();
+  if (lines.empty()) return "";
+  std::string named;
+  for (size_t i = 0; i < lines.size() && i < 10; ++i) {
+    named += fmt::format("{}{}", i == 0 ? "" : ", ", lines[i]);
+  }
+  if (lines.size() > 10) named += fmt::format(" and {} more", lines.size() - 10);
+  const bool flags = options.gaps_name.rfind("--", 0) == 0;
+  return fmt::format("note: {}: {} damaged line{} skipped ({}): line{} {}", table.source(),
+                     lines.size(), lines.size() == 1 ? "" : "s",
+                     flags ? "--bad-lines skip" : "bad_lines = 'skip'", lines.size() == 1 ? "" : "s",
+                     named);
+}
+
+CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::string* gap_note,
+                     std::vector<Eigen::Index>* record_starts,
+                     const std::vector<std::string>& columns, std::vector<bool>* logged);
+
+}  // namespace
+
 CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,
                  std::vector<Eigen::Index>* record_starts, const std::vector<std::string>& columns,
                  std::vector<bool>* logged) {
+  CsvTable table = ReadLogRows(path, options, gap_note, record_starts, columns, logged);
+  const std::string skipped = SkippedNote(table, options);
+  if (gap_note && !skipped.empty()) {
+    *gap_note = gap_note->empty() ? skipped : skipped + "\n" + *gap_note;
+  }
+  return table;
+}
+
+namespace {
+
+CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::string* gap_note,
+                     std::vector<Eigen::Index>* record_starts,
+                     const std::vector<std::string>& columns, std::vector<bool>* logged) {
   const GapPolicy gaps = options.gaps;
   auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
   if (gap_note) gap_note->clear();
@@ -59,7 +96,11 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
                      "model's fit or compensation); this one would use the made-up rows as "
                      "data: use " + spell(GapPolicy::kInterpolate) + " to say so");
   }
-  CsvReadOptions read{.delimiter = options.delimiter, .columns = columns};
+  CsvReadOptions read{.delimiter = options.delimiter,
+                      .columns = columns,
+                      .names = options.names,
+                      .skip_rows = options.skip_rows,
+                      .bad_lines = options.bad_lines};
   if (!columns.empty()) read.columns.push_back("time_s");
   CsvTable table = CsvTable::Read(path, read);
   if (!table.HasColumn("time_s")) return table;
@@ -155,6 +196,8 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
   }
   return table.WithInterpolatedRows(insert);
 }
+
+}  // namespace
 
 
 double ResolveSampleRate(const CsvTable& table, double given, std::string* how) {

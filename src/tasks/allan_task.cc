@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -129,27 +130,30 @@ void AllanSettings::Validate() const {
   FitOptions();
 }
 
-AllanRun RunAllan(const Eigen::VectorXd& data, const std::vector<bool>& logged,
+AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                   const AllanSettings& settings) {
   const al::AllanOptions o = settings.Options();
   const Execution execution = settings.MakeExecution();
   const al::NoiseFitOptions fit_options = settings.FitOptions();
-  auto compute = [&](const al::AllanOptions& options) {
-    return logged.empty() ? al::Compute(data, options, execution)
-                          : al::ComputeWithGaps(data, logged, options, execution);
+  const bool allan_curve = AllanCurve(o.deviation);
+  // The record's last use hands it over: the phase is built in its storage (no second copy).
+  auto compute = [&](const al::AllanOptions& options, bool last_use) {
+    if (!logged.empty()) return al::ComputeWithGaps(data, logged, options, execution);
+    return last_use ? al::Compute(std::move(data), options, execution)
+                    : al::Compute(data, options, execution);
   };
   AllanRun run;
-  run.curve = compute(o);
+  run.curve = compute(o, allan_curve);
   run.dev_unit = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
   run.fit_source = al::ToString(o.deviation);
   try {
-    if (AllanCurve(o.deviation)) {
+    if (allan_curve) {
       run.terms = al::IdentifyNoise(run.curve, fit_options);
     } else {
       al::AllanOptions oa = o;
       oa.deviation = al::Deviation::kOadev;
       run.fit_source = "oadev";
-      run.terms = al::IdentifyNoise(compute(oa), fit_options);
+      run.terms = al::IdentifyNoise(compute(oa, true), fit_options);
     }
   } catch (const DataError& e) {
     run.fit_error = e.what();  // too few points to fit: the deviations are still the result

@@ -27,9 +27,11 @@
 //
 // Cost
 //   O(N) to integrate, then O(N) per averaging time for every estimator (running sums; the
-//   overlapping ADEV kernel is blocked over consecutive taus and vectorised), spread over
-//   the execution's threads with ParallelFor; results are bit-identical for any thread count.
-//   Octave grid: O(N log N); every averaging factor: O(N^2). Memory: about 3 N doubles.
+//   overlapping ADEV kernel sweeps the phase once for all its taus, vectorised; the noise
+//   identification twice for all taus), spread over the execution's threads with ParallelFor;
+//   results are bit-identical for any thread count. Octave grid: O(N log N); every averaging
+//   factor: O(N^2). Memory: the phase, N + 1 doubles (none beyond the samples when they are
+//   handed over); TOTDEV 3 N more; noise identification of strongly correlated data up to N more.
 #pragma once
 
 #include <Eigen/Core>
@@ -146,6 +148,11 @@ struct AllanResult {
 // non-finite samples or a record too short for the requested taus (at least one tau must be
 // computable; list taus beyond the estimator's limit are an error).
 AllanResult Compute(const Eigen::VectorXd& data, const AllanOptions& options,
+                    const Execution& execution = {});
+// The same on samples handed over (std::move): the phase is built in their storage, so the call
+// needs no second copy of the record (at 1e8 samples, 800 MB less at the peak). `data` is
+// consumed whether or not the call succeeds.
+AllanResult Compute(Eigen::VectorXd&& data, const AllanOptions& options,
                     const Execution& execution = {});
 
 // A record with gaps (a duty-cycled or interrupted log) on its uniform time grid: `logged` holds

@@ -29,6 +29,14 @@ enum class Delimiter { kAuto, kComma, kTab, kSemicolon };
 std::string_view ToString(Delimiter delimiter);  // "auto", "comma", "tab", "semicolon"
 Delimiter DelimiterFromString(std::string_view text);  // OptionError naming the choices
 
+// What to do with a damaged data row: one with another number of cells than the header, or a
+// cell of a kept column that is not a finite number. error: refuse the table, naming the line
+// (the default, as for any table); skip: leave the row out and list its line (serial-terminal
+// captures: a line cut by a reset, two values run together).
+enum class BadLines { kError, kSkip };
+std::string_view ToString(BadLines bad_lines);         // "error", "skip"
+BadLines BadLinesFromString(std::string_view text);    // OptionError naming the choices
+
 // How a table is read.
 struct CsvReadOptions {
   Delimiter delimiter = Delimiter::kAuto;
@@ -40,7 +48,14 @@ struct CsvReadOptions {
   // Bytes read at a time; a line that crosses a block is carried to the next. In [1, 2^30],
   // default 4 MiB (the smallest values are for tests of the block boundaries).
   size_t block_bytes = size_t{4} << 20;
-  // Throws OptionError naming block_bytes.
+  // The file has no header row: these name its columns, in order (empty: the first row is the
+  // header). Serial captures print values only.
+  std::vector<std::string> names = {};
+  // Lines skipped at the start of the file, before the header (or the first data row), in
+  // [0, 1e6]: a terminal program's banner. Lines starting with '#' are skipped anyway.
+  int skip_rows = 0;
+  BadLines bad_lines = BadLines::kError;
+  // Throws OptionError naming block_bytes, skip_rows or names (empty or repeated names).
   void Validate() const;
 };
 
@@ -59,6 +74,8 @@ class CsvTable {
                         Delimiter delimiter = Delimiter::kAuto);
 
   const std::vector<std::string>& header() const { return header_; }
+  // The file lines (1-based) of the rows BadLines::kSkip left out, in order.
+  const std::vector<Eigen::Index>& skipped_lines() const { return skipped_lines_; }
   Eigen::Index rows() const { return rows_; }
   const std::string& source() const { return source_; }
 
@@ -100,6 +117,7 @@ class CsvTable {
   std::vector<Eigen::VectorXd> columns_;
   std::vector<bool> kept_;
   std::vector<BadCell> first_bad_;
+  std::vector<Eigen::Index> skipped_lines_;
   Eigen::Index rows_ = 0;
 };
 

@@ -38,6 +38,12 @@ struct LogOptions {
   // How the caller's user spells the gaps setting, so that every message names it as typed:
   // "gaps" (a manifest key: gaps = 'split') or a flag such as "--gaps" (--gaps split).
   std::string gaps_name = "gaps";
+  // A file without a header row (the names of its columns), lines to skip before the header or
+  // the first row, and what to do with damaged rows: CsvReadOptions' names, skip_rows and
+  // bad_lines. Skipped rows are listed in the note (ReadLog).
+  std::vector<std::string> names = {};
+  int skip_rows = CsvReadOptions{}.skip_rows;
+  BadLines bad_lines = CsvReadOptions{}.bad_lines;
   bool operator==(const LogOptions&) const = default;
 };
 
@@ -54,7 +60,8 @@ constexpr double kMostlyMadeUpShare = 0.5;
 // would otherwise take the samples as equally spaced, silently). Gaps are handled by
 // options.gaps; when rows were interpolated or the log was split, *gap_note (if given) says so,
 // else it is cleared (with interpolate, when more than kMostlyMadeUpShare of the rows are made up,
-// the note is a warning that suggests carry). With kSplit, *record_starts receives the first row
+// the note is a warning that suggests carry; damaged rows skipped under BadLines::kSkip are listed
+// on a line of their own). With kSplit, *record_starts receives the first row
 // (0-based) of every record after the first (empty: no gap); kSplit without record_starts is a
 // UsageError. *logged (if given) receives one flag per returned row, true where the row was
 // logged, or stays empty when every row was; kCarry without logged is a UsageError. Shorter

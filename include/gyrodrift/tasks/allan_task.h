@@ -56,10 +56,11 @@ struct AllanRun {
 };
 
 // The deviation of `data` (in settings.units) and its noise terms. `logged`: empty, or one flag
-// per sample, false where the sample is missing (allan::ComputeWithGaps). Throws what
-// AllanSettings::Validate and allan::Compute throw; a fit with too few points is reported in
-// fit_error, not thrown.
-AllanRun RunAllan(const Eigen::VectorXd& data, const std::vector<bool>& logged,
+// per sample, false where the sample is missing (allan::ComputeWithGaps). The samples are taken
+// by value: handed over (std::move), their last use builds the phase in their storage (no second
+// copy of the record, allan::Compute). Throws what AllanSettings::Validate and allan::Compute
+// throw; a fit with too few points is reported in fit_error, not thrown.
+AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                   const AllanSettings& settings);
 
 // The records the sidecar writes (docs/allan.md): the noise terms (the keys of `noise_terms`

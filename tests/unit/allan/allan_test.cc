@@ -141,6 +141,33 @@ TEST(AllanCompute, ResultsDoNotDependOnThreadCountOrGrouping) {
   EXPECT_EQ(some.points[2].dev, one.points[4999].dev);
 }
 
+TEST(AllanCompute, HandedOverSamplesGiveTheSameBits) {
+  // The phase built in the samples' own storage (rate data: grown by one point) is the phase
+  // built beside them; every field of every point is the same.
+  const Eigen::VectorXd y = WhiteNoise(5001, 2.0, 21).array() + 3.0;
+  for (DataType type : {DataType::kRate, DataType::kAngle}) {
+    for (Deviation dev : {Deviation::kOadev, Deviation::kMdev, Deviation::kTotdev}) {
+      const AllanOptions o{.rate_hz = 10.0, .data_type = type, .deviation = dev};
+      const AllanResult kept = Compute(y, o);
+      Eigen::VectorXd copy = y;
+      const AllanResult handed = Compute(std::move(copy), o);
+      EXPECT_EQ(handed.n_phase, kept.n_phase);
+      ASSERT_EQ(handed.points.size(), kept.points.size());
+      for (size_t i = 0; i < kept.points.size(); ++i) {
+        const AllanPoint& a = kept.points[i];
+        const AllanPoint& b = handed.points[i];
+        EXPECT_EQ(b.dev, a.dev);
+        EXPECT_EQ(b.edf, a.edf);
+        EXPECT_EQ(b.dev_lo, a.dev_lo);
+        EXPECT_EQ(b.alpha, a.alpha);
+      }
+    }
+  }
+  Eigen::VectorXd bad = y;
+  bad[7] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(Compute(std::move(bad), AllanOptions{}), DataError);
+}
+
 
 // ComputeWithGaps: the overlapping estimators over the cluster pairs of logged samples only.
 namespace gaps {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -285,6 +286,66 @@ TEST(Csv, StreamedTextEqualsRenderedText) {
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
   EXPECT_EQ(entries, 1);
+}
+
+}  // namespace
+}  // namespace gyrodrift::io
+
+namespace gyrodrift::io {
+namespace {
+
+// Serial-terminal captures (issue 26): no header, a banner, damaged lines.
+std::string CaptureFile(const std::string& name, const std::string& text) {
+  const std::string path = test::TempDir("csv_capture") + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(CsvCapture, NamesGivenForAFileWithoutAHeaderAfterItsBanner) {
+  const std::string path = CaptureFile(
+      "capture.csv", "=~=~= PuTTY log 2026.05.08 =~=~=\n13.25,0.5,1\n13.26,0.6,2\n13.27,0.7,3\n");
+  const CsvTable t = CsvTable::Read(path, CsvReadOptions{.names = {"temp_c", "gx", "n"},
+                                                         .skip_rows = 1});
+  EXPECT_EQ(t.header(), (std::vector<std::string>{"temp_c", "gx", "n"}));
+  ASSERT_EQ(t.rows(), 3);
+  EXPECT_EQ(t.Column("gx")[2], 0.7);
+  EXPECT_TRUE(t.skipped_lines().empty());
+  // Without skipping the banner, it is a damaged first row.
+  try {
+    CsvTable::Read(path, CsvReadOptions{.names = {"temp_c", "gx", "n"}});
+    ADD_FAILURE() << "the banner was read as data";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 1 has 1 cells, the header has 3 (the names given)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CsvCapture, DamagedLinesAreSkippedAndListedOnRequest) {
+  // Line 3 has a value run into the next, line 5 a cell too few, the last line is cut.
+  const std::string text = "a,b,c\n1,2,3\n4,-0.3-0.31,6\n7,8,9\n10,11\n13,14,15\n1";
+  const std::string path = CaptureFile("damaged.csv", text);
+  EXPECT_THROW(CsvTable::Read(path), DataError);
+  for (size_t block : {size_t{3}, size_t{4} << 20}) {
+    const CsvTable t =
+        CsvTable::Read(path, CsvReadOptions{.block_bytes = block, .bad_lines = BadLines::kSkip});
+    ASSERT_EQ(t.rows(), 3) << block;
+    EXPECT_EQ(t.Column("a"), (Eigen::VectorXd(3) << 1, 7, 13).finished());
+    EXPECT_EQ(t.skipped_lines(), (std::vector<Eigen::Index>{3, 5, 7}));
+  }
+  // A cell of a column not kept is not checked: the row stays.
+  const CsvTable only_a = CsvTable::Read(
+      path, CsvReadOptions{.columns = {"a"}, .bad_lines = BadLines::kSkip});
+  EXPECT_EQ(only_a.skipped_lines(), (std::vector<Eigen::Index>{5, 7}));
+}
+
+TEST(CsvCapture, BadOptionsAreRefused) {
+  const std::string path = CaptureFile("ok.csv", "1,2\n");
+  EXPECT_THROW(CsvTable::Read(path, CsvReadOptions{.names = {"a", "a"}}), OptionError);
+  EXPECT_THROW(CsvTable::Read(path, CsvReadOptions{.names = {"a", ""}}), OptionError);
+  EXPECT_THROW(CsvTable::Read(path, CsvReadOptions{.skip_rows = -1}), OptionError);
+  EXPECT_THROW(BadLinesFromString("ignore"), OptionError);
+  EXPECT_EQ(BadLinesFromString("skip"), BadLines::kSkip);
 }
 
 }  // namespace
