@@ -23,6 +23,8 @@ constexpr std::size_t kHeaderBytes = 16;
 constexpr std::size_t kMessageHeaderBytes = 3;
 constexpr int kMostNesting = 8;  // nested formats deeper than this are refused (and cycles)
 constexpr std::string_view kKnownTypes = "BFIMPQARDLCSO";
+constexpr std::size_t kMostBytes = 65535;          // a message's payload cannot be longer
+constexpr std::size_t kMostLeaves = 1u << 20;      // numeric fields in all layouts of a log
 
 enum class Base { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kInt64, kUint64, kFloat,
                   kDouble, kBool, kChar };
@@ -102,7 +104,7 @@ struct Leaf {
 
 struct Layout {
   std::vector<Leaf> leaves;
-  std::size_t bytes = 0;
+  std::size_t bytes = 0;  // of the whole format, padding included
   std::size_t trailing_padding = 0;  // the data message may leave these bytes out
   int timestamp = -1;                // the leaf "timestamp" (uint64_t), or -1
 };
@@ -320,39 +322,54 @@ class Reader {
     return true;
   }
 
-  // Flattens a format into leaves at `offset` with the name prefix; false for an unknown type,
-  // a cycle or nesting deeper than kMostNesting.
-  bool Flatten(const std::string& format, const std::string& prefix, std::size_t offset,
-               int depth, Layout& out, std::size_t& bytes) {
-    const auto it = formats_.find(format);
-    if (it == formats_.end() || depth > kMostNesting) return false;
-    bytes = 0;
-    for (const RawField& f : it->second) {
+  // The layout of a format, each computed once; nullptr for a missing type, a cycle, nesting
+  // deeper than kMostNesting, a format over the largest message, or past kMostLeaves in all.
+  const Layout* FormatLayout(const std::string& name, int depth) {
+    if (const auto it = layouts_.find(name); it != layouts_.end()) return &it->second;
+    const auto format = formats_.find(name);
+    if (format == formats_.end() || depth > kMostNesting || unreadable_.count(name) > 0 ||
+        !in_progress_.insert(name).second) {
+      return nullptr;
+    }
+    Layout out;
+    bool ok = true;
+    for (const RawField& f : format->second) {
       const bool padding = f.name.rfind("_padding", 0) == 0;
       const BaseType* base = FindBase(f.type);
-      std::size_t element = 0;
-      if (base == nullptr) {  // a nested format: its size from a first flattening
-        Layout probe;
-        if (!Flatten(f.type, "", 0, depth + 1, probe, element)) return false;
-      } else {
-        element = base->bytes;
+      const Layout* nested = base != nullptr ? nullptr : FormatLayout(f.type, depth + 1);
+      const std::size_t element = base != nullptr ? base->bytes : nested ? nested->bytes : 0;
+      if ((base == nullptr && nested == nullptr) || out.bytes + element * f.count > kMostBytes) {
+        ok = false;
+        break;
       }
-      for (std::size_t i = 0; i < f.count; ++i) {
-        const std::size_t at = offset + bytes + i * element;
-        const std::string name = prefix + f.name + (f.array ? Format("[%zu]", i) : std::string());
-        if (padding || (base != nullptr && base->base == Base::kChar)) continue;
-        if (base != nullptr) {
-          out.leaves.push_back({name, base, at});
-        } else {
-          std::size_t nested = 0;
-          if (!Flatten(f.type, name + ".", at, depth + 1, out, nested)) return false;
+      if (!padding && (base == nullptr || base->base != Base::kChar)) {
+        for (std::size_t i = 0; i < f.count; ++i) {
+          const std::size_t at = out.bytes + i * element;
+          const std::string field = f.name + (f.array ? Format("[%zu]", i) : std::string());
+          if (base != nullptr) {
+            out.leaves.push_back({field, base, at});
+          } else {
+            for (const Leaf& leaf : nested->leaves) {
+              out.leaves.push_back({field + "." + leaf.name, leaf.type, at + leaf.offset});
+            }
+          }
         }
       }
-      bytes += element * f.count;
-      if (depth == 0) out.trailing_padding = padding ? element * f.count : 0;
-      if (bytes > 65535) return false;
+      out.bytes += element * f.count;
+      out.trailing_padding = padding ? element * f.count : 0;
     }
-    return true;
+    in_progress_.erase(name);
+    leaves_ += out.leaves.size();
+    if (!ok || leaves_ > kMostLeaves) {
+      unreadable_.insert(name);
+      return nullptr;
+    }
+    for (std::size_t i = 0; i < out.leaves.size(); ++i) {
+      if (out.leaves[i].name == "timestamp" && out.leaves[i].type->base == Base::kUint64) {
+        out.timestamp = static_cast<int>(i);
+      }
+    }
+    return &layouts_.emplace(name, std::move(out)).first->second;
   }
 
   bool Subscribe(std::span<const std::uint8_t> p) {
@@ -360,27 +377,21 @@ class Reader {
     const int instance = p[0];
     const auto id = static_cast<std::uint16_t>(Little(&p[1], 2));
     const std::string name(p.begin() + 3, p.end());
-    Layout layout;
-    std::size_t bytes = 0;
-    if (!Flatten(name, "", 0, 0, layout, bytes)) {
+    const Layout* layout = FormatLayout(name, 0);
+    if (layout == nullptr) {
       why_ = "subscribes to \"" + name + "\", whose format is missing or not readable";
       return false;
     }
-    layout.bytes = bytes;
     UlogSeries s;
     s.topic = name;
     s.instance = instance;
     s.decoded = decode_all_ || decode_.count(name) > 0;
-    for (std::size_t i = 0; i < layout.leaves.size(); ++i) {
-      const Leaf& leaf = layout.leaves[i];
+    for (const Leaf& leaf : layout->leaves) {
       s.fields.push_back(leaf.name);
       s.types.emplace_back(leaf.type->name);
-      if (leaf.name == "timestamp" && leaf.type->base == Base::kUint64) {
-        layout.timestamp = static_cast<int>(i);
-      }
     }
     log_.series.push_back(std::move(s));
-    subscriptions_[id] = {log_.series.size() - 1, std::move(layout)};
+    subscriptions_[id] = {log_.series.size() - 1, layout};
     return true;
   }
 
@@ -391,7 +402,7 @@ class Reader {
       why_ = Format("names the message id %u, never subscribed", static_cast<unsigned>(Little(p.data(), 2)));
       return false;
     }
-    const Layout& layout = it->second.layout;
+    const Layout& layout = *it->second.layout;
     const std::span<const std::uint8_t> data = p.subspan(2);
     if (data.size() + layout.trailing_padding < layout.bytes || data.size() > layout.bytes) {
       return false;
@@ -412,7 +423,7 @@ class Reader {
 
   struct Subscription {
     std::size_t series;
-    Layout layout;
+    const Layout* layout;  // in layouts_
   };
 
   std::span<const std::uint8_t> bytes_;
@@ -423,6 +434,10 @@ class Reader {
   std::string why_;  // why the last message was refused
   std::vector<std::size_t> appended_offsets_;
   std::map<std::string, std::vector<RawField>> formats_;
+  std::map<std::string, Layout> layouts_;  // node-based: the pointers of subscriptions_ stay valid
+  std::set<std::string> in_progress_;      // the formats being laid out (a cycle)
+  std::set<std::string> unreadable_;       // formats refused once
+  std::size_t leaves_ = 0;                 // in all layouts
   std::map<std::uint16_t, Subscription> subscriptions_;
   Ulog log_;
 };

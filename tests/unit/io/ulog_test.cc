@@ -261,6 +261,13 @@ TEST(Ulog, AFormatWithoutFieldsOrACycleIsRefused) {
   Builder c;
   c.Text('F', "bad:float");
   EXPECT_THROW(ParseUlog(c.bytes(), {}, "bad.ulg"), DataError);
+  // Arrays of arrays past the largest message are refused before they are laid out.
+  Builder d;
+  d.Text('F', "a:uint8_t x;");
+  d.Text('F', "b:a[60000] y;");
+  d.Text('F', "c:b[60000] z;");
+  d.Subscribe(0, 1, "c");
+  EXPECT_THROW(ParseUlog(d.bytes(), {}, "huge.ulg"), DataError);
 }
 
 }  // namespace
