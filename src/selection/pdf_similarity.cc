@@ -2,6 +2,7 @@
 // section 2): k*, the peak of the distance D_k between the densities of the signal and of IMF k,
 // and k_N, the run of modes 1..k* whose standardised densities stay within the white-noise level
 // of G_k (noise_level.h). SelectModes (selection.cc) computes the densities and both curves.
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -32,33 +33,42 @@ void PdfSimilarityBoundaries(int length, const SelectionOptions& options,
   }
   // The noise run is judged up to k* only (Komaty et al.: the modes up to the D peak are the
   // noise-dominated ones). Past it the test cannot tell noise from drift: a white-noise IMF with
-  // a few oscillations is far from Gaussian, so the 99 % level of late modes is wide enough to
-  // let a slow drift mode through (docs/selection.md, section 2).
+  // a few oscillations is far from Gaussian, so the level of late modes is wide enough to let a
+  // slow drift mode through (docs/selection.md, section 2).
   const int judged = result->k_star;
-  int k_noise = 0;
-  int run_past_k_star = 0;  // modes after k* under the level, reported only
+  auto g = [&](int k) { return result->self_distance[static_cast<size_t>(k - 1)]; };
+  // Modes 1..family are one test at the level's confidence (noise_level.h): testing each alone
+  // at 99 % would end the run of a white record early in about 1 of 10 records of 11 modes. A
+  // NaN level (the noise rarely had a mode k, or the level stops before it) ends the run.
+  auto family_of = [&](const NoiseLevel& l) {
+    return std::min(judged, static_cast<int>(l.family_scale.size()));
+  };
+  auto run_under = [&](const NoiseLevel& l, int family) {
+    int run = 0;
+    while (run < family && g(run + 1) <= l.FamilyLevelFor(run + 1, family)) ++run;
+    return run;
+  };
+  int family = family_of(*level);
+  int k_noise = run_under(*level, family);
+  if (level->partial && k_noise == family && family < judged) {
+    // The run outlasted a level collected from the decomposition: the whole family needs the
+    // Monte-Carlo.
+    AppendNote(&result->note, "white-noise level of modes 1.." + std::to_string(family) +
+                                  " from the decomposition's noise (seed " +
+                                  std::to_string(level->seed) +
+                                  ") outlasted: modes 1..k* judged on the Monte-Carlo's");
+    level =
+        NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde, options.distance,
+                                      &result->noise_level_computed, execution);
+    family = family_of(*level);
+    k_noise = run_under(*level, family);
+  }
+  // The curve: the family's level up to k*, past it each mode's as the last of a family 1..k.
+  int run_past_k_star = 0;  // modes after k* under that level, reported only
   for (int k = 1; k <= k_count; ++k) {
-    if (level->partial && k > static_cast<int>(level->level.size()) && k_noise == k - 1 &&
-        k <= judged) {
-      // The noise run outlasted a level collected from the decomposition: the rest needs
-      // the Monte-Carlo (modes 1..k-1 agree with it when the seeds do).
-      AppendNote(&result->note, "white-noise level of modes 1.." + std::to_string(k - 1) +
-                                    " from the decomposition's noise (seed " +
-                                    std::to_string(level->seed) +
-                                    "), later modes from the Monte-Carlo");
-      level =
-          NoiseLevelCache::Global().Get(length, options.monte_carlo, options.kde, options.distance,
-                                        &result->noise_level_computed, execution);
-    }
-    const double lk = level->LevelFor(k);
+    const double lk = level->FamilyLevelFor(k, std::max(k, family));
     result->noise_level.push_back(lk);
-    // A NaN level (the noise rarely had a mode k) or G_k above it ends the run.
-    const bool under = result->self_distance[static_cast<size_t>(k - 1)] <= lk;
-    if (k_noise == k - 1 && k <= judged && under) {
-      k_noise = k;
-    } else if (k_noise == judged && k == judged + 1 + run_past_k_star && under) {
-      ++run_past_k_star;
-    }
+    if (k_noise == judged && k == judged + 1 + run_past_k_star && g(k) <= lk) ++run_past_k_star;
   }
   result->k_noise = k_noise;
   result->noise_level_realisations = level->realisations;
