@@ -1,12 +1,12 @@
 // FitDriftModel and the steps it is made of (fit_steps.h): the checks of the temperature input,
-// the decomposition and grouping into sub-series (PrepareSubSeries), and one learner or
-// identified thermal model per sub-series (FitLearners), with the automatic choice of lags.
+// the decomposition and grouping into sub-series (PrepareSubSeries; the decomposing methods' own
+// steps are in ms_elm.cc and emd_elm.cc), and one learner or identified thermal model per
+// sub-series (FitLearners), with the automatic choice of lags.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <string>
 #include <utility>
 
@@ -17,9 +17,8 @@
 #include "gyrodrift/drift/drift_model.h"
 
 namespace gyrodrift::drift {
-namespace {
+namespace internal {
 
-// Rows of inputs of sub-model g for t = first .. first + count - 1 (predict mode).
 Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eigen::VectorXd>& s,
                             const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index first,
                             Eigen::Index count) {
@@ -29,61 +28,16 @@ Eigen::MatrixXd PredictRows(const DriftModel& model, const Eigen::Ref<const Eige
   return x;
 }
 
-// Sub-model g's own random stream (common/random.h: the seed rule).
 std::uint64_t SubModelSeed(const DriftOptions& o, size_t g) {
   return SeedFor(o.seed, "sub-model", g);
 }
 
 LearnerOptions SubModelLearner(const DriftOptions& o, size_t g) {
   LearnerOptions l = o.learner;
-  l.kind = internal::KindOf(o.method);
+  l.kind = KindOf(o.method);
   l.seed = SubModelSeed(o, g);
   return l;
 }
-
-// The share of the held-out mean-square error of the training mean that the noise group's
-// learner must remove to be kept [choice, docs/drift.md 1.2]. The sum of white-noise IMFs 1..k_N
-// is white noise less its slow modes: a learner on its lags predicts a few per cent of it (4.5 %
-// of the training MSE on the chamber record), which is noise, not drift, and what it predicts is
-// added to the sum, so against the drift it costs as much as it gains against the next sample.
-// Drift content misjudged as noise would be predicted far better than that.
-constexpr double kWhiteGroupMinSkill = 0.1;
-
-// The noise group of MS-ELM is white by the selection's test, so its next value is its mean and
-// a learner on its lags mostly adds noise to the sum. It keeps its learner only if that learner,
-// fitted on the first 1 - validation_fraction of the block, predicts the rest one step ahead with
-// a mean-square error at least kWhiteGroupMinSkill below that of the mean of the first part
-// (chronological split); otherwise the training mean of the whole block predicts it.
-void PredictWhiteGroupByMean(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& series,
-                             const Eigen::Ref<const Eigen::MatrixXd>& thermal, Eigen::Index fit_end,
-                             const Execution& learners) {
-  const DriftOptions& o = model.options;
-  const int p = model.lags;
-  const Eigen::Index validation =
-      static_cast<Eigen::Index>(std::floor(o.validation_fraction * fit_end));
-  const Eigen::Index inner_end = fit_end - validation;
-  if (validation < 1 || inner_end - p < 8) return;  // too short to judge: the learner stays
-  for (size_t g = 0; g < model.sub_models.size(); ++g) {
-    SubModel& sub = model.sub_models[g];
-    if (sub.name != selection::ToString(selection::GroupKind::kNoise)) continue;
-    const auto s = series.col(static_cast<Eigen::Index>(g));
-    const auto held_out = s.segment(inner_end, validation);
-    const std::unique_ptr<Learner> inner =
-        FitLearner(PredictRows(model, s, thermal, p, inner_end - p), s.segment(p, inner_end - p),
-                   SubModelLearner(o, g), learners);
-    const double learner_sse =
-        (inner->Predict(PredictRows(model, s, thermal, inner_end, validation)) - held_out)
-            .squaredNorm();
-    const double mean_sse = (held_out.array() - s.head(inner_end).mean()).square().sum();
-    if (learner_sse < (1.0 - kWhiteGroupMinSkill) * mean_sse) continue;
-    sub.learner = nullptr;
-    sub.mean = s.head(fit_end).mean();
-  }
-}
-
-}  // namespace
-
-namespace internal {
 
 LearnerKind KindOf(Method method) {
   switch (method) {
@@ -146,35 +100,12 @@ SubSeries PrepareSubSeries(const Eigen::Ref<const Eigen::VectorXd>& y, const Dri
       execution.progress(kDecomposeShare * fraction, "decompose");
     };
   }
-  decomposition::Decomposition d;
-  std::optional<selection::SelectionResult> sel;
-  if (o.method == Method::kEmdElm) {
-    d = decomposition::Decompose(y, dopt, context);
-  } else {
-    selection::SelectionOptions sopt = o.selection;
-    // The white-noise level, when it cannot reuse the decomposition's noise, draws the same
-    // realisations itself: the user's seed, not the Monte-Carlo's default.
-    sopt.monte_carlo.seed = o.seed;
-    selection::GroupedDecomposition grouped = selection::DecomposeAndSelect(y, dopt, sopt, context);
-    d = std::move(grouped.decomposition);
-    sel = std::move(grouped.selection);
-  }
+  const decomposition::Decomposition d =
+      o.method == Method::kEmdElm ? DecomposeForEmdElm(y, dopt, context, out.model)
+                                  : DecomposeForMsElm(y, dopt, context, out.model);
   out.model.training_imfs = d.num_imfs();
   out.model.decomposition_summary = d.report.Summary();
-  if (d.num_imfs() == 0) {
-    out.model.sub_models.push_back({"signal", {}, true, nullptr});
-  } else if (o.method == Method::kEmdElm) {
-    for (int k = 1; k <= d.num_imfs(); ++k) {
-      out.model.sub_models.push_back({"imf" + std::to_string(k), {k}, false, nullptr});
-    }
-    out.model.sub_models.push_back({"residue", {}, true, nullptr});
-  } else {
-    out.model.selection_summary = sel->Summary();
-    for (const auto& group : sel->groups) {
-      out.model.sub_models.push_back(
-          {std::string(selection::ToString(group.kind)), group.imfs, group.has_residue, nullptr});
-    }
-  }
+  if (d.num_imfs() == 0) out.model.sub_models.push_back({"signal", {}, true, nullptr});
   out.series = GroupSeries(out.model, d);
   return out;
 }

@@ -1,7 +1,7 @@
 // The drift model's definition: the Mode / Method / Protocol names, DriftOptions (defaults and
 // Validate), the DriftModel accessors and Summary, and the facts every step reads off a method
 // (UsesDecomposition, IdentifiesThermalModel, EffectiveFeatures, GroupSeries). The fit is in
-// drift_fit.cc, compensate-mode estimation in compensation.cc, prediction in prediction.cc and
+// drift_fit.cc (MS-ELM's and EMD-ELM's own steps in ms_elm.cc and emd_elm.cc), compensate-mode estimation in compensation.cc, prediction in prediction.cc and
 // the causal protocol in causal_protocol.cc.
 #include "gyrodrift/drift/drift_model.h"
 

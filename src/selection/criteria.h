@@ -1,5 +1,6 @@
-// Private: the selection criteria (criteria.cc), one function per curve and per boundary rule,
-// called by SelectModes once it has the densities and distances. The formulas and edge cases are
+// Private: the selection criteria, one function per curve and per boundary rule, called by
+// SelectModes once it has the densities and distances: the PDF-similarity criterion's in
+// pdf_similarity.cc, the others in criteria.cc. The formulas and edge cases are
 // in selection.h and docs/selection.md.
 #pragma once
 

@@ -48,8 +48,11 @@ NoiseLevel LevelFromSamples(int length, double confidence, std::uint64_t seed,
   out.realisations = static_cast<int>(g.size());
   out.confidence = confidence;
   out.seed = seed;
-  out.level.assign(modes, std::numeric_limits<double>::quiet_NaN());
-  out.median.assign(modes, std::numeric_limits<double>::quiet_NaN());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.level.assign(modes, nan);
+  out.median.assign(modes, nan);
+  out.mad.assign(modes, nan);
+  out.family_scale.assign(modes, nan);
   out.realisations_with_mode.assign(modes, 0);
   std::vector<double> values;
   for (size_t k = 0; k < modes; ++k) {
@@ -62,6 +65,30 @@ NoiseLevel LevelFromSamples(int length, double confidence, std::uint64_t seed,
     std::sort(values.begin(), values.end());
     out.level[k] = SortedQuantile(values, confidence);
     out.median[k] = SortedQuantile(values, 0.5);
+    for (double& v : values) v = std::abs(v - out.median[k]);
+    std::sort(values.begin(), values.end());
+    out.mad[k] = SortedQuantile(values, 0.5);
+  }
+  // The family's statistic, realisation by realisation, over the modes with a level (a mode a
+  // realisation lacks does not count; a mode without a level ends the run anyway). A deviation
+  // above a zero MAD is unbounded.
+  std::vector<double> running(g.size(), -std::numeric_limits<double>::infinity());
+  for (size_t k = 0; k < modes; ++k) {
+    if (std::isnan(out.median[k])) {  // no level: the family's scale is that of the modes before
+      if (k > 0) out.family_scale[k] = out.family_scale[k - 1];
+      continue;
+    }
+    for (size_t i = 0; i < g.size(); ++i) {
+      if (k >= g[i].size()) continue;
+      const double deviation = g[i][k] - out.median[k];
+      const double z = out.mad[k] > 0.0 ? deviation / out.mad[k]
+                       : deviation > 0.0 ? std::numeric_limits<double>::infinity()
+                                         : 0.0;
+      running[i] = std::max(running[i], z);
+    }
+    values = running;
+    std::sort(values.begin(), values.end());
+    out.family_scale[k] = SortedQuantile(values, confidence);
   }
   return out;
 }
@@ -135,6 +162,16 @@ void MonteCarloOptions::Validate() const {
 double NoiseLevel::LevelFor(int k) const {
   if (k < 1 || k > static_cast<int>(level.size())) return std::numeric_limits<double>::quiet_NaN();
   return level[static_cast<size_t>(k - 1)];
+}
+
+double NoiseLevel::FamilyLevelFor(int k, int modes) const {
+  if (k < 1 || k > modes || modes > static_cast<int>(family_scale.size())) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const double m = median[static_cast<size_t>(k - 1)];
+  const double spread = mad[static_cast<size_t>(k - 1)];
+  if (!(spread > 0.0)) return m;  // NaN stays NaN
+  return m + family_scale[static_cast<size_t>(modes - 1)] * spread;
 }
 
 std::string NoiseLevel::Summary() const {

@@ -8,9 +8,14 @@
 //
 // Level [reconstructed from Komaty et al., IEEE TIM 63(1) 2014, METHOD.md section 4]: R
 // realisations of seeded white noise of length N (realisation i draws from Rng(seed, i)) are
-// decomposed by plain EMD; the level of mode k is the `confidence` quantile (type 7) of G_k over
-// the realisations that have a mode k (at least kMinRealisationsPerMode of them, else NaN: no
-// level, the mode cannot be called noise). Realisations run on the execution's threads
+// decomposed by plain EMD. Per mode, over the realisations that have a mode k (at least
+// kMinRealisationsPerMode of them, else NaN: no level, the mode cannot be called noise): the
+// `confidence` quantile (type 7) of G_k (`level`, mode k tested alone), its median and its median
+// absolute deviation. The selection tests modes 1..m together [choice, docs/selection.md 2]: the
+// family-wise level of mode k is median_k + c_m MAD_k, c_m the `confidence` quantile over the
+// realisations of max_{k <= m} (G_k - median_k) / MAD_k, so that a white-noise decomposition
+// passes all m modes with probability `confidence` (max-statistic simultaneous band), where the
+// per-mode level fails about 10 % of white records over 11 modes. Realisations run on the execution's threads
 // (ParallelFor); each fills its own slot, so the level is the same bits for any thread count.
 // Cost: R plain EMDs of length N plus R * K KDEs, dominated by the EMDs: for N = 28,800 about
 // 0.1 s of CPU per realisation, so R = 100 costs about 10 s of CPU (bench_selection).
@@ -57,15 +62,21 @@ struct NoiseLevel {
   int realisations = 0;  // R
   double confidence = 0.0;
   std::uint64_t seed = 0;
-  std::vector<double> level;                // level of mode k at index k - 1 (NaN: no level)
-  std::vector<double> median;               // median G_k of the white-noise mode k (diagnostic)
+  std::vector<double> level;   // level of mode k tested alone, at index k - 1 (NaN: no level)
+  std::vector<double> median;  // median G_k of the white-noise mode k
+  std::vector<double> mad;     // median |G_k - median_k| of the white-noise mode k
+  // c_m at index m - 1: the confidence quantile of max_{k <= m} (G_k - median_k) / MAD_k.
+  std::vector<double> family_scale;
   std::vector<int> realisations_with_mode;  // how many realisations had a mode k
   // The level covers modes 1..level.size() only: it was collected from a decomposition whose
   // white-noise EMDs stopped there (NoiseLevelCollector). Past them the level is unknown, not
   // absent; SelectModes then falls back to the Monte-Carlo.
   bool partial = false;
-  // Level of mode k (1-based); NaN beyond the modes the noise produced.
+  // Level of mode k (1-based) tested alone; NaN beyond the modes the noise produced.
   double LevelFor(int k) const;
+  // Level of mode k when modes 1..modes are tested together (k <= modes): median_k +
+  // c_modes MAD_k (median_k when MAD_k = 0); NaN when either is unknown.
+  double FamilyLevelFor(int k, int modes) const;
   std::string Summary() const;  // one line
 };
 

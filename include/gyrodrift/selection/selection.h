@@ -6,8 +6,9 @@
 //     2014; METHOD.md section 4]: Gaussian KDEs of the (centred) signal x and of every IMF on one
 //     common grid; D_k = distance(pdf(x), pdf(IMF k)), k* = argmax D_k. G_k = distance of the
 //     standardised IMF k to N(0, 1); k_N = length of the leading run of IMFs 1..k* with G_k under
-//     the Monte-Carlo level of white-noise IMFs of the same length (noise_level.h, cached): the
-//     run never passes k*. noise = 1..k_N, mixed = k_N+1..k*, drift = k*+1..K plus the residue.
+//     the Monte-Carlo level of white-noise IMFs of the same length, modes 1..k* tested together
+//     (the family-wise level, noise_level.h; cached): the run never passes k*.
+//     noise = 1..k_N, mixed = k_N+1..k*, drift = k*+1..K plus the residue.
 //   kKomaty: the two-way split of Komaty et al.: noise = 1..k*, drift = k*+1..K plus the residue.
 //   kEnergyModel: white-noise IMF energy model of Flandrin, Goncalves & Rilling, IEEE SPL 11(2)
 //     2004: E_k = E_1 / 0.719 * 2.01^-k with E_1 = N (median|imf_1| / 0.6745)^2; mode k >= 2 is

@@ -1,4 +1,4 @@
-// The selection criteria on hand-made curves (criteria.cc): k* on ties, the pdf criterion's noise
+// The selection criteria on hand-made curves (pdf_similarity.cc and criteria.cc): k* on ties, the pdf criterion's noise
 // run against a supplied white-noise level, the two-group rules, and the energy curve's band exit.
 // selection_test runs them through SelectModes on decomposed signals.
 #include "selection/criteria.h"
@@ -27,12 +27,16 @@ SelectionResult Curves(std::vector<double> self_distance, int k_star) {
   return r;
 }
 
-// Options with a supplied level for 100-sample records (30 realisations, seed 7).
+// Options with a supplied level for 100-sample records (30 realisations, seed 7) that is the same
+// for every family of modes tested together (no spread: the family level is the median).
 SelectionOptions WithLevel(std::vector<double> level) {
   auto supplied = std::make_shared<NoiseLevel>();
   supplied->length = 100;
   supplied->realisations = 30;
   supplied->seed = 7;
+  supplied->mad.assign(level.size(), 0.0);
+  supplied->family_scale.assign(level.size(), 0.0);
+  supplied->median = level;
   supplied->level = std::move(level);
   SelectionOptions o;
   o.noise_level = supplied;
@@ -47,6 +51,30 @@ TEST(Criteria, KStarIsTheFirstMaximumOfTheDistance) {
 
 // The noise run is the leading IMFs with G_k at or under the level: a later IMF under it does not
 // rejoin, and a NaN level ends the run. mixed_end = k*: the run never passes k*.
+// Modes 1..k* are tested together: each at median + c_{k*} MAD, the scale of the whole family, so
+// a mode above the level it would have alone (c_1) still passes; past k* the curve shows each
+// mode's level as the last of a family 1..k.
+TEST(Criteria, PdfSimilarityJudgesModesOneToKStarAsOneFamily) {
+  SelectionOptions o = WithLevel({0.1, 0.1, 0.1, 0.1, 0.1});
+  auto level = std::make_shared<NoiseLevel>(*o.noise_level);
+  level->mad = {0.01, 0.01, 0.01, 0.01, 0.01};
+  level->family_scale = {2.0, 3.0, 4.0, 4.0, 5.0};
+  o.noise_level = level;
+  SelectionResult r = Curves({0.13, 0.135, 0.139, 0.2, 0.1}, 3);
+  PdfSimilarityBoundaries(100, o, {}, &r);
+  EXPECT_EQ(r.k_noise, 3);  // mode 1 alone would fail (0.13 > 0.1 + 2 x 0.01)
+  ASSERT_EQ(r.noise_level.size(), 5u);
+  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(r.noise_level[static_cast<size_t>(k)], 0.14) << k;
+  EXPECT_DOUBLE_EQ(r.noise_level[3], 0.14);
+  EXPECT_DOUBLE_EQ(r.noise_level[4], 0.15);
+  EXPECT_EQ(r.note, "noise run reaches k*: no mixed group");
+  // With k* = 1 the family is mode 1 alone: 0.13 is above its 0.12.
+  r = Curves({0.13, 0.135, 0.139, 0.2, 0.1}, 1);
+  PdfSimilarityBoundaries(100, o, {}, &r);
+  EXPECT_EQ(r.k_noise, 0);
+  EXPECT_DOUBLE_EQ(r.noise_level[0], 0.12);
+}
+
 TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   const SelectionOptions o = WithLevel({0.5, 0.5, 0.5, 0.5, 0.5});
   SelectionResult r = Curves({0.1, 0.5, 0.9, 0.1, 0.1}, 4);

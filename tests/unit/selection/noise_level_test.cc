@@ -1,9 +1,11 @@
-// The white-noise self-similarity level: seeded, independent of the thread count, cached, and
-// white-noise IMFs stay under it while a sinusoid does not.
+// The white-noise self-similarity level: seeded, independent of the thread count, cached,
+// white-noise IMFs stay under it while a sinusoid does not, and the family-wise level of modes
+// tested together passes white records at its confidence.
 #include "gyrodrift/selection/noise_level.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -87,6 +89,83 @@ TEST(NoiseLevel, FreshWhiteNoiseModesStayUnderTheLevelSinusoidsDoNot) {
   for (int k = 1; k <= 4; ++k) {
     EXPECT_GT(SelfSimilarityDistance(sine, {}, PdfDistance::kL2), level.LevelFor(k)) << k;
   }
+}
+
+// Type-7 quantile, as the level's.
+double Quantile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  const double pos = p * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(pos);
+  if (lo + 1 >= v.size()) return v.back();
+  return v[lo] + (pos - lo) * (v[lo + 1] - v[lo]);
+}
+
+// The family-wise level recomputed from the same realisations: median_k + c_m MAD_k, c_m the
+// confidence quantile of each realisation's max over modes 1..m of (G_k - median_k) / MAD_k.
+TEST(NoiseLevel, FamilyLevelIsTheMaxStatisticOfTheRealisations) {
+  const MonteCarloOptions mc = SmallRun();
+  const NoiseLevel level = ComputeNoiseLevel(kLength, mc, {}, PdfDistance::kL2);
+  constexpr int kModes = 5;  // every realisation of 2048 samples has them
+  std::vector<std::vector<double>> g(kModes);
+  for (int i = 0; i < mc.realisations; ++i) {
+    Eigen::VectorXd w(kLength);
+    Rng(mc.seed, static_cast<std::uint64_t>(i)).FillNormal(w);
+    const decomposition::Decomposition d = decomposition::Emd(w, mc.sifting);
+    ASSERT_GE(d.num_imfs(), kModes);
+    for (int k = 0; k < kModes; ++k) {
+      g[k].push_back(SelfSimilarityDistance(d.imfs.col(k), {}, PdfDistance::kL2));
+    }
+  }
+  std::vector<double> running(static_cast<size_t>(mc.realisations), -1e300);
+  for (int k = 0; k < kModes; ++k) {
+    const double median = Quantile(g[k], 0.5);
+    std::vector<double> deviation;
+    for (double v : g[k]) deviation.push_back(std::abs(v - median));
+    const double mad = Quantile(deviation, 0.5);
+    EXPECT_NEAR(level.median[k], median, 1e-12) << k;
+    EXPECT_NEAR(level.mad[k], mad, 1e-12) << k;
+    for (size_t i = 0; i < running.size(); ++i) {
+      running[i] = std::max(running[i], (g[k][i] - median) / mad);
+    }
+    EXPECT_NEAR(level.family_scale[k], Quantile(running, mc.confidence), 1e-9) << k;
+    EXPECT_DOUBLE_EQ(level.FamilyLevelFor(k + 1, kModes),
+                     level.median[k] + level.family_scale[kModes - 1] * level.mad[k]);
+  }
+  // A larger family never lowers the level.
+  for (size_t m = 1; m < level.family_scale.size(); ++m) {
+    EXPECT_GE(level.family_scale[m], level.family_scale[m - 1]) << m;
+  }
+  EXPECT_TRUE(std::isnan(level.FamilyLevelFor(0, 3)));
+  EXPECT_TRUE(std::isnan(level.FamilyLevelFor(4, 3)));  // mode outside the family
+  EXPECT_TRUE(std::isnan(level.FamilyLevelFor(1, 100)));
+}
+
+// Fresh white noise (other streams) passes modes 1..m together at about the confidence; each
+// mode's own 99 % level, asked m times, fails several times as many records.
+TEST(NoiseLevel, FamilyLevelPassesWhiteRecordsAtItsConfidence) {
+  constexpr int kN = 1024;
+  constexpr int kModes = 7;
+  constexpr int kRecords = 200;
+  MonteCarloOptions mc;  // 100 realisations, 99 %
+  const NoiseLevel level = ComputeNoiseLevel(kN, mc, {}, PdfDistance::kL2);
+  int family_pass = 0, single_pass = 0;
+  for (int i = 0; i < kRecords; ++i) {
+    Eigen::VectorXd w(kN);
+    Rng(4242, static_cast<std::uint64_t>(i)).FillNormal(w);
+    const decomposition::Decomposition d = decomposition::Emd(w);
+    ASSERT_GE(d.num_imfs(), kModes);
+    bool family = true, single = true;
+    for (int k = 1; k <= kModes; ++k) {
+      const double gk = SelfSimilarityDistance(d.imfs.col(k - 1), {}, PdfDistance::kL2);
+      family = family && gk <= level.FamilyLevelFor(k, kModes);
+      single = single && gk <= level.LevelFor(k);
+    }
+    family_pass += family;
+    single_pass += single;
+  }
+  EXPECT_GE(family_pass, 0.96 * kRecords) << single_pass;
+  EXPECT_GE(kRecords - single_pass, 2 * (kRecords - family_pass)) << family_pass;
+  EXPECT_LE(single_pass, 0.96 * kRecords) << family_pass;
 }
 
 TEST(NoiseLevelCache, SecondCallIsCachedAndIdentical) {
