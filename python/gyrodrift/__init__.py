@@ -23,7 +23,8 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "noise_terms", "select_modes", "simulate", "temperature_warning",
+    "decompose", "evaluate", "noise_terms", "plan", "read_ulog", "select_modes", "simulate",
+    "temperature_warning", "ulog_columns",
 ]
 
 
@@ -121,6 +122,40 @@ def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1
     return _gyrodrift.simulate(duration=duration, profile=profile, preset=preset, rate_hz=rate_hz,
                                seed=seed, winding=winding, asymmetry=asymmetry,
                                input_rate_dph=input_rate_dph, noise=noise)
+
+
+def read_ulog(path, *, decode=("sensor_gyro",)):
+    """Reads a PX4 ULog file, as ``gyrodrift convert LOG.ulg --list`` does (docs/ulog.md).
+
+    Returns a dict: ``version``, ``start_us``, ``info``, ``parameters``, ``dropouts``,
+    ``appended``, ``warnings`` (damage skipped, with byte offsets), ``listing`` (the text of
+    ``--list``) and ``series``, one dict per subscription (``topic``, ``instance``, ``fields``,
+    ``types``, ``samples``, ``first_us``, ``last_us``); the series of the topics named in
+    ``decode`` (``"*"``: every topic) also hold ``timestamp_us`` and ``values`` (field -> array).
+    """
+    return _gyrodrift.read_ulog(path, decode=list(decode))
+
+
+def ulog_columns(path, *, topic="sensor_gyro", instance=0, axes=("x", "y", "z"),
+                 temperature_field="temperature", units="dph"):
+    """The columns ``gyrodrift convert`` writes for one series: ``time_s``, ``<axis>_<units>``
+    (the rad/s fields converted) and ``temperature_c``, as arrays, plus ``warnings``."""
+    return _gyrodrift.ulog_columns(path, topic=topic, instance=instance, axes=list(axes),
+                                   temperature_field=temperature_field, units=units)
+
+
+def plan(*, hours=8.0, min_c=-20.0, max_c=60.0, rate=0.0, dwell_min=80.0):
+    """A thermal-chamber programme that identifies a compensate-mode model, as ``gyrodrift plan``
+    writes it (docs/drift.md 4.9): ``time_s`` and ``temperature_c`` (set points; pass them to
+    ``simulate(profile=(time_s, temperature_c))``), ``steps``, ``rate_k_per_min``, ``warnings``
+    and ``explanation``.
+
+    >>> import gyrodrift as gd
+    >>> p = gd.plan(hours=8, min_c=-20, max_c=60)
+    >>> len(p["steps"]), p["rate_k_per_min"]
+    (8, 1.5)
+    """
+    return _gyrodrift.plan(hours=hours, min_c=min_c, max_c=max_c, rate=rate, dwell_min=dwell_min)
 
 
 class DriftModel:

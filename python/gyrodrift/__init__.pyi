@@ -50,6 +50,18 @@ def simulate(
     noise: bool = ...,
 ) -> dict[str, Any]: ...
 
+def read_ulog(path: str, *, decode: Sequence[str] = ...) -> dict[str, Any]: ...
+
+def ulog_columns(
+    path: str, *, topic: str = ..., instance: int = ..., axes: Sequence[str] = ...,
+    temperature_field: str = ..., units: Literal["dph", "dps", "rads"] = ...,
+) -> dict[str, Any]: ...
+
+def plan(
+    *, hours: float = ..., min_c: float = ..., max_c: float = ..., rate: float = ...,
+    dwell_min: float = ...,
+) -> dict[str, Any]: ...
+
 class DriftModel:
     def __init__(self) -> None: ...
     def fit(

@@ -190,5 +190,6 @@ void BindSignal(py::module_& m);      // decompose, allan, noise_terms, simulate
 void BindDriftModel(py::module_& m);  // DriftModel, temperature_warning
 void BindEvaluate(py::module_& m);    // evaluate
 void BindFleet(py::module_& m);       // calibrate and the fleet's helpers
+void BindLogs(py::module_& m);        // read_ulog, ulog_columns, plan
 
 }  // namespace gyrodrift::python

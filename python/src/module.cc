@@ -48,4 +48,5 @@ PYBIND11_MODULE(_gyrodrift, m) {
   gp::BindDriftModel(m);
   gp::BindEvaluate(m);
   gp::BindFleet(m);
+  gp::BindLogs(m);
 }

@@ -22,6 +22,7 @@ PAIRS = [
     ("allan", gyrodrift.allan, _gyrodrift.allan),
     ("noise_terms", gyrodrift.noise_terms, _gyrodrift.noise_terms),
     ("simulate", gyrodrift.simulate, _gyrodrift.simulate),
+    ("plan", gyrodrift.plan, _gyrodrift.plan),
     ("select_modes", gyrodrift.select_modes, _gyrodrift.select_modes),
     ("evaluate", gyrodrift.evaluate, _gyrodrift.evaluate),
     ("calibrate", gyrodrift.calibrate, _gyrodrift.calibrate),

@@ -1,0 +1,111 @@
+// Bindings of the logs people have and the runs they plan: read_ulog, ulog_columns (what
+// `gyrodrift convert` writes) and plan (what `gyrodrift plan` writes), as the CLI computes them.
+#include "bindings.h"
+#include "gyrodrift/drift/calibration_plan.h"
+#include "gyrodrift/io/ulog.h"
+
+namespace gyrodrift::python {
+namespace {
+
+// One series as a dict: its description, and its samples when decoded (values by field).
+py::dict SeriesDict(const io::UlogSeries& s) {
+  py::dict d;
+  d["topic"] = s.topic;
+  d["instance"] = s.instance;
+  d["fields"] = s.fields;
+  d["types"] = s.types;
+  d["samples"] = s.samples;
+  d["first_us"] = s.first_us;
+  d["last_us"] = s.last_us;
+  d["decoded"] = s.decoded;
+  if (s.decoded) {
+    d["timestamp_us"] = py::array_t<std::uint64_t>(static_cast<py::ssize_t>(s.timestamp_us.size()),
+                                                   s.timestamp_us.data());
+    py::dict values;
+    for (const std::string& f : s.fields) {
+      const std::vector<double> v = s.Column(f);
+      values[py::str(f)] = py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+    }
+    d["values"] = values;
+  }
+  return d;
+}
+
+py::dict ReadUlog(const std::string& path, const std::vector<std::string>& decode) {
+  const io::Ulog log = io::ReadUlog(path, decode);
+  py::dict d;
+  d["version"] = log.version;
+  d["start_us"] = log.start_us;
+  d["info"] = log.info;
+  d["parameters"] = log.parameters;
+  d["dropouts"] = log.dropouts;
+  d["appended"] = log.appended;
+  d["warnings"] = log.warnings;
+  py::list series;
+  for (const io::UlogSeries& s : log.series) series.append(SeriesDict(s));
+  d["series"] = series;
+  d["listing"] = io::DescribeUlog(log);
+  return d;
+}
+
+py::dict UlogColumns(const std::string& path, const std::string& topic, int instance,
+                     const std::vector<std::string>& axes, const std::string& temperature_field,
+                     const std::string& units) {
+  const io::UlogConversion conversion{.topic = topic,
+                                      .axes = axes,
+                                      .temperature = temperature_field,
+                                      .units = allan::RateUnitFromString(units)};
+  const io::Ulog log = io::ReadUlog(path, {topic});
+  const io::UlogSeries* s = log.Find(topic, instance);
+  if (s == nullptr || s->samples == 0) {
+    throw DataError(path + ": no samples of " + topic + " instance " + std::to_string(instance));
+  }
+  py::dict d;
+  for (const io::CsvColumn& c : io::UlogColumns(*s, conversion)) d[py::str(c.name)] = ToArray(c.values);
+  d["warnings"] = log.warnings;
+  return d;
+}
+
+py::dict Plan(double hours, double min_c, double max_c, double rate, double dwell_min) {
+  const drift::CalibrationPlan plan = drift::PlanCalibration(
+      {.hours = hours, .min_c = min_c, .max_c = max_c, .rate_k_per_min = rate,
+       .shortest_dwell_min = dwell_min});
+  py::dict d;
+  const auto n = static_cast<Eigen::Index>(plan.time_s.size());
+  d["time_s"] = ToArray(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(plan.time_s.data(), n)));
+  d["temperature_c"] =
+      ToArray(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(plan.temperature_c.data(), n)));
+  d["rate_k_per_min"] = plan.rate_k_per_min;
+  py::list steps;
+  for (const drift::PlanStep& s : plan.steps) {
+    py::dict step;
+    step["start_s"] = s.start_s;
+    step["end_s"] = s.end_s;
+    step["from_c"] = s.from_c;
+    step["to_c"] = s.to_c;
+    step["why"] = s.why;
+    steps.append(step);
+  }
+  d["steps"] = steps;
+  d["warnings"] = plan.warnings;
+  d["explanation"] = plan.Explanation();
+  return d;
+}
+
+}  // namespace
+
+void BindLogs(py::module_& m) {
+  using py::arg;
+  m.def("read_ulog", &ReadUlog, arg("path"), py::kw_only(),
+        arg("decode") = std::vector<std::string>{"sensor_gyro"});
+  const io::UlogConversion cd;
+  m.def("ulog_columns", &UlogColumns, arg("path"), py::kw_only(), arg("topic") = cd.topic,
+        arg("instance") = 0, arg("axes") = cd.axes, arg("temperature_field") = cd.temperature,
+        arg("units") = allan::ToString(cd.units));
+  const drift::PlanSettings pd;
+  m.def("plan", &Plan, py::kw_only(), arg("hours") = pd.hours, arg("min_c") = pd.min_c,
+        arg("max_c") = pd.max_c, arg("rate") = pd.rate_k_per_min,
+        arg("dwell_min") = pd.shortest_dwell_min);
+}
+
+}  // namespace gyrodrift::python

@@ -1,0 +1,48 @@
+"""The logs people have and the runs they plan, from Python: read_ulog and ulog_columns give the
+numbers `gyrodrift convert` gives (the same CSV, to the bit), and plan the programme `gyrodrift
+plan` writes."""
+
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+import gyrodrift as gd
+from conftest import read_csv
+
+TESTDATA = pathlib.Path(os.environ.get("GYRODRIFT_TESTDATA_DIR",
+                                       pathlib.Path(__file__).resolve().parents[3] / "shared/testdata"))
+LOG = TESTDATA / "px4_ulog_samples" / "sample_log_small.ulg"
+
+
+def test_read_ulog_lists_three_gyro_instances_with_temperature():
+    log = gd.read_ulog(str(LOG))
+    gyros = [s for s in log["series"] if s["topic"] == "sensor_gyro"]
+    assert [s["instance"] for s in gyros] == [0, 1, 2]
+    for s in gyros:
+        assert "temperature" in s["fields"] and s["samples"] == 6 and s["decoded"]
+    # pyulog's first sample of instance 0 (tests/unit/io/ulog_test.cc).
+    assert gyros[0]["timestamp_us"][0] == 21312030
+    assert gyros[0]["values"]["x"][0] == -0.04130320996046066
+    assert len(log["parameters"]) == 980 and log["warnings"] == []
+
+
+def test_ulog_columns_are_what_convert_writes(cli, tmp_path):
+    cli("convert", LOG, "--instance", "1", "--units", "dps", "-o", tmp_path / "g.csv")
+    written = read_csv(tmp_path / "g.csv")
+    columns = gd.ulog_columns(str(LOG), instance=1, units="dps")
+    for name in ("time_s", "x_dps", "y_dps", "z_dps", "temperature_c"):
+        np.testing.assert_array_equal(columns[name], written[name])
+
+
+def test_plan_is_what_the_cli_writes(cli, tmp_path):
+    cli("plan", "--hours", "12", "--min", "-40", "--max", "70", "-o", tmp_path / "p.csv")
+    written = read_csv(tmp_path / "p.csv")
+    p = gd.plan(hours=12, min_c=-40, max_c=70)
+    np.testing.assert_array_equal(p["time_s"], written["time_s"])
+    np.testing.assert_array_equal(p["temperature_c"], written["temperature_c"])
+    sim = gd.simulate(profile=(p["time_s"], p["temperature_c"]), duration=3600, seed=1)
+    assert len(sim["rate_dph"]) == 3600
+    with pytest.raises(gd.UsageError, match="give --hours"):
+        gd.plan(hours=4, min_c=-40, max_c=80)
