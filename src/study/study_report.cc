@@ -246,8 +246,7 @@ std::string RenderStudyReport(const StudyResult& s, const io::DygraphsAssets& as
     f.series.push_back(
         Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
     f.series.push_back(
-        Series("white-noise level of G_k, family-wise 99 % over modes 1..k* (right axis)",
-               vec(s.selection.noise_level), true));
+        Series("family-wise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
     f.series[1].right_axis = f.series[2].right_axis = true;
     for (const auto& g : s.selection.groups) {
       if (g.imfs.empty()) continue;
