@@ -54,19 +54,8 @@ void Run(ConvertArgs& a) {
   }
   const io::Ulog log = io::ReadUlog(a.input, {a.conversion.topic});
   for (const std::string& w : log.warnings) fmt::print(stderr, "warning: {}\n", w);
-  std::vector<const io::UlogSeries*> chosen;
-  for (const io::UlogSeries& s : log.series) {
-    if (s.topic == a.conversion.topic && (all || s.instance == instance) && s.samples > 0) {
-      chosen.push_back(&s);
-    }
-  }
-  if (chosen.empty()) {
-    throw DataError(fmt::format("{}: no samples of {}{} (gyrodrift convert {} --list shows what "
-                                "the log holds)",
-                                a.input, a.conversion.topic,
-                                all ? std::string() : fmt::format(" instance {}", instance),
-                                a.input));
-  }
+  const std::vector<const io::UlogSeries*> chosen =
+      io::SeriesWithSamples(log, a.input, a.conversion.topic, all ? -1 : instance);
   std::vector<std::pair<std::string, std::string>> files;
   std::vector<std::string> outputs;
   for (const io::UlogSeries* s : chosen) {

@@ -56,12 +56,9 @@ py::dict UlogColumns(const std::string& path, const std::string& topic, int inst
                                       .temperature = temperature_field,
                                       .units = allan::RateUnitFromString(units)};
   const io::Ulog log = io::ReadUlog(path, {topic});
-  const io::UlogSeries* s = log.Find(topic, instance);
-  if (s == nullptr || s->samples == 0) {
-    throw DataError(path + ": no samples of " + topic + " instance " + std::to_string(instance));
-  }
+  const io::UlogSeries& s = *io::SeriesWithSamples(log, path, topic, instance).front();
   py::dict d;
-  for (const io::CsvColumn& c : io::UlogColumns(*s, conversion)) d[py::str(c.name)] = ToArray(c.values);
+  for (const io::CsvColumn& c : io::UlogColumns(s, conversion)) d[py::str(c.name)] = ToArray(c.values);
   d["warnings"] = log.warnings;
   return d;
 }

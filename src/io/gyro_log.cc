@@ -32,8 +32,15 @@ GapPolicy GapPolicyFromString(std::string_view text) {
   return gyrodrift::internal::EnumFromName(text, "gaps", kGapPolicies);
 }
 
+namespace {
+
+// Whether the caller's user sets the log options as flags (--gaps) rather than manifest keys.
+bool SpeltAsFlags(const LogOptions& options) { return options.gaps_name.rfind("--", 0) == 0; }
+
+}  // namespace
+
 std::string SpellGaps(const LogOptions& options, GapPolicy policy) {
-  if (options.gaps_name.rfind("--", 0) == 0) {
+  if (SpeltAsFlags(options)) {
     return options.gaps_name + " " + std::string(ToString(policy));
   }
   return fmt::format("{} = '{}'", options.gaps_name, ToString(policy));
@@ -50,10 +57,10 @@ std::string SkippedNote(const CsvTable& table, const LogOptions& options) {
     named += fmt::format("{}{}", i == 0 ? "" : ", ", lines[i]);
   }
   if (lines.size() > 10) named += fmt::format(" and {} more", lines.size() - 10);
-  const bool flags = options.gaps_name.rfind("--", 0) == 0;
   return fmt::format("note: {}: {} damaged line{} skipped ({}): line{} {}", table.source(),
                      lines.size(), lines.size() == 1 ? "" : "s",
-                     flags ? "--bad-lines skip" : "bad_lines = 'skip'", lines.size() == 1 ? "" : "s",
+                     SpeltAsFlags(options) ? "--bad-lines skip" : "bad_lines = 'skip'",
+                     lines.size() == 1 ? "" : "s",
                      named);
 }
 

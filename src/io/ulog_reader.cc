@@ -501,6 +501,24 @@ std::string DescribeUlog(const Ulog& log) {
   return out;
 }
 
+std::vector<const UlogSeries*> SeriesWithSamples(const Ulog& log, const std::string& source,
+                                                 const std::string& topic, int instance) {
+  std::vector<const UlogSeries*> out;
+  for (const UlogSeries& s : log.series) {
+    if (s.topic == topic && (instance < 0 || s.instance == instance) && s.samples > 0) {
+      out.push_back(&s);
+    }
+  }
+  if (out.empty()) {
+    throw DataError(Format("%s: no samples of %s%s (gyrodrift convert %s --list shows what the "
+                           "log holds)",
+                           source.c_str(), topic.c_str(),
+                           instance < 0 ? "" : Format(" instance %d", instance).c_str(),
+                           source.c_str()));
+  }
+  return out;
+}
+
 std::vector<CsvColumn> UlogColumns(const UlogSeries& series, const UlogConversion& conversion) {
   const std::string name = Format("%s (instance %d)", series.topic.c_str(), series.instance);
   if (series.samples == 0) throw DataError(name + " has no samples");

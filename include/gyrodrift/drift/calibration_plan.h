@@ -22,8 +22,9 @@ struct PlanSettings {
   double max_c = 60.0;     // top, in (min_c + 15, 200]: a narrower range identifies nothing
   double rate_k_per_min = 0.0;  // the faster rate r, in [0.5, 2] K/min; 0 = auto
   // The dwells' shortest length, minutes, in [10, 600] [choice: after a 1-K/min ramp the
-  // simulator's case sensor takes 60-70 min to fall below the fit's ramp threshold, 0.1 K/min, and
-  // a dwell counts for the fit when 10 min of it are below; 60-min dwells were missed]
+  // simulator's case sensor still changed by 0.13 K/min 47 min after the ramp's end, above the
+  // fit's ramp threshold (0.1 K/min), and a dwell counts for the fit when 10 min of it are below;
+  // with 48- and 60-min dwells the fit saw 1 dwell in a plan of 8 h, with 80-min ones 4]
   double shortest_dwell_min = 80.0;
   void Validate() const;  // OptionError naming the field
 };

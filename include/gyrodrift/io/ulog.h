@@ -85,6 +85,10 @@ struct UlogConversion {
   std::string temperature = "temperature";         // a field in degC; empty: none
   allan::RateUnit units = allan::RateUnit::kDegPerHour;
 };
+// The series of `topic` with samples: the one of `instance`, or every instance when instance < 0.
+// DataError when there is none, naming the log (`source`) and what was asked.
+std::vector<const UlogSeries*> SeriesWithSamples(const Ulog& log, const std::string& source,
+                                                 const std::string& topic, int instance);
 // The columns of a decoded series. DataError naming a missing field, a series without samples or
 // a "timestamp" field.
 std::vector<CsvColumn> UlogColumns(const UlogSeries& series, const UlogConversion& conversion);
