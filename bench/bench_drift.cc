@@ -50,12 +50,17 @@ drift::DriftOptions Options(drift::Mode mode) {
 }
 
 // Args: mode, threads, BEEMDAN bound (decomposition::BeemdanBound: the default ensemble band, or
-// kFull, every stage noise-assisted as ICEEMDAN, for the time the bound saves).
+// kFull, every stage noise-assisted as ICEEMDAN, for the time the bound saves), and the
+// ensemble size, also the grouping's white-noise realisations (smoke mode: 10 and the default).
 void BM_MsElmFit(benchmark::State& state) {
   const auto& r = Record();
   drift::DriftOptions o = Options(static_cast<drift::Mode>(state.range(0)));
   o.decomposition.beemdan_bound =
       static_cast<gyrodrift::decomposition::BeemdanBound>(state.range(2));
+  if (!gyrodrift::bench::SmokeMode()) {
+    o.decomposition.ensemble_size = static_cast<int>(state.range(3));
+    o.selection.monte_carlo.realisations = static_cast<int>(state.range(3));
+  }
   const gyrodrift::Execution execution{.threads = static_cast<int>(state.range(1))};
   double cpu = 0.0;
   for (auto _ : state) {
@@ -69,7 +74,8 @@ void BM_MsElmFit(benchmark::State& state) {
       benchmark::Counter(cpu / static_cast<double>(state.iterations()));
   state.counters["samples"] = static_cast<double>(r.rate_dph.size());
   state.SetLabel(std::string(drift::ToString(o.mode)) + ", bound " +
-                 std::string(gyrodrift::decomposition::ToString(o.decomposition.beemdan_bound)));
+                 std::string(gyrodrift::decomposition::ToString(o.decomposition.beemdan_bound)) +
+                 ", I = R = " + std::to_string(o.decomposition.ensemble_size));
 }
 
 void BM_ThermalFit(benchmark::State& state) {
@@ -118,17 +124,23 @@ void BM_CausalEvaluation(benchmark::State& state) {
 }
 
 // Predict mode (the paper's task) at 1 and 2 threads, with the default bound and forced to every
-// stage (ICEEMDAN: what the bound saves); compensate mode at 2 threads.
+// stage (ICEEMDAN: what the bound saves); compensate mode at 2 threads; and predict mode with 20
+// realisations for the decomposition and the grouping's level (the fit's cost is proportional
+// to them: docs/performance.md section 4).
 BENCHMARK(BM_MsElmFit)
     ->ArgsProduct({{static_cast<int>(drift::Mode::kPredict)},
                    {1, 2},
                    {static_cast<int>(gyrodrift::decomposition::BeemdanBound::kEnsembleBand),
-                    static_cast<int>(gyrodrift::decomposition::BeemdanBound::kFull)}})
+                    static_cast<int>(gyrodrift::decomposition::BeemdanBound::kFull)},
+                   {100}})
     ->Args({static_cast<int>(drift::Mode::kCompensate), 2,
-            static_cast<int>(gyrodrift::decomposition::BeemdanBound::kEnsembleBand)})
+            static_cast<int>(gyrodrift::decomposition::BeemdanBound::kEnsembleBand), 100})
+    ->Args({static_cast<int>(drift::Mode::kPredict), 2,
+            static_cast<int>(gyrodrift::decomposition::BeemdanBound::kEnsembleBand), 20})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
+
 BENCHMARK(BM_ThermalFit)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_CausalEvaluation)->Arg(2)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
