@@ -14,33 +14,61 @@ namespace gyrodrift::cli {
 namespace {
 
 struct ExportArgs {
-  std::string model;
+  std::vector<std::string> models;
   std::string output;
   std::string format = "c";
   std::string prefix = "gyro_comp";
   bool single_precision = false;
+  std::vector<std::uint32_t> device_ids;
   bool quiet = false;
 };
 
+// What the autopilot runs of each axis, and how much of the full model it keeps.
+std::string Px4Report(const std::vector<io::LoadedModel>& axes) {
+  std::string out;
+  for (size_t a = 0; a < axes.size(); ++a) {
+    const std::string label = fmt::format("TC_G{} axis {} ({})", a / 3, a % 3,
+                                          axes[a].info.target_column);
+    out += fmt::format("  {}: {}\n", label,
+                       firmware::AxisAutopilotForm(axes[a], label).Summary());
+  }
+  return out;
+}
+
 void Run(const ExportArgs& a) {
-  RequireOutputsAreNotInputs({a.model}, {a.output});
+  RequireOutputsAreNotInputs(a.models, {a.output});
   const firmware::ExportOptions options{.format = firmware::ExportFormatFromString(a.format),
-                                  .single_precision = a.single_precision,
-                                  .prefix = a.prefix};
+                                        .single_precision = a.single_precision,
+                                        .prefix = a.prefix,
+                                        .device_ids = a.device_ids};
   options.Validate();
-  // One axis per model file for now; the library takes one model per gyro axis.
-  const std::vector<io::LoadedModel> axes = io::ReadModelFileAxes(a.model);
+  // The axes of every model file, in order (for PX4, each file one gyro instance).
+  std::vector<io::LoadedModel> axes;
+  for (const std::string& model : a.models) {
+    for (io::LoadedModel& axis : io::ReadModelFileAxes(model)) axes.push_back(std::move(axis));
+  }
   const std::string text = firmware::RenderExport(axes, options);
   io::WriteFileAtomically(a.output, text);
   if (a.quiet) return;
   // A model the calibration run could not identify says so wherever it is used (as compensate
   // does); nearly collinear regressors also amplify the header's rounding (docs/firmware.md).
   std::string warnings;
-  for (const auto& sub : axes[0].model.sub_models) {
-    if (!sub.thermal) continue;
-    for (const std::string& w : sub.thermal->report.warnings) {
-      warnings += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
+  for (const io::LoadedModel& axis : axes) {
+    const std::string whose = axes.size() == 1 ? "" : axis.info.target_column + ": ";
+    for (const auto& sub : axis.model.sub_models) {
+      if (!sub.thermal) continue;
+      for (const std::string& w : sub.thermal->report.warnings) {
+        warnings += "warning: " + whose + "the model's calibration run (" + sub.name + "): " + w +
+                    "\n";
+      }
     }
+  }
+  if (options.format == firmware::ExportFormat::kPx4Params) {
+    fmt::print("px4: {} gyro{}, the autopilot form of each axis (fitted with the model):\n{}{}"
+               "wrote {}\n",
+               a.device_ids.size(), a.device_ids.size() == 1 ? "" : "s", Px4Report(axes),
+               warnings, a.output);
+    return;
   }
   fmt::print("{}\n{}: {}{}\n{}wrote {}\n", axes[0].model.Summary(), firmware::ToString(options.format),
              firmware::SummariseExport(axes).Line(),
@@ -60,17 +88,22 @@ const RegisterCommand kRegister("export", 75, [](CLI::App& app) {
       "      -o model.json\n"
       "  gyrodrift export model.json --format c -o gyro_comp.h\n"
       "  gyrodrift export model.json --format json-coefficients -o coefficients.json\n"
+      "  gyrodrift export imu0.json imu1.json --format px4 --device-id 2490378,2621450 -o tc.params\n"
       "gyro_comp.h is dependency-free C99 (no allocation, no libm): a state struct,\n"
       "gyro_comp_init(&s, t) once with the first temperature(s), gyro_comp_step(&s, t, drift)\n"
       "at every sample at the calibration's sample rate; drift[] is what 'gyrodrift compensate'\n"
       "writes as drift_est. Exports models fitted with --method thermal, ms-elm or emd-elm in\n"
-      "compensate mode without --nonlinear; others are refused. See docs/firmware.md.");
-  cmd->add_option("model", args->model, "model file written by 'gyrodrift fit --mode compensate'")
+      "compensate mode without --nonlinear; others are refused. px4 writes the parameters of\n"
+      "PX4's thermal compensation (TC_G*) from the cubic in temperature fitted beside each\n"
+      "axis' model, and says how much of the full model's removal it keeps. See docs/firmware.md.");
+  cmd->add_option("model", args->models,
+                  "model file(s) written by 'gyrodrift fit --mode compensate' (their axes in "
+                  "order; for px4 one file per gyro, its axes x, y, z)")
       ->required()
       ->check(kInputFile);
   cmd->add_option("-o,--output", args->output, "file to write (C header or JSON)")->required();
   BindSetting(
-      cmd->add_option("--format,-f", args->format, "c|json-coefficients")->capture_default_str(),
+      cmd->add_option("--format,-f", args->format, "c|json-coefficients|px4")->capture_default_str(),
       {"format"});
   BindSetting(
       cmd->add_option("--prefix", args->prefix,
@@ -81,6 +114,11 @@ const RegisterCommand kRegister("export", 75, [](CLI::App& app) {
       cmd->add_flag("--float", args->single_precision,
                     "C: float arithmetic instead of double (FPUs without double precision)"),
       {"single_precision"});
+  BindSetting(cmd->add_option("--device-id", args->device_ids,
+                              "px4: each gyro's DEVID, comma-separated, one per model file "
+                              "(convert --list shows sensor_gyro's device_id)")
+                  ->delimiter(','),
+              {"device_ids"});
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });
 });

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <stdexcept>
 
 #include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
@@ -13,9 +14,10 @@
 namespace gyrodrift::firmware {
 namespace {
 
-constexpr gyrodrift::internal::EnumNames<ExportFormat, 2> kFormats{{
+constexpr gyrodrift::internal::EnumNames<ExportFormat, 3> kFormats{{
     {ExportFormat::kC, "c"},
     {ExportFormat::kCoefficientsJson, "json-coefficients"},
+    {ExportFormat::kPx4Params, "px4"},
 }};
 constexpr size_t kLongestPrefix = 32;
 
@@ -44,11 +46,33 @@ void ExportOptions::Validate() const {
                 "false with format " + std::string(ToString(format)) +
                     " (it chooses the C header's arithmetic)");
   }
+  if (format == ExportFormat::kPx4Params) {
+    if (device_ids.empty()) {
+      ThrowOption("device_ids", "none",
+                  "one per gyro instance with format px4 (PX4 matches its calibration to the "
+                  "sensor by it: `gyrodrift convert LOG.ulg --list` shows sensor_gyro's "
+                  "device_id)");
+    }
+    for (std::uint32_t id : device_ids) {
+      if (id == 0) ThrowOption("device_ids", "0", "a sensor's DEVID, not 0");
+    }
+  } else if (!device_ids.empty()) {
+    ThrowOption("device_ids", std::to_string(device_ids.size()) + " given",
+                "none with format " + std::string(ToString(format)) + " (they are PX4's)");
+  }
 }
 
 std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptions& options) {
-  return options.format == ExportFormat::kC ? RenderFirmwareC(axes, options)
-                                            : RenderCoefficientsJson(axes, options);
+  options.Validate();
+  switch (options.format) {
+    case ExportFormat::kC:
+      return RenderFirmwareC(axes, options);
+    case ExportFormat::kCoefficientsJson:
+      return RenderCoefficientsJson(axes, options);
+    case ExportFormat::kPx4Params:
+      return RenderPx4Params(axes, options.device_ids);
+  }
+  throw std::logic_error("unknown export format");
 }
 
 ExportSummary SummariseExport(const std::vector<LoadedModel>& axes) {

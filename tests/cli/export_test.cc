@@ -260,5 +260,47 @@ TEST(ExportCliAxes, OneHeaderForEveryAxisOfAModelFile) {
   std::filesystem::remove_all(d);
 }
 
+// Two gyros of three axes each (as a ULog's two sensor_gyro instances give them): fit each, then
+// one PX4 parameter file for both, each axis' autopilot form and its share of the full model
+// said; without device ids, or with the axes of one gyro only, it is refused and nothing written.
+TEST(ExportCliPx4, TwoGyrosFromOneFitEachToOneParameterFile) {
+  const std::string d = test::TempDir("cli_export_px4");
+  const std::string q = "'";
+  for (int gyro = 0; gyro < 2; ++gyro) {
+    const io::CsvTable log = io::CsvTable::Parse(test::ThermalLogCsv(3600, 20 + gyro), "log");
+    const Eigen::VectorXd r = log.Column("rate_dph");
+    const std::string csv = d + "/gyro" + std::to_string(gyro) + ".csv";
+    io::WriteCsv(csv, {{"time_s", log.Column("time_s")},
+                       {"x_dph", r},
+                       {"y_dph", (-0.5 * r).eval()},
+                       {"z_dph", (0.2 * r).eval()},
+                       {"temperature_c", log.Column("temperature_c")}});
+    ASSERT_EQ(test::RunCli("fit " + q + csv + "' -t x_dph,y_dph,z_dph -T temperature_c --mode "
+                           "compensate -q -o " + q + d + "/gyro" + std::to_string(gyro) + ".json'")
+                  .exit_code,
+              0);
+  }
+  const std::string models = q + d + "/gyro0.json' " + q + d + "/gyro1.json'";
+  const std::string out = d + "/tc.params";
+  const test::CommandResult r = test::RunCli("export " + models +
+                                             " --format px4 --device-id 2490378,2621450 -o " + q +
+                                             out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("TC_G1 axis 2 (z_dph): "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the full model removes"), std::string::npos) << r.out;
+  const std::string text = io::ReadTextFile(out);
+  std::vector<io::LoadedModel> axes = io::ReadModelFileAxes(d + "/gyro0.json");
+  for (io::LoadedModel& axis : io::ReadModelFileAxes(d + "/gyro1.json")) axes.push_back(axis);
+  EXPECT_EQ(text, firmware::RenderPx4Params(axes, {2490378, 2621450}));
+  EXPECT_NE(text.find("1\t1\tTC_G1_ID\t2621450\t6\n"), std::string::npos) << text;
+  const std::string out2 = d + "/bad.params";
+  test::ExpectCleanFailure(test::RunCli("export " + models + " --format px4 -o " + q + out2 + "'"),
+                           2, "device_ids = none", out2, "no device id");
+  test::ExpectCleanFailure(test::RunCli("export " + q + d + "/gyro0.json' --format px4 "
+                                        "--device-id 1,2 -o " + q + out2 + "'"),
+                           2, "PX4 calibrates 1 to 3 gyros of 3 axes each", out2, "one gyro");
+  std::filesystem::remove_all(d);
+}
+
 }  // namespace
 }  // namespace gyrodrift

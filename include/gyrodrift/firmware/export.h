@@ -1,6 +1,7 @@
 // Firmware export: compensate-mode drift models, one per gyro axis, as a dependency-free C99
-// header that a navigation computer compiles, or as a plain JSON of their coefficients for other
-// tools (docs/firmware.md gives the header's API and the JSON schema).
+// header that a navigation computer compiles, as a plain JSON of their coefficients for other
+// tools (docs/firmware.md gives the header's API and the JSON schema), or as the parameters of
+// PX4's thermal compensation (RenderPx4Params: the autopilot form fitted beside each model).
 //
 // What the C header computes: at every sample, from the temperature channel(s) only, the drift
 // estimate of each axis exactly as drift::EstimateDrift does (thermal_model.h): the cascaded
@@ -25,18 +26,20 @@
 // operations per lag stage and per regressor, no loops, no division by a variable.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/drift/thermal_model.h"
 #include "gyrodrift/io/model_file.h"
 
 namespace gyrodrift::firmware {
 
 using io::LoadedModel;
 
-enum class ExportFormat { kC, kCoefficientsJson };
-std::string_view ToString(ExportFormat format);              // "c", "json-coefficients"
+enum class ExportFormat { kC, kCoefficientsJson, kPx4Params };
+std::string_view ToString(ExportFormat format);  // "c", "json-coefficients", "px4"
 ExportFormat ExportFormatFromString(std::string_view name);  // OptionError naming `format`
 
 struct ExportOptions {
@@ -48,6 +51,9 @@ struct ExportOptions {
   // then letters, digits or underscores, at most 32 characters (C99 guarantees 63 significant
   // characters of an internal identifier; the longest suffix is 20).
   std::string prefix = "gyro_comp";
+  // PX4: the DEVID of each gyro instance (PX4's sensor_gyro device_id; `gyrodrift convert --list`
+  // shows it), one per three axes; only with format kPx4Params, which needs them.
+  std::vector<std::uint32_t> device_ids = {};
   void Validate() const;  // throws OptionError naming the field
 };
 
@@ -68,6 +74,23 @@ std::string RenderFirmwareC(const std::vector<LoadedModel>& axes, const ExportOp
 std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                                    const ExportOptions& options);
 
+// The polynomial an autopilot runs for one axis (drift::AutopilotForm, in the model's unit): its
+// thermal sub-models' forms summed (the sum's share_kept NaN), relative to equilibrium at the
+// model's reference temperature when it has one, as the full model's estimate. UsageError naming
+// `label` for a model without one (not an identified compensate-mode model, or a file older than
+// format 8).
+drift::AutopilotForm AxisAutopilotForm(const LoadedModel& axis, const std::string& label);
+
+// The PX4 parameter file (QGroundControl's tab-separated form: vehicle 1, component 1, name,
+// value, MAV_PARAM_TYPE): TC_G_ENABLE = 1 and, for gyro instance i (axes 3i, 3i+1, 3i+2 are its
+// x, y and z), TC_G{i}_ID = device_ids[i], TC_G{i}_TMIN, TMAX (the calibrated range), TREF (its
+// middle) and TC_G{i}_X{k}_{axis}, the coefficients of dT^k in rad/s (AxisAutopilotForm times
+// the unit's factor), floats written to 9 significant digits (they read back to the same float).
+// UsageError unless there are 1 to 3 instances of 3 axes each, each instance's axes calibrated
+// over one range, and every model records its unit.
+std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
+                            const std::vector<std::uint32_t>& device_ids);
+
 // What an export holds, for the CLI's report.
 struct ExportSummary {
   int axes = 0;
@@ -79,7 +102,7 @@ struct ExportSummary {
 };
 ExportSummary SummariseExport(const std::vector<LoadedModel>& axes);
 
-// The file of options.format: RenderFirmwareC or RenderCoefficientsJson.
+// The file of options.format: RenderFirmwareC, RenderCoefficientsJson or RenderPx4Params.
 std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptions& options);
 
 }  // namespace gyrodrift::firmware
