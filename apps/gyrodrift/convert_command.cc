@@ -35,7 +35,8 @@ std::string InstancePath(const std::string& output, int instance, bool all) {
 void Run(ConvertArgs& a) {
   a.conversion.units = allan::RateUnitFromString(a.units);
   if (a.list) {
-    const io::Ulog log = io::ReadUlog(a.input);
+    // The topic asked for is decoded, for its sensors' ids.
+    const io::Ulog log = io::ReadUlog(a.input, {a.conversion.topic});
     fmt::print("{}", io::DescribeUlog(log));
     for (const std::string& w : log.warnings) fmt::print(stderr, "warning: {}\n", w);
     return;
@@ -78,7 +79,8 @@ const RegisterCommand kRegister("convert", 9, [](CLI::App& app) {
       "convert", "Convert a PX4 ULog's gyro series to CSV logs the other commands read.");
   cmd->add_option("input", a->input, "ULog file (.ulg)")->required()->check(kInputFile);
   cmd->add_flag("--list", a->list,
-                "print the log's series (topic, instance, samples, duration, rate, fields) and stop");
+                "print the log's series (topic, instance, samples, duration, rate, fields) and the "
+                "device_id of each instance of --topic, and stop");
   cmd->add_option("--topic", a->conversion.topic, "topic to convert")->capture_default_str();
   cmd->add_option("--instance", a->instance,
                   "multi-instance id, or all (one file per instance: OUT_<id>.csv)")

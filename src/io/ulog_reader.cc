@@ -498,6 +498,12 @@ std::string DescribeUlog(const Ulog& log) {
     out += Format("%-32s %8d %9zu %10.3f %9.3g  %s\n", s.topic.c_str(), s.instance, s.samples,
                   span, rate, fields.c_str());
   }
+  // The sensors' ids, which PX4's calibration parameters name (export --format px4).
+  for (const UlogSeries& s : log.series) {
+    if (!s.decoded || s.samples == 0 || s.Field("device_id") < 0) continue;
+    out += Format("%s instance %d: device_id %.0f\n", s.topic.c_str(), s.instance,
+                  s.values[static_cast<size_t>(s.Field("device_id"))]);
+  }
   return out;
 }
 
