@@ -501,7 +501,7 @@ std::string DescribeUlog(const Ulog& log) {
   // The sensors' ids, which PX4's calibration parameters name (export --format px4).
   for (const UlogSeries& s : log.series) {
     if (!s.decoded || s.samples == 0 || s.Field("device_id") < 0) continue;
-    out += Format("%s instance %d: device_id %.0f\n", s.topic.c_str(), s.instance,
+    out += Format("device_id of %s instance %d: %.0f\n", s.topic.c_str(), s.instance,
                   s.values[static_cast<size_t>(s.Field("device_id"))]);
   }
   return out;

@@ -31,9 +31,9 @@ TEST(ConvertCli, ListsTheThreeGyroInstancesWithTheirTemperature) {
   }
   EXPECT_EQ(gyros, 3) << r.out;
   // Each instance's device_id (what export --format px4 needs), as pyulog reads it.
-  for (const char* id : {"sensor_gyro instance 0: device_id 2424842\n",
-                         "sensor_gyro instance 1: device_id 3670050\n",
-                         "sensor_gyro instance 2: device_id 2621474\n"}) {
+  for (const char* id : {"device_id of sensor_gyro instance 0: 2424842\n",
+                         "device_id of sensor_gyro instance 1: 3670050\n",
+                         "device_id of sensor_gyro instance 2: 2621474\n"}) {
     EXPECT_NE(r.out.find(id), std::string::npos) << id << r.out;
   }
 }

@@ -75,7 +75,7 @@ Ulog ParseUlog(std::span<const std::uint8_t> bytes, const std::vector<std::strin
 
 // A table of the log's series for `gyrodrift convert --list`: topic, instance, samples, duration,
 // mean rate and fields, one line each; then, for each decoded series with a device_id field, its
-// first sample's id ("sensor_gyro instance 0: device_id 2490378").
+// first sample's id ("device_id of sensor_gyro instance 0: 2490378").
 std::string DescribeUlog(const Ulog& log);
 
 // What a conversion writes of one series: time_s (its time stamps, s), the axes in `units` as
