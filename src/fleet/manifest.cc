@@ -173,7 +173,9 @@ std::vector<std::string> UnitSpec::Logs() const {
   return logs;
 }
 
-drift::DriftOptions Manifest::FitOptions() const {
+drift::DriftOptions Manifest::FitOptions() const { return drift::MakeDriftOptions(Settings()); }
+
+drift::FitSettings Manifest::Settings() const {
   drift::FitSettings s;
   s.mode = "compensate";
   s.method = std::string(drift::ToString(method));
@@ -182,7 +184,7 @@ drift::DriftOptions Manifest::FitOptions() const {
   if (!std::isnan(reference_c)) s.reference_temperature = reference_c;
   s.hysteresis = std::string(drift::ToString(hysteresis));
   s.has_temperature = true;
-  return drift::MakeDriftOptions(s);
+  return s;
 }
 
 Manifest ParseManifest(const std::string& text, const std::string& path) {

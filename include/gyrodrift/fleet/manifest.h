@@ -44,6 +44,7 @@
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/gyro_log.h"
 
 namespace gyrodrift::fleet {
@@ -90,6 +91,8 @@ struct Manifest {
   // The drift options every axis is fitted with (compensate mode; drift::MakeDriftOptions, as
   // fit's flags); rate_hz is settled per log.
   drift::DriftOptions FitOptions() const;
+  // The fit settings of those options (drift::FitSettings, compensate mode).
+  drift::FitSettings Settings() const;
 };
 
 // Parses a manifest's text; `path` names it in messages and anchors relative log paths. Checks
