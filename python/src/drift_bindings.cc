@@ -21,6 +21,7 @@
 #include "gyrodrift/tasks/decompose_task.h"
 #include "gyrodrift/tasks/fit_task.h"
 #include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/predict_task.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -191,37 +192,24 @@ class PyDriftModel {
     return out;
   }
 
-  // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
+  // As `gyrodrift predict` (tasks::RunPredict): predictions of y[t] for t = first .. N-1.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
-                    const std::string& protocol_name, int window, int threads,
+                    const std::string& protocol, int window, int threads,
                     const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
     LongCall call(progress);
-    const drift::Protocol protocol = drift::ProtocolFromString(protocol_name);
-    if (window < 16 || window > 1000000) {
-      throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
-    }
-    const drift::DriftModel& model = Loaded().model;
-    const Execution execution = ExecutionOf(threads, call);  // it never changes the result
+    const tasks::PredictSettings settings{
+        .protocol = protocol, .window = window, .horizon = horizon, .threads = threads};
+    settings.Validate();
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
-    if (model.uses_temperature()) {
+    if (Loaded().model.uses_temperature()) {
       if (!temperature_in) throw UsageError("predict: this model needs temperature");
       temperature = ToVector(*temperature_in, "temperature");
     }
-    const Eigen::Index first = drift::FirstPredictable(model, protocol, horizon);
-    if (y.size() <= first) {
-      throw DataError("y has " + std::to_string(y.size()) + " samples: the model needs more than " +
-                      std::to_string(first) + " (its history) to predict any");
-    }
-    drift::CausalOptions causal;
-    causal.window = window;
-    Eigen::VectorXd prediction;
-    call.Run([&] {
-      prediction =
-          drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal, execution);
-    });
-    return py::make_tuple(first, ToArray(prediction));
+    tasks::PredictResult r;
+    call.Run([&] { r = tasks::RunPredict(Loaded(), y, temperature, settings, "y", call.Hook()); });
+    return py::make_tuple(r.first, ToArray(r.prediction));
   }
 
   void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
@@ -325,6 +313,7 @@ void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
 void BindDriftModel(py::module_& m) {
   using py::arg;
   const gyrodrift::drift::FitSettings fd;
+  const gyrodrift::tasks::PredictSettings pd;
   py::class_<gp::PyDriftModel>(m, "DriftModel")
       .def(py::init<>())
       .def("fit", &FitKeywords, arg("y"), arg("temperature") = py::none(), py::kw_only(),
@@ -347,8 +336,8 @@ void BindDriftModel(py::module_& m) {
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
-           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal",
-           arg("window") = gyrodrift::drift::CausalOptions{}.window, arg("threads") = 0,
+           py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
+           arg("window") = pd.window, arg("threads") = pd.threads,
            arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
