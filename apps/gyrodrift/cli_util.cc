@@ -138,7 +138,12 @@ io::LogOptions LogArgs::Options() const {
           .gaps_name = "--gaps",
           .names = columns,
           .skip_rows = skip_rows,
-          .bad_lines = io::BadLinesFromString(bad_lines)};
+          .bad_lines = io::BadLinesFromString(bad_lines),
+          .ulog = {.topic = ulog.topic,
+                   .axes = ulog.axes,
+                   .temperature = ulog.temperature,
+                   .units = allan::RateUnitFromString(ulog_units)},
+          .ulog_instance = ulog_instance};
 }
 
 void LogArgs::RequireOneRecord(std::string_view who, std::string_view why) const {
@@ -178,6 +183,19 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log) {
                   "a row with another number of cells, or a cell that is not a number: error "
                   "(refuse, naming the line) | skip (leave it out; the note lists the lines)")
       ->check(CLI::IsMember({"error", "skip"}))
+      ->capture_default_str();
+  // A ULog is recognised by its first bytes; these choose what is read of it (as convert does).
+  cmd->add_option("--ulog-topic", log->ulog.topic,
+                  "a PX4 ULog log: the topic read (its time stamps, rate fields and temperature)")
+      ->capture_default_str();
+  BindSetting(cmd->add_option("--ulog-instance", log->ulog_instance,
+                              "a PX4 ULog log: the topic's multi-instance id (convert --list "
+                              "shows them)")
+                  ->capture_default_str(),
+              {"ulog_instance"});
+  cmd->add_option("--ulog-units", log->ulog_units,
+                  "a PX4 ULog log: unit of its rate columns <axis>_<units>: dph | dps | rads")
+      ->check(CLI::IsMember({"dph", "dps", "rads"}))
       ->capture_default_str();
 }
 

@@ -60,6 +60,10 @@ struct LogArgs {
   std::vector<std::string> columns;
   int skip_rows = io::CsvReadOptions{}.skip_rows;
   std::string bad_lines{io::ToString(io::CsvReadOptions{}.bad_lines)};
+  // A PX4 ULog read directly: --ulog-topic, --ulog-instance, --ulog-units (io::LogOptions::ulog).
+  io::UlogConversion ulog;
+  int ulog_instance = io::LogOptions{}.ulog_instance;
+  std::string ulog_units{allan::ToString(io::UlogConversion{}.units)};
   // Messages spell the settings as the flags (--gaps); UsageError for --columns without
   // --no-header or the other way round.
   io::LogOptions Options() const;
@@ -70,7 +74,8 @@ struct LogArgs {
 };
 // --gaps error|interpolate|split|carry (every command takes the same modes; one that cannot
 // honour split or carry refuses it, LogArgs::RequireOneRecord),
-// --delimiter auto|comma|tab|semicolon, and the serial-capture flags of LogArgs.
+// --delimiter auto|comma|tab|semicolon, the serial-capture flags and the ULog selection of
+// LogArgs.
 void AddLogOptions(CLI::App* cmd, LogArgs* log);
 // ReadLog under those choices; the note on filled or split gaps, if any, is appended (with a
 // newline) to *notes; record_starts, columns (the only ones kept, with time_s; empty = all) and

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -70,6 +73,13 @@ CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::st
 
 }  // namespace
 
+bool IsUlogFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[7] = {};
+  return in.read(magic, sizeof magic) &&
+         std::string_view(magic, sizeof magic) == std::string_view("ULog\x01\x12\x35", 7);
+}
+
 CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string* gap_note,
                  std::vector<Eigen::Index>* record_starts, const std::vector<std::string>& columns,
                  std::vector<bool>* logged) {
@@ -83,33 +93,172 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options, std::string
 
 namespace {
 
-CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::string* gap_note,
-                     std::vector<Eigen::Index>* record_starts,
-                     const std::vector<std::string>& columns, std::vector<bool>* logged) {
-  const GapPolicy gaps = options.gaps;
+// Refuses a gap policy the caller cannot honour.
+void RequireHonoured(const std::string& path, const LogOptions& options, bool takes_records,
+                     bool takes_mask) {
   auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
-  if (gap_note) gap_note->clear();
-  if (record_starts) record_starts->clear();
-  if (logged) logged->clear();
-  if (gaps == GapPolicy::kSplit && record_starts == nullptr) {
-    throw UsageError(path + ": " + spell(gaps) +
+  if (options.gaps == GapPolicy::kSplit && !takes_records) {
+    throw UsageError(path + ": " + spell(options.gaps) +
                      " needs a caller that takes several records (a thermal model's fit or "
                      "compensation); this one needs one uniform record: use " +
                      spell(GapPolicy::kInterpolate) + ", or split the file");
   }
-  if (gaps == GapPolicy::kCarry && logged == nullptr) {
-    throw UsageError(path + ": " + spell(gaps) +
+  if (options.gaps == GapPolicy::kCarry && !takes_mask) {
+    throw UsageError(path + ": " + spell(options.gaps) +
                      " needs a caller that fits and scores on the logged rows only (a thermal "
                      "model's fit or compensation); this one would use the made-up rows as "
                      "data: use " + spell(GapPolicy::kInterpolate) + " to say so");
   }
+}
+
+// The log's table: a CSV file under the read settings, or a ULog's series rendered as `convert`
+// writes it and parsed back (so a ULog gives the numbers its converted CSV gives, to the bit).
+// The ULog's damage skipped is added to *notes as warnings.
+CsvTable ReadTable(const std::string& path, const LogOptions& options,
+                   const std::vector<std::string>& columns, std::string* notes) {
   CsvReadOptions read{.delimiter = options.delimiter,
                       .columns = columns,
                       .names = options.names,
                       .skip_rows = options.skip_rows,
                       .bad_lines = options.bad_lines};
   if (!columns.empty()) read.columns.push_back("time_s");
-  CsvTable table = CsvTable::Read(path, read);
+  if (!IsUlogFile(path)) return CsvTable::Read(path, read);
+  RequireInRange("ulog_instance", options.ulog_instance, 0, 255);
+  if (!options.names.empty() || options.skip_rows != 0) {
+    throw UsageError(fmt::format(
+        "{} is a ULog: {} apply to CSV logs only", path,
+        SpeltAsFlags(options) ? "--no-header, --columns and --skip-rows"
+                              : "names and skip_rows"));
+  }
+  const Ulog log = ReadUlog(path, {options.ulog.topic});
+  for (const std::string& w : log.warnings) {
+    if (notes) *notes += (notes->empty() ? "" : "\n") + fmt::format("warning: {}: {}", path, w);
+  }
+  const UlogSeries& series =
+      *SeriesWithSamples(log, path, options.ulog.topic, options.ulog_instance).front();
+  read.delimiter = Delimiter::kComma;
+  read.names.clear();
+  std::istringstream text(RenderCsv(UlogColumns(series, options.ulog)));
+  return CsvTable::Read(text, path, read);
+}
+
+// Refuses a time_s that repeats or goes backwards, naming the row.
+void RequireIncreasing(const std::string& path, const Eigen::VectorXd& t) {
+  for (Eigen::Index i = 1; i < t.size(); ++i) {
+    if (t[i] > t[i - 1]) continue;
+    throw DataError(fmt::format(
+        "{}: time_s {} at data row {} ({:g} s after {:g} s): time stamps must increase (sort "
+        "the log or split it where the clock jumped)",
+        path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
+  }
+}
+
+// The gaps of time_s: a step of 1.5 median steps or more, so at least one sample is missing.
+// Each as (the row before it, the samples missing); with split, the records' starts instead.
+struct Gaps {
+  double median = 0.0;
+  std::vector<std::pair<Eigen::Index, int>> insert;
+  long missing = 0;
+};
+
+Gaps FindGaps(const std::string& path, const Eigen::VectorXd& t, const LogOptions& options,
+              std::vector<Eigen::Index>* record_starts) {
+  auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
+  Gaps gaps{.median = MedianStep(t), .insert = {}, .missing = 0};
+  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
+    const double step = t[i + 1] - t[i];
+    if (!(step >= 1.5 * gaps.median)) continue;
+    const double samples = std::round(step / gaps.median) - 1.0;
+    gaps.missing += static_cast<long>(samples);
+    if (options.gaps == GapPolicy::kSplit) {
+      record_starts->push_back(i + 1);
+      continue;
+    }
+    // A gap of more than 1e7 samples or 10 times the log is a clock jump, not lost samples.
+    if (options.gaps == GapPolicy::kError || samples > 1e7 ||
+        samples > 10.0 * static_cast<double>(t.size())) {
+      throw DataError(fmt::format(
+          "{}: time_s jumps by {:g} s before data row {} ({:g} missing samples at the median step "
+          "{:g} s): {}",
+          path, step, i + 2, samples, gaps.median,
+          options.gaps == GapPolicy::kError
+              ? fmt::format("fill gaps by linear interpolation ({}, or {} to fit on the logged "
+                            "rows only) or split the log into records at its gaps ({})",
+                            spell(GapPolicy::kInterpolate), spell(GapPolicy::kCarry),
+                            spell(GapPolicy::kSplit))
+              : fmt::format("too long to fill by interpolation: split the log at its gaps ({})",
+                            spell(GapPolicy::kSplit))));
+    }
+    gaps.insert.push_back({i, static_cast<int>(samples)});
+  }
+  return gaps;
+}
+
+// What the gaps' handling did, for the user; with interpolate a warning when most rows are made
+// up. Empty when there is nothing to say.
+std::string GapNote(const Gaps& gaps, const LogOptions& options, Eigen::Index logged_rows,
+                    size_t records) {
+  auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
+  auto plural = [](size_t n) { return n == 1 ? "" : "s"; };
+  if (options.gaps == GapPolicy::kSplit) {
+    if (records <= 1) return "";
+    return fmt::format(
+        "note: time_s has {} gap{} (median step {:g} s, {} samples missing): the log is split "
+        "into {} records, and the thermal model's lag states restart after each gap ({})",
+        records - 1, plural(records - 1), gaps.median, gaps.missing, records,
+        spell(options.gaps));
+  }
+  if (gaps.insert.empty()) return "";
+  const long rows = static_cast<long>(logged_rows) + gaps.missing;
+  const double made_up = static_cast<double>(gaps.missing) / static_cast<double>(rows);
+  const size_t count = gaps.insert.size();
+  if (options.gaps == GapPolicy::kCarry) {
+    return fmt::format(
+        "note: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) filled by "
+        "linear interpolation for the thermal states to run across; fits, scores and reports use "
+        "the {} logged rows only ({})",
+        count, plural(count), gaps.median, gaps.missing, rows, 100.0 * made_up, logged_rows,
+        spell(options.gaps));
+  }
+  if (made_up > kMostlyMadeUpShare) {
+    return fmt::format(
+        "warning: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) are made up "
+        "by linear interpolation ({}), and they count as data wherever the rows are used; {} "
+        "fits, scores and reports on the {} logged rows only",
+        count, plural(count), gaps.median, gaps.missing, rows, 100.0 * made_up,
+        spell(options.gaps), spell(GapPolicy::kCarry), logged_rows);
+  }
+  return fmt::format(
+      "note: time_s has {} gap{} (median step {:g} s): {} samples filled by linear "
+      "interpolation ({})",
+      count, plural(count), gaps.median, gaps.missing, spell(options.gaps));
+}
+
+// One flag per row after filling: true where the row was logged.
+std::vector<bool> LoggedMask(const Gaps& gaps, Eigen::Index logged_rows) {
+  std::vector<bool> logged;
+  logged.reserve(static_cast<size_t>(logged_rows + gaps.missing));
+  size_t next = 0;
+  for (Eigen::Index i = 0; i < logged_rows; ++i) {
+    logged.push_back(true);
+    if (next < gaps.insert.size() && gaps.insert[next].first == i) {
+      logged.insert(logged.end(), static_cast<size_t>(gaps.insert[next].second), false);
+      ++next;
+    }
+  }
+  return logged;
+}
+
+CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::string* gap_note,
+                     std::vector<Eigen::Index>* record_starts,
+                     const std::vector<std::string>& columns, std::vector<bool>* logged) {
+  if (gap_note) gap_note->clear();
+  if (record_starts) record_starts->clear();
+  if (logged) logged->clear();
+  RequireHonoured(path, options, record_starts != nullptr, logged != nullptr);
+  std::string ulog_note;
+  CsvTable table = ReadTable(path, options, columns, &ulog_note);
+  if (gap_note) *gap_note = ulog_note;
   if (!table.HasColumn("time_s")) return table;
   const Eigen::VectorXd* time = nullptr;
   try {
@@ -118,90 +267,15 @@ CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::st
     return table;  // unreadable: refused where the rate is read from it (ResolveSampleRate)
   }
   const Eigen::VectorXd& t = *time;
-  for (Eigen::Index i = 1; i < t.size(); ++i) {
-    if (t[i] > t[i - 1]) continue;
-    throw DataError(fmt::format(
-        "{}: time_s {} at data row {} ({:g} s after {:g} s): time stamps must increase (sort "
-        "the log or split it where the clock jumped)",
-        path, t[i] == t[i - 1] ? "repeats" : "goes backwards", i + 1, t[i], t[i - 1]));
-  }
+  RequireIncreasing(path, t);
   if (t.size() < 3) return table;
-  // A gap: a step of 1.5 median steps or more, so at least one sample is missing.
-  const double median = MedianStep(t);
-  std::vector<std::pair<Eigen::Index, int>> insert;
-  long missing = 0;
-  for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
-    const double step = t[i + 1] - t[i];
-    if (!(step >= 1.5 * median)) continue;
-    const double samples = std::round(step / median) - 1.0;
-    if (gaps == GapPolicy::kSplit) {
-      record_starts->push_back(i + 1);
-      missing += static_cast<long>(samples);
-      continue;
-    }
-    // A gap of more than 1e7 samples or 10 times the log is a clock jump, not lost samples.
-    if (gaps == GapPolicy::kError || samples > 1e7 ||
-        samples > 10.0 * static_cast<double>(t.size())) {
-      throw DataError(fmt::format(
-          "{}: time_s jumps by {:g} s before data row {} ({:g} missing samples at the median step "
-          "{:g} s): {}",
-          path, step, i + 2, samples, median,
-          gaps == GapPolicy::kError
-              ? fmt::format("fill gaps by linear interpolation ({}, or {} to fit on the logged "
-                            "rows only) or split the log into records at its gaps ({})",
-                            spell(GapPolicy::kInterpolate), spell(GapPolicy::kCarry),
-                            spell(GapPolicy::kSplit))
-              : fmt::format("too long to fill by interpolation: split the log at its gaps ({})",
-                            spell(GapPolicy::kSplit))));
-    }
-    insert.push_back({i, static_cast<int>(samples)});
-    missing += static_cast<long>(samples);
-  }
-  if (gaps == GapPolicy::kSplit) {
-    if (gap_note && !record_starts->empty()) {
-      *gap_note = fmt::format(
-          "note: time_s has {} gap{} (median step {:g} s, {} samples missing): the log is split "
-          "into {} records, and the thermal model's lag states restart after each gap ({})",
-          record_starts->size(), record_starts->size() == 1 ? "" : "s", median, missing,
-          record_starts->size() + 1, spell(gaps));
-    }
-    return table;
-  }
-  if (insert.empty()) return table;
-  const long rows = static_cast<long>(t.size()) + missing;
-  const double made_up = static_cast<double>(missing) / static_cast<double>(rows);
-  if (gap_note && gaps == GapPolicy::kCarry) {
-    *gap_note = fmt::format(
-        "note: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) filled by "
-        "linear interpolation for the thermal states to run across; fits, scores and reports use "
-        "the {} logged rows only ({})",
-        insert.size(), insert.size() == 1 ? "" : "s", median, missing, rows, 100.0 * made_up,
-        t.size(), spell(gaps));
-  } else if (gap_note && made_up > kMostlyMadeUpShare) {
-    *gap_note = fmt::format(
-        "warning: time_s has {} gap{} (median step {:g} s): {} of {} rows ({:.1f} %) are made up "
-        "by linear interpolation ({}), and they count as data wherever the rows are used; {} "
-        "fits, scores and reports on the {} logged rows only",
-        insert.size(), insert.size() == 1 ? "" : "s", median, missing, rows, 100.0 * made_up,
-        spell(gaps), spell(GapPolicy::kCarry), t.size());
-  } else if (gap_note) {
-    *gap_note = fmt::format(
-        "note: time_s has {} gap{} (median step {:g} s): {} samples filled by linear "
-        "interpolation ({})",
-        insert.size(), insert.size() == 1 ? "" : "s", median, missing, spell(gaps));
-  }
-  if (logged) {
-    logged->reserve(static_cast<size_t>(rows));
-    size_t next = 0;
-    for (Eigen::Index i = 0; i < t.size(); ++i) {
-      logged->push_back(true);
-      if (next < insert.size() && insert[next].first == i) {
-        logged->insert(logged->end(), static_cast<size_t>(insert[next].second), false);
-        ++next;
-      }
-    }
-  }
-  return table.WithInterpolatedRows(insert);
+  const Gaps gaps = FindGaps(path, t, options, record_starts);
+  const std::string note = GapNote(gaps, options, t.size(),
+                                   record_starts ? record_starts->size() + 1 : 1);
+  if (gap_note && !note.empty()) *gap_note += (gap_note->empty() ? "" : "\n") + note;
+  if (options.gaps == GapPolicy::kSplit || gaps.insert.empty()) return table;
+  if (logged) *logged = LoggedMask(gaps, t.size());
+  return table.WithInterpolatedRows(gaps.insert);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/ulog.h"
 
 namespace gyrodrift::io {
 
@@ -44,6 +45,11 @@ struct LogOptions {
   std::vector<std::string> names = {};
   int skip_rows = CsvReadOptions{}.skip_rows;
   BadLines bad_lines = CsvReadOptions{}.bad_lines;
+  // A PX4 ULog (a file that starts with ULog's magic bytes, whatever its name) is read as
+  // `gyrodrift convert` writes it: the series of ulog.topic and ulog_instance as time_s,
+  // <axis>_<units> and temperature_c; the CSV settings above do not apply to it.
+  UlogConversion ulog = {};
+  int ulog_instance = 0;  // [0, 255]
   bool operator==(const LogOptions&) const = default;
 };
 
@@ -54,14 +60,17 @@ std::string SpellGaps(const LogOptions& options, GapPolicy policy);
 // rows nobody logged) and suggests carry.
 constexpr double kMostlyMadeUpShare = 0.5;
 
-// Reads a gyro log (CsvTable::Read) and, when it has a numeric time_s column, requires it to
+// Whether `path` starts with ULog's magic bytes (false for a file that cannot be opened).
+bool IsUlogFile(const std::string& path);
+
+// Reads a gyro log (CsvTable::Read, or a ULog's series as LogOptions says) and, when it has a numeric time_s column, requires it to
 // increase strictly: a time stamp that repeats or goes backwards is a DataError naming its row
 // (the log was merged, sorted wrongly or its clock jumped; every model and the Allan analysis
 // would otherwise take the samples as equally spaced, silently). Gaps are handled by
 // options.gaps; when rows were interpolated or the log was split, *gap_note (if given) says so,
 // else it is cleared (with interpolate, when more than kMostlyMadeUpShare of the rows are made up,
-// the note is a warning that suggests carry; damaged rows skipped under BadLines::kSkip are listed
-// on a line of their own). With kSplit, *record_starts receives the first row
+// the note is a warning that suggests carry; damaged rows skipped under BadLines::kSkip, and a
+// ULog's damage skipped, are on lines of their own). With kSplit, *record_starts receives the first row
 // (0-based) of every record after the first (empty: no gap); kSplit without record_starts is a
 // UsageError. *logged (if given) receives one flag per returned row, true where the row was
 // logged, or stays empty when every row was; kCarry without logged is a UsageError. Shorter

@@ -84,6 +84,7 @@ struct UlogConversion {
   std::vector<std::string> axes{"x", "y", "z"};  // fields in rad/s (PX4's sensor_gyro)
   std::string temperature = "temperature";         // a field in degC; empty: none
   allan::RateUnit units = allan::RateUnit::kDegPerHour;
+  bool operator==(const UlogConversion&) const = default;
 };
 // The series of `topic` with samples: the one of `instance`, or every instance when instance < 0.
 // DataError when there is none, naming the log (`source`) and what was asked.
