@@ -255,7 +255,7 @@ std::string VerifyLog(const Manifest& m, const UnitSpec& spec, size_t k,
     // interpolated rows of gaps = 'interpolate' count as data here.
     const tasks::AxisCompensation c = tasks::CompensateAxis(
         models[i], ver.table.Column(axis.target), Temperatures(ver.table, axis), ver.record_starts,
-        {}, truth, {.rate_hz = ver.rate_hz, .slow_block_s = m.drift_window_s});
+        {}, truth, {.rate_hz = ver.rate_hz, .drift_window_s = m.drift_window_s});
     for (io::CsvColumn& column : c.Columns(m.axes.size() == 1 ? "" : "_" + axis.target)) {
       columns.push_back(std::move(column));
     }

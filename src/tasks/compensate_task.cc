@@ -132,7 +132,7 @@ void CheckLog(const std::vector<io::LoadedModel>& axes, const TaskLog& log,
 
 void CompensateSettings::Validate() const {
   if (rate_hz != 0.0) RequireInRange("rate_hz", rate_hz, 1e-9, 1e9);
-  RequireInRange("slow_block_s", slow_block_s, 1e-3, 1e9);
+  RequireInRange("drift_window_s", drift_window_s, 1e-3, 1e9);
 }
 
 std::vector<io::CsvColumn> AxisCompensation::Columns(const std::string& suffix) const {
@@ -165,7 +165,7 @@ AxisCompensation CompensateAxis(const io::LoadedModel& loaded, const Eigen::Vect
   // bias, which the std alone hides), blocks timed at the model's sample rate unless given.
   c.summary = drift::SummariseCompensation(
       y, compensated, settings.rate_hz > 0.0 ? settings.rate_hz : model.options.features.rate_hz,
-      settings.slow_block_s);
+      settings.drift_window_s);
   // Against a known drift: how much of its RMS the estimate removes, RMS about zero (the
   // drift's offset is part of it).
   if (truth_all.size() > 0) {

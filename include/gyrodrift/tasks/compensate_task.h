@@ -27,8 +27,8 @@ struct CompensateSettings {
   // Sample rate of the figures' slow-variation blocks, Hz; 0 = the model's.
   double rate_hz = 0.0;
   // Length of those blocks, s (the fleet's drift_window_s).
-  double slow_block_s = drift::kSlowVariationBlockS;
-  // Throws OptionError naming the field (rate_hz: 0 or in [1e-9, 1e9]; slow_block_s in
+  double drift_window_s = drift::kSlowVariationBlockS;
+  // Throws OptionError naming the field (rate_hz: 0 or in [1e-9, 1e9]; drift_window_s in
   // [1e-3, 1e9]).
   void Validate() const;
 };

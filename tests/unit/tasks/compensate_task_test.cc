@@ -61,7 +61,7 @@ TEST(CompensateTask, TheOutputIsTheTargetMinusTheEstimate) {
                                                {}, Eigen::VectorXd::Zero(y.size()));
   EXPECT_TRUE(std::isnan(zero.truth_removed));
   EXPECT_THROW(CompensateAxis(axes[0], y, log.table.Column("temperature_c"), {}, {}, {},
-                              {.slow_block_s = 0.0}),
+                              {.drift_window_s = 0.0}),
                OptionError);
 }
 
