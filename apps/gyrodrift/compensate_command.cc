@@ -24,7 +24,7 @@ struct CompensateArgs {
   std::string model;
   std::string input;
   std::string output;
-  std::string truth;  // "" = none
+  tasks::CompensateSettings settings;  // --truth, --drift-window-s
   LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
@@ -41,7 +41,7 @@ void Run(const CompensateArgs& a) {
     for (const std::string& w : warnings) fmt::print("warning: {}\n", w);
   }
   const tasks::CompensateResult r =
-      tasks::RunCompensate(axes, log, log_options, {.truth = a.truth}, a.model);
+      tasks::RunCompensate(axes, log, log_options, a.settings, a.model);
   nlohmann::json sidecar = SidecarHeader("compensate");
   sidecar.update(r.record);
   io::WriteFilesAtomically(
@@ -80,7 +80,12 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
       ->check(kInputFile);
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();
-  cmd->add_option("--truth", args->truth,
+  BindSetting(cmd->add_option("--drift-window-s", args->settings.drift_window_s,
+                              "length of the blocks whose means give the slow variation before and "
+                              "after, s (the fleet manifest's drift_window_s)")
+                  ->capture_default_str(),
+              {"drift_window_s"});
+  cmd->add_option("--truth", args->settings.truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "
                   "share of its RMS the estimate removes");
   AddLogOptions(cmd, &args->log);

@@ -111,7 +111,8 @@ class PyDriftModel {
   // tasks::CompensateAxis of y (or of zeros: the estimate alone), as `gyrodrift compensate`.
   tasks::AxisCompensation Compensation(const char* what, const Array& temperature_in,
                                        const Array* y_in,
-                                       const std::vector<Eigen::Index>& record_starts) const {
+                                       const std::vector<Eigen::Index>& record_starts,
+                                       const tasks::CompensateSettings& settings = {}) const {
     RequireMode(drift::Mode::kCompensate, what);
     const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
     const Eigen::VectorXd y = y_in ? ToVector(*y_in, "y") : Eigen::VectorXd::Zero(t.rows());
@@ -120,7 +121,7 @@ class PyDriftModel {
                       " samples, temperature " + std::to_string(t.rows()));
     }
     py::gil_scoped_release release;
-    return tasks::CompensateAxis(Loaded(), y, t, record_starts, {}, Eigen::VectorXd());
+    return tasks::CompensateAxis(Loaded(), y, t, record_starts, {}, Eigen::VectorXd(), settings);
   }
 
   py::tuple Estimate(const Array& temperature_in,
@@ -138,9 +139,12 @@ class PyDriftModel {
   // The figures `gyrodrift compensate` prints and keeps in its sidecar for y compensated by this
   // model (at the model's sample rate).
   py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
-                               const std::vector<Eigen::Index>& record_starts) const {
+                               const std::vector<Eigen::Index>& record_starts,
+                               double drift_window_s) const {
     const drift::CompensationSummary s =
-        Compensation("compensation_summary", temperature_in, &y_in, record_starts).summary;
+        Compensation("compensation_summary", temperature_in, &y_in, record_starts,
+                     {.drift_window_s = drift_window_s})
+            .summary;
     auto figures = [](const drift::SignalSummary& f) {
       py::dict d;
       d["mean"] = f.mean;
@@ -332,7 +336,8 @@ void BindDriftModel(py::module_& m) {
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
-           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{},
+           arg("drift_window_s") = gyrodrift::tasks::CompensateSettings{}.drift_window_s)
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
