@@ -7,7 +7,7 @@
 #include "cli_util.h"
 #include "command.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/io/firmware_export.h"
+#include "gyrodrift/firmware/export.h"
 #include "gyrodrift/io/model_file.h"
 
 namespace gyrodrift::cli {
@@ -24,13 +24,13 @@ struct ExportArgs {
 
 void Run(const ExportArgs& a) {
   RequireOutputsAreNotInputs({a.model}, {a.output});
-  const io::ExportOptions options{.format = io::ExportFormatFromString(a.format),
+  const firmware::ExportOptions options{.format = firmware::ExportFormatFromString(a.format),
                                   .single_precision = a.single_precision,
                                   .prefix = a.prefix};
   options.Validate();
   // One axis per model file for now; the library takes one model per gyro axis.
   const std::vector<io::LoadedModel> axes = io::ReadModelFileAxes(a.model);
-  const std::string text = io::RenderExport(axes, options);
+  const std::string text = firmware::RenderExport(axes, options);
   io::WriteFileAtomically(a.output, text);
   if (a.quiet) return;
   // A model the calibration run could not identify says so wherever it is used (as compensate
@@ -42,9 +42,9 @@ void Run(const ExportArgs& a) {
       warnings += "warning: the model's calibration run (" + sub.name + "): " + w + "\n";
     }
   }
-  fmt::print("{}\n{}: {}{}\n{}wrote {}\n", axes[0].model.Summary(), io::ToString(options.format),
-             io::SummariseExport(axes).Line(),
-             options.format == io::ExportFormat::kC
+  fmt::print("{}\n{}: {}{}\n{}wrote {}\n", axes[0].model.Summary(), firmware::ToString(options.format),
+             firmware::SummariseExport(axes).Line(),
+             options.format == firmware::ExportFormat::kC
                  ? fmt::format(", {}, prefix {}", a.single_precision ? "float" : "double", a.prefix)
                  : std::string(),
              warnings, a.output);

@@ -57,6 +57,7 @@ void PrintThermalModel(const std::string& name, const drift::ThermalRegression& 
                unit, term.unit, note);
   }
   fmt::print("           calibration: {}\n", t.report.Summary());
+  if (t.autopilot.fitted()) fmt::print("           autopilot form: {}\n", t.autopilot.Summary());
   for (const std::string& w : t.report.warnings) {
     fmt::print("warning: calibration run ({}): {}\n", name, w);
   }

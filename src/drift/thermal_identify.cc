@@ -19,6 +19,7 @@
 #include "gyrodrift/drift/thermal_model.h"
 #include "gyrodrift/elm/elm.h"
 #include "thermal_columns.h"
+#include "thermal_folds.h"
 #include "thermal_report.h"
 #include "thermal_search.h"
 
@@ -31,12 +32,8 @@ using internal::StaticColumns;
 
 constexpr double kBlockS = 600.0;            // blocks of the residual's batch means
 constexpr double kShortBlockS = 10.0;        // blocks that measure the residual's fast noise
-constexpr Eigen::Index kShortestFold = 16;   // logged samples
-// Held-out regimes beyond this many are grouped with their neighbours (the search's cost grows
-// with the folds).
-constexpr int kMostRegimeFolds = 24;
-// The range ends held out: the top and the bottom fifth of channel 0's span.
-constexpr double kRangeEndShare = 0.2;
+using internal::kShortestFold;
+using internal::MakeFolds;
 // The skill needs this many 10-min blocks of residual to tell slow error from noise.
 constexpr int kLeastSkillBlocks = 4;
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
@@ -48,39 +45,7 @@ double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
   return std::sqrt((x.array() - x.mean()).square().mean());
 }
 
-// A partition of the run into folds: contiguous groups of whole units (regimes or time blocks),
-// cut at the unit boundaries nearest to i N / K, i = 1..K-1; each fold a range [first, last) of
-// unit indices. Fewer folds when units are few.
-std::vector<std::pair<int, int>> Partition(const std::vector<ThermalSegment>& segments,
-                                           Eigen::Index n, int k) {
-  std::vector<int> cuts{0};
-  const int count = static_cast<int>(segments.size());
-  for (int i = 1; i < k; ++i) {
-    const double ideal = static_cast<double>(n) * i / k;
-    int best = 0;
-    double best_distance = std::numeric_limits<double>::infinity();
-    for (int j = 1; j < count; ++j) {
-      const double d = std::abs(static_cast<double>(segments[static_cast<size_t>(j)].begin) - ideal);
-      if (d < best_distance) {
-        best_distance = d;
-        best = j;
-      }
-    }
-    if (best > cuts.back()) cuts.push_back(best);
-  }
-  cuts.push_back(count);
-  std::vector<std::pair<int, int>> folds;
-  for (size_t i = 0; i + 1 < cuts.size(); ++i) folds.emplace_back(cuts[i], cuts[i + 1]);
-  return folds;
-}
 
-// Equal time blocks as segments, for a run with too few regimes.
-std::vector<ThermalSegment> TimeBlocks(Eigen::Index n, int k) {
-  std::vector<ThermalSegment> blocks;
-  k = static_cast<int>(std::min<Eigen::Index>(k, n / kShortestFold));
-  for (int i = 0; i < k; ++i) blocks.push_back({n * i / k, n * (i + 1) / k, false});
-  return blocks;
-}
 
 // Mean of squares of the block means of x over blocks of `block` samples, each mean taken over the
 // block's logged samples (weight 1; 0 = made up across a gap), blocks without one left out.
@@ -139,57 +104,6 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
   return x;
 }
 
-// The folds of thermal_model.h: equal time blocks (or groups of whole regimes with
-// folds_at_regimes), every regime held out in turn (neighbours grouped beyond kMostRegimeFolds),
-// the top and the bottom fifth of channel 0's range. Folds with fewer than kShortestFold logged
-// samples, or leaving fewer to train on, are dropped.
-std::vector<internal::FoldRows> MakeFolds(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
-                                          const std::vector<ThermalSegment>& segments,
-                                          const Eigen::VectorXd& weight,
-                                          const ThermalModelOptions& options) {
-  using internal::FoldRows;
-  const Eigen::Index n = temperature_c.size();
-  std::vector<FoldRows> folds;
-  std::vector<ThermalSegment> units = TimeBlocks(n, options.folds);
-  if (options.folds_at_regimes && Partition(segments, n, options.folds).size() >= 3) {
-    units = segments;
-  }
-  for (const auto& [first, last] : Partition(units, n, options.folds)) {
-    folds.push_back({internal::kTimeBlocks,
-                     {{units[static_cast<size_t>(first)].begin,
-                       units[static_cast<size_t>(last - 1)].end}}});
-  }
-  if (segments.size() >= 2) {
-    for (const auto& [first, last] : Partition(segments, n, kMostRegimeFolds)) {
-      folds.push_back({internal::kRegimes,
-                       {{segments[static_cast<size_t>(first)].begin,
-                         segments[static_cast<size_t>(last - 1)].end}}});
-    }
-  }
-  const double lo = temperature_c.minCoeff(), hi = temperature_c.maxCoeff();
-  const double edge = kRangeEndShare * (hi - lo);
-  for (bool top : {true, false}) {
-    FoldRows f{internal::kRangeEnds, {}};
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const bool in = top ? temperature_c[i] >= hi - edge : temperature_c[i] <= lo + edge;
-      if (!in) continue;
-      if (!f.ranges.empty() && f.ranges.back().second == i) {
-        f.ranges.back().second = i + 1;
-      } else {
-        f.ranges.emplace_back(i, i + 1);
-      }
-    }
-    folds.push_back(std::move(f));
-  }
-  const double total = weight.sum();
-  std::vector<FoldRows> kept;
-  for (FoldRows& f : folds) {
-    double logged = 0.0;
-    for (const auto& [begin, end] : f.ranges) logged += weight.segment(begin, end - begin).sum();
-    if (logged >= kShortestFold && total - logged >= kShortestFold) kept.push_back(std::move(f));
-  }
-  return kept;
-}
 
 // The nonlinear correction of the header comment: its candidates on one shared hidden layer of
 // the chosen regressors xs (intercept left out), scored against each fold's linear fit on the
@@ -457,37 +371,108 @@ Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
   return residual;
 }
 
+// The slow part of a held-out residual: the mean square of its block means (kBlockS) less what
+// the fast noise contributes to them, from the means of kShortBlockS blocks scaled to a block's
+// logged samples (exact for white noise, and not fooled by the anti-correlated quantization noise
+// that first differences would count as white). The noise share is measured once, on the chosen
+// structure's refit residual.
+class SlowError {
+ public:
+  SlowError(const Eigen::VectorXd& residual, const Eigen::VectorXd& weight, const Search& search,
+            double rate_hz)
+      : weight_(weight), scores_(*search.scores) {
+    const Eigen::Index n = residual.size();
+    block_ = BlockSamples(kBlockS, rate_hz, n);
+    const Eigen::Index short_block = std::min(block_, BlockSamples(kShortBlockS, rate_hz, n));
+    double logged_per_block = 0.0, logged_per_short_block = 0.0;
+    BlockMeanSquare(residual, block_, weight, &logged_per_block);
+    const double short_ms = BlockMeanSquare(residual, short_block, weight, &logged_per_short_block);
+    white_share_ =
+        logged_per_block > 0.0 ? short_ms * logged_per_short_block / logged_per_block : 0.0;
+  }
+  // Of the time blocks' held-out residual of the columns `cols`.
+  double operator()(const std::vector<int>& cols) const {
+    return std::max(0.0,
+                    BlockMeanSquare(scores_.TimeResidual(cols), block_, weight_) - white_share_);
+  }
+
+ private:
+  const Eigen::VectorXd& weight_;
+  const internal::FoldScores& scores_;
+  Eigen::Index block_ = 1;
+  double white_share_ = 0.0;
+};
+
 // The slow part of the cross-validated residual (model.cv_slow_sd) and the skill against the
-// constant on it: the block means' mean square less what the fast noise contributes to them,
-// from the means of kShortBlockS blocks scaled to a block's logged samples (exact for white
-// noise, and not fooled by the anti-correlated quantization noise that first differences would
-// count as white).
-void SlowErrorAndSkill(const Eigen::VectorXd& residual, const Eigen::VectorXd& weight,
-                       const Search& search, ThermalRegression& model) {
-  const Eigen::Index n = residual.size();
-  const Eigen::Index block = BlockSamples(kBlockS, model.rate_hz, n);
-  const Eigen::Index short_block =
-      std::min(block, BlockSamples(kShortBlockS, model.rate_hz, n));
-  double logged_per_block = 0.0, logged_per_short_block = 0.0;
-  BlockMeanSquare(residual, block, weight, &logged_per_block);
-  const double short_ms = BlockMeanSquare(residual, short_block, weight, &logged_per_short_block);
-  const double white_share =
-      logged_per_block > 0.0 ? short_ms * logged_per_short_block / logged_per_block : 0.0;
-  auto slow_ms = [&](const std::vector<int>& cols) {
-    return std::max(0.0, BlockMeanSquare(search.scores->TimeResidual(cols), block, weight) -
-                             white_share);
-  };
+// constant on it.
+void SlowErrorAndSkill(const SlowError& slow_ms, const Search& search, ThermalRegression& model) {
   const double chosen_ms = slow_ms(search.result.chosen.cols);
   const double constant_ms = slow_ms({0});
   model.cv_slow_sd = std::sqrt(chosen_ms);
   CalibrationReport& report = model.report;
   report.cv_rmse = std::sqrt(search.scores->TimeMse(search.result.chosen.cols));
   report.cv_rmse_constant = std::sqrt(search.scores->TimeMse({0}));
-  if (static_cast<double>(n) < kLeastSkillBlocks * kBlockS * model.rate_hz) {
+  if (static_cast<double>(search.yc.size()) < kLeastSkillBlocks * kBlockS * model.rate_hz) {
     report.skill = std::numeric_limits<double>::quiet_NaN();
   } else {
     report.skill = constant_ms > 0.0 ? 1.0 - chosen_ms / constant_ms : 0.0;
   }
+}
+
+// The autopilot form (thermal_model.h) of channel 0: its degree by the rule on the search's fold
+// scores (channel 0's static columns span the polynomials of dT of each degree), its coefficients
+// refitted on the logged samples in dT scaled to the half range, its share of the slow drift the
+// full model removes.
+void FitAutopilotForm(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
+                      const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::VectorXd& weight,
+                      const Search& search, double standard_errors, const SlowError& slow_ms,
+                      ThermalRegression& model) {
+  const internal::FoldScores& scores = *search.scores;
+  std::vector<std::vector<int>> cols{{0}};
+  for (int p = 1; p <= std::min(3, search.layout.static_powers); ++p) {
+    cols.push_back(cols.back());
+    cols.back().push_back(search.layout.StaticColumn(0, p));
+  }
+  std::vector<Eigen::VectorXd> fold_scores;
+  size_t best = 0;
+  for (size_t p = 0; p < cols.size(); ++p) {
+    fold_scores.push_back(scores.Scores(cols[p]));
+    if (scores.Mean(fold_scores[p]) < scores.Mean(fold_scores[best])) best = p;
+  }
+  size_t degree = best;
+  for (size_t p = 0; p < best; ++p) {
+    const Eigen::VectorXd d = fold_scores[p] - fold_scores[best];
+    if (scores.Mean(d) <= standard_errors * scores.StandardError(d)) {
+      degree = p;
+      break;
+    }
+  }
+  const Eigen::VectorXd gain = fold_scores[degree] - fold_scores[0];
+  if (degree > 0 && !(scores.Mean(gain) < -standard_errors * scores.StandardError(gain))) {
+    degree = 0;
+  }
+  AutopilotForm& form = model.autopilot;
+  form.degree = static_cast<int>(degree);
+  form.tmin_c = temperature_c.minCoeff();
+  form.tmax_c = temperature_c.maxCoeff();
+  form.tref_c = 0.5 * (form.tmin_c + form.tmax_c);
+  const double half = std::max(0.5 * (form.tmax_c - form.tmin_c), 1e-12);
+  const auto rows = static_cast<Eigen::Index>(weight.sum());
+  Eigen::MatrixXd x(rows, form.degree + 1);
+  Eigen::VectorXd ys(rows);
+  for (Eigen::Index i = 0, r = 0; i < y.size(); ++i) {
+    if (weight[i] <= 0.0) continue;
+    const double u = (temperature_c[i] - form.tref_c) / half;
+    for (int k = 0; k <= form.degree; ++k) x(r, k) = k == 0 ? 1.0 : x(r, k - 1) * u;
+    ys[r++] = y[i];
+  }
+  const Eigen::VectorXd a = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(x).solve(ys);
+  for (int k = 0; k <= form.degree; ++k) form.coefficients[k] = a[k] / std::pow(half, k);
+  const double constant_ms = slow_ms({0});
+  const double removed = constant_ms - slow_ms(search.result.chosen.cols);
+  form.share_kept = std::isnan(model.report.skill) || !(removed > 0.0)
+                        ? std::numeric_limits<double>::quiet_NaN()
+                        : (constant_ms - slow_ms(cols[degree])) / removed;
 }
 
 // The nonlinear correction (header comment) on the chosen structure's residual. The network
@@ -533,7 +518,10 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   ReportHeldOut(search, model.report);
   Eigen::MatrixXd gram;
   const Eigen::VectorXd residual = RefitChosen(y, weight, search, model, gram);
-  SlowErrorAndSkill(residual, weight, search, model);
+  const SlowError slow_ms(residual, weight, search, rate_hz);
+  SlowErrorAndSkill(slow_ms, search, model);
+  FitAutopilotForm(temperatures_c.col(0), y, weight, search, options.standard_errors, slow_ms,
+                   model);
   if (run.nonlinear && search.result.chosen.cols.size() > 1) {
     AddCorrection(residual, run.seed, search, model);
   }

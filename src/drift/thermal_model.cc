@@ -219,6 +219,24 @@ std::string ThermalRegression::Summary() const {
                 hysteresis.c_str(), report.cv_rmse);
 }
 
+double AutopilotForm::Estimate(double temperature_c) const {
+  const double dt = std::clamp(temperature_c, tmin_c, tmax_c) - tref_c;
+  return coefficients[0] + dt * (coefficients[1] + dt * (coefficients[2] + dt * coefficients[3]));
+}
+
+std::string AutopilotForm::Summary() const {
+  using gyrodrift::internal::Format;
+  static constexpr std::array<const char*, 4> kDegree{"constant", "linear", "quadratic", "cubic"};
+  const std::string kept =
+      std::isnan(share_kept)
+          ? std::string("its share of what the full model removes not measured")
+          : Format("keeps %.1f %% of the slow drift the full model removes (held out)",
+                   100.0 * share_kept);
+  return Format("%s in (T - %.4g degC), T held within [%.4g, %.4g] degC: %s",
+                kDegree[static_cast<size_t>(std::clamp(degree, 0, 3))], tref_c, tmin_c, tmax_c,
+                kept.c_str());
+}
+
 void ThermalRegression::Validate() const {
   const size_t c = centre_c.size();
   if (c == 0 || scale_k.size() != c || static_power.size() != c || static_min.size() != c ||
@@ -265,6 +283,18 @@ void ThermalRegression::Validate() const {
     throw DataError("thermal model: " + std::to_string(coefficients.size()) +
                     " coefficients (and covariance) for " + std::to_string(m) +
                     " regressors, or non-finite values");
+  }
+  if (autopilot.fitted()) {
+    const AutopilotForm& a = autopilot;
+    bool finite = std::isfinite(a.tref_c) && a.degree <= 3;
+    for (size_t k = 0; k < a.coefficients.size(); ++k) {
+      finite = finite && std::isfinite(a.coefficients[k]) &&
+               (static_cast<int>(k) <= a.degree || a.coefficients[k] == 0.0);
+    }
+    if (!finite || !(a.tmin_c <= a.tref_c && a.tref_c <= a.tmax_c)) {
+      throw DataError("thermal model: the autopilot form needs a degree in [0, 3], finite "
+                      "coefficients (0 above the degree) and tmin_c <= tref_c <= tmax_c");
+    }
   }
 }
 

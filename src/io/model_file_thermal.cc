@@ -1,5 +1,6 @@
 // The thermal models in a model file (model_json.h): their identification options, the fitted
 // regression with its calibration report, and the form an autopilot runs.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -24,6 +25,34 @@ json ThermalOptionsJson(const drift::ThermalModelOptions& t) {
           {"max_condition", Number(t.max_condition)},
           {"standard_errors", Number(t.standard_errors)}};
 }
+
+namespace {
+
+json AutopilotJson(const drift::AutopilotForm& a) {
+  if (!a.fitted()) return nullptr;
+  return {{"degree", a.degree},
+          {"tref_c", Number(a.tref_c)},
+          {"tmin_c", Number(a.tmin_c)},
+          {"tmax_c", Number(a.tmax_c)},
+          {"coefficients", Numbers({a.coefficients.begin(), a.coefficients.end()})},
+          {"share_kept", Number(a.share_kept)}};
+}
+
+drift::AutopilotForm ReadAutopilot(const Node& n) {
+  drift::AutopilotForm a;
+  if (n.IsNull()) return a;
+  a.degree = static_cast<int>(n["degree"].Int(0, 3));
+  a.tref_c = n["tref_c"].Double();
+  a.tmin_c = n["tmin_c"].Double();
+  a.tmax_c = n["tmax_c"].Double();
+  const std::vector<double> c = n["coefficients"].Doubles();
+  if (c.size() != a.coefficients.size()) n["coefficients"].Fail("must hold 4 numbers");
+  std::copy(c.begin(), c.end(), a.coefficients.begin());
+  a.share_kept = n["share_kept"].Double();
+  return a;
+}
+
+}  // namespace
 
 json ThermalJson(const drift::ThermalRegression& t) {
   json states = json::array();
@@ -54,6 +83,7 @@ json ThermalJson(const drift::ThermalRegression& t) {
           {"covariance", Array(t.covariance)},
           {"cv_slow_sd", Number(t.cv_slow_sd)},
           {"correction", t.correction ? LearnerJson(*t.correction) : json(nullptr)},
+          {"autopilot", AutopilotJson(t.autopilot)},
           {"report",
            {{"duration_s", Number(r.duration_s)},
             {"span_k", Numbers(r.span_k)},
@@ -203,6 +233,7 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
   t->covariance = n["covariance"].Matrix();
   t->cv_slow_sd = n["cv_slow_sd"].Double();
   t->report = ReadReport(n["report"]);
+  if (n.raw().contains("autopilot")) t->autopilot = ReadAutopilot(n["autopilot"]);
   if (!n["correction"].IsNull()) t->correction = ReadLearner(n["correction"], "correction");
   try {
     t->Validate();

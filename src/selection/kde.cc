@@ -18,13 +18,20 @@ constexpr double kInvSqrt2Pi = 0.39894228040143267794;
 // double round-off of the largest weight.
 constexpr double kKernelCutBandwidths = 8.5;
 
-// Quantile of type 7 (linear interpolation between order statistics) of buf[0..n-1]; reorders buf.
-double Quantile(std::vector<double>& buf, size_t n, double p) {
+// Quantile of type 7 (linear interpolation between order statistics) of buf[0..n-1], selected
+// within buf[from..n-1] (reordered): every value before `from` is at or below those after it,
+// and `from` is at most the quantile's lower order statistic, whose index goes to *lower when
+// asked. After one quantile, values past its lower order statistic hold the rest, so a larger
+// quantile may start there and select among fewer values.
+double Quantile(std::vector<double>& buf, size_t from, size_t n, double p,
+                size_t* lower = nullptr) {
   const double pos = p * static_cast<double>(n - 1);
   const size_t lo = static_cast<size_t>(std::floor(pos));
   const double frac = pos - static_cast<double>(lo);
-  std::nth_element(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(lo),
+  std::nth_element(buf.begin() + static_cast<std::ptrdiff_t>(from),
+                   buf.begin() + static_cast<std::ptrdiff_t>(lo),
                    buf.begin() + static_cast<std::ptrdiff_t>(n));
+  if (lower != nullptr) *lower = lo;
   const double a = buf[lo];
   if (frac == 0.0 || lo + 1 >= n) return a;
   // The next order statistic is the minimum of the upper part after nth_element.
@@ -124,8 +131,9 @@ double SilvermanBandwidth(const Eigen::Ref<const Eigen::VectorXd>& x, KdeWorkspa
   const size_t count = static_cast<size_t>(n);
   if (buf.size() < count) buf.resize(count);
   for (Eigen::Index i = 0; i < n; ++i) buf[static_cast<size_t>(i)] = x[i];
-  const double q1 = Quantile(buf, count, 0.25);
-  const double q3 = Quantile(buf, count, 0.75);
+  size_t q1_index = 0;
+  const double q1 = Quantile(buf, 0, count, 0.25, &q1_index);
+  const double q3 = Quantile(buf, q1_index, count, 0.75);
   const double iqr_sd = (q3 - q1) / 1.34;
   const double spread = iqr_sd > 0.0 ? std::min(sd, iqr_sd) : sd;
   return 0.9 * spread * std::pow(static_cast<double>(n), -0.2);

@@ -17,7 +17,7 @@
 #include "gyrodrift/drift/features.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/io/firmware_export.h"
+#include "gyrodrift/firmware/export.h"
 #include "gyrodrift/io/model_file.h"
 #include "support/firmware_driver.h"
 #include "support/test_support.h"
@@ -204,7 +204,7 @@ TEST_F(ExportCli, CoefficientsJsonAndRefusals) {
   const std::string text = io::ReadTextFile(out);
   const io::LoadedModel two = io::ReadModelFile(Dir() + "/two.json");
   EXPECT_EQ(text,
-            io::RenderCoefficientsJson({two}, {.format = io::ExportFormat::kCoefficientsJson}));
+            firmware::RenderCoefficientsJson({two}, {.format = firmware::ExportFormat::kCoefficientsJson}));
   const auto json = nlohmann::json::parse(text);
   EXPECT_EQ(json["channels"], (std::vector<std::string>{"temperature_c", "board_c"}));
 

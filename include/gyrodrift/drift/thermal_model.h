@@ -62,6 +62,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -194,6 +195,29 @@ struct CalibrationReport {
   std::string Summary() const;                 // one line
 };
 
+// The form an autopilot runs (PX4's thermal compensation of a gyro: docs/firmware.md, section
+// "PX4"): a polynomial of degree at most 3 in dT = clamp(T, tmin_c, tmax_c) - tref_c of the first
+// temperature channel, nothing else: no lag, no rate. Fitted to the calibration run itself (not to
+// the full model's estimate) on the logged samples, its degree chosen as the structure is: the
+// lowest within `standard_errors` of the best on the held-out time blocks, and the constant unless
+// a higher degree beats it by as much. tref_c is the middle of the calibrated range, tmin_c and
+// tmax_c its ends.
+struct AutopilotForm {
+  int degree = -1;  // 0..3; -1: not fitted (model files older than format 8)
+  double tref_c = 0.0, tmin_c = 0.0, tmax_c = 0.0;
+  std::array<double, 4> coefficients{};  // of dT^k, target units per K^k (0 above the degree)
+  // Of the slow drift the full model removes on the held-out time blocks (the measure of its
+  // skill), the share this form removes; NaN when not measured (a run too short for the skill, or
+  // a full model that removes nothing).
+  double share_kept = std::numeric_limits<double>::quiet_NaN();
+
+  bool fitted() const { return degree >= 0; }
+  double Estimate(double temperature_c) const;  // clamped to [tmin_c, tmax_c]
+  // "cubic in (T - 20 degC), T held within [5.2, 34.8] degC: keeps 87.3 % of the slow drift the
+  // full model removes (held out)".
+  std::string Summary() const;
+};
+
 // A fitted thermal drift model (see the header comment).
 struct ThermalRegression {
   double rate_hz = 1.0;
@@ -216,6 +240,7 @@ struct ThermalRegression {
   // added to the linear estimate; null = linear. The standard deviation ignores it.
   std::shared_ptr<const Learner> correction;
   CalibrationReport report;
+  AutopilotForm autopilot;  // fitted beside the model, for an autopilot's parameters
 
   int channels() const { return static_cast<int>(centre_c.size()); }
   bool has_hysteresis() const { return hysteresis_state >= 0; }

@@ -63,7 +63,9 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // (drift/baseline.h: methods none, constant, persistence, trailing-mean, exp-smoothing,
 // kalman-level, kalman-trend) hold a "baseline" (its parameters) in their one sub-model and no
 // learner. Older files have none of these.
-inline constexpr int kModelFormatVersion = 7;
+// Version 8 (issue 26): a thermal model's autopilot form ("autopilot": degree, tref_c, tmin_c,
+// tmax_c, coefficients of dT^0..3, share_kept); older files read without one (not fitted).
+inline constexpr int kModelFormatVersion = 8;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 

@@ -79,19 +79,29 @@ TEST(Beemdan, FixedStagesAreIceemdanThenPlainEmdOfTheResidue) {
             "residue has fewer than 3 extrema");
 }
 
-// A bound past the last stage is no bound: BEEMDAN is then ICEEMDAN, like BeemdanBound::kFull.
-TEST(Beemdan, ABoundCoveringEveryModeIsIceemdan) {
+// Forced to the full depth, BEEMDAN is ICEEMDAN bit for bit: BeemdanBound::kFull, and a bound
+// past the last stage (no bound), with both noise scalings.
+TEST(Beemdan, FullDepthIsIceemdan) {
   const Eigen::VectorXd x = NoiseAndSine();
-  DecompositionOptions o = Beemdan(BeemdanBound::kFixedStages);
-  o.noise_stages = 1000;
-  DecompositionOptions ice = o;
-  ice.method = Method::kIceemdan;
-  const Decomposition d = Decompose(x, o);
-  const Decomposition reference = Decompose(x, ice);
-  EXPECT_EQ(d.imfs, reference.imfs);
-  EXPECT_EQ(d.residue, reference.residue);
-  EXPECT_EQ(d.report.noise_assisted_stages, d.num_imfs());
-  EXPECT_EQ(d.report.stop_reason, reference.report.stop_reason);
+  for (const NoiseScaling scaling : {NoiseScaling::kColominas2014, NoiseScaling::kConstantSnr}) {
+    DecompositionOptions fixed = Beemdan(BeemdanBound::kFixedStages);
+    fixed.noise_stages = 1000;
+    fixed.noise_scaling = scaling;
+    DecompositionOptions full = fixed;
+    full.beemdan_bound = BeemdanBound::kFull;
+    DecompositionOptions ice = fixed;
+    ice.method = Method::kIceemdan;
+    const Decomposition reference = Decompose(x, ice);
+    for (const DecompositionOptions& o : {fixed, full}) {
+      const Decomposition d = Decompose(x, o);
+      SCOPED_TRACE(std::string(ToString(o.beemdan_bound)));
+      EXPECT_EQ(d.imfs, reference.imfs);
+      EXPECT_EQ(d.residue, reference.residue);
+      EXPECT_EQ(d.report.noise_assisted_stages, d.num_imfs());
+      EXPECT_EQ(d.report.sifts_per_imf, reference.report.sifts_per_imf);
+      EXPECT_EQ(d.report.stop_reason, reference.report.stop_reason);
+    }
+  }
 }
 
 // Flandrin, Goncalves & Rilling (2004), written out independently of energy_band.cc: with

@@ -31,7 +31,9 @@
 
 #include "gyrodrift/io/model_file.h"
 
-namespace gyrodrift::io {
+namespace gyrodrift::firmware {
+
+using io::LoadedModel;
 
 enum class ExportFormat { kC, kCoefficientsJson };
 std::string_view ToString(ExportFormat format);              // "c", "json-coefficients"
@@ -80,4 +82,4 @@ ExportSummary SummariseExport(const std::vector<LoadedModel>& axes);
 // The file of options.format: RenderFirmwareC or RenderCoefficientsJson.
 std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptions& options);
 
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::firmware

@@ -3,7 +3,7 @@
 // hysteresis term, several axes); rendering is deterministic; the C header has the documented shape; models that cannot
 // run in firmware and bad options are refused with one line naming the reason. The C header's
 // arithmetic is checked by compiling it: tests/cli/export_test.cc.
-#include "gyrodrift/io/firmware_export.h"
+#include "gyrodrift/firmware/export.h"
 
 #include <gtest/gtest.h>
 
@@ -22,10 +22,13 @@
 #include "support/firmware_driver.h"
 #include "support/test_support.h"
 
-namespace gyrodrift::io {
+namespace gyrodrift::firmware {
 namespace {
 
 using drift::Method;
+using io::LoadedModel;
+using io::ParseModelFile;
+using io::WriteFileAtomically;
 using drift::Mode;
 using nlohmann::json;
 
@@ -421,4 +424,4 @@ TEST(ExportOptions, ValidatesThePrefixAndTheFormat) {
 }
 
 }  // namespace
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::firmware
