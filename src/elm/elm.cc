@@ -290,6 +290,49 @@ std::string ElmReport::Summary() const {
   return s;
 }
 
+namespace {
+
+// selection = auto: draws the largest candidate's units, scores every (L, C) pair by its
+// leave-one-out error (report->candidates) and keeps the best pair's units in *model (its
+// options' hidden_units and ridge_c set to the pair). Returns the Gram matrix of all the units
+// drawn, whose leading block the refit reuses.
+internal::Gram SelectByLoo(const ElmOptions& options, const Eigen::MatrixXd& xs,
+                           const Eigen::MatrixXd& ts, int threads, ElmModel* model,
+                           ElmReport* report) {
+  const std::vector<int> hidden_grid = options.HiddenUnitGrid();
+  const std::vector<double> ridge_grid = options.RidgeGrid();
+  internal::DrawUnits(static_cast<int>(xs.cols()), hidden_grid.back(), options.seed,
+                      &model->input_weights, &model->biases);
+  internal::Gram gram = internal::ComputeGram(options.activation, xs, ts, model->input_weights,
+                                              model->biases, threads);
+  internal::LooGrid(options.activation, xs, ts, model->input_weights, model->biases, gram,
+                    hidden_grid, ridge_grid, options.max_condition, model->target_scaler.scale,
+                    threads, &report->candidates);
+  const LooCandidate* best = nullptr;
+  for (const auto& c : report->candidates) {
+    // Ties (to the bit) go to the smaller network, then the stronger regularisation.
+    if (!c.skipped && std::isfinite(c.loo_mse) &&
+        (best == nullptr || c.loo_mse < best->loo_mse)) {
+      best = &c;
+    }
+  }
+  if (best == nullptr) {
+    throw DataError(
+        "ELM auto selection: every (L, C) pair has cond(H^T H + I/C) above "
+        "max_condition = " +
+        FormatValue(options.max_condition) +
+        " or an undefined leave-one-out error; add smaller C candidates");
+  }
+  report->loo_rmse = best->loo_rmse;
+  model->input_weights.conservativeResize(Eigen::NoChange, best->hidden_units);
+  model->biases.conservativeResize(best->hidden_units);
+  model->options.hidden_units = best->hidden_units;
+  model->options.ridge_c = best->ridge_c;
+  return gram;
+}
+
+}  // namespace
+
 ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Eigen::MatrixXd>& t,
            const ElmOptions& options, const Execution& execution) {
   options.Validate();
@@ -319,38 +362,10 @@ ElmFit Fit(const Eigen::Ref<const Eigen::MatrixXd>& x, const Eigen::Ref<const Ei
   internal::Gram gram;
   bool have_gram = false;
   if (options.selection == Selection::kAuto) {
-    const std::vector<int> hidden_grid = options.HiddenUnitGrid();
-    const std::vector<double> ridge_grid = options.RidgeGrid();
-    internal::DrawUnits(static_cast<int>(x.cols()), hidden_grid.back(), options.seed,
-                        &model.input_weights, &model.biases);
-    gram = internal::ComputeGram(options.activation, xs, ts, model.input_weights, model.biases,
-                                 threads);
+    gram = SelectByLoo(options, xs, ts, threads, &model, &report);
     have_gram = true;
-    internal::LooGrid(options.activation, xs, ts, model.input_weights, model.biases, gram,
-                      hidden_grid, ridge_grid, options.max_condition, model.target_scaler.scale,
-                      threads, &report.candidates);
-    const LooCandidate* best = nullptr;
-    for (const auto& c : report.candidates) {
-      // Ties (to the bit) go to the smaller network, then the stronger regularisation.
-      if (!c.skipped && std::isfinite(c.loo_mse) &&
-          (best == nullptr || c.loo_mse < best->loo_mse)) {
-        best = &c;
-      }
-    }
-    if (best == nullptr) {
-      throw DataError(
-          "ELM auto selection: every (L, C) pair has cond(H^T H + I/C) above "
-          "max_condition = " +
-          FormatValue(options.max_condition) +
-          " or an undefined leave-one-out error; add smaller C candidates");
-    }
-    hidden = best->hidden_units;
-    ridge_c = best->ridge_c;
-    report.loo_rmse = best->loo_rmse;
-    model.input_weights.conservativeResize(Eigen::NoChange, hidden);
-    model.biases.conservativeResize(hidden);
-    model.options.hidden_units = hidden;
-    model.options.ridge_c = ridge_c;
+    hidden = model.options.hidden_units;
+    ridge_c = model.options.ridge_c;
   } else {
     internal::DrawUnits(static_cast<int>(x.cols()), hidden, options.seed, &model.input_weights,
                         &model.biases);

@@ -12,7 +12,6 @@
 #include <string_view>
 
 #include "common/enum_names.h"
-#include "common/enum_names.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
 
@@ -135,6 +134,7 @@ class CsvTable::Parser {
   Parser(const std::string& source, const CsvReadOptions& options, std::uint64_t size_hint)
       : given_(options.delimiter),
         specs_(options.columns),
+        time_axis_spec_(options.time_axis),
         names_(options.names),
         skip_rows_(options.skip_rows),
         skip_bad_(options.bad_lines == BadLines::kSkip),
@@ -224,25 +224,41 @@ class CsvTable::Parser {
     }
     if (skip_bad_) {
       for (const size_t c : kept_) {
-        double value;
-        if (!ParseDouble(cells_[c], value) || !std::isfinite(value)) {
+        if (!IsFinite(cells_[c])) {
           t.skipped_lines_.push_back(line_number_);
           return;
         }
       }
+      if (t.time_axis_index_ >= 0 && !IsFinite(cells_[AxisColumn()])) {
+        t.skipped_lines_.push_back(line_number_);
+        return;
+      }
     }
     if (t.rows_ == capacity_) Reserve();
     const Eigen::Index row = t.rows_++;
-    for (const size_t c : kept_) {
-      double value;
-      if (!ParseDouble(cells_[c], value)) {
-        value = std::numeric_limits<double>::quiet_NaN();
-        if (t.first_bad_[c].row < 0) t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
-      } else if (!std::isfinite(value) && t.first_bad_[c].row < 0) {
-        t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
-      }
-      t.columns_[c][row] = value;
+    for (const size_t c : kept_) t.columns_[c][row] = Value(c);
+    if (t.time_axis_index_ >= 0) t.time_axis_.Add(Value(AxisColumn()));
+  }
+
+  static bool IsFinite(std::string_view cell) {
+    double value;
+    return ParseDouble(cell, value) && std::isfinite(value);
+  }
+
+  size_t AxisColumn() const { return static_cast<size_t>(table_.time_axis_index_); }
+
+  // Cell c of the current row, recorded as the column's first bad cell when it is one (NaN when
+  // it is not a number).
+  double Value(size_t c) {
+    CsvTable& t = table_;
+    double value;
+    if (!ParseDouble(cells_[c], value)) {
+      value = std::numeric_limits<double>::quiet_NaN();
+      if (t.first_bad_[c].row < 0) t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
+    } else if (!std::isfinite(value) && t.first_bad_[c].row < 0) {
+      t.first_bad_[c] = {t.rows_, std::string(cells_[c])};
     }
+    return value;
   }
 
   void Header(std::string_view line) {
@@ -279,6 +295,10 @@ class CsvTable::Parser {
     for (size_t c = 0; c < t.header_.size(); ++c) {
       if (t.kept_[c]) kept_.push_back(c);
     }
+    if (!time_axis_spec_.empty()) {
+      const int c = FindColumn(t.header_, time_axis_spec_);
+      if (c >= 0 && !t.kept_[static_cast<size_t>(c)]) t.time_axis_index_ = c;
+    }
     have_header_ = true;
   }
 
@@ -299,6 +319,7 @@ class CsvTable::Parser {
 
   const Delimiter given_;
   const std::vector<std::string> specs_;
+  const std::string time_axis_spec_;
   const std::vector<std::string> names_;  // the header, when the file has none
   const Eigen::Index skip_rows_;
   const bool skip_bad_;

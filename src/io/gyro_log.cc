@@ -37,6 +37,16 @@ GapPolicy GapPolicyFromString(std::string_view text) {
 
 namespace {
 
+// A gap: a step of this many median steps or more, so at least one sample is missing.
+constexpr double kGapSteps = 1.5;
+
+// The table's time axis (CsvReadOptions::time_axis) when every step of it is counted and > 0:
+// what the checks and the notes can use instead of the time_s column.
+const TimeAxis* RegularAxis(const CsvTable& table) {
+  const TimeAxis* axis = table.time_axis();
+  return axis && axis->complete() && axis->increasing() && axis->rows() >= 2 ? axis : nullptr;
+}
+
 // Whether the caller's user sets the log options as flags (--gaps) rather than manifest keys.
 bool SpeltAsFlags(const LogOptions& options) { return options.gaps_name.rfind("--", 0) == 0; }
 
@@ -111,6 +121,23 @@ void RequireHonoured(const std::string& path, const LogOptions& options, bool ta
   }
 }
 
+// A caller that names its columns needs of time_s only ReadLogRows' checks and the notes: its
+// steps are gathered while reading (8 bytes a row less), and it is read whole (again) only when
+// they show a fault or a gap, for the checks to name it as before.
+CsvTable ReadColumns(const std::string& path, CsvReadOptions read) {
+  if (read.columns.empty()) return CsvTable::Read(path, read);
+  read.time_axis = "time_s";
+  CsvTable table = CsvTable::Read(path, read);
+  const TimeAxis* axis = RegularAxis(table);
+  if (!table.time_axis() ||
+      (axis && (axis->rows() < 3 || axis->LargestStep() < kGapSteps * axis->MedianStep()))) {
+    return table;
+  }
+  read.time_axis.clear();
+  read.columns.push_back("time_s");
+  return CsvTable::Read(path, read);
+}
+
 // The log's table: a CSV file under the read settings, or a ULog's series rendered as `convert`
 // writes it and parsed back (so a ULog gives the numbers its converted CSV gives, to the bit).
 // The ULog's damage skipped is added to *notes as warnings.
@@ -121,8 +148,8 @@ CsvTable ReadTable(const std::string& path, const LogOptions& options,
                       .names = options.names,
                       .skip_rows = options.skip_rows,
                       .bad_lines = options.bad_lines};
+  if (!IsUlogFile(path)) return ReadColumns(path, read);
   if (!columns.empty()) read.columns.push_back("time_s");
-  if (!IsUlogFile(path)) return CsvTable::Read(path, read);
   RequireInRange("ulog_instance", options.ulog_instance, 0, 255);
   if (!options.names.empty() || options.skip_rows != 0) {
     throw UsageError(fmt::format(
@@ -153,7 +180,7 @@ void RequireIncreasing(const std::string& path, const Eigen::VectorXd& t) {
   }
 }
 
-// The gaps of time_s: a step of 1.5 median steps or more, so at least one sample is missing.
+// The gaps of time_s: a step of kGapSteps median steps or more, so at least one sample is missing.
 // Each as (the row before it, the samples missing); with split, the records' starts instead.
 struct Gaps {
   double median = 0.0;
@@ -167,7 +194,7 @@ Gaps FindGaps(const std::string& path, const Eigen::VectorXd& t, const LogOption
   Gaps gaps{.median = MedianStep(t), .insert = {}, .missing = 0};
   for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
     const double step = t[i + 1] - t[i];
-    if (!(step >= 1.5 * gaps.median)) continue;
+    if (!(step >= kGapSteps * gaps.median)) continue;
     const double samples = std::round(step / gaps.median) - 1.0;
     gaps.missing += static_cast<long>(samples);
     if (options.gaps == GapPolicy::kSplit) {
@@ -290,7 +317,8 @@ double ResolveSampleRate(const CsvTable& table, double given, std::string* how) 
     *how = "default";
     return 1.0;
   }
-  const double median = MedianStep(table.ColumnRef("time_s"));
+  const TimeAxis* axis = RegularAxis(table);
+  const double median = axis ? axis->MedianStep() : MedianStep(table.ColumnRef("time_s"));
   if (!(median > 0.0)) {
     throw DataError(table.source() + ": column 'time_s' has a median step of " +
                     FormatValue(median) +
@@ -315,8 +343,28 @@ void RequireSameSampleRate(const std::string& first, double first_hz, const std:
       first, first_hz, log, rate_hz));
 }
 
+namespace {
+
+std::string NonUniformNote(long off, Eigen::Index steps, double median, double shortest,
+                           Eigen::Index shortest_row) {
+  if (off == 0) return "";
+  return fmt::format(
+      "note: time_s is not uniform: {} of {} steps are shorter than half the median step {:g} s "
+      "(shortest {:g} s, before data row {}); the models and the Allan analysis treat the "
+      "samples as equally spaced",
+      off, steps, median, shortest, shortest_row);
+}
+
+}  // namespace
+
 std::string NonUniformTimeNote(const CsvTable& table) {
   if (!table.HasColumn("time_s") || table.rows() < 3) return "";
+  if (const TimeAxis* axis = RegularAxis(table)) {
+    const double median = axis->MedianStep();
+    const TimeAxis::Step shortest = axis->Shortest();
+    return NonUniformNote(axis->StepsBelow(0.5 * median), table.rows() - 1, median,
+                          shortest.value, shortest.first + 2);
+  }
   const Eigen::VectorXd* time = nullptr;
   try {
     time = &table.ColumnRef("time_s");
@@ -336,12 +384,8 @@ std::string NonUniformTimeNote(const CsvTable& table) {
       shortest_row = i + 2;
     }
   }
-  if (off == 0) return "";
-  return fmt::format(
-      "note: time_s is not uniform: {} of {} steps are shorter than half the median step {:g} s "
-      "(shortest {:g} s, before data row {}); the models and the Allan analysis treat the "
-      "samples as equally spaced",
-      off, t.size() - 1, median, shortest, shortest_row);
+  return NonUniformNote(off, t.size() - 1, median, shortest, shortest_row);
 }
+
 
 }  // namespace gyrodrift::io

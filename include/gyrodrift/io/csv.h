@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "gyrodrift/io/time_axis.h"
+
 namespace gyrodrift::io {
 
 // The cell delimiter: auto = a comma where the header has one, else a tab, else a semicolon.
@@ -55,6 +57,11 @@ struct CsvReadOptions {
   // [0, 1e6]: a terminal program's banner. Lines starting with '#' are skipped anyway.
   int skip_rows = 0;
   BadLines bad_lines = BadLines::kError;
+  // A column read as a time axis: its cells are parsed and checked as a kept column's (a bad one
+  // is refused or skipped alike), but only what a log's checks need of them is kept
+  // (CsvTable::time_axis), not the values: 8 bytes a row less. Empty: none. A column also named
+  // in `columns`, or not in the header, is read as the other columns are.
+  std::string time_axis = {};
   // Throws OptionError naming block_bytes, skip_rows or names (empty or repeated names).
   void Validate() const;
 };
@@ -76,6 +83,9 @@ class CsvTable {
   const std::vector<std::string>& header() const { return header_; }
   // The file lines (1-based) of the rows BadLines::kSkip left out, in order.
   const std::vector<Eigen::Index>& skipped_lines() const { return skipped_lines_; }
+  // The column read as CsvReadOptions::time_axis, or nullptr when none was (the column is then
+  // not kept: ColumnRef refuses it).
+  const TimeAxis* time_axis() const { return time_axis_index_ >= 0 ? &time_axis_ : nullptr; }
   Eigen::Index rows() const { return rows_; }
   const std::string& source() const { return source_; }
 
@@ -100,7 +110,7 @@ class CsvTable {
 
   // A copy with rows inserted by linear interpolation: for each (row, count), `count` rows evenly
   // spaced between data rows `row` and `row + 1` (0-based), in every kept column. Messages about
-  // a bad cell keep naming its row in the file.
+  // a bad cell keep naming its row in the file. The copy has no time axis (its steps changed).
   CsvTable WithInterpolatedRows(const std::vector<std::pair<Eigen::Index, int>>& insert) const;
 
  private:
@@ -118,6 +128,8 @@ class CsvTable {
   std::vector<bool> kept_;
   std::vector<BadCell> first_bad_;
   std::vector<Eigen::Index> skipped_lines_;
+  TimeAxis time_axis_;
+  int time_axis_index_ = -1;  // the header column read as time_axis_, -1 for none
   Eigen::Index rows_ = 0;
 };
 

@@ -75,7 +75,10 @@ bool IsUlogFile(const std::string& path);
 // UsageError. *logged (if given) receives one flag per returned row, true where the row was
 // logged, or stays empty when every row was; kCarry without logged is a UsageError. Shorter
 // irregular steps stay a note (NonUniformTimeNote). `columns`: the columns the caller needs
-// (CsvReadOptions::columns; time_s is kept with them); empty = every column.
+// (CsvReadOptions::columns); empty = every column. With columns named, time_s is read as a time
+// axis (CsvTable::time_axis: its steps, not its values; NonUniformTimeNote and ResolveSampleRate
+// use it), and kept whole only when it repeats, goes backwards, has a bad cell, a gap or more
+// than TimeAxis::kMaxDistinctSteps distinct steps.
 CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
                  std::string* gap_note = nullptr,
                  std::vector<Eigen::Index>* record_starts = nullptr,

@@ -339,6 +339,40 @@ TEST(CsvCapture, DamagedLinesAreSkippedAndListedOnRequest) {
   EXPECT_EQ(only_a.skipped_lines(), (std::vector<Eigen::Index>{5, 7}));
 }
 
+TEST(CsvTable, ATimeAxisIsCheckedAsAKeptColumnButNotStored) {
+  const std::string text = "time_s,rate_dph,status\n0,1,ok\n0.5,2,ok\n1.5,3,ok\n2,4,ok\n";
+  for (size_t block : {size_t{3}, size_t{4} << 20}) {
+    const Reading r =
+        ReadBlocks(text, {.columns = {"rate_dph"}, .block_bytes = block, .time_axis = "time_s"});
+    ASSERT_TRUE(r.table.has_value()) << r.error;
+    const CsvTable& t = *r.table;
+    EXPECT_FALSE(t.IsKept(0));
+    EXPECT_THROW(t.ColumnRef("time_s"), UsageError);
+    ASSERT_NE(t.time_axis(), nullptr);
+    EXPECT_EQ(t.time_axis()->rows(), 4);
+    EXPECT_EQ(t.time_axis()->MedianStep(), 0.5);
+    EXPECT_EQ(t.time_axis()->LargestStep(), 1.0);
+    EXPECT_EQ(t.ColumnRef("rate_dph"), (Eigen::VectorXd(4) << 1, 2, 3, 4).finished());
+  }
+  // Named among the columns too: kept whole, no axis.
+  const Reading both = ReadBlocks(text, {.columns = {"time_s"}, .time_axis = "time_s"});
+  ASSERT_TRUE(both.table.has_value());
+  EXPECT_EQ(both.table->time_axis(), nullptr);
+  EXPECT_TRUE(both.table->IsKept(0));
+  // A damaged time cell skips its row as a kept column's does; without kSkip the axis says so.
+  const std::string damaged = "time_s,rate\n0,1\n1x,2\n2,3\n";
+  const std::string path = CaptureFile("axis.csv", damaged);
+  const CsvTable skipped = CsvTable::Read(
+      path, {.columns = {"rate"}, .bad_lines = BadLines::kSkip, .time_axis = "time_s"});
+  EXPECT_EQ(skipped.skipped_lines(), (std::vector<Eigen::Index>{3}));
+  EXPECT_EQ(skipped.time_axis()->rows(), skipped.rows());
+  EXPECT_TRUE(skipped.time_axis()->complete());
+  const CsvTable kept_bad =
+      CsvTable::Read(path, {.columns = {"rate"}, .time_axis = "time_s"});
+  EXPECT_EQ(kept_bad.rows(), 3);
+  EXPECT_FALSE(kept_bad.time_axis()->complete());
+}
+
 TEST(CsvCapture, BadOptionsAreRefused) {
   const std::string path = CaptureFile("ok.csv", "1,2\n");
   EXPECT_THROW(CsvTable::Read(path, CsvReadOptions{.names = {"a", "a"}}), OptionError);

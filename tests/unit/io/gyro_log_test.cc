@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
 #include "support/test_support.h"
@@ -149,6 +151,61 @@ TEST(GyroLog, MostlyMadeUpRowsAreAWarningThatSuggestsCarry) {
     EXPECT_NE(std::string(e.what()).find("(--gaps split)"), std::string::npos) << e.what();
   }
   EXPECT_EQ(SpellGaps({}, GapPolicy::kSplit), "gaps = 'split'");
+}
+
+TEST(GyroLog, ACallerNamingItsColumnsGetsTheSameChecksWithoutTheTimeColumn) {
+  // Regular with short steps (a note), a gap, a repeat, a bad cell: each gives the same table,
+  // notes, rate and messages read with its columns named (time_s then kept as steps only, or
+  // read whole again for a fault or a gap) as read whole.
+  const std::string regular = "time_s,r,x\n0,1,a\n1,2,a\n1.2,3,a\n2,4,a\n3,5,a\n4,6,a\n";
+  const std::string gap = "time_s,r,x\n0,1,a\n1,2,a\n2,3,a\n5,4,a\n6,5,a\n";
+  const std::string repeat = "time_s,r,x\n0,1,a\n1,2,a\n1,3,a\n";
+  const std::string bad = "time_s,r,x\n0,1,a\n1,2,a\nx,3,a\n3,4,a\n";
+  int n = 0;
+  for (const std::string& text : {regular, gap, repeat, bad}) {
+    const std::string path = Write("named" + std::to_string(n++) + ".csv", text);
+    for (const GapPolicy gaps : {GapPolicy::kError, GapPolicy::kInterpolate}) {
+      std::string whole_note, named_note, whole_error, named_error;
+      std::optional<CsvTable> whole, named;
+      try {
+        whole = ReadLog(path, {gaps}, &whole_note);
+      } catch (const Error& e) {
+        whole_error = e.what();
+      }
+      try {
+        named = ReadLog(path, {gaps}, &named_note, nullptr, {"r"});
+      } catch (const Error& e) {
+        named_error = e.what();
+      }
+      EXPECT_EQ(named_error, whole_error) << path;
+      ASSERT_EQ(named.has_value(), whole.has_value()) << path;
+      if (!named) continue;
+      EXPECT_EQ(named_note, whole_note) << path;
+      EXPECT_EQ(named->Column("r"), whole->Column("r")) << path;
+      EXPECT_EQ(NonUniformTimeNote(*named), NonUniformTimeNote(*whole)) << path;
+      std::string how_named, how_whole, rate_named, rate_whole;
+      try {
+        rate_whole = std::to_string(ResolveSampleRate(*whole, 0.0, &how_whole));
+      } catch (const Error& e) {
+        rate_whole = e.what();
+      }
+      try {
+        rate_named = std::to_string(ResolveSampleRate(*named, 0.0, &how_named));
+      } catch (const Error& e) {
+        rate_named = e.what();
+      }
+      EXPECT_EQ(rate_named, rate_whole) << path;
+      EXPECT_EQ(how_named, how_whole) << path;
+    }
+  }
+  // The regular log's time_s is not held, only its steps.
+  const CsvTable t = ReadLog(Write("named_regular.csv", regular), {}, nullptr, nullptr, {"r"});
+  EXPECT_FALSE(t.IsKept(0));
+  ASSERT_NE(t.time_axis(), nullptr);
+  EXPECT_NE(NonUniformTimeNote(t).find("1 of 5 steps are shorter than half the median step 1 s "
+                                       "(shortest 0.2 s, before data row 3)"),
+            std::string::npos)
+      << NonUniformTimeNote(t);
 }
 
 TEST(GyroLog, TheDelimiterCanBeNamed) {
