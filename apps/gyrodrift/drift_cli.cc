@@ -13,16 +13,6 @@
 #include "gyrodrift/drift/temperature_check.h"
 
 namespace gyrodrift::cli {
-namespace {
-
-std::string Columns(const io::CsvTable& table) {
-  std::string names;
-  for (const auto& h : table.header()) names += (names.empty() ? "" : ", ") + h;
-  return names;
-}
-
-}  // namespace
-
 void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
   if (split_records) {
     cmd->add_option("input", a->inputs,
@@ -145,54 +135,6 @@ std::string InputWarnings(const std::string& path, const std::string& rate_how,
   for (const std::string& column : temperature_columns) {
     const std::string w = drift::TemperatureWarning(table.Column(column), column);
     if (!w.empty()) out += "warning: " + path + ": " + w + "\n";
-  }
-  return out;
-}
-
-void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table) {
-  auto require = [&](const std::string& column, const char* option) {
-    if (table.HasColumn(column)) return;
-    throw DataError("model needs column '" + column + "' (trained with " + option + " " + column +
-                    "); " + table.source() + " has: " + Columns(table));
-  };
-  require(loaded.info.target_column, "--target");
-  if (loaded.model.uses_temperature()) {
-    for (const std::string& c : SplitColumns(loaded.info.temperature_column)) {
-      require(c, "--temperature");
-    }
-  }
-}
-
-std::vector<std::string> SplitColumns(const std::string& names) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (start <= names.size()) {
-    const size_t comma = names.find(',', start);
-    out.push_back(names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
-SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
-                            const std::string& option) {
-  const std::vector<std::string> items = SplitColumns(spec);
-  SelectedColumns out;
-  out.values.resize(0, static_cast<Eigen::Index>(items.size()));
-  std::vector<std::string> seen;
-  for (size_t c = 0; c < items.size(); ++c) {
-    if (items[c].empty()) ThrowOption(option, "'" + spec + "'", "column names without empty items");
-    const std::string name = ColumnName(table, items[c]);
-    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
-      ThrowOption(option, "'" + spec + "'", "a list without repeats");
-    }
-    seen.push_back(name);
-    const Eigen::VectorXd column = table.Column(items[c]);
-    if (c == 0) out.values.resize(column.size(), static_cast<Eigen::Index>(items.size()));
-    out.values.col(static_cast<Eigen::Index>(c)) = column;
-    out.joined += (c ? "," : "") + name;
-    out.names.push_back(name);
   }
   return out;
 }

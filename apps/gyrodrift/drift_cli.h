@@ -14,6 +14,8 @@
 #include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
+#include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/task_log.h"
 #include "cli_util.h"
 
 namespace gyrodrift::cli {
@@ -57,26 +59,14 @@ std::string InputWarnings(const std::string& path, const std::string& rate_how,
                           const io::CsvTable& table,
                           const std::vector<std::string>& temperature_columns);
 
-// Throws DataError "model needs column 'X' (trained with --target X); IN.csv has: a, b" unless
-// the table has the model's target column and, when the model uses it, its temperature column.
-void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& table);
+using tasks::RequireModelColumns;
 
 // --methods: "all" (every drift::Method of `mode`) or a comma-separated list without repeats or
 // empty items. Throws UsageError naming --methods.
 std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode);
 
-// The columns of `spec` ("a" or "a,b", names or 1-based indices), the value of `option`: their
-// names, the names joined by commas, and the N x C matrix. Throws UsageError naming `option` for
-// an unknown, empty or repeated column.
-struct SelectedColumns {
-  std::vector<std::string> names;
-  std::string joined;
-  Eigen::MatrixXd values;
-};
-SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
-                            const std::string& option);
-
-// The comma-separated names of a model file's temperature_column.
-std::vector<std::string> SplitColumns(const std::string& names);
+using tasks::ReadColumns;
+using tasks::SelectedColumns;
+using tasks::SplitColumns;
 
 }  // namespace gyrodrift::cli

@@ -13,7 +13,9 @@
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
+#include "gyrodrift/tasks/fit_task.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -106,104 +108,70 @@ struct FitArgs : DriftArgs {
   std::string output;
 };
 
+// The calibration logs as one run of several records: the targets' columns, then the
+// temperatures', of every log one after the other (tasks::AssembleFitRun). Notes and the
+// warnings to print before the work go to *notes and *warnings.
+tasks::FitRun ReadRun(const FitArgs& a, std::string* notes, std::string* warnings) {
+  const io::LogOptions log = a.log.Options();
+  const bool rate_given = a.rate_option != nullptr && a.rate_option->count() > 0;
+  std::vector<tasks::TaskLog> logs;
+  for (const std::string& input : a.inputs) {
+    tasks::TaskLog l = tasks::ReadTaskLog(input, log, rate_given ? a.settings.rate_hz : 0.0);
+    if (!l.gap_note.empty()) *notes += l.gap_note + "\n";
+    if (!l.time_note.empty()) *notes += (a.inputs.size() > 1 ? input + ": " : "") + l.time_note + "\n";
+    // Each log's columns are checked where they are read, before its warnings.
+    (void)tasks::ReadColumns(l.table, a.target, "--target");
+    const std::vector<std::string> temperatures =
+        a.temperature.empty() ? std::vector<std::string>{}
+                              : tasks::ReadColumns(l.table, a.temperature, "--temperature").names;
+    for (const std::string& w : tasks::LogWarnings(l, l.rate_how, temperatures, true)) {
+      *warnings += "warning: " + w + "\n";
+    }
+    logs.push_back(std::move(l));
+  }
+  return tasks::AssembleFitRun(logs, a.target, a.temperature, log);
+}
+
 void Run(const FitArgs& a) {
   RequireOutputsAreNotInputs(a.inputs, {a.output});
   const drift::FitSettings settings = Settings(a, a.method);
-  drift::DriftOptions o = drift::MakeDriftOptions(settings);
-  Execution execution = drift::MakeExecution(settings);
-  const drift::Method method = o.method;
-
-  // Several calibration logs (or one split at its gaps) become one run of several records: the
-  // targets' columns, then the temperatures', of every log one after the other.
-  std::string notes, rate_how, sources, warnings;
-  SelectedColumns targets, temperature;
-  drift::RecordRows run;
-  for (const std::string& input : a.inputs) {
-    std::vector<Eigen::Index> starts;
-    std::vector<bool> logged;  // --gaps carry: the rows that were logged
-    const io::CsvTable table = ReadLog(input, a.log, &notes, &starts, {}, &logged);
-    std::string how;
-    const double rate_hz = ResolveRateHz(a, table, &how);
-    const std::string time_note = NonUniformTimeNote(table);
-    if (!time_note.empty()) notes += (a.inputs.size() > 1 ? input + ": " : "") + time_note + "\n";
-    targets = ReadColumns(table, a.target, "--target");
-    if (!a.temperature.empty()) temperature = ReadColumns(table, a.temperature, "--temperature");
-    warnings += InputWarnings(input, how, table, temperature.names);
-    if (sources.empty()) {
-      o.features.rate_hz = rate_hz;
-      rate_how = how;
-    } else {
-      io::RequireSameSampleRate(a.inputs.front(), o.features.rate_hz, input, rate_hz);
-    }
-    Eigen::MatrixXd block(table.rows(), targets.values.cols() + temperature.values.cols());
-    block.leftCols(targets.values.cols()) = targets.values;
-    if (temperature.values.cols() > 0) block.rightCols(temperature.values.cols()) = temperature.values;
-    // interpolate fits on the made-up rows as data; only carry keeps the fit to the logged ones.
-    if (a.log.gaps != "carry") logged.clear();
-    run.Append(block, starts, logged);
-    sources += (sources.empty() ? "" : ",") + input;
-  }
-  targets.values = run.rows.leftCols(targets.values.cols());
-  temperature.values = run.rows.rightCols(temperature.values.cols());
-  const std::vector<Eigen::Index>& record_starts = run.record_starts;
-  for (const std::string& name : temperature.names) {
-    for (const std::string& target : targets.names) {
-      if (name == target) {
-        throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
-      }
-    }
-  }
-  if (!record_starts.empty() && method != drift::Method::kThermal) {
-    throw UsageError(fmt::format(
-        "--method {}: several records ({}) are fitted by --method thermal only (a decomposition "
-        "or lags would run across the breaks)",
-        drift::ToString(method), a.inputs.size() > 1 ? "several input logs" : "--gaps split"));
-  }
-  if (!run.logged.empty() && (o.mode != drift::Mode::kCompensate || drift::UsesDecomposition(method))) {
-    throw UsageError(fmt::format(
-        "--gaps carry: the fit uses the logged rows only, which --mode {} --method {} cannot do "
-        "({}): use --method thermal or poly in compensate mode, or --gaps interpolate",
-        drift::ToString(o.mode), drift::ToString(method),
-        o.mode == drift::Mode::kCompensate ? "a decomposition runs across the made-up rows"
-                                           : "a prediction from the output's past reads made-up "
-                                             "rows"));
-  }
+  settings.Validate();  // option errors before any file is read
+  std::string notes, warnings;
+  const tasks::FitRun run = ReadRun(a, &notes, &warnings);
+  tasks::CheckFitRun(run, drift::MakeDriftOptions(settings), a.log.Options());
   // What the user must know before waiting for the fit: an assumed rate, a temperature that
   // does not look like degC.
   if (!a.quiet && !warnings.empty()) {
     fmt::print("{}", warnings);
     std::fflush(stdout);
   }
-  const auto axes = static_cast<int>(targets.names.size());
-  std::vector<io::LoadedModel> fitted;
+  const auto axes = static_cast<int>(run.targets.size());
+  tasks::FitResult fit;
   {
     ProgressBar progress(std::vector<double>(static_cast<size_t>(axes), 1.0),
                          IsTerminal() && !a.quiet);
-    for (int i = 0; i < axes; ++i) {
-      io::LoadedModel axis;
-      axis.info.source = sources;
-      axis.info.target_column = targets.names[static_cast<size_t>(i)];
-      axis.info.temperature_column = temperature.joined;
-      axis.info.rate_unit = a.units;
-      const std::string label = axes > 1 ? axis.info.target_column + ": " + std::string(drift::ToString(method))
-                                         : std::string(drift::ToString(method));
-      progress.BeginStage(i, label);
-      execution.progress = [&progress, &label](double fraction, std::string_view step) {
-        progress.Update(fraction, label + ": " + std::string(step));
-      };
-      axis.model = drift::FitDriftModel(targets.values.col(i), temperature.values, o, record_starts,
-                                        execution, run.logged);
-      fitted.push_back(std::move(axis));
-    }
+    std::string label;
+    const std::string method(drift::ToString(drift::MakeDriftOptions(settings).method));
+    fit = tasks::RunFit(run, settings, a.units, a.log.Options(),
+                        [&](int axis, double fraction, std::string_view step) {
+                          if (step.empty()) {  // the axis starts
+                            label = axes > 1 ? run.targets[static_cast<size_t>(axis)] + ": " + method
+                                             : method;
+                            progress.BeginStage(axis, label);
+                            return;
+                          }
+                          progress.Update(fraction, label + ": " + std::string(step));
+                        });
   }
-  io::WriteModelFile(a.output, fitted);
+  io::WriteFileAtomically(a.output, fit.ModelFile());
   if (a.quiet) return;
-  for (const io::LoadedModel& axis : fitted) {
+  for (const io::LoadedModel& axis : fit.axes) {
     if (axes > 1) fmt::print("axis {}:\n", axis.info.target_column);
-    PrintModel(axis, o);
+    PrintModel(axis, fit.options);
   }
-  fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", o.features.rate_hz,
-             rate_how == "time_s" ? "from the median step of time_s" : rate_how, notes, a.output);
+  fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", fit.options.features.rate_hz,
+             run.rate_how == "time_s" ? "from the median step of time_s" : run.rate_how, notes,
+             a.output);
 }
 
 const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {

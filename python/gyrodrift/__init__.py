@@ -223,14 +223,16 @@ class DriftModel:
         ``gyrodrift compensate``."""
         return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
-    def compensation_summary(self, temperature, y, *, record_starts=()):
+    def compensation_summary(self, temperature, y, *, record_starts=(), drift_window_s=600.0):
         """Compensate mode: what compensating ``y`` does to it, the figures ``gyrodrift
         compensate`` prints and keeps in its sidecar. Returns a dict: ``before`` and ``after``
         (each ``mean``, ``rms`` about zero, ``std`` about the mean and ``slow_variation``, the RMS
-        about their mean of 10-min block means, NaN on a log shorter than two blocks),
+        about their mean of ``drift_window_s`` block means, NaN on a log shorter than two blocks),
         ``samples``, ``slow_variation_block_s``, ``slow_variation_blocks`` and ``table`` (the
-        printed lines). The blocks are timed at the model's sample rate (docs/drift.md 1.5)."""
-        return self._core.compensation_summary(temperature, y, record_starts=list(record_starts))
+        printed lines). The blocks are timed at the model's sample rate (docs/drift.md 1.5);
+        ``drift_window_s`` as ``compensate --drift-window-s`` and the manifest key."""
+        return self._core.compensation_summary(temperature, y, record_starts=list(record_starts),
+                                               drift_window_s=drift_window_s)
 
     def coefficients(self, *, reference_temperature=None):
         """The thermal sub-models' coefficients in physical units, as ``gyrodrift fit`` prints

@@ -19,6 +19,9 @@
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/tasks/allan_task.h"
 #include "gyrodrift/tasks/decompose_task.h"
+#include "gyrodrift/tasks/fit_task.h"
+#include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/predict_task.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -34,14 +37,14 @@ class PyDriftModel {
   PyDriftModel() = default;
   explicit PyDriftModel(io::LoadedModel loaded) : loaded_(std::move(loaded)), fitted_(true) {}
 
-  // As `gyrodrift fit` (MakeDriftOptions above).
+  // As `gyrodrift fit`: tasks::RunFit on the run of the arrays.
   void Fit(const Array& y_in, const std::optional<Array>& temperature_in,
            const drift::FitSettings& settings, const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
            const std::string& source, const std::vector<Eigen::Index>& record_starts,
            const std::vector<bool>& logged, const py::object& progress) {
     LongCall call(progress);
-    const drift::DriftOptions o = drift::MakeDriftOptions(settings);
+    settings.Validate();  // option errors before the arrays are looked at
     const Execution execution = ExecutionOf(settings.threads, call);
 
     const Eigen::VectorXd y = ToVector(y_in, "y");
@@ -68,17 +71,27 @@ class PyDriftModel {
         throw py::error_already_set();
       }
     }
-    io::LoadedModel loaded;
-    loaded.info.source = source;
-    loaded.info.target_column = target;
-    if (temperature_in) {
-      for (size_t c = 0; c < names.size(); ++c)
-        loaded.info.temperature_column += (c ? "," : "") + names[c];
+    // One target: the run of the arrays, as tasks::AssembleFitRun makes it of logs.
+    tasks::FitRun run{.targets = {target}, .temperatures = {}, .rows = {}, .source = source};
+    if (temperature_in) run.temperatures = names;
+    Eigen::MatrixXd rows(y.size(), 1 + temperature.cols());
+    rows.col(0) = y;
+    if (temperature.cols() > 0) {
+      if (temperature.rows() != y.size()) {
+        throw DataError("temperature has " + std::to_string(temperature.rows()) +
+                        " samples, the target " + std::to_string(y.size()) + ": they must match");
+      }
+      rows.rightCols(temperature.cols()) = temperature;
     }
+    run.rows.Append(rows, record_starts, logged);
+    tasks::FitResult fit;
     call.Run([&] {
-      loaded.model = drift::FitDriftModel(y, temperature, o, record_starts, execution, logged);
+      fit = tasks::RunFit(run, settings, io::ModelFileInfo{}.rate_unit, {},
+                          [&execution](int, double fraction, std::string_view step) {
+                            if (execution.progress) execution.progress(fraction, step);
+                          });
     });
-    loaded_ = std::move(loaded);
+    loaded_ = std::move(fit.axes.front());
     fitted_ = true;
   }
 
@@ -95,55 +108,43 @@ class PyDriftModel {
     }
   }
 
+  // tasks::CompensateAxis of y (or of zeros: the estimate alone), as `gyrodrift compensate`.
+  tasks::AxisCompensation Compensation(const char* what, const Array& temperature_in,
+                                       const Array* y_in,
+                                       const std::vector<Eigen::Index>& record_starts,
+                                       const tasks::CompensateSettings& settings = {}) const {
+    RequireMode(drift::Mode::kCompensate, what);
+    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
+    const Eigen::VectorXd y = y_in ? ToVector(*y_in, "y") : Eigen::VectorXd::Zero(t.rows());
+    if (y.size() != t.rows()) {
+      throw DataError(std::string(what) + ": y has " + std::to_string(y.size()) +
+                      " samples, temperature " + std::to_string(t.rows()));
+    }
+    py::gil_scoped_release release;
+    return tasks::CompensateAxis(Loaded(), y, t, record_starts, {}, Eigen::VectorXd(), settings);
+  }
+
   py::tuple Estimate(const Array& temperature_in,
                      const std::vector<Eigen::Index>& record_starts) const {
-    RequireMode(drift::Mode::kCompensate, "estimate");
-    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
-    Eigen::MatrixXd e;
-    {
-      py::gil_scoped_release release;
-      e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
-    }
-    return py::make_tuple(ToArray(Eigen::VectorXd(e.col(0))), ToArray(Eigen::VectorXd(e.col(1))));
+    const tasks::AxisCompensation c = Compensation("estimate", temperature_in, nullptr, record_starts);
+    return py::make_tuple(ToArray(c.estimate), ToArray(c.sd));
   }
 
   // y - estimate, as `gyrodrift compensate` writes it.
   py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in,
                                  const std::vector<Eigen::Index>& record_starts) const {
-    RequireMode(drift::Mode::kCompensate, "compensate");
-    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
-    const Eigen::VectorXd y = ToVector(y_in, "y");
-    if (y.size() != t.rows()) {
-      throw DataError("compensate: y has " + std::to_string(y.size()) + " samples, temperature " +
-                      std::to_string(t.rows()));
-    }
-    Eigen::VectorXd compensated;
-    {
-      py::gil_scoped_release release;
-      const Eigen::MatrixXd e = drift::EstimateDriftWithSd(Loaded().model, t, record_starts);
-      compensated = y - e.col(0);
-    }
-    return ToArray(compensated);
+    return ToArray(Compensation("compensate", temperature_in, &y_in, record_starts).compensated);
   }
 
   // The figures `gyrodrift compensate` prints and keeps in its sidecar for y compensated by this
-  // model (drift::SummariseCompensation at the model's sample rate).
+  // model (at the model's sample rate).
   py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
-                               const std::vector<Eigen::Index>& record_starts) const {
-    RequireMode(drift::Mode::kCompensate, "compensation_summary");
-    const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
-    const Eigen::VectorXd y = ToVector(y_in, "y");
-    if (y.size() != t.rows()) {
-      throw DataError("compensation_summary: y has " + std::to_string(y.size()) +
-                      " samples, temperature " + std::to_string(t.rows()));
-    }
-    drift::CompensationSummary s;
-    {
-      py::gil_scoped_release release;
-      const Eigen::VectorXd compensated =
-          y - drift::EstimateDriftWithSd(Loaded().model, t, record_starts).col(0);
-      s = drift::SummariseCompensation(y, compensated, Loaded().model.options.features.rate_hz);
-    }
+                               const std::vector<Eigen::Index>& record_starts,
+                               double drift_window_s) const {
+    const drift::CompensationSummary s =
+        Compensation("compensation_summary", temperature_in, &y_in, record_starts,
+                     {.drift_window_s = drift_window_s})
+            .summary;
     auto figures = [](const drift::SignalSummary& f) {
       py::dict d;
       d["mean"] = f.mean;
@@ -195,37 +196,24 @@ class PyDriftModel {
     return out;
   }
 
-  // As `gyrodrift predict`: predictions of y[t] for t = first .. N-1, from FirstPredictable.
+  // As `gyrodrift predict` (tasks::RunPredict): predictions of y[t] for t = first .. N-1.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
-                    const std::string& protocol_name, int window, int threads,
+                    const std::string& protocol, int window, int threads,
                     const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
     LongCall call(progress);
-    const drift::Protocol protocol = drift::ProtocolFromString(protocol_name);
-    if (window < 16 || window > 1000000) {
-      throw OptionError("window", std::to_string(window), "an integer in [16, 1000000]");
-    }
-    const drift::DriftModel& model = Loaded().model;
-    const Execution execution = ExecutionOf(threads, call);  // it never changes the result
+    const tasks::PredictSettings settings{
+        .protocol = protocol, .window = window, .horizon = horizon, .threads = threads};
+    settings.Validate();
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
-    if (model.uses_temperature()) {
+    if (Loaded().model.uses_temperature()) {
       if (!temperature_in) throw UsageError("predict: this model needs temperature");
       temperature = ToVector(*temperature_in, "temperature");
     }
-    const Eigen::Index first = drift::FirstPredictable(model, protocol, horizon);
-    if (y.size() <= first) {
-      throw DataError("y has " + std::to_string(y.size()) + " samples: the model needs more than " +
-                      std::to_string(first) + " (its history) to predict any");
-    }
-    drift::CausalOptions causal;
-    causal.window = window;
-    Eigen::VectorXd prediction;
-    call.Run([&] {
-      prediction =
-          drift::PredictAhead(model, y, temperature, first, horizon, protocol, causal, execution);
-    });
-    return py::make_tuple(first, ToArray(prediction));
+    tasks::PredictResult r;
+    call.Run([&] { r = tasks::RunPredict(Loaded(), y, temperature, settings, "y", call.Hook()); });
+    return py::make_tuple(r.first, ToArray(r.prediction));
   }
 
   void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
@@ -329,6 +317,7 @@ void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
 void BindDriftModel(py::module_& m) {
   using py::arg;
   const gyrodrift::drift::FitSettings fd;
+  const gyrodrift::tasks::PredictSettings pd;
   py::class_<gp::PyDriftModel>(m, "DriftModel")
       .def(py::init<>())
       .def("fit", &FitKeywords, arg("y"), arg("temperature") = py::none(), py::kw_only(),
@@ -347,12 +336,13 @@ void BindDriftModel(py::module_& m) {
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
-           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{})
+           arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{},
+           arg("drift_window_s") = gyrodrift::tasks::CompensateSettings{}.drift_window_s)
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
-           py::kw_only(), arg("horizon") = 1, arg("protocol") = "causal",
-           arg("window") = gyrodrift::drift::CausalOptions{}.window, arg("threads") = 0,
+           py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
+           arg("window") = pd.window, arg("threads") = pd.threads,
            arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))

@@ -18,6 +18,7 @@
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/tasks/allan_task.h"
 #include "gyrodrift/tasks/decompose_task.h"
+#include "gyrodrift/tasks/evaluate_task.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -27,58 +28,31 @@ namespace dec = gyrodrift::decomposition;
 namespace sim = gyrodrift::simulation;
 namespace gp = gyrodrift::python;
 
-// ---- evaluate -------------------------------------------------------------------------------
-
-std::vector<drift::Method> MethodList(const py::object& methods, drift::Mode mode) {
-  std::vector<std::string> names;
-  if (py::isinstance<py::str>(methods)) {
-    const std::string text = methods.cast<std::string>();
-    if (text == "all") return drift::AllMethods(mode);
-    names = SplitColumns(text);
-  } else {
-    names = methods.cast<std::vector<std::string>>();
+// The method list as text: a string as given, a sequence joined by commas (tasks::ParseMethods).
+std::string MethodList(const py::object& methods) {
+  if (py::isinstance<py::str>(methods)) return methods.cast<std::string>();
+  std::string text;
+  for (const std::string& name : methods.cast<std::vector<std::string>>()) {
+    text += (text.empty() ? "" : ",") + name;
   }
-  std::vector<drift::Method> out;
-  for (const std::string& name : names) {
-    const drift::Method m = drift::MethodFromString(name);
-    if (std::find(out.begin(), out.end(), m) != out.end()) {
-      throw OptionError("methods", "'" + name + "' twice", "a list without repeats");
-    }
-    out.push_back(m);
-  }
-  if (out.empty()) throw OptionError("methods", "(empty)", "at least one method");
-  return out;
+  if (text.empty()) throw OptionError("methods", "(empty)", "at least one method");
+  return text;
 }
 
-// As `gyrodrift evaluate`: the same options (the model's as for fit), the rows as dicts.
+// As `gyrodrift evaluate` (tasks::RunEvaluate): the rows as dicts.
 py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
-                  const std::optional<Array>& truth_in, const drift::FitSettings& settings,
-                  const py::object& methods, const std::string& protocol, double split, int repeats,
-                  int horizon, int window, const py::object& progress) {
+                  const std::optional<Array>& truth_in, const tasks::EvaluateSettings& settings,
+                  const py::object& progress) {
   LongCall call(progress);
-  const drift::DriftOptions base = drift::MakeDriftOptions(settings);
-  const Execution execution = ExecutionOf(settings.threads, call);
-  drift::EvaluationOptions e;
-  e.split = split;
-  e.repeats = repeats;
-  e.methods = MethodList(methods, base.mode);
-  if (protocol == "both") {
-    e.protocols = {drift::Protocol::kPaper, drift::Protocol::kCausal};
-  } else if (protocol == "paper" || protocol == "causal") {
-    e.protocols = {drift::ProtocolFromString(protocol)};
-  } else {
-    throw OptionError("protocol", "'" + protocol + "'", "paper, causal or both");
-  }
-  e.causal.window = window;
-  e.horizon = horizon;
-  e.Validate();
+  settings.Validate();
+  (void)ExecutionOf(settings.fit.threads, call);
   const Eigen::VectorXd y = ToVector(y_in, "y");
   Eigen::MatrixXd temperature;
   if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
   Eigen::VectorXd truth;
   if (truth_in) truth = ToVector(*truth_in, "truth");
   drift::EvaluationResult result;
-  call.Run([&] { result = drift::Evaluate(y, temperature, truth, base, e, execution); });
+  call.Run([&] { result = tasks::RunEvaluate(y, temperature, truth, settings, call.Hook()).result; });
 
   py::list rows;
   for (const drift::EvaluationRow& r : result.rows) {
@@ -115,7 +89,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
 
 void BindEvaluate(py::module_& m) {
   using py::arg;
-  const gyrodrift::drift::EvaluationOptions ed;
+  const gyrodrift::tasks::EvaluateSettings ed;
   const gyrodrift::drift::FitSettings fd;
   m.def(
       "evaluate",
@@ -129,7 +103,7 @@ void BindEvaluate(py::module_& m) {
          std::optional<double> reference_temperature, const std::string& hysteresis,
          const py::object& progress) {
         // The models' settings as fit's; the method is evaluate's list (ms-elm stands in).
-        const gyrodrift::drift::FitSettings s{.mode = mode,
+        const gyrodrift::drift::FitSettings fit{.mode = mode,
                                               .method = "ms-elm",
                                               .decomposition = decomposition,
                                               .lags = gp::AutoOrIntegerSetting("lags", lags),
@@ -145,13 +119,19 @@ void BindEvaluate(py::module_& m) {
                                               .reference_temperature = reference_temperature,
                                               .hysteresis = hysteresis,
                                               .has_temperature = temperature.has_value()};
-        return gp::Evaluate(y, temperature, truth, s, methods, protocol, split, repeats, horizon,
-                            window, progress);
+        const gyrodrift::tasks::EvaluateSettings s{.fit = fit,
+                                                   .methods = gp::MethodList(methods),
+                                                   .protocol = protocol,
+                                                   .split = split,
+                                                   .repeats = repeats,
+                                                   .window = window,
+                                                   .horizon = horizon};
+        return gp::Evaluate(y, temperature, truth, s, progress);
       },
       arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
-      arg("mode") = "predict", arg("methods") = "all", arg("protocol") = "both",
+      arg("mode") = "predict", arg("methods") = ed.methods, arg("protocol") = ed.protocol,
       arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
-      arg("window") = ed.causal.window, arg("decomposition") = fd.decomposition,
+      arg("window") = ed.window, arg("decomposition") = fd.decomposition,
       arg("lags") = py::none(), arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
       arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
       arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations, arg("seed") = fd.seed,

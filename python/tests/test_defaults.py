@@ -28,6 +28,8 @@ PAIRS = [
     ("calibrate", gyrodrift.calibrate, _gyrodrift.calibrate),
     ("DriftModel.fit", gyrodrift.DriftModel.fit, _gyrodrift.DriftModel.fit),
     ("DriftModel.predict", gyrodrift.DriftModel.predict, _gyrodrift.DriftModel.predict),
+    ("DriftModel.compensation_summary", gyrodrift.DriftModel.compensation_summary,
+     _gyrodrift.DriftModel.compensation_summary),
 ]
 
 

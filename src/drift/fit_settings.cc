@@ -44,6 +44,10 @@ Execution MakeExecution(const FitSettings& s) {
   return execution;
 }
 
+void FitSettings::Validate() const {
+  (void)MakeDriftOptions(*this);  // which checks the threads too
+}
+
 Method ResolveMethod(std::string_view method, Mode mode) {
   if (method != "auto") return MethodFromString(method);
   return mode == Mode::kCompensate ? Method::kThermal : Method::kMsElm;

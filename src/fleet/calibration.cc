@@ -22,6 +22,8 @@
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/gyro_log.h"
 #include "gyrodrift/io/model_file.h"
+#include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/fit_task.h"
 #include "unit_report.h"
 
 namespace gyrodrift::fleet {
@@ -59,7 +61,6 @@ allan::NoiseTerms NoiseOf(const Eigen::Ref<const Eigen::VectorXd>& rate, double 
   return allan::IdentifyNoise(r);
 }
 
-std::string Fmt(double v) { return std::isnan(v) ? "" : io::FormatDouble(v); }
 
 // The limits a verification breaks, one phrase each. A set limit whose figure could not be
 // measured is broken, not passed: a calibration tool must not pass what it did not check.
@@ -92,49 +93,6 @@ std::vector<std::string> Failures(const Limits& limits, const VerificationResult
   return out;
 }
 
-struct Log {
-  io::CsvTable table;
-  double rate_hz = 1.0;
-  std::vector<Eigen::Index> record_starts;  // gaps = split: where the log's records start
-  std::vector<bool> logged;  // gaps = carry: the rows that were logged (empty: every row)
-  std::vector<std::string> warnings;        // about its inputs (InputWarnings)
-};
-
-// What the user must know about a log's inputs: an assumed sample rate, temperature columns of
-// the axes that do not look like degC (drift::TemperatureWarning), each naming the log's file.
-std::vector<std::string> InputWarnings(const Manifest& m, const std::string& path,
-                                       const io::CsvTable& table, const std::string& rate_how) {
-  std::vector<std::string> out;
-  const std::string name = fs::path(path).filename().string();
-  if (rate_how == "default") {
-    out.push_back(name +
-                  ": no time_s column: its sample rate is taken as 1 Hz (set rate_hz in the "
-                  "manifest if it is not)");
-  }
-  std::vector<std::string> seen;
-  for (const AxisSpec& axis : m.axes) {
-    for (const std::string& column : axis.temperature) {
-      if (std::find(seen.begin(), seen.end(), column) != seen.end()) continue;
-      seen.push_back(column);
-      const std::string w = drift::TemperatureWarning(table.Column(column), column);
-      if (!w.empty()) out.push_back(name + ": " + w);
-    }
-  }
-  return out;
-}
-
-Log ReadUnitLog(const Manifest& m, const std::string& path) {
-  Log log;
-  log.table = io::ReadLog(path, m.log, nullptr,
-                          m.log.gaps == io::GapPolicy::kSplit ? &log.record_starts : nullptr, {},
-                          m.log.gaps == io::GapPolicy::kCarry ? &log.logged : nullptr);
-  std::string how;
-  log.rate_hz = io::ResolveSampleRate(log.table, m.rate_hz, &how);
-  log.warnings = InputWarnings(m, path, log.table, how);
-  return log;
-}
-
-
 Eigen::MatrixXd Temperatures(const io::CsvTable& table, const AxisSpec& axis) {
   Eigen::MatrixXd t(table.rows(), static_cast<Eigen::Index>(axis.temperature.size()));
   for (size_t c = 0; c < axis.temperature.size(); ++c) {
@@ -143,10 +101,174 @@ Eigen::MatrixXd Temperatures(const io::CsvTable& table, const AxisSpec& axis) {
   return t;
 }
 
+// The figures of one axis on one verification log (`path`), from its compensation `c`: the
+// compensate task's, the drift_window_s block means for the report, the Allan analysis before and
+// after (of the longest record), and the limits broken.
+VerificationResult Verification(const Manifest& m, const std::string& path, double rate_hz,
+                                const std::vector<Eigen::Index>& record_starts,
+                                const tasks::AxisCompensation& c, const Eigen::VectorXd& y,
+                                const Eigen::VectorXd& truth) {
+  VerificationResult v;
+  v.log = path;
+  v.samples = y.size();
+  v.rate_hz = rate_hz;
+  v.mean_before = c.summary.before.mean;
+  v.mean_after = c.summary.after.mean;
+  v.std_before = c.summary.before.std;
+  v.std_after = c.summary.after.std;
+  v.drift_rms_before = c.summary.before.slow;
+  v.drift_rms_after = c.summary.after.slow;
+  const auto block = std::max<Eigen::Index>(
+      1, static_cast<Eigen::Index>(std::llround(m.drift_window_s * rate_hz)));
+  v.output_means = drift::BlockMeans(y, block);
+  v.compensated_means = drift::BlockMeans(c.compensated, block);
+  v.estimate_means = drift::BlockMeans(c.estimate, block);
+  v.block_hours.resize(v.output_means.size());
+  for (Eigen::Index b = 0; b < v.block_hours.size(); ++b) {
+    v.block_hours[b] =
+        (static_cast<double>(b) + 0.5) * static_cast<double>(block) / rate_hz / 3600.0;
+  }
+  if (truth.size() > 0) {
+    v.truth_means = drift::BlockMeans(truth, block);
+    v.truth_removed = c.truth_removed;
+  }
+  v.outside_share = c.outside_share;
+  // The Allan analysis needs uniform samples: of a log split at its gaps, its longest record.
+  const auto [first, length] = LongestRecord(y.size(), record_starts);
+  v.noise_before = NoiseOf(y.segment(first, length), rate_hz, m.rate_unit, &v.tau_s, &v.adev_before);
+  Eigen::VectorXd tau_after;
+  v.noise_after = NoiseOf(c.compensated.segment(first, length), rate_hz, m.rate_unit, &tau_after,
+                          &v.adev_after);
+  v.failures = Failures(m.limits, v);
+  return v;
+}
+
+// A unit's calibration: one model per axis, fitted on the calibration logs as `gyrodrift fit`
+// fits them (tasks::RunFit, one thread), and each axis's model figures and warnings.
+struct FittedUnit {
+  std::vector<io::LoadedModel> models;
+  std::vector<AxisResult> axes;
+};
+
+// The temperature columns of every axis, each once (the warnings name each column once).
+std::vector<std::string> TemperatureColumns(const Manifest& m) {
+  std::vector<std::string> seen;
+  for (const AxisSpec& axis : m.axes) {
+    for (const std::string& column : axis.temperature) {
+      if (std::find(seen.begin(), seen.end(), column) == seen.end()) seen.push_back(column);
+    }
+  }
+  return seen;
+}
+
+// What the user must know about a log's inputs: an assumed sample rate, temperature columns of
+// the axes that do not look like degC, each naming the log's file.
+std::vector<std::string> Warnings(const Manifest& m, const tasks::TaskLog& log) {
+  return tasks::LogWarnings(log, log.rate_how, TemperatureColumns(m), false);
+}
+
 std::string Joined(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ",") + n;
   return out;
+}
+
+// The figures of an axis's fitted model: its thermal sub-models' regressors, bias, skill and
+// warnings (a warning: the run could not identify that sub-model).
+AxisResult ModelFigures(const AxisSpec& axis, const io::LoadedModel& model) {
+  AxisResult a;
+  a.target = axis.target;
+  a.temperature = model.info.temperature_column;
+  a.model_summary = model.model.Summary();
+  for (const drift::SubModel& sub : model.model.sub_models) {
+    if (!sub.thermal) continue;
+    const drift::ThermalRegression& t = *sub.thermal;
+    if (model.model.sub_models.size() == 1) {
+      a.regressors = t.RegressorNames(axis.temperature);
+      a.bias = t.coefficients[0];
+      a.cv_rmse = t.report.cv_rmse;
+      a.skill = t.report.skill;
+    }
+    a.identified = a.identified.value_or(true) && t.report.warnings.empty();
+    for (const std::string& w : t.report.warnings) a.warnings.push_back(sub.name + ": " + w);
+    for (const std::string& w : t.report.advice) a.warnings.push_back(sub.name + ": advice: " + w);
+  }
+  return a;
+}
+
+FittedUnit FitUnit(const Manifest& m, const UnitSpec& unit) {
+  std::vector<tasks::TaskLog> cal;
+  std::vector<std::string> warnings;
+  for (const std::string& path : unit.calibration) {
+    cal.push_back(tasks::ReadTaskLog(path, m.log, m.rate_hz));
+    io::RequireSameSampleRate(unit.calibration.front(), cal.front().rate_hz, path,
+                              cal.back().rate_hz);
+    for (const std::string& w : Warnings(m, cal.back())) warnings.push_back(w);
+  }
+  // Units run in parallel (RunFleet's threads, or one Dask task per worker thread), so a unit
+  // runs on one thread: a decomposing method (ms-elm, emd-elm) would otherwise take every core
+  // per unit, T units x every core on the machine, and a one-thread Dask worker would use them
+  // all. The results do not depend on it: the model is the one `fit` writes with any --threads.
+  drift::FitSettings settings = m.Settings();
+  settings.threads = 1;
+  FittedUnit fitted;
+  for (const AxisSpec& axis : m.axes) {
+    const tasks::FitRun run = tasks::AssembleFitRun(cal, axis.target, Joined(axis.temperature),
+                                                    m.log, "target", "temperature");
+    tasks::FitResult fit = tasks::RunFit(run, settings, std::string(allan::ToString(m.rate_unit)), m.log);
+    AxisResult a = ModelFigures(axis, fit.axes.front());
+    a.warnings.insert(a.warnings.end(), warnings.begin(), warnings.end());
+    fitted.axes.push_back(std::move(a));
+    fitted.models.push_back(std::move(fit.axes.front()));
+  }
+  return fitted;
+}
+
+// One verification log (the k-th, 0-based) compensated by every axis's model: its output CSV, each
+// axis's figures (appended to unit.axes[i].verification) and its Allan columns.
+std::string VerifyLog(const Manifest& m, const UnitSpec& spec, size_t k,
+                      const std::vector<io::LoadedModel>& models, UnitResult& unit,
+                      std::vector<io::CsvColumn>& allan_columns) {
+  const std::string& path = spec.verification[k];
+  const tasks::TaskLog ver = tasks::ReadTaskLog(path, m.log, m.rate_hz);
+  // Block means and the Allan analysis of the verification need the time grid of a log with
+  // no made-up rows; carry serves duty-cycled calibration logs.
+  if (m.log.gaps == io::GapPolicy::kCarry && !ver.logged.empty()) {
+    throw DataError(fmt::format(
+        "{}: gaps = 'carry' fills this verification log's gaps ({} of {} rows made up), but the "
+        "verification's block means and Allan deviation need logged rows: verify on a "
+        "continuous log",
+        path, ver.table.rows() - drift::CountLogged(ver.logged, ver.table.rows()),
+        ver.table.rows()));
+  }
+  const std::vector<std::string> warnings = Warnings(m, ver);
+  for (AxisResult& a : unit.axes) a.warnings.insert(a.warnings.end(), warnings.begin(), warnings.end());
+  std::vector<io::CsvColumn> columns;
+  for (int c = 0; c < static_cast<int>(ver.table.header().size()); ++c) {
+    columns.push_back({ver.table.header()[static_cast<size_t>(c)], ver.table.Column(c)});
+  }
+  for (size_t i = 0; i < m.axes.size(); ++i) {
+    const AxisSpec& axis = m.axes[i];
+    const Eigen::VectorXd truth =
+        axis.truth.empty() ? Eigen::VectorXd() : ver.table.Column(axis.truth);
+    // The figures `gyrodrift compensate` reports, the slow variation over drift_window_s; the
+    // interpolated rows of gaps = 'interpolate' count as data here.
+    const tasks::AxisCompensation c = tasks::CompensateAxis(
+        models[i], ver.table.Column(axis.target), Temperatures(ver.table, axis), ver.record_starts,
+        {}, truth, {.rate_hz = ver.rate_hz, .drift_window_s = m.drift_window_s});
+    for (io::CsvColumn& column : c.Columns(m.axes.size() == 1 ? "" : "_" + axis.target)) {
+      columns.push_back(std::move(column));
+    }
+    VerificationResult v = Verification(m, path, ver.rate_hz, ver.record_starts, c,
+                                        ver.table.Column(axis.target), truth);
+    // Every axis of one log has the same length, so the same taus.
+    if (i == 0) allan_columns.push_back({fmt::format("tau_s_v{}", k + 1), v.tau_s});
+    const std::string tag = fmt::format("{}_v{}", axis.target, k + 1);
+    allan_columns.push_back({"adev_before_" + tag, v.adev_before});
+    allan_columns.push_back({"adev_after_" + tag, v.adev_after});
+    unit.axes[i].verification.push_back(std::move(v));
+  }
+  return io::RenderCsv(columns);
 }
 
 // Everything CalibrateUnit does, throwing on the unit's own errors.
@@ -154,147 +276,13 @@ UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::Dygraph
   UnitOutputs out;
   UnitResult& r = out.result;
   r.serial = unit.serial;
-
-  std::vector<Log> cal;
-  for (const std::string& path : unit.calibration) {
-    cal.push_back(ReadUnitLog(m, path));
-    io::RequireSameSampleRate(unit.calibration.front(), cal.front().rate_hz, path,
-                              cal.back().rate_hz);
-  }
-  drift::DriftOptions options = m.FitOptions();
-  options.features.rate_hz = cal.front().rate_hz;
-  // Units run in parallel (RunFleet's threads, or one Dask task per worker thread), so a unit
-  // runs on one thread: a decomposing method (ms-elm, emd-elm) would otherwise take every core
-  // per unit, T units x every core on the machine, and a one-thread Dask worker would use them
-  // all. The results do not depend on it: the model is the one `fit` writes with any --threads.
-  const Execution one_thread{.threads = 1};
-  std::vector<io::LoadedModel> models;
-  for (const AxisSpec& axis : m.axes) {
-    // The calibration logs one after the other: the target, then the temperatures.
-    drift::RecordRows run;
-    for (const Log& log : cal) {
-      Eigen::MatrixXd block(log.table.rows(), 1 + static_cast<Eigen::Index>(axis.temperature.size()));
-      block << log.table.Column(axis.target), Temperatures(log.table, axis);
-      run.Append(block, log.record_starts, log.logged);
-    }
-    io::LoadedModel model;
-    model.info.target_column = axis.target;
-    model.info.temperature_column = Joined(axis.temperature);
-    model.info.source = Joined(unit.calibration);
-    model.info.rate_unit = std::string(allan::ToString(m.rate_unit));
-    model.model = drift::FitDriftModel(run.rows.col(0), run.rows.rightCols(run.rows.cols() - 1),
-                                       options, run.record_starts, one_thread, run.logged);
-    AxisResult a;
-    a.target = axis.target;
-    a.temperature = model.info.temperature_column;
-    a.model_summary = model.model.Summary();
-    for (const drift::SubModel& sub : model.model.sub_models) {
-      if (!sub.thermal) continue;
-      const drift::ThermalRegression& t = *sub.thermal;
-      if (model.model.sub_models.size() == 1) {
-        a.regressors = t.RegressorNames(axis.temperature);
-        a.bias = t.coefficients[0];
-        a.cv_rmse = t.report.cv_rmse;
-        a.skill = t.report.skill;
-      }
-      // A warning of the calibration report: the run could not identify this sub-model.
-      a.identified = a.identified.value_or(true) && t.report.warnings.empty();
-      for (const std::string& w : t.report.warnings) a.warnings.push_back(sub.name + ": " + w);
-      for (const std::string& w : t.report.advice) a.warnings.push_back(sub.name + ": advice: " + w);
-    }
-    for (const Log& log : cal) {
-      a.warnings.insert(a.warnings.end(), log.warnings.begin(), log.warnings.end());
-    }
-    r.axes.push_back(std::move(a));
-    models.push_back(std::move(model));
-  }
-  out.files.push_back({"model.json", io::RenderModelFile(models)});
-
+  FittedUnit fitted = FitUnit(m, unit);
+  r.axes = std::move(fitted.axes);
+  out.files.push_back({"model.json", io::RenderModelFile(fitted.models)});
   std::vector<io::CsvColumn> allan_columns;
   for (size_t k = 0; k < unit.verification.size(); ++k) {
-    const Log ver = ReadUnitLog(m, unit.verification[k]);
-    // Block means and the Allan analysis of the verification need the time grid of a log with
-    // no made-up rows; carry serves duty-cycled calibration logs.
-    if (!ver.logged.empty()) {
-      throw DataError(fmt::format(
-          "{}: gaps = 'carry' fills this verification log's gaps ({} of {} rows made up), but the "
-          "verification's block means and Allan deviation need logged rows: verify on a "
-          "continuous log",
-          unit.verification[k], ver.table.rows() - drift::CountLogged(ver.logged, ver.table.rows()),
-          ver.table.rows()));
-    }
-    for (AxisResult& a : r.axes) {
-      a.warnings.insert(a.warnings.end(), ver.warnings.begin(), ver.warnings.end());
-    }
-    std::vector<io::CsvColumn> columns;
-    for (int c = 0; c < static_cast<int>(ver.table.header().size()); ++c) {
-      columns.push_back({ver.table.header()[static_cast<size_t>(c)], ver.table.Column(c)});
-    }
-    const auto block = std::max<Eigen::Index>(
-        1, static_cast<Eigen::Index>(std::llround(m.drift_window_s * ver.rate_hz)));
-    for (size_t i = 0; i < m.axes.size(); ++i) {
-      const AxisSpec& axis = m.axes[i];
-      const drift::DriftModel& model = models[i].model;
-      const Eigen::VectorXd y = ver.table.Column(axis.target);
-      const Eigen::MatrixXd temperature = Temperatures(ver.table, axis);
-      const Eigen::MatrixXd est_sd =
-          drift::EstimateDriftWithSd(model, temperature, ver.record_starts);
-      const Eigen::VectorXd estimate = est_sd.col(0);
-      const Eigen::VectorXd compensated = y - estimate;
-      const std::string suffix = m.axes.size() == 1 ? "" : "_" + axis.target;
-      columns.push_back({"drift_est" + suffix, estimate});
-      if (model.identified()) columns.push_back({"drift_sd" + suffix, est_sd.col(1)});
-      columns.push_back({"compensated" + suffix, compensated});
-
-      VerificationResult v;
-      v.log = unit.verification[k];
-      v.samples = y.size();
-      v.rate_hz = ver.rate_hz;
-      // The figures `gyrodrift compensate` reports, the slow variation over drift_window_s.
-      const drift::CompensationSummary summary =
-          drift::SummariseCompensation(y, compensated, ver.rate_hz, m.drift_window_s);
-      v.mean_before = summary.before.mean;
-      v.mean_after = summary.after.mean;
-      v.std_before = summary.before.std;
-      v.std_after = summary.after.std;
-      v.output_means = drift::BlockMeans(y, block);
-      v.compensated_means = drift::BlockMeans(compensated, block);
-      v.estimate_means = drift::BlockMeans(estimate, block);
-      v.block_hours.resize(v.output_means.size());
-      for (Eigen::Index b = 0; b < v.block_hours.size(); ++b) {
-        v.block_hours[b] = (static_cast<double>(b) + 0.5) * static_cast<double>(block) /
-                           ver.rate_hz / 3600.0;
-      }
-      v.drift_rms_before = summary.before.slow;
-      v.drift_rms_after = summary.after.slow;
-      if (!axis.truth.empty()) {
-        const Eigen::VectorXd truth = ver.table.Column(axis.truth);
-        v.truth_means = drift::BlockMeans(truth, block);
-        const double truth_rms = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
-        const double residual =
-            std::sqrt((truth - estimate).squaredNorm() / static_cast<double>(truth.size()));
-        v.truth_removed = truth_rms > 0.0 ? 1.0 - residual / truth_rms
-                                          : std::numeric_limits<double>::quiet_NaN();
-      }
-      v.outside_share = drift::ShareOutsideRange(temperature.col(0), model.temperature_min_c,
-                                                 model.temperature_max_c);
-      // The Allan analysis needs uniform samples: of a log split at its gaps, its longest record.
-      const auto [first, length] = LongestRecord(y.size(), ver.record_starts);
-      v.noise_before =
-          NoiseOf(y.segment(first, length), ver.rate_hz, m.rate_unit, &v.tau_s, &v.adev_before);
-      Eigen::VectorXd tau_after;
-      v.noise_after = NoiseOf(compensated.segment(first, length), ver.rate_hz, m.rate_unit,
-                              &tau_after, &v.adev_after);
-      v.failures = Failures(m.limits, v);
-      // Every axis of one log has the same length, so the same taus.
-      if (i == 0) allan_columns.push_back({fmt::format("tau_s_v{}", k + 1), v.tau_s});
-      const std::string tag = fmt::format("{}_v{}", axis.target, k + 1);
-      allan_columns.push_back({"adev_before_" + tag, v.adev_before});
-      allan_columns.push_back({"adev_after_" + tag, v.adev_after});
-      r.axes[i].verification.push_back(std::move(v));
-    }
     out.files.push_back({fmt::format("verification_{}_compensated.csv", k + 1),
-                         io::RenderCsv(columns)});
+                         VerifyLog(m, unit, k, fitted.models, r, allan_columns)});
   }
   // Verification logs of different lengths have different tau grids: shorter columns are padded
   // with nan to the longest.
@@ -338,55 +326,6 @@ bool ReadFinished(const std::string& path, const std::string& fingerprint,
   }
 }
 
-int ColumnIndex(const std::string& name) {
-  const auto& c = FleetColumns();
-  return static_cast<int>(std::find(c.begin(), c.end(), name) - c.begin());
-}
-
-// Flags, per axis across the fleet, the rows whose figure lies more than 3.5 robust standard
-// deviations (1.4826 MAD) from the fleet's median (Iglewicz & Hoaglin's modified z-score): a unit
-// unlike its siblings deserves a look even when it passes its limits.
-void FlagOutliers(std::vector<FleetRow>& rows) {
-  const int axis_col = ColumnIndex("axis");
-  const int outlier_col = ColumnIndex("outliers");
-  for (const char* metric : {"drift_rms_after", "truth_removed", "bias_instability_after_dph",
-                             "arw_after_dpsh", "bias"}) {
-    const int col = ColumnIndex(metric);
-    std::vector<std::string> axes;
-    for (const FleetRow& r : rows) {
-      const std::string& a = r.cells[static_cast<size_t>(axis_col)];
-      if (!a.empty() && std::find(axes.begin(), axes.end(), a) == axes.end()) axes.push_back(a);
-    }
-    for (const std::string& axis : axes) {
-      std::vector<std::pair<size_t, double>> values;
-      for (size_t i = 0; i < rows.size(); ++i) {
-        const auto& cells = rows[i].cells;
-        if (cells[static_cast<size_t>(axis_col)] != axis) continue;
-        const std::string& text = cells[static_cast<size_t>(col)];
-        if (text.empty()) continue;
-        const double v = std::strtod(text.c_str(), nullptr);
-        if (std::isfinite(v)) values.push_back({i, v});
-      }
-      // Too few units to call one unusual. Units, not rows: a unit has a row per verification log.
-      std::set<std::string> units;
-      for (const auto& [i, v] : values) units.insert(rows[i].cells[0]);
-      if (units.size() < 5) continue;
-      std::vector<double> x;
-      for (const auto& [i, v] : values) x.push_back(v);
-      const double median = Median(x);
-      std::vector<double> dev;
-      for (double v : x) dev.push_back(std::abs(v - median));
-      const double mad = 1.4826 * Median(dev);
-      if (!(mad > 0.0)) continue;
-      for (const auto& [i, v] : values) {
-        if (std::abs(v - median) / mad <= 3.5) continue;
-        std::string& flag = rows[i].cells[static_cast<size_t>(outlier_col)];
-        flag += (flag.empty() ? "" : " ") + std::string(metric);
-      }
-    }
-  }
-}
-
 }  // namespace
 
 bool AxisResult::pass() const {
@@ -417,76 +356,6 @@ UnitOutputs CalibrateUnit(const Manifest& manifest, const UnitSpec& unit,
   }
   out.result.seconds = Seconds(start);
   return out;
-}
-
-const std::vector<std::string>& FleetColumns() {
-  static const std::vector<std::string> kColumns = {
-      "serial", "axis", "verification", "status", "failures", "outliers", "method", "samples",
-      "std_before", "std_after", "drift_rms_before", "drift_rms_after", "drift_removed",
-      "truth_removed", "arw_before_dpsh", "arw_after_dpsh", "bias_instability_before_dph",
-      "bias_instability_after_dph", "rrw_before_dphpsh", "rrw_after_dphpsh", "bias", "cv_rmse",
-      "skill", "regressors", "warnings", "identified", "outside_share", "mean_before",
-      "mean_after", "unit_seconds"};
-  return kColumns;
-}
-
-std::vector<FleetRow> Rows(const UnitResult& unit) {
-  std::vector<FleetRow> rows;
-  const std::string seconds = io::FormatDouble(unit.seconds);
-  if (!unit.error.empty()) {
-    FleetRow row;
-    row.cells.assign(FleetColumns().size(), "");
-    row.cells[0] = unit.serial;
-    row.cells[3] = "error";
-    row.cells[4] = unit.error;
-    row.cells.back() = seconds;
-    rows.push_back(std::move(row));
-    return rows;
-  }
-  for (const AxisResult& a : unit.axes) {
-    std::string regressors;
-    for (const std::string& name : a.regressors) regressors += (regressors.empty() ? "" : "; ") + name;
-    std::string warnings;
-    for (const std::string& w : a.warnings) warnings += (warnings.empty() ? "" : "; ") + w;
-    for (const VerificationResult& v : a.verification) {
-      std::string failures;
-      for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
-      const double drift_removed =
-          v.drift_rms_before > 0.0 ? 1.0 - v.drift_rms_after / v.drift_rms_before
-                                   : std::numeric_limits<double>::quiet_NaN();
-      rows.push_back(FleetRow{{unit.serial,
-                               a.target,
-                               fs::path(v.log).filename().string(),
-                               v.failures.empty() ? "pass" : "fail",
-                               failures,
-                               "",
-                               a.model_summary.substr(0, a.model_summary.find(' ')),
-                               std::to_string(v.samples),
-                               Fmt(v.std_before),
-                               Fmt(v.std_after),
-                               Fmt(v.drift_rms_before),
-                               Fmt(v.drift_rms_after),
-                               Fmt(drift_removed),
-                               Fmt(v.truth_removed),
-                               Fmt(v.noise_before.n_dpsh.value),
-                               Fmt(v.noise_after.n_dpsh.value),
-                               Fmt(v.noise_before.b_dph.value),
-                               Fmt(v.noise_after.b_dph.value),
-                               Fmt(v.noise_before.k_dphpsh.value),
-                               Fmt(v.noise_after.k_dphpsh.value),
-                               Fmt(a.bias),
-                               Fmt(a.cv_rmse),
-                               Fmt(a.skill),
-                               regressors,
-                               warnings,
-                               !a.identified ? "" : *a.identified ? "yes" : "no",
-                               Fmt(v.outside_share),
-                               Fmt(v.mean_before),
-                               Fmt(v.mean_after),
-                               seconds}});
-    }
-  }
-  return rows;
 }
 
 std::string FleetResult::Summary() const {

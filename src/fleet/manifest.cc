@@ -15,6 +15,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
+#include "gyrodrift/tasks/settings_json.h"
 
 namespace gyrodrift::fleet {
 namespace {
@@ -173,7 +174,9 @@ std::vector<std::string> UnitSpec::Logs() const {
   return logs;
 }
 
-drift::DriftOptions Manifest::FitOptions() const {
+drift::DriftOptions Manifest::FitOptions() const { return drift::MakeDriftOptions(Settings()); }
+
+drift::FitSettings Manifest::Settings() const {
   drift::FitSettings s;
   s.mode = "compensate";
   s.method = std::string(drift::ToString(method));
@@ -182,24 +185,66 @@ drift::DriftOptions Manifest::FitOptions() const {
   if (!std::isnan(reference_c)) s.reference_temperature = reference_c;
   s.hysteresis = std::string(drift::ToString(hysteresis));
   s.has_temperature = true;
-  return drift::MakeDriftOptions(s);
+  return s;
 }
 
-Manifest ParseManifest(const std::string& text, const std::string& path) {
-  const Context c(path);
-  toml::table root;
-  try {
-    root = toml::parse(text, path);
-  } catch (const toml::parse_error& e) {
-    c.Fail(static_cast<int>(e.source().begin.line),
-           fmt::format("not valid TOML: {}", e.description()));
+namespace {
+
+// A TOML value as JSON (strings, numbers, booleans and arrays of them), for the settings' reader.
+nlohmann::json ToJson(const toml::node& n) {
+  if (n.is_string()) return *n.value<std::string>();
+  if (n.is_integer()) return *n.value<std::int64_t>();
+  if (n.is_floating_point()) return *n.value<double>();
+  if (n.is_boolean()) return *n.value<bool>();
+  nlohmann::json out = nlohmann::json::array();
+  if (const toml::array* a = n.as_array()) {
+    for (const toml::node& item : *a) out.push_back(ToJson(item));
   }
-  Manifest m;
-  m.path = path;
-  const Table top(root, c, "",
-                  {"method", "rate_unit", "rate_hz", "gaps", "delimiter", "seed", "nonlinear",
-                   "reference_temperature_c", "hysteresis", "drift_window_s", "limits", "axis",
-                   "unit"});
+  return out;
+}
+
+// The manifest's top-level keys: the fleet's, the fit's and every log setting
+// (tasks::LogOptionsToJson's keys).
+std::set<std::string> TopKeys() {
+  std::set<std::string> keys = {"method", "rate_unit", "rate_hz", "seed", "nonlinear",
+                                "reference_temperature_c", "hysteresis", "drift_window_s",
+                                "limits", "axis", "unit"};
+  const nlohmann::json log = tasks::LogOptionsToJson({});
+  for (const auto& [key, value] : log.items()) keys.insert(key);
+  return keys;
+}
+
+// The log settings, read through their one mapping (tasks::LogOptionsFromJson); a refusal is
+// placed at its key.
+void ReadLogKeys(const Table& top, const Context& c, Manifest& m) {
+  nlohmann::json keys = nlohmann::json::object();
+  const nlohmann::json log = tasks::LogOptionsToJson({});
+  for (const auto& [key, value] : log.items()) {
+    if (const toml::node* n = top.Find(key)) keys[key] = ToJson(*n);
+  }
+  try {
+    tasks::LogOptionsFromJson(keys, &m.log);
+  } catch (const OptionError& e) {
+    c.Fail(*top.Find(e.option()), e.what());
+  }
+  if (const toml::node* n = top.Find("gaps")) {
+    if (m.log.gaps == io::GapPolicy::kSplit && m.method != drift::Method::kThermal) {
+      c.Fail(*n, fmt::format("gaps = 'split' needs method = 'thermal', not '{}' (a "
+                             "decomposition would run across the gaps)",
+                             drift::ToString(m.method)));
+    }
+    if (m.log.gaps == io::GapPolicy::kCarry && drift::UsesDecomposition(m.method)) {
+      c.Fail(*n, fmt::format("gaps = 'carry' needs a method that fits on the logged "
+                             "rows only (thermal or poly), not '{}' (a "
+                             "decomposition would run across the made-up rows)",
+                             drift::ToString(m.method)));
+    }
+  }
+}
+
+// The fit keys, checked together as fit's flags are (drift::MakeDriftOptions); a refusal is
+// placed at the key it names.
+void ReadFitKeys(const Table& top, const Context& c, Manifest& m) {
   if (top.Find("method")) {
     m.method = top.Enum("method", drift::MethodFromString);
     if (!drift::SupportsMode(m.method, drift::Mode::kCompensate)) {
@@ -207,23 +252,6 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
              fmt::format("method = '{}' does not compensate", drift::ToString(m.method)));
     }
   }
-  if (top.Find("rate_unit")) m.rate_unit = top.Enum("rate_unit", allan::RateUnitFromString);
-  m.rate_hz = top.Number("rate_hz", 0.0, 1e-9, 1e6);
-  if (top.Find("gaps")) {
-    m.log.gaps = top.Enum("gaps", io::GapPolicyFromString);
-    if (m.log.gaps == io::GapPolicy::kSplit && m.method != drift::Method::kThermal) {
-      c.Fail(*top.Find("gaps"), fmt::format("gaps = 'split' needs method = 'thermal', not '{}' (a "
-                                            "decomposition would run across the gaps)",
-                                            drift::ToString(m.method)));
-    }
-    if (m.log.gaps == io::GapPolicy::kCarry && drift::UsesDecomposition(m.method)) {
-      c.Fail(*top.Find("gaps"), fmt::format("gaps = 'carry' needs a method that fits on the logged "
-                                            "rows only (thermal or poly), not '{}' (a "
-                                            "decomposition would run across the made-up rows)",
-                                            drift::ToString(m.method)));
-    }
-  }
-  if (top.Find("delimiter")) m.log.delimiter = top.Enum("delimiter", io::DelimiterFromString);
   if (const toml::node* n = top.Find("seed")) {
     if (!n->is_integer() || *n->value<std::int64_t>() < 0) {
       c.Fail(*n, "'seed' must be a non-negative integer");
@@ -236,8 +264,6 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
                              -std::numeric_limits<double>::max(),
                              std::numeric_limits<double>::max());
   if (top.Find("hysteresis")) m.hysteresis = top.Enum("hysteresis", drift::HysteresisTermFromString);
-  // The fit keys together, as fit's flags are checked (drift::MakeDriftOptions); a refusal is
-  // placed at the key it names.
   try {
     (void)m.FitOptions();
   } catch (const OptionError& e) {
@@ -247,8 +273,9 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     if (const toml::node* n = top.Find(key)) c.Fail(*n, message);
     c.Fail(top.line(), message);
   }
-  m.drift_window_s = top.Number("drift_window_s", m.drift_window_s, 1.0, 1e5);
+}
 
+void ReadLimits(const Table& top, const Context& c, Manifest& m) {
   if (const toml::node* n = top.Find("limits")) {
     if (!n->is_table()) c.Fail(*n, "'limits' must be a table ([limits])");
     const Table limits(*n->as_table(), c, " in [limits]",
@@ -258,6 +285,9 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     m.limits.removed_share_min = limits.Number("removed_share_min", kNoLimit, 0.0, 1.0);
   }
 
+}
+
+void ReadAxes(const toml::table& root, const Context& c, Manifest& m) {
   for (const toml::table* t : TableArray(root, "axis", c)) {
     const Table axis(*t, c, " in [[axis]]", {"target", "temperature", "truth"});
     AxisSpec a;
@@ -294,6 +324,9 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     }
   }
 
+}
+
+void ReadUnits(const toml::table& root, const Context& c, const std::string& path, Manifest& m) {
   for (const toml::table* t : TableArray(root, "unit", c)) {
     const Table unit(*t, c, " in [[unit]]", {"serial", "calibration", "verification"});
     UnitSpec u;
@@ -332,6 +365,30 @@ Manifest ParseManifest(const std::string& text, const std::string& path) {
     }
     m.units.push_back(std::move(u));
   }
+}
+
+}  // namespace
+
+Manifest ParseManifest(const std::string& text, const std::string& path) {
+  const Context c(path);
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    c.Fail(static_cast<int>(e.source().begin.line),
+           fmt::format("not valid TOML: {}", e.description()));
+  }
+  Manifest m;
+  m.path = path;
+  const Table top(root, c, "", TopKeys());
+  ReadFitKeys(top, c, m);
+  if (top.Find("rate_unit")) m.rate_unit = top.Enum("rate_unit", allan::RateUnitFromString);
+  m.rate_hz = top.Number("rate_hz", 0.0, 1e-9, 1e6);
+  ReadLogKeys(top, c, m);
+  m.drift_window_s = top.Number("drift_window_s", m.drift_window_s, 1.0, 1e5);
+  ReadLimits(top, c, m);
+  ReadAxes(root, c, m);
+  ReadUnits(root, c, path, m);
   return m;
 }
 
@@ -339,19 +396,28 @@ Manifest ReadManifest(const std::string& path) { return ParseManifest(io::ReadTe
 
 namespace {
 
-// The header row of a log, parsed by the CSV reader from the log's first lines up to its first
-// data row (comments and blank lines included), so the whole file need not be read.
-std::vector<std::string> Header(const std::string& log, io::Delimiter delimiter) {
+// The column names of a log as the log settings read it: the names given for a file without a
+// header row (a serial capture), else its header row, parsed by the CSV reader from the log's
+// first lines after skip_rows up to its first data row (comments and blank lines included), so the
+// whole file need not be read. A ULog's columns are those `convert` writes (time_s, one per axis
+// and temperature_c): io::ReadLog checks its series when the unit is calibrated, so nothing is
+// read here (empty: not checked).
+std::vector<std::string> Header(const std::string& log, const io::LogOptions& options) {
+  if (!options.names.empty() || io::IsUlogFile(log)) return options.names;
   std::ifstream in(log, std::ios::binary);
   if (!in) throw IoError(log + ": cannot be read");
   std::string text, line;
-  int rows = 0;
+  int rows = 0, skipped = 0;
   while (rows < 2 && std::getline(in, line)) {
+    if (skipped < options.skip_rows) {
+      ++skipped;
+      continue;
+    }
     text += line + "\n";
     const size_t first = line.find_first_not_of(" \t\r");
     if (first != std::string::npos && line[first] != '#') ++rows;
   }
-  return io::CsvTable::Parse(text, log, delimiter).header();
+  return io::CsvTable::Parse(text, log, options.delimiter).header();
 }
 
 }  // namespace
@@ -363,10 +429,11 @@ void CheckLogColumns(const Manifest& m) {
     for (size_t k = 0; k < logs.size(); ++k) {
       std::vector<std::string> header;
       try {
-        header = Header(logs[k], m.log.delimiter);
+        header = Header(logs[k], m.log);
       } catch (const Error& e) {
         c.Fail(u.line, fmt::format("unit '{}': {}", u.serial, e.what()));
       }
+      if (header.empty()) continue;  // a ULog: checked when read
       auto has = [&](const std::string& name) {
         return std::find(header.begin(), header.end(), name) != header.end();
       };
@@ -385,29 +452,33 @@ void CheckLogColumns(const Manifest& m) {
   }
 }
 
-std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
-  std::string text = fmt::format(
-      "method={};unit={};rate={};gaps={};seed={};nonlinear={};ref={};window={};limits={},{},{};",
-      drift::ToString(m.method), allan::ToString(m.rate_unit), m.rate_hz, io::ToString(m.log.gaps), m.seed, m.nonlinear,
-      m.reference_c, m.drift_window_s, m.limits.residual_drift_rms, m.limits.bias_instability_dph,
-      m.limits.removed_share_min);
+nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
+  nlohmann::json axes = nlohmann::json::array();
   for (const AxisSpec& a : m.axes) {
-    text += "axis=" + a.target + "|" + a.truth + "|";
-    for (const std::string& t : a.temperature) text += t + ",";
+    axes.push_back({{"target", a.target}, {"temperature", a.temperature}, {"truth", a.truth}});
   }
-  // Added only when not the default, so the fingerprints of earlier runs stay valid.
-  if (m.log.delimiter != io::Delimiter::kAuto) {
-    text += fmt::format("delimiter={};", io::ToString(m.log.delimiter));
-  }
-  // Always: models identified before the term existed were fitted without it, which the default
-  // (auto) no longer does for long calibrations, so their units are fitted again.
-  text += fmt::format("hysteresis={};", drift::ToString(m.hysteresis));
-  text += "serial=" + u.serial + ";";
-  if (u.calibration.size() > 1) text += fmt::format("calibration_logs={};", u.calibration.size());
+  // NaN (a limit not set) as null.
+  auto limit = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
+  nlohmann::json logs = nlohmann::json::array();
   for (const std::string& log : u.Logs()) {
-    text += "log=" + log + ":" + fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log))) + ";";
+    logs.push_back({{"path", log}, {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
-  return fmt::format("fnv1a64:{:016x}", io::Fnv1a64(text));
+  return {{"settings", tasks::SettingsToJson(m.Settings(), m.log)},
+          {"fleet",
+           {{"rate_unit", allan::ToString(m.rate_unit)},
+            {"rate_hz", m.rate_hz},
+            {"drift_window_s", m.drift_window_s},
+            {"limits",
+             {{"residual_drift_rms", limit(m.limits.residual_drift_rms)},
+              {"bias_instability_dph", limit(m.limits.bias_instability_dph)},
+              {"removed_share_min", limit(m.limits.removed_share_min)}}},
+            {"axes", axes}}},
+          {"unit",
+           {{"serial", u.serial}, {"calibration_logs", u.calibration.size()}, {"logs", logs}}}};
+}
+
+std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {
+  return fmt::format("fnv1a64:{:016x}", io::Fnv1a64(FingerprintJson(m, u).dump()));
 }
 
 }  // namespace gyrodrift::fleet

@@ -54,6 +54,81 @@ const std::string& Text(const FleetRow& row, const std::string& column) {
   return row.cells[static_cast<size_t>(std::find(c.begin(), c.end(), column) - c.begin())];
 }
 
+// An axis's model and verification table on its unit's page.
+void AddAxisSummary(io::HtmlReport& report, const Manifest& m, const AxisResult& a,
+                    const std::string& unit_name) {
+  report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));
+  std::string model = a.model_summary + "\nregressors: ";
+  for (size_t i = 0; i < a.regressors.size(); ++i) model += (i ? ", " : "") + a.regressors[i];
+  if (!std::isnan(a.bias)) model += fmt::format("\nintercept (repeatable bias): {:.6g} {}", a.bias, unit_name);
+  if (!std::isnan(a.cv_rmse)) model += fmt::format("\ncross-validated RMSE {:.4g} {}, skill {:.3f}", a.cv_rmse, unit_name, a.skill);
+  if (a.identified && !*a.identified) {
+    model += "\nnot identified: the calibration run could not identify this model (warnings below)";
+  }
+  for (const std::string& w : a.warnings) model += "\nwarning: " + w;
+  report.AddPreformatted(model);
+  io::ReportTable table;
+  table.title = "Verification of " + a.target;
+  table.header = {"log", "samples", "mean before", "mean after", "std before", "std after",
+                  "residual drift before",
+                  "residual drift after", "true drift removed", "ARW after (deg/rt h)",
+                  "B before (deg/h)", "B after (deg/h)", "outside cal. range", "limits broken"};
+  for (const VerificationResult& v : a.verification) {
+    std::string failures;
+    for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
+    table.rows.push_back({std::filesystem::path(v.log).filename().string(),
+                          std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
+                          Num(v.std_before), Num(v.std_after),
+                          Num(v.drift_rms_before), Num(v.drift_rms_after),
+                          Percent(v.truth_removed), Num(v.noise_after.n_dpsh.value),
+                          Num(v.noise_before.b_dph.value), Num(v.noise_after.b_dph.value),
+                          Percent(v.outside_share), failures.empty() ? "none" : failures});
+  }
+  table.caption = fmt::format(
+      "Residual drift: RMS of the output's {:g}-s means about their mean, {}. True drift "
+      "removed: 1 - RMS(truth - estimate) / RMS(truth). Noise terms: IEEE 952 fit to the "
+      "overlapping Allan deviation.",
+      m.drift_window_s, unit_name);
+  report.AddTable(table);
+}
+
+// An axis's figures on its unit's page: per verification log, the block means and the Allan
+// deviation before and after.
+void AddAxisFigures(io::HtmlReport& report, const Manifest& m, const AxisResult& a,
+                    const std::string& unit_name) {
+  for (size_t k = 0; k < a.verification.size(); ++k) {
+    const VerificationResult& v = a.verification[k];
+    io::ReportFigure drift;
+    drift.title = fmt::format("{}: verification log {} ({:g}-s means)", a.target, k + 1,
+                              m.drift_window_s);
+    drift.caption = "The output before and after compensation, and the model's estimate"
+                    " (with the true drift when the log has it). After compensation the "
+                    "curve should be flat.";
+    drift.x_label = "time (h)";
+    drift.y_label = unit_name;
+    drift.x = v.block_hours;
+    drift.series.push_back(Line("output", v.output_means, "#999999"));
+    drift.series.push_back(Line("compensated", v.compensated_means, "#1f77b4"));
+    drift.series.push_back(Line("estimate", v.estimate_means, "#d62728", true));
+    if (v.truth_means.size() == v.block_hours.size()) {
+      drift.series.push_back(Line("true drift", v.truth_means, "#2ca02c"));
+    }
+    report.AddFigure(drift);
+    io::ReportFigure adev;
+    adev.title = fmt::format("{}: Allan deviation, verification log {}", a.target, k + 1);
+    adev.caption = "Overlapping Allan deviation before and after compensation: the thermal "
+                   "drift lifts the long-tau end; compensation should bring it down.";
+    adev.x_label = "tau (s)";
+    adev.y_label = unit_name;
+    adev.x = v.tau_s;
+    adev.log_x = adev.log_y = true;
+    adev.draw_points = true;
+    adev.series.push_back(Line("before", v.adev_before, "#999999"));
+    adev.series.push_back(Line("after", v.adev_after, "#1f77b4"));
+    report.AddFigure(adev);
+  }
+}
+
 }  // namespace
 
 std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const UnitResult& unit,
@@ -75,85 +150,16 @@ std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const Unit
       calibration, verification,
       LimitsText(m.limits), unit.pass() ? "PASS" : "FAIL"));
   for (const AxisResult& a : unit.axes) {
-    report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));
-    std::string model = a.model_summary + "\nregressors: ";
-    for (size_t i = 0; i < a.regressors.size(); ++i) model += (i ? ", " : "") + a.regressors[i];
-    if (!std::isnan(a.bias)) model += fmt::format("\nintercept (repeatable bias): {:.6g} {}", a.bias, unit_name);
-    if (!std::isnan(a.cv_rmse)) model += fmt::format("\ncross-validated RMSE {:.4g} {}, skill {:.3f}", a.cv_rmse, unit_name, a.skill);
-    if (a.identified && !*a.identified) {
-      model += "\nnot identified: the calibration run could not identify this model (warnings below)";
-    }
-    for (const std::string& w : a.warnings) model += "\nwarning: " + w;
-    report.AddPreformatted(model);
-    io::ReportTable table;
-    table.title = "Verification of " + a.target;
-    table.header = {"log", "samples", "mean before", "mean after", "std before", "std after",
-                    "residual drift before",
-                    "residual drift after", "true drift removed", "ARW after (deg/rt h)",
-                    "B before (deg/h)", "B after (deg/h)", "outside cal. range", "limits broken"};
-    for (const VerificationResult& v : a.verification) {
-      std::string failures;
-      for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
-      table.rows.push_back({std::filesystem::path(v.log).filename().string(),
-                            std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
-                            Num(v.std_before), Num(v.std_after),
-                            Num(v.drift_rms_before), Num(v.drift_rms_after),
-                            Percent(v.truth_removed), Num(v.noise_after.n_dpsh.value),
-                            Num(v.noise_before.b_dph.value), Num(v.noise_after.b_dph.value),
-                            Percent(v.outside_share), failures.empty() ? "none" : failures});
-    }
-    table.caption = fmt::format(
-        "Residual drift: RMS of the output's {:g}-s means about their mean, {}. True drift "
-        "removed: 1 - RMS(truth - estimate) / RMS(truth). Noise terms: IEEE 952 fit to the "
-        "overlapping Allan deviation.",
-        m.drift_window_s, unit_name);
-    report.AddTable(table);
-    for (size_t k = 0; k < a.verification.size(); ++k) {
-      const VerificationResult& v = a.verification[k];
-      io::ReportFigure drift;
-      drift.title = fmt::format("{}: verification log {} ({:g}-s means)", a.target, k + 1,
-                                m.drift_window_s);
-      drift.caption = "The output before and after compensation, and the model's estimate"
-                      " (with the true drift when the log has it). After compensation the "
-                      "curve should be flat.";
-      drift.x_label = "time (h)";
-      drift.y_label = unit_name;
-      drift.x = v.block_hours;
-      drift.series.push_back(Line("output", v.output_means, "#999999"));
-      drift.series.push_back(Line("compensated", v.compensated_means, "#1f77b4"));
-      drift.series.push_back(Line("estimate", v.estimate_means, "#d62728", true));
-      if (v.truth_means.size() == v.block_hours.size()) {
-        drift.series.push_back(Line("true drift", v.truth_means, "#2ca02c"));
-      }
-      report.AddFigure(drift);
-      io::ReportFigure adev;
-      adev.title = fmt::format("{}: Allan deviation, verification log {}", a.target, k + 1);
-      adev.caption = "Overlapping Allan deviation before and after compensation: the thermal "
-                     "drift lifts the long-tau end; compensation should bring it down.";
-      adev.x_label = "tau (s)";
-      adev.y_label = unit_name;
-      adev.x = v.tau_s;
-      adev.log_x = adev.log_y = true;
-      adev.draw_points = true;
-      adev.series.push_back(Line("before", v.adev_before, "#999999"));
-      adev.series.push_back(Line("after", v.adev_after, "#1f77b4"));
-      report.AddFigure(adev);
-    }
+    AddAxisSummary(report, m, a, unit_name);
+    AddAxisFigures(report, m, a, unit_name);
   }
   return report.Render(assets);
 }
 
-std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
-                              const io::DygraphsAssets& assets) {
-  const std::string unit_name(allan::ToString(m.rate_unit));
-  io::HtmlReport report("gyrodrift fleet calibration");
-  report.AddParagraph(fleet.Summary() + ". Limits: " + LimitsText(m.limits) + ".");
-  std::vector<std::string> serials;
-  for (const FleetRow& row : fleet.rows) {
-    if (std::find(serials.begin(), serials.end(), row.cells[0]) == serials.end()) {
-      serials.push_back(row.cells[0]);
-    }
-  }
+namespace {
+
+// The fleet page's findings: the unit axes whose model was not identified, and the outliers.
+void AddFindings(io::HtmlReport& report, const FleetResult& fleet) {
   std::vector<std::string> outliers;
   for (const FleetRow& row : fleet.rows) {
     if (!Text(row, "outliers").empty()) {
@@ -188,8 +194,12 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
                               return s;
                             }() + ".");
 
-  // Distributions: one point per unit (x = its row in the table below), one series per axis,
-  // the limit as a dashed line.
+}
+
+// Distributions: one point per unit (x = its row in the table below), one series per axis, the
+// limit as a dashed line.
+void AddDistributions(io::HtmlReport& report, const Manifest& m, const FleetResult& fleet,
+                      const std::vector<std::string>& serials, const std::string& unit_name) {
   auto distribution = [&](const std::string& column, const std::string& title,
                           const std::string& y_label, double limit, double scale) {
     io::ReportFigure f;
@@ -246,6 +256,11 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
   distribution("bias", "Repeatable bias (the thermal model's intercept)", unit_name,
                std::numeric_limits<double>::quiet_NaN(), 1.0);
 
+}
+
+// The table of every unit, axis and verification log, with links to the units' pages.
+void AddUnitsTable(io::HtmlReport& report, const FleetResult& fleet,
+                   const std::vector<std::string>& serials, const std::string& unit_name) {
   report.AddHeading("Units");
   io::ReportTable table;
   table.title = "Every unit, axis and verification log (fleet.csv)";
@@ -272,6 +287,24 @@ std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
                   "the calibration run could not identify the thermal model (its warnings are on "
                   "the unit's page and in fleet.csv).";
   report.AddTable(table);
+}
+
+}  // namespace
+
+std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
+                              const io::DygraphsAssets& assets) {
+  const std::string unit_name(allan::ToString(m.rate_unit));
+  io::HtmlReport report("gyrodrift fleet calibration");
+  report.AddParagraph(fleet.Summary() + ". Limits: " + LimitsText(m.limits) + ".");
+  std::vector<std::string> serials;
+  for (const FleetRow& row : fleet.rows) {
+    if (std::find(serials.begin(), serials.end(), row.cells[0]) == serials.end()) {
+      serials.push_back(row.cells[0]);
+    }
+  }
+  AddFindings(report, fleet);
+  AddDistributions(report, m, fleet, serials, unit_name);
+  AddUnitsTable(report, fleet, serials, unit_name);
   return report.Render(assets);
 }
 

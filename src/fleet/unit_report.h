@@ -13,4 +13,7 @@ namespace gyrodrift::fleet {
 std::string RenderUnitReport(const Manifest& manifest, const UnitSpec& spec,
                              const UnitResult& unit, const io::DygraphsAssets& assets);
 
+// Flags, per axis across the fleet, the rows whose figures are outliers (fleet_rows.cc).
+void FlagOutliers(std::vector<FleetRow>& rows);
+
 }  // namespace gyrodrift::fleet

@@ -13,6 +13,7 @@
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/fit_task.h"
 #include "study_steps.h"
 
 namespace gyrodrift::study {
@@ -86,6 +87,28 @@ std::function<void(double, std::string_view)> TrialProgress(
         std::min(cumulative.size() - 1, static_cast<size_t>(std::lround(fraction * trials)));
     notify.Progress(stage, cumulative[i] / cumulative.back(), prefix + std::string(label));
   };
+}
+
+// A compensate-mode model of `method` fitted on (y, temperature) through the fit task, as
+// `gyrodrift fit` fits it: the study's settings (StudyDriftOptions' as drift::FitSettings).
+drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
+                                  const Eigen::VectorXd& y, const Eigen::VectorXd& temperature) {
+  tasks::FitRun run{.targets = {"y"}, .temperatures = {"temperature"}};
+  Eigen::MatrixXd rows(y.size(), 2);
+  rows << y, temperature;
+  run.rows.Append(rows);
+  const StudyOptions& a = s.options;
+  const drift::FitSettings settings{
+      .mode = "compensate",
+      .method = std::string(drift::ToString(method)),
+      .rate_hz = s.rate_hz,
+      .ensemble = a.ensemble_size,
+      .realisations = a.realisations,
+      .seed = a.seed,
+      .threads = s.threads,
+      .reference_temperature = s.drift_options.reference_c,
+      .has_temperature = true};
+  return tasks::RunFit(run, settings, "dph").axes.front().model;
 }
 
 drift::EvaluationOptions EvaluationFor(const StudyOptions& a, std::vector<drift::Method> methods) {
@@ -177,8 +200,6 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
   drift::EvaluationOptions e;
   e.methods = s.options.methods;
   const std::vector<drift::Method> methods = drift::EvaluatedMethods(e);
-  drift::DriftOptions base = s.drift_options;
-  base.mode = drift::Mode::kCompensate;
   s.compensate_reference = s.run_b.drift_dph;
   s.compensate_output = s.run_b.rate_dph;
   s.compensate_time_h = s.run_b.time_s / 3600.0;
@@ -186,12 +207,10 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
   for (size_t i = 0; i < methods.size(); ++i) {
     notify.Progress(3, static_cast<double>(i) / static_cast<double>(methods.size()),
                     "compensate: " + std::string(drift::ToString(methods[i])));
-    drift::DriftOptions o = base;
-    o.method = methods[i];
     StudyResult::CompensateRow row{methods[i], "train A test B", {}, 0.0, 0.0, 0.0, {}, {}};
     auto start = Clock::now();
-    const drift::DriftModel model = drift::FitDriftModel(s.run_a.rate_dph, s.run_a.temperature_c, o,
-                                                         {}, Execution{.threads = s.threads});
+    const drift::DriftModel model =
+        FitCompensation(s, methods[i], s.run_a.rate_dph, s.run_a.temperature_c);
     row.train_s = Seconds(start);
     start = Clock::now();
     row.estimate = drift::EstimateDrift(model, s.run_b.temperature_c);
@@ -240,10 +259,7 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
   }
   // Models for the files: fitted on the whole record (what a user would deploy).
   for (drift::Method m : methods) {
-    drift::DriftOptions o = base;
-    o.method = m;
-    const drift::DriftModel model =
-        drift::FitDriftModel(s.output, s.temperature, o, {}, Execution{.threads = s.threads});
+    const drift::DriftModel model = FitCompensation(s, m, s.output, s.temperature);
     // gyrodrift compensate reads the temperature from the column named here.
     io::ModelFileInfo info{s.target_name, s.temperature_name, s.source, "",
                            std::string(allan::ToString(s.options.units))};

@@ -42,6 +42,26 @@ class CompensateCli : public ::testing::Test {
 };
 std::string* CompensateCli::dir_ = nullptr;
 
+// --drift-window-s: the slow variation's blocks (the manifest's drift_window_s), as
+// drift::SummariseCompensation computes it over blocks of that length; refused out of range.
+TEST_F(CompensateCli, TheDriftWindowSetsTheSlowVariationsBlocks) {
+  const std::string out = Dir() + "/window.csv";
+  const auto r = test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                              "/test.csv' --drift-window-s 60 -q -o '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json side = nlohmann::json::parse(io::ReadTextFile(out + ".json"));
+  EXPECT_EQ(side["slow_variation_block_s"].get<double>(), 60.0);
+  EXPECT_EQ(side["slow_variation_blocks"].get<int>(), 10);
+  const io::CsvTable t = io::CsvTable::Read(out);
+  const drift::CompensationSummary s =
+      drift::SummariseCompensation(t.Column("rate_dph"), t.Column("compensated"), 1.0, 60.0);
+  EXPECT_EQ(side["after"]["slow_variation"].get<double>(), s.after.slow);
+  test::ExpectCleanFailure(test::RunCli("compensate '" + Dir() + "/ms.json' '" + Dir() +
+                                        "/test.csv' --drift-window-s 0 -o '" + out + "2'"),
+                           2, "--drift-window-s = 0: must be in [0.001, 1e+09]", out + "2",
+                           "drift window 0");
+}
+
 TEST_F(CompensateCli, AddsTheEstimateAndTheCompensatedOutput) {
   const std::string out = Dir() + "/out.csv";
   const auto r =

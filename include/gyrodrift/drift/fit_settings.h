@@ -48,6 +48,10 @@ struct FitSettings {
   // name ("auto": for calibration runs of at least kHysteresisAutoMinDurationS).
   std::string hysteresis = "auto";
   bool has_temperature = false;  // a temperature channel is given (needed by compensate mode)
+
+  // Every check of MakeDriftOptions and MakeExecution, before any data is read: OptionError
+  // naming the setting, or UsageError.
+  void Validate() const;
 };
 
 // The method "auto" stands for in `mode`.

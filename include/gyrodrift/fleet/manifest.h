@@ -10,6 +10,10 @@
 //                                 # decomposition, and calibration logs only: a verification
 //                                 # log with made-up rows is refused)
 //   delimiter = "auto"            # optional: auto | comma | tab | semicolon (io::Delimiter)
+//   names = ["t", "gx"]           # optional, and every other io::LogOptions field as its key
+//   skip_rows = 0                 # (tasks::LogOptionsFromJson: names, skip_rows, bad_lines,
+//   bad_lines = "error"           # ulog_topic, ulog_axes, ulog_temperature, ulog_units,
+//                                 # ulog_instance), as the flags of the same names
 //   seed = 1                      # optional
 //   nonlinear = false             # optional, fit --nonlinear
 //   reference_temperature_c = 20  # optional, fit --reference-temperature
@@ -39,11 +43,13 @@
 
 #include <cstdint>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/io/gyro_log.h"
 
 namespace gyrodrift::fleet {
@@ -77,7 +83,7 @@ struct Manifest {
   drift::Method method = drift::Method::kThermal;
   allan::RateUnit rate_unit = allan::RateUnit::kDegPerHour;
   double rate_hz = 0.0;  // 0 = from each log
-  io::LogOptions log;  // gaps and delimiter of every log
+  io::LogOptions log;  // how every log is read (every field a key)
   std::uint64_t seed = 1;
   bool nonlinear = false;
   double reference_c = std::numeric_limits<double>::quiet_NaN();
@@ -90,6 +96,8 @@ struct Manifest {
   // The drift options every axis is fitted with (compensate mode; drift::MakeDriftOptions, as
   // fit's flags); rate_hz is settled per log.
   drift::DriftOptions FitOptions() const;
+  // The fit settings of those options (drift::FitSettings, compensate mode).
+  drift::FitSettings Settings() const;
 };
 
 // Parses a manifest's text; `path` names it in messages and anchors relative log paths. Checks
@@ -103,8 +111,14 @@ Manifest ReadManifest(const std::string& path);
 // line) naming the first missing axis, temperature or truth column.
 void CheckLogColumns(const Manifest& manifest);
 
-// A unit's fingerprint: FNV-1a 64 of the settings that shape its results and of the bytes of its
-// logs, so a rerun redoes a unit whose logs or settings changed and skips one that is done.
+// A unit's fingerprint: FNV-1a 64 of FingerprintJson's text, so a rerun redoes a unit whose logs
+// or settings changed and skips one that is done. FingerprintJson: the settings' JSON with its
+// version (tasks::SettingsToJson: every fit and log setting, so a setting added there is in the
+// fingerprint too), the fleet's own keys (rate_unit, rate_hz, drift_window_s, limits, axes) and
+// the unit (serial, number of calibration logs, each log's path and FNV-1a 64 of its bytes).
+// Before this form (2026-11, issue 25) the fingerprint hashed a hand-made list of some of these;
+// a summary.json of that form never matches, so each unit is calibrated once more.
+nlohmann::json FingerprintJson(const Manifest& manifest, const UnitSpec& unit);
 std::string UnitFingerprint(const Manifest& manifest, const UnitSpec& unit);
 
 }  // namespace gyrodrift::fleet

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/files.h"
@@ -86,6 +87,44 @@ TEST_F(ManifestTest, TheFingerprintFollowsTheHysteresisSetting) {
   ASSERT_EQ(a.units.size(), 1u);
   EXPECT_EQ(UnitFingerprint(a, a.units[0]), UnitFingerprint(Parse(""), a.units[0]));
   EXPECT_NE(UnitFingerprint(a, a.units[0]), UnitFingerprint(off, off.units[0]));
+}
+
+TEST_F(ManifestTest, EveryLogSettingIsAKeyThroughItsOneMapping) {
+  const Manifest m =
+      Parse("names = [\"time_s\", \"gyro\", \"temp\"]\nskip_rows = 2\nbad_lines = \"skip\"\n"
+            "delimiter = \"comma\"\ngaps = \"interpolate\"\nulog_instance = 1\n"
+            "ulog_units = \"rads\"\n");
+  EXPECT_EQ(m.log.names, (std::vector<std::string>{"time_s", "gyro", "temp"}));
+  EXPECT_EQ(m.log.skip_rows, 2);
+  EXPECT_EQ(m.log.bad_lines, io::BadLines::kSkip);
+  EXPECT_EQ(m.log.delimiter, io::Delimiter::kComma);
+  EXPECT_EQ(m.log.gaps, io::GapPolicy::kInterpolate);
+  EXPECT_EQ(m.log.ulog_instance, 1);
+  EXPECT_EQ(m.log.ulog.units, allan::RateUnit::kRadPerSecond);
+  const std::string file = dir_ + "/fleet.toml:";
+  EXPECT_EQ(Refusal("seed = 1\nskip_rows = -1\n"),
+            file + "2: skip_rows = -1: must be an integer in [0, 1000000]");
+  EXPECT_EQ(Refusal("bad_lines = \"sometimes\"\n"),
+            file + "1: bad_lines = 'sometimes': must be one of error, skip");
+  EXPECT_EQ(Refusal("names = \"gyro\"\n"), file + "1: names = \"gyro\": must be an array of strings");
+}
+
+// The fingerprint is the settings' JSON (tasks::SettingsToJson) with the fleet's keys and the
+// unit's logs: every setting, of the fit or of the log, changes it.
+TEST_F(ManifestTest, EverySettingChangesTheFingerprint) {
+  const Manifest a = Parse("");
+  const std::string base = UnitFingerprint(a, a.units[0]);
+  EXPECT_EQ(base, UnitFingerprint(Parse(""), a.units[0]));
+  EXPECT_EQ(FingerprintJson(a, a.units[0])["settings"]["version"], 1);
+  for (const char* top : {"hysteresis = \"off\"\n", "seed = 2\n", "method = \"poly\"\n",
+                          "nonlinear = true\n", "reference_temperature_c = 20\n",
+                          "skip_rows = 1\n", "bad_lines = \"skip\"\n", "delimiter = \"comma\"\n",
+                          "gaps = \"interpolate\"\n", "ulog_instance = 1\n", "rate_hz = 2\n",
+                          "drift_window_s = 50\n", "rate_unit = \"dps\"\n",
+                          "[limits]\nresidual_drift_rms = 1\n"}) {
+    const Manifest b = Parse(top);
+    EXPECT_NE(UnitFingerprint(b, b.units[0]), base) << top;
+  }
 }
 
 }  // namespace

@@ -1,0 +1,63 @@
+// A gyro log as the drift tasks read it (fit, compensate, evaluate; the fleet's calibration and
+// verification logs): the table under the log settings, where its records start, which rows were
+// logged, its sample rate and what the user must hear about it. One home for the rules
+// `gyrodrift fit` / `compensate` / `evaluate` and `gyrodrift calibrate` share (issue 25).
+//
+// Messages spell a setting as the caller's user types it: flags (--rate-hz, --target) when the log
+// settings' gaps_name is a flag ("--gaps"), else keys (rate_hz, target), as io::SpellGaps does.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/gyro_log.h"
+
+namespace gyrodrift::tasks {
+
+struct TaskLog {
+  std::string path;
+  io::CsvTable table;
+  std::vector<Eigen::Index> record_starts;  // gaps split: the first row of every later record
+  std::vector<bool> logged;  // gaps interpolate or carry: one flag per row, true where logged
+  double rate_hz = 0.0;
+  std::string rate_how;  // "given", "time_s" or "default" (io::ResolveSampleRate)
+  std::string gap_note;   // io::ReadLog's note on filled or split gaps and skipped lines, or ""
+  std::string time_note;  // io::NonUniformTimeNote, or ""
+};
+
+// Reads `path` under `log` (io::ReadLog, record starts and the logged mask always asked for) and
+// settles its sample rate: `rate_hz_given` when > 0, else from time_s, else 1 Hz
+// (io::ResolveSampleRate). Without a rate (a task that takes none, such as compensate: the
+// model's), rate_hz stays 0 and rate_how "".
+TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log, double rate_hz_given);
+TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log);
+
+// True when the caller's user spells settings as flags (log.gaps_name "--gaps").
+bool SpeltAsFlags(const io::LogOptions& log);
+
+// The columns of `spec` ("a" or "a,b", names or 1-based indices): their names, the names joined by
+// commas, and the N x C matrix. Throws UsageError naming `option` (--target, target) for an
+// unknown, empty or repeated column.
+struct SelectedColumns {
+  std::vector<std::string> names;
+  std::string joined;
+  Eigen::MatrixXd values;
+};
+SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
+                            const std::string& option);
+
+// The comma-separated names of a model file's temperature_column ("" gives one empty name).
+std::vector<std::string> SplitColumns(const std::string& names);
+
+// What the user must know about a log before the work: its sample rate assumed (rate_how
+// "default"; "" = the task takes no rate) and each `temperature_columns` that does not look like
+// degC (drift::TemperatureWarning). One line each, without "warning: ": spelt for flags
+// "PATH has no time_s column: ... (give --rate-hz if it is not)", for keys
+// "FILE: no time_s column: ... (set rate_hz in the manifest if it is not)".
+std::vector<std::string> LogWarnings(const TaskLog& log, const std::string& rate_how,
+                                     const std::vector<std::string>& temperature_columns,
+                                     bool flags);
+
+}  // namespace gyrodrift::tasks

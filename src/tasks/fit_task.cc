@@ -1,0 +1,119 @@
+#include "gyrodrift/tasks/fit_task.h"
+
+#include <fmt/core.h>
+
+#include <utility>
+
+#include "gyrodrift/common/error.h"
+
+namespace gyrodrift::tasks {
+
+FitRun AssembleFitRun(const std::vector<TaskLog>& logs, const std::string& target,
+                      const std::string& temperature, const io::LogOptions& log,
+                      const std::string& target_option, const std::string& temperature_option) {
+  FitRun run;
+  run.logs = logs.size();
+  run.temperature_spec = temperature;
+  for (const TaskLog& l : logs) {
+    const SelectedColumns targets = ReadColumns(l.table, target, target_option);
+    SelectedColumns temps;
+    if (!temperature.empty()) temps = ReadColumns(l.table, temperature, temperature_option);
+    if (run.source.empty()) {
+      run.rate_hz = l.rate_hz;
+      run.rate_how = l.rate_how;
+    } else {
+      io::RequireSameSampleRate(logs.front().path, run.rate_hz, l.path, l.rate_hz);
+    }
+    Eigen::MatrixXd block(l.table.rows(), targets.values.cols() + temps.values.cols());
+    block.leftCols(targets.values.cols()) = targets.values;
+    if (temps.values.cols() > 0) block.rightCols(temps.values.cols()) = temps.values;
+    // interpolate fits on the made-up rows as data; only carry keeps the fit to the logged ones.
+    run.rows.Append(block, l.record_starts,
+                    log.gaps == io::GapPolicy::kCarry ? l.logged : std::vector<bool>{});
+    run.source += (run.source.empty() ? "" : ",") + l.path;
+    run.targets = targets.names;
+    run.temperatures = temps.names;
+  }
+  return run;
+}
+
+std::string FitResult::ModelFile() const { return io::RenderModelFile(axes); }
+
+void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogOptions& log) {
+  const bool flags = SpeltAsFlags(log);
+  for (const std::string& name : run.temperatures) {
+    for (const std::string& target : run.targets) {
+      if (name != target) continue;
+      throw UsageError(flags ? "--temperature = " + run.temperature_spec +
+                                   ": must differ from --target"
+                             : "temperature = " + run.temperature_spec +
+                                   ": must differ from the target");
+    }
+  }
+  const std::string method(drift::ToString(o.method));
+  if (!run.rows.record_starts.empty() && o.method != drift::Method::kThermal) {
+    // Keys: the fleet refuses these when it reads its manifest; arrays give record_starts.
+    const std::string why = run.logs > 1 ? (flags ? "several input logs" : "several calibration logs")
+                            : flags     ? io::SpellGaps(log, io::GapPolicy::kSplit)
+                                        : "record_starts";
+    throw UsageError(
+        flags ? fmt::format("--method {}: several records ({}) are fitted by --method thermal only "
+                            "(a decomposition or lags would run across the breaks)",
+                            method, why)
+              : fmt::format("method = '{}': several records ({}) are fitted by method = "
+                            "'thermal' only (a decomposition or lags would run across the breaks)",
+                            method, why));
+  }
+  if (!run.rows.logged.empty() &&
+      (o.mode != drift::Mode::kCompensate || drift::UsesDecomposition(o.method))) {
+    const std::string mode(drift::ToString(o.mode));
+    const std::string why = o.mode == drift::Mode::kCompensate
+                                ? "a decomposition runs across the made-up rows"
+                                : "a prediction from the output's past reads made-up rows";
+    throw UsageError(
+        flags ? fmt::format("--gaps carry: the fit uses the logged rows only, which --mode {} "
+                            "--method {} cannot do ({}): use --method thermal or poly in "
+                            "compensate mode, or --gaps interpolate",
+                            mode, method, why)
+              : fmt::format("logged: the fit uses the logged rows only, which mode '{}' method "
+                            "'{}' cannot do ({}): use method thermal or poly in compensate mode",
+                            mode, method, why));
+  }
+}
+
+FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
+                 const std::string& rate_unit, const io::LogOptions& log,
+                 const FitProgress& progress) {
+  drift::FitSettings s = settings;
+  if (run.rate_hz > 0.0) s.rate_hz = run.rate_hz;
+  FitResult r;
+  r.options = drift::MakeDriftOptions(s);
+  Execution execution = drift::MakeExecution(s);
+  CheckFitRun(run, r.options, log);
+  const auto targets = static_cast<Eigen::Index>(run.targets.size());
+  const Eigen::Index temperatures = run.rows.rows.cols() - targets;
+  std::string temperature_column;
+  for (size_t c = 0; c < run.temperatures.size(); ++c) {
+    temperature_column += (c ? "," : "") + run.temperatures[c];
+  }
+  const Eigen::MatrixXd temperature = run.rows.rows.rightCols(temperatures);
+  for (Eigen::Index i = 0; i < targets; ++i) {
+    io::LoadedModel axis;
+    axis.info.source = run.source;
+    axis.info.target_column = run.targets[static_cast<size_t>(i)];
+    axis.info.temperature_column = temperature_column;
+    axis.info.rate_unit = rate_unit;
+    if (progress) {
+      progress(static_cast<int>(i), 0.0, "");  // the axis starts
+      execution.progress = [&progress, i](double fraction, std::string_view step) {
+        progress(static_cast<int>(i), fraction, step);
+      };
+    }
+    axis.model = drift::FitDriftModel(run.rows.rows.col(i), temperature, r.options,
+                                      run.rows.record_starts, execution, run.rows.logged);
+    r.axes.push_back(std::move(axis));
+  }
+  return r;
+}
+
+}  // namespace gyrodrift::tasks

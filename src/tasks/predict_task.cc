@@ -1,0 +1,75 @@
+#include "gyrodrift/tasks/predict_task.h"
+
+#include <utility>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/common/error.h"
+#include "gyrodrift/common/execution.h"
+
+namespace gyrodrift::tasks {
+
+void PredictSettings::Validate() const {
+  (void)drift::ProtocolFromString(protocol);
+  if (window < 16 || window > 1000000) {
+    ThrowOption("window", std::to_string(window), "an integer in [16, 1000000]");
+  }
+  ValidateThreads(threads);
+}
+
+void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_path) {
+  if (loaded.model.options.mode != drift::Mode::kPredict) {
+    throw UsageError(model_path +
+                     " is a compensate-mode model: use 'gyrodrift compensate' (predict "
+                     "needs a model fitted with --mode predict)");
+  }
+}
+
+PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y,
+                         const Eigen::VectorXd& temperature, const PredictSettings& settings,
+                         const std::string& y_name,
+                         std::function<void(double, std::string_view)> progress) {
+  settings.Validate();
+  const drift::DriftModel& model = loaded.model;
+  const drift::Protocol protocol = drift::ProtocolFromString(settings.protocol);
+  PredictResult r;
+  r.first = drift::FirstPredictable(model, protocol, settings.horizon);
+  if (y.size() <= r.first) {
+    throw DataError(y_name + " has " + std::to_string(y.size()) +
+                    " samples: the model needs more than " + std::to_string(r.first) +
+                    " (its history) to predict any");
+  }
+  drift::CausalOptions causal;
+  causal.window = settings.window;
+  // The threads never change the result.
+  const Execution execution{.threads = settings.threads, .progress = std::move(progress)};
+  r.prediction = drift::PredictAhead(model, y, temperature, r.first, settings.horizon, protocol,
+                                     causal, execution);
+  if (protocol == drift::Protocol::kCausal) {
+    r.window_note = drift::CausalWindowNote(model, settings.window);
+  }
+  return r;
+}
+
+nlohmann::json PredictRecord(const PredictResult& r, const io::LoadedModel& loaded,
+                             const PredictSettings& s, Eigen::Index samples,
+                             const std::string& model_path, const std::string& input) {
+  const drift::DriftModel& model = loaded.model;
+  nlohmann::json j;
+  j["options"] = {{"model", model_path}, {"input", input},     {"protocol", s.protocol},
+                  {"window", s.window},  {"horizon", s.horizon}, {"threads", s.threads}};
+  j["model"] = {{"summary", model.Summary()},
+                {"method", drift::ToString(model.options.method)},
+                {"target_column", loaded.info.target_column},
+                {"temperature_column", loaded.info.temperature_column},
+                {"lags", model.lags},
+                {"seed", model.options.seed},
+                {"tool_version", loaded.info.tool_version}};
+  j["notes"] = r.window_note.empty() ? nlohmann::json::array()
+                                     : nlohmann::json::array({r.window_note});
+  j["samples"] = samples;
+  j["first_predicted_sample"] = r.first + 1;
+  j["predicted"] = samples - r.first;
+  return j;
+}
+
+}  // namespace gyrodrift::tasks

@@ -1,0 +1,83 @@
+#include "gyrodrift/tasks/task_log.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "gyrodrift/common/check.h"
+#include "gyrodrift/drift/temperature_check.h"
+
+namespace gyrodrift::tasks {
+
+TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log) {
+  TaskLog t;
+  t.path = path;
+  t.table = io::ReadLog(path, log, &t.gap_note, &t.record_starts, {}, &t.logged);
+  t.time_note = io::NonUniformTimeNote(t.table);
+  return t;
+}
+
+TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log, double rate_hz_given) {
+  TaskLog t = ReadTaskLog(path, log);
+  t.rate_hz = io::ResolveSampleRate(t.table, rate_hz_given, &t.rate_how);
+  return t;
+}
+
+bool SpeltAsFlags(const io::LogOptions& log) { return log.gaps_name.rfind("--", 0) == 0; }
+
+std::vector<std::string> SplitColumns(const std::string& names) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= names.size()) {
+    const size_t comma = names.find(',', start);
+    out.push_back(names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
+                            const std::string& option) {
+  const std::vector<std::string> items = SplitColumns(spec);
+  SelectedColumns out;
+  out.values.resize(0, static_cast<Eigen::Index>(items.size()));
+  std::vector<std::string> seen;
+  for (size_t c = 0; c < items.size(); ++c) {
+    if (items[c].empty()) ThrowOption(option, "'" + spec + "'", "column names without empty items");
+    const std::string name = table.header()[static_cast<size_t>(table.ResolveColumn(items[c]))];
+    if (std::find(seen.begin(), seen.end(), name) != seen.end()) {
+      ThrowOption(option, "'" + spec + "'", "a list without repeats");
+    }
+    seen.push_back(name);
+    const Eigen::VectorXd column = table.Column(items[c]);
+    if (c == 0) out.values.resize(column.size(), static_cast<Eigen::Index>(items.size()));
+    out.values.col(static_cast<Eigen::Index>(c)) = column;
+    out.joined += (c ? "," : "") + name;
+    out.names.push_back(name);
+  }
+  return out;
+}
+
+std::vector<std::string> LogWarnings(const TaskLog& log, const std::string& rate_how,
+                                     const std::vector<std::string>& temperature_columns,
+                                     bool flags) {
+  std::vector<std::string> out;
+  // Flags name the file as typed; a manifest's table names its file only.
+  const std::string name =
+      flags ? log.path : std::filesystem::path(log.path).filename().string();
+  if (rate_how == "default") {
+    out.push_back(flags ? name + " has no time_s column: its sample rate is taken as 1 Hz (give "
+                                 "--rate-hz if it is not)"
+                        : name + ": no time_s column: its sample rate is taken as 1 Hz (set "
+                                 "rate_hz in the manifest if it is not)");
+  }
+  for (const std::string& column : temperature_columns) {
+    const std::string w = drift::TemperatureWarning(log.table.Column(column), column);
+    if (!w.empty()) out.push_back(name + ": " + w);
+  }
+  return out;
+}
+
+}  // namespace gyrodrift::tasks
