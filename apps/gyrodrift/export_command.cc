@@ -41,14 +41,9 @@ void Run(const ExportArgs& a) {
                                         .single_precision = a.single_precision,
                                         .prefix = a.prefix,
                                         .device_ids = a.device_ids};
-  options.Validate();
-  // The axes of every model file, in order (for PX4, each file one gyro instance).
-  std::vector<io::LoadedModel> axes;
-  for (const std::string& model : a.models) {
-    for (io::LoadedModel& axis : io::ReadModelFileAxes(model)) axes.push_back(std::move(axis));
-  }
-  const std::string text = firmware::RenderExport(axes, options);
-  io::WriteFileAtomically(a.output, text);
+  const firmware::ExportResult exported = firmware::ExportModelFiles(a.models, options);
+  const std::vector<io::LoadedModel>& axes = exported.axes;
+  io::WriteFileAtomically(a.output, exported.text);
   if (a.quiet) return;
   // A model the calibration run could not identify says so wherever it is used (as compensate
   // does); nearly collinear regressors also amplify the header's rounding (docs/firmware.md).

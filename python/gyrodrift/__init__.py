@@ -18,13 +18,15 @@ processed, a ValueError) and ``FileError`` (an OSError), with the library's one-
 See docs/python.md.
 """
 
+import os
+
 from . import _gyrodrift
 from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "noise_terms", "plan", "read_ulog", "select_modes", "simulate",
-    "temperature_warning", "ulog_columns",
+    "decompose", "evaluate", "export", "noise_terms", "plan", "read_ulog", "select_modes",
+    "simulate", "temperature_warning", "ulog_columns",
 ]
 
 
@@ -302,6 +304,22 @@ class DriftModel:
 
     def __repr__(self):
         return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"
+
+
+def export(models, *, format="c", single_precision=False, prefix="gyro_comp", device_ids=()):
+    """The text ``gyrodrift export`` writes for compensate-mode model files (docs/firmware.md):
+    ``format="c"`` a C99 header, ``"json-coefficients"`` their coefficients, ``"px4"`` the
+    parameters of PX4's thermal compensation (one model file of axes x, y, z per gyro, one
+    ``device_ids`` entry each). ``models``: a path or a list of paths, their axes in order.
+    A model's ``sub_models[0]["thermal"]["autopilot"]`` is the form ``"px4"`` writes.
+
+    >>> import gyrodrift as gd
+    >>> header = gd.export("model.json")                                  # doctest: +SKIP
+    >>> params = gd.export("imu0.json", format="px4", device_ids=[2490378])  # doctest: +SKIP
+    """
+    paths = [str(models)] if isinstance(models, (str, os.PathLike)) else [str(m) for m in models]
+    return _gyrodrift.export(paths, format=format, single_precision=single_precision,
+                             prefix=prefix, device_ids=list(device_ids))
 
 
 def temperature_warning(temperature, name="temperature"):

@@ -126,6 +126,12 @@ class DriftModel:
     @property
     def fitted(self) -> bool: ...
 
+def export(
+    models: str | PathLike[str] | Sequence[str | PathLike[str]], *,
+    format: Literal["c", "json-coefficients", "px4"] = ..., single_precision: bool = ...,
+    prefix: str = ..., device_ids: Sequence[int] = ...,
+) -> str: ...
+
 def temperature_warning(temperature: ArrayLike, name: str = ...) -> str: ...
 
 def select_modes(

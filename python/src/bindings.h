@@ -188,6 +188,7 @@ inline Execution ExecutionOf(int threads, LongCall& call) {
 // The functions of each binding file, called by PYBIND11_MODULE (module.cc).
 void BindSignal(py::module_& m);      // decompose, allan, noise_terms, simulate, select_modes
 void BindDriftModel(py::module_& m);  // DriftModel, temperature_warning
+void BindExport(py::module_& m);      // export (model files for firmware and PX4)
 void BindEvaluate(py::module_& m);    // evaluate
 void BindFleet(py::module_& m);       // calibrate and the fleet's helpers
 void BindLogs(py::module_& m);        // read_ulog, ulog_columns, plan

@@ -10,6 +10,7 @@
 #include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/drift/temperature_check.h"
 #include "gyrodrift/drift/thermal_coefficients.h"
+#include "gyrodrift/firmware/export.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
 #include "gyrodrift/io/model_file.h"
@@ -259,6 +260,20 @@ class PyDriftModel {
         th["warnings"] = t.report.warnings;
         th["advice"] = t.report.advice;
         th["structure"] = t.report.level;  // CalibrationReport::Level: 0 the constant .. 5
+        if (t.autopilot.fitted()) {
+          py::dict a;
+          a["degree"] = t.autopilot.degree;
+          a["tref_c"] = t.autopilot.tref_c;
+          a["tmin_c"] = t.autopilot.tmin_c;
+          a["tmax_c"] = t.autopilot.tmax_c;
+          a["coefficients"] = std::vector<double>(t.autopilot.coefficients.begin(),
+                                                  t.autopilot.coefficients.end());
+          a["share_kept"] = t.autopilot.share_kept;
+          a["summary"] = t.autopilot.Summary();
+          th["autopilot"] = a;
+        } else {
+          th["autopilot"] = py::none();
+        }
         if (t.has_hysteresis()) {
           py::dict h;
           h["tau_s"] = t.states[static_cast<size_t>(t.hysteresis_state)].tau_s;
@@ -378,6 +393,25 @@ void BindDriftModel(py::module_& m) {
         return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
       },
       arg("temperature"), arg("name") = "temperature");
+}
+
+void BindExport(py::module_& m) {
+  using py::arg;
+  namespace fw = gyrodrift::firmware;
+  const fw::ExportOptions ed;
+  m.def(
+      "export",
+      [](const std::vector<std::string>& models, const std::string& format, bool single_precision,
+         const std::string& prefix, const std::vector<std::uint32_t>& device_ids) {
+        return fw::ExportModelFiles(models, {.format = fw::ExportFormatFromString(format),
+                                             .single_precision = single_precision,
+                                             .prefix = prefix,
+                                             .device_ids = device_ids})
+            .text;
+      },
+      arg("models"), py::kw_only(), arg("format") = std::string(fw::ToString(ed.format)),
+      arg("single_precision") = ed.single_precision, arg("prefix") = ed.prefix,
+      arg("device_ids") = ed.device_ids);
 }
 
 }  // namespace gyrodrift::python

@@ -46,6 +46,7 @@ PYBIND11_MODULE(_gyrodrift, m) {
 
   gp::BindSignal(m);
   gp::BindDriftModel(m);
+  gp::BindExport(m);
   gp::BindEvaluate(m);
   gp::BindFleet(m);
   gp::BindLogs(m);

@@ -214,3 +214,27 @@ def test_evaluate_matches_cli(cli, sim_csv, tmp_path, mode, args, kwargs):
     # The references open every table.
     assert list(dict.fromkeys(row["method"] for row in r["rows"]))[:2] == ["none", "constant"]
     assert r["first_test_sample"] == round(0.7 * len(log["rate_dph"]))
+
+
+@pytest.mark.parametrize("fmt, extra", [("c", []), ("json-coefficients", []),
+                                        ("px4", ["--device-id", "2490378"])])
+def test_export_matches_cli(cli, sim_csv, tmp_path, fmt, extra):
+    """gd.export gives the bytes `gyrodrift export` writes; the autopilot form PX4's file holds is
+    the one the model shows."""
+    sim = read_csv(sim_csv)
+    three = tmp_path / "xyz.csv"
+    write_csv(three, {"time_s": sim["time_s"], "x_dph": sim["rate_dph"],
+                      "y_dph": -0.5 * sim["rate_dph"], "z_dph": 2.0 * sim["rate_dph"],
+                      "temperature_c": sim["temperature_c"]})
+    model = tmp_path / "m.json"
+    cli("fit", three, "-t", "x_dph,y_dph,z_dph", "-T", "temperature_c", "--mode", "compensate",
+        "-q", "-o", model)
+    out = tmp_path / "out"
+    cli("export", model, "--format", fmt, *extra, "-q", "-o", out)
+    ids = [2490378] if fmt == "px4" else []
+    assert gd.export(model, format=fmt, device_ids=ids) == out.read_text()
+    autopilot = gd.DriftModel.load(model, axis="x_dph").sub_models[0]["thermal"]["autopilot"]
+    assert 0 <= autopilot["degree"] <= 3 and "in (T - " in autopilot["summary"]
+    if fmt == "px4":
+        with pytest.raises(gd.UsageError, match="device_ids"):
+            gd.export(model, format="px4")

@@ -75,6 +75,17 @@ std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptio
   throw std::logic_error("unknown export format");
 }
 
+ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
+                              const ExportOptions& options) {
+  options.Validate();
+  ExportResult out;
+  for (const std::string& path : model_paths) {
+    for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));
+  }
+  out.text = RenderExport(out.axes, options);
+  return out;
+}
+
 ExportSummary SummariseExport(const std::vector<LoadedModel>& axes) {
   const internal::Plan plan = internal::MakePlan(axes);
   return {static_cast<int>(plan.axes.size()), static_cast<int>(plan.channels.size()), plan.states,

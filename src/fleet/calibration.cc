@@ -188,6 +188,10 @@ AxisResult ModelFigures(const AxisSpec& axis, const io::LoadedModel& model) {
       a.bias = t.coefficients[0];
       a.cv_rmse = t.report.cv_rmse;
       a.skill = t.report.skill;
+      if (t.autopilot.fitted()) {
+        a.autopilot = t.autopilot.Summary();
+        a.autopilot_kept = t.autopilot.share_kept;
+      }
     }
     a.identified = a.identified.value_or(true) && t.report.warnings.empty();
     for (const std::string& w : t.report.warnings) a.warnings.push_back(sub.name + ": " + w);

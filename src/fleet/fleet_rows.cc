@@ -76,7 +76,7 @@ const std::vector<std::string>& FleetColumns() {
       "std_before", "std_after", "drift_rms_before", "drift_rms_after", "drift_removed",
       "truth_removed", "arw_before_dpsh", "arw_after_dpsh", "bias_instability_before_dph",
       "bias_instability_after_dph", "rrw_before_dphpsh", "rrw_after_dphpsh", "bias", "cv_rmse",
-      "skill", "regressors", "warnings", "identified", "outside_share", "mean_before",
+      "skill", "autopilot_kept", "regressors", "warnings", "identified", "outside_share", "mean_before",
       "mean_after", "unit_seconds"};
   return kColumns;
 }
@@ -128,6 +128,7 @@ std::vector<FleetRow> Rows(const UnitResult& unit) {
                                Fmt(a.bias),
                                Fmt(a.cv_rmse),
                                Fmt(a.skill),
+                               Fmt(a.autopilot_kept),
                                regressors,
                                warnings,
                                !a.identified ? "" : *a.identified ? "yes" : "no",

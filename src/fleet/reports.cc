@@ -62,6 +62,7 @@ void AddAxisSummary(io::HtmlReport& report, const Manifest& m, const AxisResult&
   for (size_t i = 0; i < a.regressors.size(); ++i) model += (i ? ", " : "") + a.regressors[i];
   if (!std::isnan(a.bias)) model += fmt::format("\nintercept (repeatable bias): {:.6g} {}", a.bias, unit_name);
   if (!std::isnan(a.cv_rmse)) model += fmt::format("\ncross-validated RMSE {:.4g} {}, skill {:.3f}", a.cv_rmse, unit_name, a.skill);
+  if (!a.autopilot.empty()) model += "\nautopilot form (export --format px4): " + a.autopilot;
   if (a.identified && !*a.identified) {
     model += "\nnot identified: the calibration run could not identify this model (warnings below)";
   }

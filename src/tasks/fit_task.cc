@@ -2,8 +2,10 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <utility>
 
+#include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::tasks {
@@ -81,6 +83,33 @@ void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogO
   }
 }
 
+namespace {
+
+// A ULog's rate columns are in log.ulog.units (as convert writes them): a model recording another
+// unit would mislabel every estimate and export.
+void RequireUlogUnit(const std::string& sources, const std::string& rate_unit,
+                     const io::LogOptions& log) {
+  const std::string ulog_unit = allan::ToString(log.ulog.units);
+  if (rate_unit == ulog_unit) return;
+  size_t start = 0;
+  while (start <= sources.size()) {
+    const size_t comma = std::min(sources.find(',', start), sources.size());
+    const std::string path = sources.substr(start, comma - start);
+    if (io::IsUlogFile(path)) {
+      throw UsageError(SpeltAsFlags(log)
+                           ? fmt::format("--units {}: {} is a ULog read in --ulog-units {}: give "
+                                         "the same unit to both",
+                                         rate_unit, path, ulog_unit)
+                           : fmt::format("units = '{}': {} is a ULog read in ulog_units = '{}': "
+                                         "give the same unit to both",
+                                         rate_unit, path, ulog_unit));
+    }
+    start = comma + 1;
+  }
+}
+
+}  // namespace
+
 FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
                  const std::string& rate_unit, const io::LogOptions& log,
                  const FitProgress& progress) {
@@ -90,6 +119,7 @@ FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
   r.options = drift::MakeDriftOptions(s);
   Execution execution = drift::MakeExecution(s);
   CheckFitRun(run, r.options, log);
+  RequireUlogUnit(run.source, rate_unit, log);
   const auto targets = static_cast<Eigen::Index>(run.targets.size());
   const Eigen::Index temperatures = run.rows.rows.cols() - targets;
   std::string temperature_column;

@@ -72,6 +72,13 @@ TEST(UlogInputCli, AMissingInstanceOrACsvFlagIsRefusedCleanly) {
                            "instance out of range");
   test::ExpectCleanFailure(test::RunCli(fit + "--ulog-instance 1 --ulog-topic vehicle_imu"), 3,
                            "vehicle_imu", out, "topic absent");
+  // The model records the unit of its target: the ULog's columns are in --ulog-units.
+  test::ExpectCleanFailure(test::RunCli("fit '" + ulg + "' -t x_rads -T temperature_c --mode "
+                                        "compensate --ulog-instance 1 --ulog-units rads -o '" +
+                                        out + "'"),
+                           2,
+                           "--units dph: " + ulg + " is a ULog read in --ulog-units rads", out,
+                           "units differ");
 }
 
 }  // namespace

@@ -105,4 +105,14 @@ ExportSummary SummariseExport(const std::vector<LoadedModel>& axes);
 // The file of options.format: RenderFirmwareC, RenderCoefficientsJson or RenderPx4Params.
 std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptions& options);
 
+// The `export` operation as every front end runs it: the axes of every model file, in order
+// (for PX4, one file per gyro), and RenderExport's text of them. Throws as io::ReadModelFileAxes
+// and RenderExport.
+struct ExportResult {
+  std::vector<LoadedModel> axes;
+  std::string text;
+};
+ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
+                              const ExportOptions& options);
+
 }  // namespace gyrodrift::firmware

@@ -63,6 +63,11 @@ struct AxisResult {
   double bias = std::numeric_limits<double>::quiet_NaN();  // intercept, rate unit (thermal)
   double cv_rmse = std::numeric_limits<double>::quiet_NaN();
   double skill = std::numeric_limits<double>::quiet_NaN();
+  // The autopilot form fitted beside a one-sub-model thermal model (drift::AutopilotForm: what
+  // export --format px4 writes): its summary ("" when none) and the share of the slow drift the
+  // full model removes that it keeps (NaN: not measured).
+  std::string autopilot;
+  double autopilot_kept = std::numeric_limits<double>::quiet_NaN();
   // The calibration-run warnings of its thermal sub-models ("<sub-model>: ..."), then those on
   // its logs' inputs ("<log file>: ...": an assumed sample rate, a temperature that does not
   // look like degC).

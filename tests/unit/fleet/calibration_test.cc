@@ -320,6 +320,7 @@ TEST(Rows, EveryCellComesFromTheResult) {
   a.bias = 0.125;
   a.cv_rmse = 0.0625;
   a.skill = 0.875;
+  a.autopilot_kept = 0.5;
   a.warnings = {"no dwell", "narrow span"};
   a.identified = false;
   VerificationResult v;
@@ -371,6 +372,7 @@ TEST(Rows, EveryCellComesFromTheResult) {
       {"bias", "0.125"},
       {"cv_rmse", "0.0625"},
       {"skill", "0.875"},
+      {"autopilot_kept", "0.5"},
       {"regressors", "T; dT/dt"},
       {"warnings", "no dwell; narrow span"},
       {"identified", "no"},  // the calibration run could not identify the model
