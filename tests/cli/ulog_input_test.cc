@@ -1,6 +1,7 @@
-// A PX4 ULog given directly to fit and compensate: the same numbers as its converted CSV (the
-// model and the compensated log byte for byte), the instance chosen by --ulog-instance, the log
-// untouched, and the CSV-only flags refused for a ULog.
+// A PX4 ULog given directly to fit, compensate and calibrate: the same numbers as its converted
+// CSV (the model and the compensated log byte for byte), the instance chosen by --ulog-instance
+// (the manifest's ulog_instance), the log untouched, and the CSV-only flags and a unit other than
+// the ULog's refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -56,6 +57,33 @@ TEST(UlogInputCli, FitAndCompensateReadAUlogAsItsConvertedCsv) {
   EXPECT_EQ(Read(d + "/c_m_csv.csv"), Read(d + "/c_conv.csv"));
   EXPECT_EQ(io::CsvTable::Read(d + "/c_conv.csv").rows(), 2400);
   EXPECT_EQ(Read(ulg), before);
+}
+
+// A fleet manifest names the ULog's instance as a key: calibrate fits the model fit writes, and
+// its model exports to PX4's parameters.
+TEST(UlogInputCli, CalibrateReadsAUlogAsFitDoes) {
+  const std::string d = test::TempDir("cli_ulog_calibrate");
+  const std::string ulg = WriteLog(d);
+  std::string manifest = "ulog_instance = 1\n";
+  for (const char* axis : {"x_dph", "y_dph", "z_dph"}) {
+    manifest += std::string("[[axis]]\ntarget = \"") + axis + "\"\ntemperature = \"temperature_c\"\n";
+  }
+  manifest += "[[unit]]\nserial = \"IMU\"\ncalibration = \"" + ulg + "\"\nverification = \"" +
+              ulg + "\"\n";
+  io::WriteFileAtomically(d + "/fleet.toml", manifest);
+  const test::CommandResult cal =
+      test::RunCli("calibrate '" + d + "/fleet.toml' -o '" + d + "/out' -q");
+  ASSERT_EQ(cal.exit_code, 0) << cal.out << cal.err;
+  const test::CommandResult fit =
+      test::RunCli("fit '" + ulg + "' --ulog-instance 1 -t x_dph,y_dph,z_dph -T temperature_c "
+                   "--mode compensate -q -o '" + d + "/fit.json'");
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  EXPECT_EQ(io::ReadTextFile(d + "/out/IMU/model.json"), io::ReadTextFile(d + "/fit.json"));
+  const test::CommandResult px4 =
+      test::RunCli("export '" + d + "/out/IMU/model.json' --format px4 --device-id 2490378 -q -o '" +
+                   d + "/tc.params'");
+  ASSERT_EQ(px4.exit_code, 0) << px4.err;
+  EXPECT_NE(io::ReadTextFile(d + "/tc.params").find("TC_G0_ID\t2490378\t6"), std::string::npos);
 }
 
 TEST(UlogInputCli, AMissingInstanceOrACsvFlagIsRefusedCleanly) {
