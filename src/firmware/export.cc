@@ -77,7 +77,7 @@ std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptio
 
 ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options) {
-  options.Validate();
+  options.Validate();  // before any file is read, so a bad option is the error the user sees
   ExportResult out;
   for (const std::string& path : model_paths) {
     for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));

@@ -2,7 +2,6 @@
 
 #include <fmt/core.h>
 
-#include <algorithm>
 #include <utility>
 
 #include "gyrodrift/allan/allan.h"
@@ -33,6 +32,7 @@ FitRun AssembleFitRun(const std::vector<TaskLog>& logs, const std::string& targe
     run.rows.Append(block, l.record_starts,
                     log.gaps == io::GapPolicy::kCarry ? l.logged : std::vector<bool>{});
     run.source += (run.source.empty() ? "" : ",") + l.path;
+    if (run.ulog.empty() && io::IsUlogFile(l.path)) run.ulog = l.path;
     run.targets = targets.names;
     run.temperatures = temps.names;
   }
@@ -87,25 +87,16 @@ namespace {
 
 // A ULog's rate columns are in log.ulog.units (as convert writes them): a model recording another
 // unit would mislabel every estimate and export.
-void RequireUlogUnit(const std::string& sources, const std::string& rate_unit,
-                     const io::LogOptions& log) {
+void RequireUlogUnit(const FitRun& run, const std::string& rate_unit, const io::LogOptions& log) {
   const std::string ulog_unit = allan::ToString(log.ulog.units);
-  if (rate_unit == ulog_unit) return;
-  size_t start = 0;
-  while (start <= sources.size()) {
-    const size_t comma = std::min(sources.find(',', start), sources.size());
-    const std::string path = sources.substr(start, comma - start);
-    if (io::IsUlogFile(path)) {
-      throw UsageError(SpeltAsFlags(log)
-                           ? fmt::format("--units {}: {} is a ULog read in --ulog-units {}: give "
-                                         "the same unit to both",
-                                         rate_unit, path, ulog_unit)
-                           : fmt::format("units = '{}': {} is a ULog read in ulog_units = '{}': "
-                                         "give the same unit to both",
-                                         rate_unit, path, ulog_unit));
-    }
-    start = comma + 1;
-  }
+  if (run.ulog.empty() || rate_unit == ulog_unit) return;
+  throw UsageError(SpeltAsFlags(log)
+                       ? fmt::format("--units {}: {} is a ULog read in --ulog-units {}: give the "
+                                     "same unit to both",
+                                     rate_unit, run.ulog, ulog_unit)
+                       : fmt::format("units = '{}': {} is a ULog read in ulog_units = '{}': give "
+                                     "the same unit to both",
+                                     rate_unit, run.ulog, ulog_unit));
 }
 
 }  // namespace
@@ -119,7 +110,7 @@ FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
   r.options = drift::MakeDriftOptions(s);
   Execution execution = drift::MakeExecution(s);
   CheckFitRun(run, r.options, log);
-  RequireUlogUnit(run.source, rate_unit, log);
+  RequireUlogUnit(run, rate_unit, log);
   const auto targets = static_cast<Eigen::Index>(run.targets.size());
   const Eigen::Index temperatures = run.rows.rows.cols() - targets;
   std::string temperature_column;

@@ -30,6 +30,7 @@ struct FitRun {
   double rate_hz = 0.0;  // of the logs; 0 = the settings' rate_hz (arrays without a time axis)
   std::string rate_how;  // how the first log's rate was settled (TaskLog::rate_how)
   std::string source;    // the logs, comma-separated (informative, kept in the model file)
+  std::string ulog;      // the first log that is a PX4 ULog (io::IsUlogFile), or ""
   size_t logs = 1;       // how many logs were appended (messages)
   std::string temperature_spec;  // the temperature columns as the user gave them (messages)
 };
