@@ -91,10 +91,11 @@ void Run(const AllanArgs& a) {
   RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
   a.settings.Validate();  // every option error before any file is read
 
-  // Only the analysed column and time_s are read; the column is moved out of the table, and
-  // time_s is dropped with the table before the analysis, which builds the phase in the column's
-  // storage: at 1e8 samples each is 800 MB (docs/errors.md, Memory). The note on the time axis is
-  // worked out while time_s is there, and printed at the end.
+  // Only the analysed column is read as values (time_s as its steps, io::TimeAxis, unless they
+  // show a gap or a fault); the column is moved out of the table before the analysis, which
+  // builds the phase in the column's storage: at 1e8 samples it is 800 MB (docs/errors.md,
+  // Memory). The note on the time axis is worked out while the table is there, printed at the
+  // end.
   std::string notes, time_note;
   std::vector<bool> logged;
   Eigen::VectorXd data = [&] {

@@ -97,9 +97,10 @@ CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_vi
 
 std::string OptionErrorMessage(const OptionError& error) {
   // Only a flag the user gave: a value the command derived (a rate read from time_s, a duration
-  // from a profile file) keeps the library's name rather than blaming a flag nobody typed.
+  // from a profile file) keeps the library's name rather than blaming a flag nobody typed. A
+  // setting missing ("none") is named by the flag that gives it.
   for (const auto& [name, flag] : Bindings()) {
-    if (name == error.option() && flag->count() > 0) {
+    if (name == error.option() && (flag->count() > 0 || error.value() == "none")) {
       const std::string shown = flag->get_lnames().empty() ? "-" + flag->get_snames().front()
                                                            : "--" + flag->get_lnames().front();
       return shown + " = " + error.value() + ": must be " + error.rule();

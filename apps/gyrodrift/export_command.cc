@@ -1,5 +1,5 @@
-// gyrodrift export: a compensate-mode model as a C99 header for firmware, or its coefficients as
-// plain JSON (io/firmware_export.h does the work).
+// gyrodrift export: compensate-mode models as a C99 header for firmware, their coefficients as
+// plain JSON, or PX4's thermal-compensation parameters (firmware/export.h does the work).
 #include <fmt/core.h>
 
 #include <memory>
@@ -22,18 +22,6 @@ struct ExportArgs {
   std::vector<std::uint32_t> device_ids;
   bool quiet = false;
 };
-
-// What the autopilot runs of each axis, and how much of the full model it keeps.
-std::string Px4Report(const std::vector<io::LoadedModel>& axes) {
-  std::string out;
-  for (size_t a = 0; a < axes.size(); ++a) {
-    const std::string label = fmt::format("TC_G{} axis {} ({})", a / 3, a % 3,
-                                          axes[a].info.target_column);
-    out += fmt::format("  {}: {}\n", label,
-                       firmware::AxisAutopilotForm(axes[a], label).Summary());
-  }
-  return out;
-}
 
 void Run(const ExportArgs& a) {
   RequireOutputsAreNotInputs(a.models, {a.output});
@@ -59,10 +47,14 @@ void Run(const ExportArgs& a) {
     }
   }
   if (options.format == firmware::ExportFormat::kPx4Params) {
+    std::string forms;
+    for (const firmware::Px4AxisForm& f : exported.px4_forms) {
+      forms += fmt::format("  {}: {}\n", f.label, f.form.Summary());
+    }
     fmt::print("px4: {} gyro{}, the autopilot form of each axis (fitted with the model):\n{}{}"
                "wrote {}\n",
-               a.device_ids.size(), a.device_ids.size() == 1 ? "" : "s", Px4Report(axes),
-               warnings, a.output);
+               a.device_ids.size(), a.device_ids.size() == 1 ? "" : "s", forms, warnings,
+               a.output);
     return;
   }
   fmt::print("{}\n{}: {}{}\n{}wrote {}\n", axes[0].model.Summary(), firmware::ToString(options.format),

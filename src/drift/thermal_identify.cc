@@ -403,9 +403,16 @@ class SlowError {
   double white_share_ = 0.0;
 };
 
+// The slow mean squares of the chosen structure's and the constant's held-out residuals.
+struct SlowParts {
+  double chosen_ms = 0.0;
+  double constant_ms = 0.0;
+};
+
 // The slow part of the cross-validated residual (model.cv_slow_sd) and the skill against the
-// constant on it.
-void SlowErrorAndSkill(const SlowError& slow_ms, const Search& search, ThermalRegression& model) {
+// constant on it; returns both slow parts for the autopilot form's share.
+SlowParts SlowErrorAndSkill(const SlowError& slow_ms, const Search& search,
+                            ThermalRegression& model) {
   const double chosen_ms = slow_ms(search.result.chosen.cols);
   const double constant_ms = slow_ms({0});
   model.cv_slow_sd = std::sqrt(chosen_ms);
@@ -417,6 +424,7 @@ void SlowErrorAndSkill(const SlowError& slow_ms, const Search& search, ThermalRe
   } else {
     report.skill = constant_ms > 0.0 ? 1.0 - chosen_ms / constant_ms : 0.0;
   }
+  return {chosen_ms, constant_ms};
 }
 
 // The autopilot form (thermal_model.h) of channel 0: its degree by the rule on the search's fold
@@ -426,7 +434,7 @@ void SlowErrorAndSkill(const SlowError& slow_ms, const Search& search, ThermalRe
 void FitAutopilotForm(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
                       const Eigen::Ref<const Eigen::VectorXd>& y, const Eigen::VectorXd& weight,
                       const Search& search, double standard_errors, const SlowError& slow_ms,
-                      ThermalRegression& model) {
+                      const SlowParts& slow, ThermalRegression& model) {
   const internal::FoldScores& scores = *search.scores;
   std::vector<std::vector<int>> cols{{0}};
   for (int p = 1; p <= std::min(3, search.layout.static_powers); ++p) {
@@ -468,11 +476,10 @@ void FitAutopilotForm(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
   }
   const Eigen::VectorXd a = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(x).solve(ys);
   for (int k = 0; k <= form.degree; ++k) form.coefficients[k] = a[k] / std::pow(half, k);
-  const double constant_ms = slow_ms({0});
-  const double removed = constant_ms - slow_ms(search.result.chosen.cols);
+  const double removed = slow.constant_ms - slow.chosen_ms;
   form.share_kept = std::isnan(model.report.skill) || !(removed > 0.0)
                         ? std::numeric_limits<double>::quiet_NaN()
-                        : (constant_ms - slow_ms(cols[degree])) / removed;
+                        : (slow.constant_ms - slow_ms(cols[degree])) / removed;
 }
 
 // The nonlinear correction (header comment) on the chosen structure's residual. The network
@@ -519,9 +526,9 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
   Eigen::MatrixXd gram;
   const Eigen::VectorXd residual = RefitChosen(y, weight, search, model, gram);
   const SlowError slow_ms(residual, weight, search, rate_hz);
-  SlowErrorAndSkill(slow_ms, search, model);
+  const SlowParts slow = SlowErrorAndSkill(slow_ms, search, model);
   FitAutopilotForm(temperatures_c.col(0), y, weight, search, options.standard_errors, slow_ms,
-                   model);
+                   slow, model);
   if (run.nonlinear && search.result.chosen.cols.size() > 1) {
     AddCorrection(residual, run.seed, search, model);
   }

@@ -82,7 +82,13 @@ ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
   for (const std::string& path : model_paths) {
     for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));
   }
-  out.text = RenderExport(out.axes, options);
+  if (options.format == ExportFormat::kPx4Params) {
+    Px4Params px4 = MakePx4Params(out.axes, options.device_ids);
+    out.text = std::move(px4.text);
+    out.px4_forms = std::move(px4.forms);
+  } else {
+    out.text = RenderExport(out.axes, options);
+  }
   return out;
 }
 

@@ -76,6 +76,11 @@ drift::AutopilotForm AxisAutopilotForm(const LoadedModel& axis, const std::strin
 
 std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
                             const std::vector<std::uint32_t>& device_ids) {
+  return MakePx4Params(axes, device_ids).text;
+}
+
+Px4Params MakePx4Params(const std::vector<LoadedModel>& axes,
+                        const std::vector<std::uint32_t>& device_ids) {
   const size_t instances = device_ids.size();
   if (instances == 0 || instances > kMostInstances || axes.size() != kAxes * instances) {
     throw UsageError(fmt::format(
@@ -84,7 +89,9 @@ std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
         axes.size(), axes.size() == 1 ? "is" : "es", instances, instances == 1 ? "" : "s",
         kMostInstances));
   }
-  std::string out = fmt::format(
+  Px4Params result;
+  std::string& out = result.text;
+  out = fmt::format(
       "# PX4 thermal compensation of {} gyro{} (TC_G*), written by gyrodrift {}\n"
       "# offset = X0 + X1 dT + X2 dT^2 + X3 dT^3, dT = clamp(T, TMIN, TMAX) - TREF, rad/s, "
       "subtracted from the gyro\n#\n# Vehicle-Id Component-Id Name Value Type\n",
@@ -98,6 +105,8 @@ std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
       const LoadedModel& axis = axes[kAxes * i + a];
       const std::string label = internal::AxisLabel(kAxes * i + a, axis);
       forms[a] = AxisAutopilotForm(axis, label);
+      result.forms.push_back({fmt::format("TC_G{} axis {} ({})", i, a, axis.info.target_column),
+                              forms[a]});
       const double scale = RadsPer(axis, label);
       for (double& c : forms[a].coefficients) c *= scale;
       if (forms[a].tmin_c != forms[0].tmin_c || forms[a].tmax_c != forms[0].tmax_c) {
@@ -116,7 +125,7 @@ std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
       }
     }
   }
-  return out;
+  return result;
 }
 
 }  // namespace gyrodrift::firmware

@@ -295,7 +295,7 @@ TEST(ExportCliPx4, TwoGyrosFromOneFitEachToOneParameterFile) {
   EXPECT_NE(text.find("1\t1\tTC_G1_ID\t2621450\t6\n"), std::string::npos) << text;
   const std::string out2 = d + "/bad.params";
   test::ExpectCleanFailure(test::RunCli("export " + models + " --format px4 -o " + q + out2 + "'"),
-                           2, "device_ids = none", out2, "no device id");
+                           2, "--device-id = none", out2, "no device id");
   test::ExpectCleanFailure(test::RunCli("export " + q + d + "/gyro0.json' --format px4 "
                                         "--device-id 1,2 -o " + q + out2 + "'"),
                            2, "PX4 calibrates 1 to 3 gyros of 3 axes each", out2, "one gyro");

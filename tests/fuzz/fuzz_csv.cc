@@ -5,7 +5,9 @@
 // must give what the whole-text parse gives: the same message if it throws, else the same header
 // and rows and, for every column it kept (all, or time_s and the second one), the same values to
 // the bit or the same message. Anything else (a crash, a sanitizer finding, another exception, a
-// difference) is a finding.
+// difference) is a finding. Read with time_s as a time axis (CsvReadOptions::time_axis), the
+// axis must say of a time_s that loads what its values say: rows, finite, increasing, and the
+// median, largest and shortest step to the bit.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -16,6 +18,7 @@
 #include <vector>
 
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/statistics.h"
 #include "gyrodrift/io/csv.h"
 
 namespace {
@@ -72,6 +75,38 @@ void CompareBlockReader(const std::string& text, Delimiter delimiter,
   }
 }
 
+// The time axis gathered while reading against the time_s column the whole-text parse loads.
+void CompareTimeAxis(const std::string& text, Delimiter delimiter, const CsvTable& whole) {
+  std::optional<Eigen::VectorXd> t;
+  try {
+    t = whole.Column("time_s");
+  } catch (const gyrodrift::Error&) {
+    return;
+  }
+  const CsvReadOptions options{.delimiter = delimiter, .columns = {"2"}, .time_axis = "time_s"};
+  std::optional<CsvTable> read;
+  try {
+    std::istringstream in(text);
+    read = CsvTable::Read(in, "fuzz.csv", options);
+  } catch (const gyrodrift::Error&) {
+    return;  // column "2" may not exist or load
+  }
+  const gyrodrift::io::TimeAxis* axis = read->time_axis();
+  if (!axis) return;  // time_s is column 2, kept as values
+  Check(axis->rows() == t->size() && axis->complete() == t->allFinite());
+  if (!axis->complete()) return;
+  const Eigen::Index n = t->size();
+  const Eigen::VectorXd steps =
+      n >= 2 ? Eigen::VectorXd(t->tail(n - 1) - t->head(n - 1)) : Eigen::VectorXd();
+  Check(axis->increasing() == (n < 2 || steps.minCoeff() > 0.0));
+  if (!axis->increasing() || n < 2) return;
+  const double median = gyrodrift::MedianStep(*t), largest = axis->LargestStep();
+  Check(axis->MedianStep() == median && largest == steps.maxCoeff());
+  Eigen::Index first = 0;
+  steps.minCoeff(&first);
+  Check(axis->Shortest().value == steps.minCoeff() && axis->Shortest().first == first);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -96,6 +131,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       error = e.what();
     }
     CompareBlockReader(text, delimiter, table, error);
+    if (table) CompareTimeAxis(text, delimiter, *table);
   }
   return 0;
 }

@@ -91,6 +91,20 @@ drift::AutopilotForm AxisAutopilotForm(const LoadedModel& axis, const std::strin
 std::string RenderPx4Params(const std::vector<LoadedModel>& axes,
                             const std::vector<std::uint32_t>& device_ids);
 
+// One axis' form as the PX4 file holds it, for a front end's report: its parameters' names
+// ("TC_G0 axis 0 (x_dph)") and the form in the model's unit (AxisAutopilotForm).
+struct Px4AxisForm {
+  std::string label;
+  drift::AutopilotForm form;
+};
+// RenderPx4Params's text and the forms it wrote, each computed once.
+struct Px4Params {
+  std::string text;
+  std::vector<Px4AxisForm> forms;
+};
+Px4Params MakePx4Params(const std::vector<LoadedModel>& axes,
+                        const std::vector<std::uint32_t>& device_ids);
+
 // What an export holds, for the CLI's report.
 struct ExportSummary {
   int axes = 0;
@@ -111,6 +125,7 @@ std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptio
 struct ExportResult {
   std::vector<LoadedModel> axes;
   std::string text;
+  std::vector<Px4AxisForm> px4_forms;  // format px4: each axis' form, in file order
 };
 ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options);
