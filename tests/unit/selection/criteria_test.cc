@@ -156,7 +156,9 @@ TEST(Criteria, EnergyCurveExitsAtTheFirstModeAboveTheBand) {
     EXPECT_TRUE(std::isnan(r.energy_band_log2_upper[0]));
     for (int k = 1; k <= 4; ++k) {
       EXPECT_EQ(r.log2_energy[k - 1], std::log2(imfs.col(k - 1).squaredNorm())) << k;
-      if (k >= 2) EXPECT_EQ(r.energy_band_log2_upper[k - 1], band.Log2Upper(k)) << k;
+      if (k >= 2) {
+        EXPECT_EQ(r.energy_band_log2_upper[k - 1], band.Log2Upper(k)) << k;
+      }
     }
     EXPECT_EQ(r.energy_signal_start, 3) << confidence;
   }
