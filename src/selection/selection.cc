@@ -1,6 +1,7 @@
 // SelectModes in named steps: the checks, the KDE of x and of every IMF on one common grid, the
 // distances D_k and G_k, then the curves and boundary rules of the chosen criterion
-// (pdf_similarity.cc, criteria.cc) and the groups. Also the criterion and group names, and DecomposeAndSelect.
+// (pdf_similarity.cc, criteria.cc) and the groups. Also the criterion and group names, and
+// DecomposeAndSelect.
 #include "gyrodrift/selection/selection.h"
 
 #include <algorithm>

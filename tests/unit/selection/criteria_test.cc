@@ -1,6 +1,6 @@
-// The selection criteria on hand-made curves (pdf_similarity.cc and criteria.cc): k* on ties, the pdf criterion's noise
-// run against a supplied white-noise level, the two-group rules, and the energy curve's band exit.
-// selection_test runs them through SelectModes on decomposed signals.
+// The selection criteria on hand-made curves (pdf_similarity.cc and criteria.cc): k* on ties, the
+// pdf criterion's noise run against a supplied white-noise level, the two-group rules, and the
+// energy curve's band exit. selection_test runs them through SelectModes on decomposed signals.
 #include "selection/criteria.h"
 
 #include <gtest/gtest.h>

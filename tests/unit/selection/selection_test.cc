@@ -153,9 +153,9 @@ double KdeInnerProduct(const Eigen::VectorXd& a, double ha, const Eigen::VectorX
 // whose widths differ by 4 % (D by 1.5 %) are ordered as the exact distance orders them.
 TEST(SelectModes, DistanceOfNarrowModesIsTheExactL2OnTheRefinedGrid) {
   const int n = 512;
-  const Synthetic s = Build({Noise(0.05, 71, n), Noise(0.0104, 72, n), Noise(0.01, 73, n),
-                             Sine(2.0, 300.0, n)},
-                            Trend(0.0002, n));
+  const Synthetic s =
+      Build({Noise(0.05, 71, n), Noise(0.0104, 72, n), Noise(0.01, 73, n), Sine(2.0, 300.0, n)},
+            Trend(0.0002, n));
   const Eigen::VectorXd centred = s.x.array() - s.x.mean();
   SelectionOptions options;
   options.criterion = Criterion::kKomaty;  // D_k and k* only, no Monte-Carlo
