@@ -1,6 +1,7 @@
-// SelectModes: the checks, the KDE of x and of every IMF on one common grid, the distances D_k
-// and G_k, then the curves and boundary rules of the chosen criterion (pdf_similarity.cc,
-// criteria.cc) and the groups. Also the criterion and group names, and DecomposeAndSelect.
+// SelectModes in named steps: the checks, the KDE of x and of every IMF on one common grid, the
+// distances D_k and G_k, then the curves and boundary rules of the chosen criterion
+// (pdf_similarity.cc, criteria.cc) and the groups. Also the criterion and group names, and
+// DecomposeAndSelect.
 #include "gyrodrift/selection/selection.h"
 
 #include <algorithm>
@@ -118,16 +119,19 @@ GroupedDecomposition DecomposeAndSelect(
   return out;
 }
 
-SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
-                            const Eigen::Ref<const Eigen::MatrixXd>& imfs,
-                            const Eigen::Ref<const Eigen::VectorXd>& residue,
-                            const SelectionOptions& options, const Execution& execution) {
+namespace {
+
+// The caller's mistakes: bad options or threads, a short or non-finite signal, a decomposition
+// that does not match it, a supplied level of another length.
+void CheckInputs(const Eigen::Ref<const Eigen::VectorXd>& x,
+                 const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                 const Eigen::Ref<const Eigen::VectorXd>& residue, const SelectionOptions& options,
+                 const Execution& execution) {
   options.Validate();
   execution.Validate();
   RequireFiniteSignal("x", x, 16);
   const Eigen::Index n = x.size();
-  const int k_count = static_cast<int>(imfs.cols());
-  if (k_count < 1) throw DataError("imfs: the decomposition has no IMF, nothing to select");
+  if (imfs.cols() < 1) throw DataError("imfs: the decomposition has no IMF, nothing to select");
   if (imfs.rows() != n) {
     throw DataError("imfs: " + std::to_string(imfs.rows()) + " rows for a signal of " +
                     std::to_string(n) + " samples");
@@ -143,56 +147,72 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
     ThrowOption("noise_level", "length " + std::to_string(options.noise_level->length),
                 "a level computed for the signal's length " + std::to_string(n));
   }
+}
 
-  const KdeOptions& kde = options.kde;
-  SelectionResult result;
-  result.criterion = options.criterion;
-  result.distance = options.distance;
-  result.length = static_cast<int>(n);
-  result.num_imfs = k_count;
+// max_t |x - (sum_k imf_k + residue)| / max_t |x|: reported, not enforced (EEMD is not
+// complete).
+double ReconstructionError(const Eigen::Ref<const Eigen::VectorXd>& x,
+                           const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                           const Eigen::Ref<const Eigen::VectorXd>& residue) {
+  Eigen::VectorXd sum = residue;
+  for (Eigen::Index k = 0; k < imfs.cols(); ++k) sum += imfs.col(k);
+  const double scale = x.cwiseAbs().maxCoeff();
+  const double err = (x - sum).cwiseAbs().maxCoeff();
+  return scale > 0.0 ? err / scale : err;
+}
 
-  // Reconstruction check (reported, not enforced: EEMD is not complete).
-  {
-    Eigen::VectorXd sum = residue;
-    for (int k = 0; k < k_count; ++k) sum += imfs.col(k);
-    const double scale = x.cwiseAbs().maxCoeff();
-    const double err = (x - sum).cwiseAbs().maxCoeff();
-    result.reconstruction_error = scale > 0.0 ? err / scale : err;
-  }
-
-  // Bandwidths: x (centred or not, the same), then each IMF.
-  const int workers = std::min(ResolveThreads(execution.threads), k_count + 1);
-  std::vector<internal::Scratch> scratch(static_cast<size_t>(workers));
-  const double h_x = kde.bandwidth_scale * SilvermanBandwidth(x, &scratch[0].kde);
-  if (!(h_x > 0.0)) throw DataError("x: constant signal, nothing to select");
-  result.signal_bandwidth = h_x;
+// Silverman bandwidths of every IMF (index k - 1), on the workers' scratch.
+std::vector<double> ImfBandwidths(const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                                  const KdeOptions& kde, std::vector<internal::Scratch>& scratch) {
+  const int k_count = static_cast<int>(imfs.cols());
   std::vector<double> h(static_cast<size_t>(k_count));
-  ParallelFor(k_count, workers, [&](int k, int w) {
+  ParallelFor(k_count, static_cast<int>(scratch.size()), [&](int k, int w) {
     h[static_cast<size_t>(k)] =
         kde.bandwidth_scale * SilvermanBandwidth(imfs.col(k), &scratch[static_cast<size_t>(w)].kde);
   });
+  return h;
+}
 
-  // One common grid over the centred signal and every IMF, padded by each density's own
-  // bandwidths, resolving the narrowest density.
-  const double shift = options.center_signal ? x.mean() : 0.0;
+// One common grid over the (shifted) signal and every IMF, padded by each density's own
+// bandwidths, resolving the narrowest density (docs/selection.md section 1).
+Grid CommonGrid(const Eigen::Ref<const Eigen::VectorXd>& x, double shift, double h_x,
+                const Eigen::Ref<const Eigen::MatrixXd>& imfs, const std::vector<double>& h,
+                const KdeOptions& kde) {
   double lo = x.minCoeff() - shift - kde.padding_bandwidths * h_x;
   double hi = x.maxCoeff() - shift + kde.padding_bandwidths * h_x;
   double h_min = h_x;
-  for (int k = 0; k < k_count; ++k) {
+  for (Eigen::Index k = 0; k < imfs.cols(); ++k) {
     const double hk = h[static_cast<size_t>(k)];
     lo = std::min(lo, imfs.col(k).minCoeff() - kde.padding_bandwidths * hk);
     hi = std::max(hi, imfs.col(k).maxCoeff() + kde.padding_bandwidths * hk);
     if (hk > 0.0) h_min = std::min(h_min, hk);
   }
-  const Grid grid = MakeGrid(lo, hi, h_min, kde);
-  result.grid_points = grid.points;
-  result.grid_under_resolved = grid.under_resolved;
+  return MakeGrid(lo, hi, h_min, kde);
+}
+
+// The curves every criterion starts from: D_k (the signal's density against IMF k's on the common
+// grid) and G_k (IMF k's standardised density against N(0, 1)), with the grid diagnostics.
+void DensityCurves(const Eigen::Ref<const Eigen::VectorXd>& x,
+                   const Eigen::Ref<const Eigen::MatrixXd>& imfs, const SelectionOptions& options,
+                   const Execution& execution, SelectionResult* result) {
+  const KdeOptions& kde = options.kde;
+  const int k_count = static_cast<int>(imfs.cols());
+  const int workers = std::min(ResolveThreads(execution.threads), k_count + 1);
+  std::vector<internal::Scratch> scratch(static_cast<size_t>(workers));
+  // The bandwidth of x is the same centred or not.
+  const double h_x = kde.bandwidth_scale * SilvermanBandwidth(x, &scratch[0].kde);
+  if (!(h_x > 0.0)) throw DataError("x: constant signal, nothing to select");
+  result->signal_bandwidth = h_x;
+  const std::vector<double> h = ImfBandwidths(imfs, kde, scratch);
+  const double shift = options.center_signal ? x.mean() : 0.0;
+  const Grid grid = CommonGrid(x, shift, h_x, imfs, h, kde);
+  result->grid_points = grid.points;
+  result->grid_under_resolved = grid.under_resolved;
 
   Eigen::VectorXd pdf_x(grid.points);
   EstimateDensity(x, shift, 1.0, h_x, grid, kde.method, &scratch[0].kde, pdf_x);
-  result.pdf_distance.assign(static_cast<size_t>(k_count), 0.0);
-  result.self_distance.assign(static_cast<size_t>(k_count), 0.0);
-  bool constant_imf = false;
+  result->pdf_distance.assign(static_cast<size_t>(k_count), 0.0);
+  result->self_distance.assign(static_cast<size_t>(k_count), 0.0);
   ParallelFor(k_count, workers, [&](int k, int w) {
     internal::Scratch& s = scratch[static_cast<size_t>(w)];
     // A constant IMF (zero bandwidth) is a spike: give it one grid step of bandwidth.
@@ -200,39 +220,44 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
     if (!(hk > 0.0)) hk = grid.step;
     s.common.resize(grid.points);
     EstimateDensity(imfs.col(k), 0.0, 1.0, hk, grid, kde.method, &s.kde, s.common);
-    result.pdf_distance[static_cast<size_t>(k)] =
+    result->pdf_distance[static_cast<size_t>(k)] =
         Distance(options.distance, pdf_x, s.common, grid.step);
-    result.self_distance[static_cast<size_t>(k)] =
+    result->self_distance[static_cast<size_t>(k)] =
         internal::SelfSimilarity(imfs.col(k), kde, options.distance, &s);
   });
-  for (int k = 0; k < k_count; ++k) {
-    if (!(h[static_cast<size_t>(k)] > 0.0)) constant_imf = true;
+  if (std::any_of(h.begin(), h.end(), [](double hk) { return !(hk > 0.0); })) {
+    AppendNote(&result->note, "constant IMF (density given one grid step)");
   }
-  if (constant_imf) AppendNote(&result.note, "constant IMF (density given one grid step)");
+}
 
-  result.k_star = internal::KStar(result.pdf_distance);
-  internal::EnergyCurve(imfs, options.band_confidence, &result);
-
-  // Boundaries per criterion.
+// k_noise and mixed_end by the chosen criterion's rule (criteria.h).
+void Boundaries(int length, const SelectionOptions& options, const Execution& execution,
+                SelectionResult* result) {
   switch (options.criterion) {
     case Criterion::kPdfSimilarity:
-      internal::PdfSimilarityBoundaries(static_cast<int>(n), options, execution, &result);
+      internal::PdfSimilarityBoundaries(length, options, execution, result);
       break;
     case Criterion::kKomaty:
-      internal::KomatyBoundaries(&result);
+      internal::KomatyBoundaries(result);
       break;
     case Criterion::kEnergyModel:
-      internal::EnergyModelBoundaries(&result);
+      internal::EnergyModelBoundaries(result);
       break;
   }
-  if (result.mixed_end == k_count) AppendNote(&result.note, "drift group is the residue alone");
+  if (result->mixed_end == result->num_imfs) {
+    AppendNote(&result->note, "drift group is the residue alone");
+  }
+}
 
-  // Groups: noise 1..k_noise, mixed k_noise+1..mixed_end, drift mixed_end+1..K + residue.
+// Groups: noise 1..k_noise, mixed k_noise+1..mixed_end, drift mixed_end+1..K + residue; empty
+// groups dropped, each series summed in increasing k, the residue last.
+void FormGroups(const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                const Eigen::Ref<const Eigen::VectorXd>& residue, SelectionResult* result) {
   auto make_group = [&](GroupKind kind, int first, int last, bool with_residue) {
     ModeGroup g;
     g.kind = kind;
     g.has_residue = with_residue;
-    g.series = Eigen::VectorXd::Zero(n);
+    g.series = Eigen::VectorXd::Zero(imfs.rows());
     for (int k = first; k <= last; ++k) {
       g.imfs.push_back(k);
       g.series += imfs.col(k - 1);
@@ -240,14 +265,35 @@ SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
     if (with_residue) g.series += residue;
     return g;
   };
-  if (result.k_noise >= 1) {
-    result.groups.push_back(make_group(GroupKind::kNoise, 1, result.k_noise, false));
+  if (result->k_noise >= 1) {
+    result->groups.push_back(make_group(GroupKind::kNoise, 1, result->k_noise, false));
   }
-  if (result.mixed_end > result.k_noise) {
-    result.groups.push_back(
-        make_group(GroupKind::kMixed, result.k_noise + 1, result.mixed_end, false));
+  if (result->mixed_end > result->k_noise) {
+    result->groups.push_back(
+        make_group(GroupKind::kMixed, result->k_noise + 1, result->mixed_end, false));
   }
-  result.groups.push_back(make_group(GroupKind::kDrift, result.mixed_end + 1, k_count, true));
+  result->groups.push_back(
+      make_group(GroupKind::kDrift, result->mixed_end + 1, result->num_imfs, true));
+}
+
+}  // namespace
+
+SelectionResult SelectModes(const Eigen::Ref<const Eigen::VectorXd>& x,
+                            const Eigen::Ref<const Eigen::MatrixXd>& imfs,
+                            const Eigen::Ref<const Eigen::VectorXd>& residue,
+                            const SelectionOptions& options, const Execution& execution) {
+  CheckInputs(x, imfs, residue, options, execution);
+  SelectionResult result;
+  result.criterion = options.criterion;
+  result.distance = options.distance;
+  result.length = static_cast<int>(x.size());
+  result.num_imfs = static_cast<int>(imfs.cols());
+  result.reconstruction_error = ReconstructionError(x, imfs, residue);
+  DensityCurves(x, imfs, options, execution, &result);
+  result.k_star = internal::KStar(result.pdf_distance);
+  internal::EnergyCurve(imfs, options.band_confidence, &result);
+  Boundaries(result.length, options, execution, &result);
+  FormGroups(imfs, residue, &result);
   return result;
 }
 

@@ -1,6 +1,6 @@
-// The selection criteria on hand-made curves (pdf_similarity.cc and criteria.cc): k* on ties, the pdf criterion's noise
-// run against a supplied white-noise level, the two-group rules, and the energy curve's band exit.
-// selection_test runs them through SelectModes on decomposed signals.
+// The selection criteria on hand-made curves (pdf_similarity.cc and criteria.cc): k* on ties, the
+// pdf criterion's noise run against a supplied white-noise level, the two-group rules, and the
+// energy curve's band exit. selection_test runs them through SelectModes on decomposed signals.
 #include "selection/criteria.h"
 
 #include <gtest/gtest.h>
@@ -156,7 +156,9 @@ TEST(Criteria, EnergyCurveExitsAtTheFirstModeAboveTheBand) {
     EXPECT_TRUE(std::isnan(r.energy_band_log2_upper[0]));
     for (int k = 1; k <= 4; ++k) {
       EXPECT_EQ(r.log2_energy[k - 1], std::log2(imfs.col(k - 1).squaredNorm())) << k;
-      if (k >= 2) EXPECT_EQ(r.energy_band_log2_upper[k - 1], band.Log2Upper(k)) << k;
+      if (k >= 2) {
+        EXPECT_EQ(r.energy_band_log2_upper[k - 1], band.Log2Upper(k)) << k;
+      }
     }
     EXPECT_EQ(r.energy_signal_start, 3) << confidence;
   }
