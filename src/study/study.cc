@@ -98,16 +98,15 @@ drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
   rows << y, temperature;
   run.rows.Append(rows);
   const StudyOptions& a = s.options;
-  const drift::FitSettings settings{
-      .mode = "compensate",
-      .method = std::string(drift::ToString(method)),
-      .rate_hz = s.rate_hz,
-      .ensemble = a.ensemble_size,
-      .realisations = a.realisations,
-      .seed = a.seed,
-      .threads = s.threads,
-      .reference_temperature = s.drift_options.reference_c,
-      .has_temperature = true};
+  const drift::FitSettings settings{.mode = "compensate",
+                                    .method = std::string(drift::ToString(method)),
+                                    .rate_hz = s.rate_hz,
+                                    .ensemble = a.ensemble_size,
+                                    .realisations = a.realisations,
+                                    .seed = a.seed,
+                                    .threads = s.threads,
+                                    .reference_temperature = s.drift_options.reference_c,
+                                    .has_temperature = true};
   return tasks::RunFit(run, settings, "dph").axes.front().model;
 }
 
@@ -150,9 +149,9 @@ void TakeLog(const StudyOptions& a, const StudyLog& log, StudyResult& s) {
   s.rate_hz = log.rate_hz;
   s.rate_source = log.rate_source;
   s.time_note = log.time_note;
-  s.time_h = Eigen::VectorXd::LinSpaced(s.output.size(), 0.0,
-                                        static_cast<double>(s.output.size() - 1)) /
-             (3600.0 * s.rate_hz);
+  s.time_h =
+      Eigen::VectorXd::LinSpaced(s.output.size(), 0.0, static_cast<double>(s.output.size() - 1)) /
+      (3600.0 * s.rate_hz);
 }
 
 void DecomposeStep(StudyResult& s) {
@@ -245,8 +244,7 @@ void CompensateSplit(StudyResult& s, const Notifier& notify) {
   s.compensate_time_h = s.time_h.tail(s.output.size() - split);
   // The measured output carries the sensor's constant bias, which any model removes; the share is
   // taken of the output's variation about its mean instead.
-  const double reference_rms =
-      Rms(s.compensate_reference.array() - s.compensate_reference.mean());
+  const double reference_rms = Rms(s.compensate_reference.array() - s.compensate_reference.mean());
   for (const auto& r : s.compensate_split.rows) {
     StudyResult::CompensateRow row{r.method,   std::string(drift::ToString(r.protocol)),
                                    {},         0.0,
@@ -328,84 +326,93 @@ void AllanStep(StudyResult& s) {
   if (s.simulated) fit(s.allan_noise, s.terms_noise);
 }
 
+// Refuses a log the study cannot analyse, before any work.
+void CheckLog(const StudyOptions& options, const StudyLog& log) {
+  ValidateAsSettings({{"features.rate_hz", "rate_hz"}},
+                     [&] { internal::StudyDriftOptions(options, log.rate_hz, false).Validate(); });
+  if (log.output.size() < kMinLogSamples) {
+    throw DataError(log.source + ": " + std::to_string(log.output.size()) +
+                    " samples; the study needs at least 64 (a 70/30 split with 32 training and "
+                    "16 test samples, and room for the decomposition)");
+  }
+  if (log.temperature.size() != log.output.size()) {
+    throw DataError(log.source + ": the temperature has " + std::to_string(log.temperature.size()) +
+                    " samples, the output " + std::to_string(log.output.size()) +
+                    ": one per output sample expected");
+  }
+}
+
+// Records how long the stage `name` took since t0 (plus extra_s spent before the study).
+void TimeStage(StudyResult& s, const std::string& name, Clock::time_point t0,
+               double extra_s = 0.0) {
+  s.stage_s.push_back({name, extra_s + Seconds(t0)});
+}
+
+// Stage 1: runs A and B simulated, or the log taken; then the study's drift options.
+void DataStage(StudyResult& s, const StudyLog* log, const Notifier& notify) {
+  notify.Progress(0, 0.0, s.simulated ? "simulating runs A and B" : "checking " + log->source);
+  const auto t0 = Clock::now();
+  if (s.simulated) {
+    SimulateRuns(s.options, s);
+  } else {
+    TakeLog(s.options, *log, s);
+  }
+  s.drift_options = internal::StudyDriftOptions(s.options, s.rate_hz, s.simulated);
+  TimeStage(s, s.simulated ? "simulate A and B" : "read", t0, log ? log->read_s : 0.0);
+  if (s.simulated) {
+    notify.StageDone(0, fmt::format("1. simulated run A: {}\n   simulated run B: {}\n",
+                                    s.run_a.Summary(), s.run_b.Summary()));
+  } else {
+    notify.StageDone(
+        0, fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", s.source, s.output.size(),
+                       s.target_name, RoundedText(s.rate_hz), s.rate_source) +
+               (s.time_note.empty() ? "" : "   " + s.time_note + "\n"));
+  }
+}
+
+// The study's steps in order, each reported to the context as it ends.
 StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyContext& context) {
   options.Validate();
   ValidateThreads(context.threads);
-  const bool simulated = log == nullptr;
-  if (log) {
-    ValidateAsSettings({{"features.rate_hz", "rate_hz"}}, [&] {
-      internal::StudyDriftOptions(options, log->rate_hz, false).Validate();
-    });
-    if (log->output.size() < kMinLogSamples) {
-      throw DataError(log->source + ": " + std::to_string(log->output.size()) +
-                      " samples; the study needs at least 64 (a 70/30 split with 32 training and "
-                      "16 test samples, and room for the decomposition)");
-    }
-    if (log->temperature.size() != log->output.size()) {
-      throw DataError(log->source + ": the temperature has " +
-                      std::to_string(log->temperature.size()) + " samples, the output " +
-                      std::to_string(log->output.size()) + ": one per output sample expected");
-    }
-  }
+  if (log) CheckLog(options, *log);
   const auto start = Clock::now();
   const double read_s = log ? log->read_s : 0.0;
   const Notifier notify{context};
   StudyResult s;
   s.options = options;
   s.threads = context.threads;
-  s.simulated = simulated;
-  auto time_stage = [&](const std::string& name, Clock::time_point t0, double extra_s = 0.0) {
-    s.stage_s.push_back({name, extra_s + Seconds(t0)});
-  };
-
-  notify.Progress(0, 0.0, simulated ? "simulating runs A and B" : "checking " + log->source);
-  auto t0 = Clock::now();
-  if (simulated) {
-    SimulateRuns(options, s);
-  } else {
-    TakeLog(options, *log, s);
-  }
-  s.drift_options = internal::StudyDriftOptions(options, s.rate_hz, simulated);
-  time_stage(simulated ? "simulate A and B" : "read", t0, read_s);
-  if (simulated) {
-    notify.StageDone(0, fmt::format("1. simulated run A: {}\n   simulated run B: {}\n",
-                                    s.run_a.Summary(), s.run_b.Summary()));
-  } else {
-    notify.StageDone(0, fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", s.source,
-                                    s.output.size(), s.target_name, RoundedText(s.rate_hz),
-                                    s.rate_source) +
-                            (s.time_note.empty() ? "" : "   " + s.time_note + "\n"));
-  }
+  s.simulated = log == nullptr;
+  DataStage(s, log, notify);
 
   notify.Progress(1, 0.0, "BEEMDAN decomposition and mode selection");
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   DecomposeStep(s);
-  time_stage("decompose + select", t0);
-  notify.StageDone(1, fmt::format("2. {}\n   {}\n", s.decomposition.report.Summary(),
-                                  s.selection.Summary()));
+  TimeStage(s, "decompose + select", t0);
+  notify.StageDone(
+      1, fmt::format("2. {}\n   {}\n", s.decomposition.report.Summary(), s.selection.Summary()));
 
   notify.Progress(2, 0.0, "predict mode");
   t0 = Clock::now();
   PredictStep(s, notify);
-  time_stage("predict mode (both protocols)", t0);
+  TimeStage(s, "predict mode (both protocols)", t0);
   internal::FillPredictTable(s);
   notify.StageDone(2, "3. " + s.predict_table.Text());
 
   notify.Progress(3, 0.0, "compensate mode");
   t0 = Clock::now();
-  if (simulated) {
+  if (s.simulated) {
     CompensateSimulated(s, notify);
   } else {
     CompensateSplit(s, notify);
   }
-  time_stage("compensate mode", t0);
+  TimeStage(s, "compensate mode", t0);
   internal::FillCompensateTable(s);
   notify.StageDone(3, "4. " + s.compensate_table.Text());
 
   notify.Progress(4, 0.0, "Allan deviation");
   t0 = Clock::now();
   AllanStep(s);
-  time_stage("Allan deviation + noise fits", t0);
+  TimeStage(s, "Allan deviation + noise fits", t0);
   internal::FillNoiseTermsTable(s);
   notify.StageDone(4, "5. " + s.terms_table.Text());
 
@@ -418,8 +425,7 @@ StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyCon
 
 namespace internal {
 
-drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz,
-                                      bool simulated) {
+drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz, bool simulated) {
   drift::DriftOptions o;
   o.decomposition.ensemble_size = options.ensemble_size;
   o.selection.monte_carlo.realisations = options.realisations;
