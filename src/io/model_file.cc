@@ -350,7 +350,10 @@ std::string FirstUnknownField(const json& file, const json& known, const std::st
   return "";
 }
 
-std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source) {
+namespace {
+
+// The JSON of `text`, refused unless it is an object whose "format" is a model file's.
+json ParseModelJson(const std::string& text, const std::string& source) {
   json j;
   try {
     j = json::parse(text);
@@ -366,7 +369,11 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": not a gyrodrift model file (\"format\" must be \"" +
                     std::string(kModelFormat) + "\")");
   }
-  const Node root(j, "", source);
+  return j;
+}
+
+// The file's format_version, refused unless this version reads it.
+long long ReadFormatVersion(const Node& root, const std::string& source) {
   const long long version = root["format_version"].Int(0, std::numeric_limits<int>::max());
   if (version < kOldestReadableModelFormatVersion || version > kModelFormatVersion) {
     throw DataError(source + ": model format_version " + std::to_string(version) +
@@ -374,6 +381,11 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
                     std::to_string(kOldestReadableModelFormatVersion) + " to " +
                     std::to_string(kModelFormatVersion) + ")");
   }
+  return version;
+}
+
+// The stored checksum, refused unless the content (all but the checksum) gives it.
+std::string CheckChecksum(const json& j, const Node& root, const std::string& source) {
   const std::string stored = root["checksum"].String();
   json body = j;
   body.erase("checksum");
@@ -382,52 +394,49 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": checksum mismatch (file says " + stored + ", content gives " +
                     computed + "): the model file is damaged or was edited");
   }
-  const std::string tool_version = root["tool_version"].String();
-  std::vector<LoadedModel> axes;
-  auto read_axis = [&](const Node& at) {
-    LoadedModel out;
-    out.info.tool_version = tool_version;
-    const Node training = at["training"];
-    out.info.target_column = training["target_column"].String();
-    out.info.temperature_column = training["temperature_column"].String();
-    out.info.source = training["source"].String();
-    out.info.rate_unit = "";
-    if (version >= 4) {
-      out.info.rate_unit = training["rate_unit"].String();
-      if (!out.info.rate_unit.empty()) {
-        try {
-          (void)allan::RateUnitFromString(out.info.rate_unit);
-        } catch (const UsageError&) {
-          training["rate_unit"].Fail("= '" + out.info.rate_unit + "': must be dph, dps or rads");
-        }
+  return stored;
+}
+
+// The axis at `at` of a file of `version`; `earlier`: the axes read before it (one target each).
+LoadedModel ReadAxis(const Node& at, long long version, const std::string& tool_version,
+                     const std::vector<LoadedModel>& earlier) {
+  LoadedModel out;
+  out.info.tool_version = tool_version;
+  const Node training = at["training"];
+  out.info.target_column = training["target_column"].String();
+  out.info.temperature_column = training["temperature_column"].String();
+  out.info.source = training["source"].String();
+  out.info.rate_unit = "";
+  if (version >= 4) {
+    out.info.rate_unit = training["rate_unit"].String();
+    if (!out.info.rate_unit.empty()) {
+      try {
+        (void)allan::RateUnitFromString(out.info.rate_unit);
+      } catch (const UsageError&) {
+        training["rate_unit"].Fail("= '" + out.info.rate_unit + "': must be dph, dps or rads");
       }
     }
-    out.model = ReadModel(at);
-    if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
-      training["samples"].Fail("differs from model.training_samples");
-    }
-    if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
-      training["temperature_column"].Fail("is empty but the model uses temperature");
-    }
-    for (const LoadedModel& earlier : axes) {
-      if (earlier.info.target_column == out.info.target_column) {
-        training["target_column"].Fail("= '" + out.info.target_column +
-                                       "' is the target of an earlier axis too");
-      }
-    }
-    axes.push_back(std::move(out));
-  };
-  if (j.contains("axes")) {
-    const std::vector<Node> items = root["axes"].Items();
-    if (items.size() < 2 || static_cast<int>(items.size()) > kMaxModelAxes) {
-      root["axes"].Fail("holds " + std::to_string(items.size()) + " axes (2 to " +
-                        std::to_string(kMaxModelAxes) +
-                        " expected; a one-axis file keeps its fields at the top level)");
-    }
-    for (const Node& item : items) read_axis(item);
-  } else {
-    read_axis(root);
   }
+  out.model = ReadModel(at);
+  if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
+    training["samples"].Fail("differs from model.training_samples");
+  }
+  if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
+    training["temperature_column"].Fail("is empty but the model uses temperature");
+  }
+  for (const LoadedModel& e : earlier) {
+    if (e.info.target_column == out.info.target_column) {
+      training["target_column"].Fail("= '" + out.info.target_column +
+                                     "' is the target of an earlier axis too");
+    }
+  }
+  return out;
+}
+
+// Refuses a field of the file `j` that `axes` (read from it) written back by this version lacks:
+// one that reading would silently ignore.
+void RejectUnknownFields(const json& j, const std::vector<LoadedModel>& axes,
+                         const std::string& stored, long long version, const std::string& source) {
   json known = ModelFileJson(axes);
   known["checksum"] = stored;
   if (version <= kLastModelFormatVersionWithThreads) {
@@ -453,6 +462,29 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": field '" + unknown +
                     "' is not part of a gyrodrift model file (misspelt, or from another tool)");
   }
+}
+
+}  // namespace
+
+std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source) {
+  const json j = ParseModelJson(text, source);
+  const Node root(j, "", source);
+  const long long version = ReadFormatVersion(root, source);
+  const std::string stored = CheckChecksum(j, root, source);
+  const std::string tool_version = root["tool_version"].String();
+  std::vector<LoadedModel> axes;
+  if (j.contains("axes")) {
+    const std::vector<Node> items = root["axes"].Items();
+    if (items.size() < 2 || static_cast<int>(items.size()) > kMaxModelAxes) {
+      root["axes"].Fail("holds " + std::to_string(items.size()) + " axes (2 to " +
+                        std::to_string(kMaxModelAxes) +
+                        " expected; a one-axis file keeps its fields at the top level)");
+    }
+    for (const Node& item : items) axes.push_back(ReadAxis(item, version, tool_version, axes));
+  } else {
+    axes.push_back(ReadAxis(root, version, tool_version, axes));
+  }
+  RejectUnknownFields(j, axes, stored, version, source);
   return axes;
 }
 
