@@ -13,6 +13,8 @@
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/evaluate_task.h"
 #include "gyrodrift/tasks/fit_task.h"
 #include "study_steps.h"
 
@@ -90,32 +92,42 @@ std::function<void(double, std::string_view)> TrialProgress(
 }
 
 // A compensate-mode model of `method` fitted on (y, temperature) through the fit task, as
-// `gyrodrift fit` fits it: the study's settings (StudyDriftOptions' as drift::FitSettings).
+// `gyrodrift fit` fits it.
 drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
                                   const Eigen::VectorXd& y, const Eigen::VectorXd& temperature) {
   tasks::FitRun run{.targets = {"y"}, .temperatures = {"temperature"}};
   Eigen::MatrixXd rows(y.size(), 2);
   rows << y, temperature;
   run.rows.Append(rows);
-  const StudyOptions& a = s.options;
-  const drift::FitSettings settings{.mode = "compensate",
-                                    .method = std::string(drift::ToString(method)),
-                                    .rate_hz = s.rate_hz,
-                                    .ensemble = a.ensemble_size,
-                                    .realisations = a.realisations,
-                                    .seed = a.seed,
-                                    .threads = s.threads,
-                                    .reference_temperature = s.drift_options.reference_c,
-                                    .has_temperature = true};
+  drift::FitSettings settings = internal::StudyFitSettings(s, drift::Mode::kCompensate);
+  settings.method = std::string(drift::ToString(method));
   return tasks::RunFit(run, settings, "dph").axes.front().model;
 }
 
-drift::EvaluationOptions EvaluationFor(const StudyOptions& a, std::vector<drift::Method> methods) {
-  drift::EvaluationOptions e;
-  e.methods = std::move(methods);
-  e.causal.window = a.causal_window;
-  e.causal.ensemble_size = a.ensemble_size;
-  return e;
+// The study's evaluation of `methods` ("all" or a comma-separated list) with the models' settings
+// `fit`: the causal protocol's window and ensemble are the study's.
+tasks::EvaluateSettings EvaluationSettings(const StudyOptions& a, drift::FitSettings fit,
+                                           std::string methods) {
+  return {.fit = std::move(fit),
+          .methods = std::move(methods),
+          .window = a.causal_window,
+          .causal_ensemble = a.ensemble_size};
+}
+
+// `methods` scored in `mode` on the record through the evaluate task (against `truth` when not
+// empty), reporting to stage `stage` of the context.
+drift::EvaluationResult EvaluateStep(const StudyResult& s, drift::Mode mode,
+                                     const std::vector<drift::Method>& methods,
+                                     const Eigen::VectorXd& truth, const Notifier& notify,
+                                     int stage, const std::string& prefix) {
+  std::string list;
+  for (drift::Method m : methods)
+    list += (list.empty() ? "" : ",") + std::string(drift::ToString(m));
+  const tasks::EvaluateSettings settings =
+      EvaluationSettings(s.options, internal::StudyFitSettings(s, mode), list);
+  auto progress =
+      TrialProgress(notify, stage, drift::EvaluatedMethods(settings.Options()), mode, prefix);
+  return tasks::RunEvaluate(s.output, s.temperature, truth, settings, std::move(progress)).result;
 }
 
 void SimulateRuns(const StudyOptions& a, StudyResult& s) {
@@ -174,8 +186,6 @@ void DecomposeStep(StudyResult& s) {
 }
 
 void PredictStep(StudyResult& s, const Notifier& notify) {
-  drift::DriftOptions o = s.drift_options;
-  o.mode = drift::Mode::kPredict;
   std::vector<drift::Method> methods;
   for (drift::Method m : s.options.methods) {
     if (drift::SupportsMode(m, drift::Mode::kPredict)) methods.push_back(m);
@@ -187,11 +197,7 @@ void PredictStep(StudyResult& s, const Notifier& notify) {
       methods.push_back(m);
     }
   }
-  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{.threads = s.threads,
-                            .progress = TrialProgress(notify, 2, drift::EvaluatedMethods(e),
-                                                      drift::Mode::kPredict, "predict: ")};
-  s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e, execution);
+  s.predict = EvaluateStep(s, drift::Mode::kPredict, methods, s.truth, notify, 2, "predict: ");
 }
 
 void CompensateSimulated(StudyResult& s, const Notifier& notify) {
@@ -208,21 +214,23 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
                     "compensate: " + std::string(drift::ToString(methods[i])));
     StudyResult::CompensateRow row{methods[i], "train A test B", {}, 0.0, 0.0, 0.0, {}, {}};
     auto start = Clock::now();
-    const drift::DriftModel model =
-        FitCompensation(s, methods[i], s.run_a.rate_dph, s.run_a.temperature_c);
+    const io::LoadedModel loaded{
+        FitCompensation(s, methods[i], s.run_a.rate_dph, s.run_a.temperature_c),
+        {"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"}};
     row.train_s = Seconds(start);
     start = Clock::now();
-    row.estimate = drift::EstimateDrift(model, s.run_b.temperature_c);
+    // Through the compensate task, as `gyrodrift compensate` applies the model file to run B.
+    row.estimate =
+        tasks::CompensateAxis(loaded, s.run_b.rate_dph, s.run_b.temperature_c, {}, {}, {}).estimate;
     row.estimate_s = Seconds(start);
     row.metrics = drift::ComputeMetrics(s.compensate_reference - row.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
-    row.summary = model.Summary();
+    row.summary = loaded.model.Summary();
     row.slow_removed = drift::SlowVariationRemoved(s.compensate_reference, row.estimate, s.rate_hz);
     if (!drift::IsBaseline(methods[i])) {
-      io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"};
       s.model_files.push_back(
           {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
-           io::RenderModelFile(model, info)});
+           io::RenderModelFile({loaded})});
     }
     s.compensate.push_back(std::move(row));
   }
@@ -230,14 +238,8 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
 
 void CompensateSplit(StudyResult& s, const Notifier& notify) {
   const std::vector<drift::Method>& methods = s.options.methods;
-  drift::DriftOptions base = s.drift_options;
-  base.mode = drift::Mode::kCompensate;
-  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{.threads = s.threads,
-                            .progress = TrialProgress(notify, 3, drift::EvaluatedMethods(e),
-                                                      drift::Mode::kCompensate, "compensate: ")};
-  s.compensate_split =
-      drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e, execution);
+  s.compensate_split = EvaluateStep(s, drift::Mode::kCompensate, methods, Eigen::VectorXd(), notify,
+                                    3, "compensate: ");
   const Eigen::Index split = s.compensate_split.split_index;
   s.compensate_reference = s.compensate_split.reference;
   s.compensate_output = s.output.tail(s.output.size() - split);
@@ -435,6 +437,20 @@ drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_h
   return o;
 }
 
+drift::FitSettings StudyFitSettings(const StudyResult& s, drift::Mode mode) {
+  const StudyOptions& a = s.options;
+  const bool compensate = mode == drift::Mode::kCompensate;
+  return {.mode = std::string(drift::ToString(mode)),
+          .rate_hz = s.rate_hz,
+          .ensemble = a.ensemble_size,
+          .realisations = a.realisations,
+          .seed = a.seed,
+          .threads = s.threads,
+          // A compensate-mode setting: the estimate's reference (StudyDriftOptions).
+          .reference_temperature = compensate ? s.drift_options.reference_c : std::nullopt,
+          .has_temperature = compensate};
+}
+
 std::string GroupOf(const sel::SelectionResult& selection, int k) {
   for (const auto& g : selection.groups) {
     if (std::find(g.imfs.begin(), g.imfs.end(), k) != g.imfs.end())
@@ -451,10 +467,12 @@ void StudyOptions::Validate() const {
   // refusal names the study's field that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
                       {"selection.monte_carlo.realisations", "realisations"},
-                      {"window", "causal_window"}},
+                      {"causal.window", "causal_window"}},
                      [&] {
                        internal::StudyDriftOptions(*this, 1.0, true).Validate();
-                       EvaluationFor(*this, methods).causal.Validate();
+                       // The causal protocol's settings; the study's method list is checked
+                       // below by its own rule.
+                       EvaluationSettings(*this, {.mode = "predict"}, "all").Validate();
                      });
   if (!(duration_s >= kMinDurationS)) {
     ThrowOption("duration_s", FormatValue(duration_s),
