@@ -84,8 +84,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
     // test block gives the filter states a navigation computer would have.
     trial.estimate = EstimateDrift(model, temperature_c).tail(test);
   } else if (decompose_all) {
-    trial.estimate = PredictFromSeries(
-        model, series_all, thermal_all, split, test, horizon);
+    trial.estimate = PredictFromSeries(model, series_all, thermal_all, split, test, horizon);
   } else {
     trial.estimate = PredictAhead(
         model, y, thermal_needed ? Eigen::VectorXd(temperature_c.col(0)) : Eigen::VectorXd(), split,
@@ -146,29 +145,24 @@ double SlowVariationRemoved(const Eigen::Ref<const Eigen::VectorXd>& reference,
   return 1.0 - SlowVariation(reference - estimate, rate_hz, block_s) / before;
 }
 
-EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
-                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
-                          const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
-                          const EvaluationOptions& options, const Execution& execution) {
-  base.Validate();
-  options.Validate();
-  execution.Validate();
-  if (base.mode == Mode::kCompensate && options.horizon != 1) {
-    ThrowOption("horizon", std::to_string(options.horizon),
-                "1 in compensate mode (the estimate at t is read from the temperature, not "
-                "predicted ahead)");
-  }
+namespace {
+
+// Refuses, before any fit, inputs the methods cannot be scored on: a method of another mode, a
+// missing, short or non-finite temperature where one is needed (several channels only for
+// identified models), a truth of another length or not finite.
+void CheckInputs(const Eigen::Ref<const Eigen::VectorXd>& y,
+                 const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                 const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
+                 const std::vector<Method>& methods) {
   RequireFiniteSignal("target", y, 64);
   const Eigen::Index n = y.size();
-  const std::vector<Method> methods = EvaluatedMethods(options);
   for (Method m : methods) {
     if (!SupportsMode(m, base.mode)) {
       ThrowOption("methods", std::string(ToString(m)),
                   "methods of " + std::string(ToString(base.mode)) + " mode");
     }
   }
-  const bool thermal_needed = base.uses_temperature();
-  if (thermal_needed) {
+  if (base.uses_temperature()) {
     if (temperature_c.rows() != n || temperature_c.cols() < 1) {
       throw DataError(std::string(ToString(base.mode)) + " mode" +
                       (base.features.use_temperature ? " with temperature features" : "") +
@@ -189,6 +183,103 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
     if (truth.size() != n) throw DataError("truth column length differs from the target's");
     RequireFiniteSignal("truth", truth, n);
   }
+}
+
+// The first test sample must be predictable with the most lags the fit may choose, under the
+// causal protocol's rule (the stricter one): refused before any fit.
+void CheckHorizon(const DriftOptions& base, int horizon, Eigen::Index split) {
+  if (base.mode != Mode::kPredict || horizon <= 1) return;
+  const int lags = base.auto_lags
+                       ? *std::max_element(base.lag_candidates.begin(), base.lag_candidates.end())
+                       : base.features.lags;
+  const Eigen::Index first = internal::FirstPredictable(lags, true, horizon);
+  if (split < first) {
+    ThrowOption("horizon", std::to_string(horizon),
+                "at most " + std::to_string(horizon - (first - split)) +
+                    " with the split at sample " + std::to_string(split) +
+                    " (the lags and the shortest causal window before the first origin)");
+  }
+}
+
+// What every trial of one evaluation shares.
+struct Trials {
+  const Eigen::Ref<const Eigen::VectorXd>& y;
+  const Eigen::Ref<const Eigen::MatrixXd>& temperature_c;
+  const DriftOptions& base;
+  const EvaluationOptions& options;
+  const Execution& execution;
+  Eigen::Index split;
+  const Eigen::VectorXd& reference;  // the test block's scores are against it
+  Eigen::VectorXd measured;          // the test block of y
+  double total;                      // trials in the evaluation (progress)
+};
+
+// The row of `method` under `protocol`: the mean scores of options.repeats trials, seeded
+// RepeatSeed(base.seed, r); `done` counts the trials run (progress).
+EvaluationRow ScoreRow(const Trials& t, Method method, Protocol protocol, double& done) {
+  const int repeats = t.options.repeats;
+  EvaluationRow row;
+  row.method = method;
+  row.protocol = protocol;
+  std::vector<double> rmse;
+  for (int r = 0; r < repeats; ++r) {
+    DriftOptions o = t.base;
+    o.method = method;
+    o.seed = RepeatSeed(t.base.seed, r);
+    const std::string label = std::string(ToString(method)) + " / " +
+                              std::string(ToString(protocol)) + " / seed " + std::to_string(o.seed);
+    t.execution.Report(done / t.total, label);
+    Execution windows{.threads = t.execution.threads};
+    if (t.execution.progress) {
+      // The causal trial's windows are most of an evaluation's time: report within it too.
+      windows.progress = [&execution = t.execution, done, total = t.total,
+                          label = label + " / windows"](double fraction, std::string_view) {
+        execution.progress((done + fraction) / total, label);
+      };
+    }
+    const Trial trial = RunTrial(t.y, t.temperature_c, o, protocol, t.split, t.options.horizon,
+                                 t.options.causal, windows);
+    const Metrics m = ComputeMetrics(trial.estimate - t.reference);
+    rmse.push_back(m.rmse);
+    row.mae += m.mae / repeats;
+    row.max_abs += m.max_abs / repeats;
+    row.rmse_measured += ComputeMetrics(trial.estimate - t.measured).rmse / repeats;
+    row.slow_removed +=
+        SlowVariationRemoved(t.reference, trial.estimate, t.base.features.rate_hz) / repeats;
+    row.train_s += trial.train_s / repeats;
+    row.predict_s += trial.predict_s / repeats;
+    row.estimate = trial.estimate;
+    row.model_summary = trial.summary;
+    if (!trial.note.empty())
+      row.notes.push_back("seed " + std::to_string(o.seed) + ": " + trial.note);
+    done += 1;
+  }
+  double mean = 0;
+  for (double v : rmse) mean += v / static_cast<double>(rmse.size());
+  double var = 0;
+  for (double v : rmse) var += (v - mean) * (v - mean);
+  row.rmse = mean;
+  row.rmse_std = rmse.size() > 1 ? std::sqrt(var / static_cast<double>(rmse.size() - 1)) : 0.0;
+  return row;
+}
+
+}  // namespace
+
+EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
+                          const Eigen::Ref<const Eigen::MatrixXd>& temperature_c,
+                          const Eigen::Ref<const Eigen::VectorXd>& truth, const DriftOptions& base,
+                          const EvaluationOptions& options, const Execution& execution) {
+  base.Validate();
+  options.Validate();
+  execution.Validate();
+  if (base.mode == Mode::kCompensate && options.horizon != 1) {
+    ThrowOption("horizon", std::to_string(options.horizon),
+                "1 in compensate mode (the estimate at t is read from the temperature, not "
+                "predicted ahead)");
+  }
+  const std::vector<Method> methods = EvaluatedMethods(options);
+  CheckInputs(y, temperature_c, truth, base, methods);
+  const Eigen::Index n = y.size();
   EvaluationResult result;
   result.mode = base.mode;
   result.split_index =
@@ -198,93 +289,41 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
     throw DataError("split at sample " + std::to_string(split) + " of " + std::to_string(n) +
                     " leaves too little data (at least 32 training and 16 test samples)");
   }
-  if (base.mode == Mode::kPredict && options.horizon > 1) {
-    // The first test sample must be predictable with the most lags the fit may choose, under
-    // the causal protocol's rule (the stricter one): refuse before any fit.
-    const int lags = base.auto_lags
-                         ? *std::max_element(base.lag_candidates.begin(), base.lag_candidates.end())
-                         : base.features.lags;
-    const Eigen::Index first = internal::FirstPredictable(lags, true, options.horizon);
-    if (split < first) {
-      ThrowOption("horizon", std::to_string(options.horizon),
-                  "at most " + std::to_string(options.horizon - (first - split)) +
-                      " with the split at sample " + std::to_string(split) +
-                      " (the lags and the shortest causal window before the first origin)");
-    }
-  }
+  CheckHorizon(base, options.horizon, split);
   if (temperature_c.rows() == n && temperature_c.cols() > 0) {
     const auto t = temperature_c.col(0);
     result.training_temperature_min_c = t.head(split).minCoeff();
     result.training_temperature_max_c = t.head(split).maxCoeff();
-    result.test_outside_training_temperature_share =
-        ShareOutsideRange(t.tail(n - split), result.training_temperature_min_c,
-                          result.training_temperature_max_c);
+    result.test_outside_training_temperature_share = ShareOutsideRange(
+        t.tail(n - split), result.training_temperature_min_c, result.training_temperature_max_c);
   }
   result.against_truth = truth.size() != 0;
   result.reference = result.against_truth ? Eigen::VectorXd(truth.tail(n - split))
                                           : Eigen::VectorXd(y.tail(n - split));
-  const Eigen::VectorXd measured = y.tail(n - split);
-  const double total = static_cast<double>(methods.size() * options.protocols.size() *
-                                           static_cast<size_t>(options.repeats));
+  const Trials trials{y,
+                      temperature_c,
+                      base,
+                      options,
+                      execution,
+                      split,
+                      result.reference,
+                      y.tail(n - split),
+                      static_cast<double>(methods.size() * options.protocols.size() *
+                                          static_cast<size_t>(options.repeats))};
   double done = 0;
   for (Method method : methods) {
     // Single models never decompose: both protocols are the same computation, run once.
     std::vector<EvaluationRow> computed;
     for (Protocol protocol : options.protocols) {
-      EvaluationRow row;
-      row.method = method;
-      row.protocol = protocol;
       if (!UsesDecomposition(method) && !computed.empty()) {
-        row = computed.front();
+        EvaluationRow row = computed.front();
         row.protocol = protocol;
         result.rows.push_back(row);
         done += options.repeats;
         continue;
       }
-      std::vector<double> rmse;
-      for (int r = 0; r < options.repeats; ++r) {
-        DriftOptions o = base;
-        o.method = method;
-        o.seed = RepeatSeed(base.seed, r);
-        const std::string label = std::string(ToString(method)) + " / " +
-                                  std::string(ToString(protocol)) + " / seed " +
-                                  std::to_string(o.seed);
-        execution.Report(done / total, label);
-        Execution windows{.threads = execution.threads};
-        if (execution.progress) {
-          // The causal trial's windows are most of an evaluation's time: report within it too.
-          windows.progress = [&execution, done, total, label = label + " / windows"](
-                                 double fraction, std::string_view) {
-            execution.progress((done + fraction) / total, label);
-          };
-        }
-        const Trial trial = RunTrial(y, temperature_c, o, protocol, split, options.horizon,
-                                     options.causal, windows);
-        const Metrics m = ComputeMetrics(trial.estimate - result.reference);
-        rmse.push_back(m.rmse);
-        row.mae += m.mae / options.repeats;
-        row.max_abs += m.max_abs / options.repeats;
-        row.rmse_measured += ComputeMetrics(trial.estimate - measured).rmse / options.repeats;
-        row.slow_removed += SlowVariationRemoved(result.reference, trial.estimate,
-                                                 base.features.rate_hz) /
-                            options.repeats;
-        row.train_s += trial.train_s / options.repeats;
-        row.predict_s += trial.predict_s / options.repeats;
-        row.estimate = trial.estimate;
-        row.model_summary = trial.summary;
-        if (!trial.note.empty()) {
-          row.notes.push_back("seed " + std::to_string(o.seed) + ": " + trial.note);
-        }
-        done += 1;
-      }
-      double mean = 0;
-      for (double v : rmse) mean += v / static_cast<double>(rmse.size());
-      double var = 0;
-      for (double v : rmse) var += (v - mean) * (v - mean);
-      row.rmse = mean;
-      row.rmse_std = rmse.size() > 1 ? std::sqrt(var / static_cast<double>(rmse.size() - 1)) : 0.0;
-      computed.push_back(row);
-      result.rows.push_back(row);
+      computed.push_back(ScoreRow(trials, method, protocol, done));
+      result.rows.push_back(computed.back());
     }
   }
   execution.Report(1.0, "done");
@@ -303,11 +342,10 @@ std::string EvaluationResult::Table() const {
     if (std::isfinite(r.slow_removed)) {
       std::snprintf(slow, sizeof(slow), "%.1f%%", 100.0 * r.slow_removed);
     }
-    std::snprintf(line, sizeof(line),
-                  "%-13s %-8s %12.6g %12.3g %12.6g %12.6g %13.6g %8s %9.3f %10.3f\n",
-                  std::string(ToString(r.method)).c_str(),
-                  std::string(ToString(r.protocol)).c_str(), r.rmse, r.rmse_std, r.mae, r.max_abs,
-                  r.rmse_measured, slow, r.train_s, r.predict_s);
+    std::snprintf(
+        line, sizeof(line), "%-13s %-8s %12.6g %12.3g %12.6g %12.6g %13.6g %8s %9.3f %10.3f\n",
+        std::string(ToString(r.method)).c_str(), std::string(ToString(r.protocol)).c_str(), r.rmse,
+        r.rmse_std, r.mae, r.max_abs, r.rmse_measured, slow, r.train_s, r.predict_s);
     out += line;
   }
   return out;

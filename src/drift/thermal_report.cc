@@ -88,9 +88,12 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
   return regimes;
 }
 
-void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                 bool fell_back_to_constant, const RunRegimes& regimes,
-                 CalibrationReport& report) {
+namespace {
+
+// What the calibration run lacks (duration, span, ramps both ways, dwells, regimes), in that
+// order.
+void AddRunWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
+                    const RunRegimes& regimes, CalibrationReport& report) {
   auto& w = report.warnings;
   auto& advice = report.advice;
   if (report.duration_s < kShortestCalibrationS) {
@@ -137,13 +140,22 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
       {&regimes.heating_k_per_min, "heating"}, {&regimes.cooling_k_per_min, "cooling"}};
   for (const auto& [rates, name] : directions) {
     if (rates->size() != 1) continue;
-    advice.push_back(Format("%s at one rate (%.2g K/min): add a %s ramp at about half or twice "
-                            "it, so that the rate terms are told from the level",
-                            name, rates->front(), name));
+    advice.push_back(
+        Format("%s at one rate (%.2g K/min): add a %s ramp at about half or twice "
+               "it, so that the rate terms are told from the level",
+               name, rates->front(), name));
   }
   if (report.ramps + report.dwells < 3) {
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
   }
+}
+
+// What limits the model the run gave: how far its states can lag, how little it beats a constant
+// bias, how collinear its regressors are.
+void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
+                      bool fell_back_to_constant, CalibrationReport& report) {
+  auto& w = report.warnings;
+  auto& advice = report.advice;
   // The slowest candidate state's mean delay: order x tau.
   const std::vector<double> grid = options.Grid(report.duration_s);
   const double longest_delay = grid.empty() ? 0.0 : options.state_order * grid.back();
@@ -184,6 +196,14 @@ void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& opti
     w.push_back(
         Format("the chosen regressors are nearly collinear (condition %.2g)", report.condition));
   }
+}
+
+}  // namespace
+
+void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
+                 bool fell_back_to_constant, const RunRegimes& regimes, CalibrationReport& report) {
+  AddRunWarnings(model, options, regimes, report);
+  AddModelWarnings(model, options, fell_back_to_constant, report);
 }
 
 }  // namespace internal

@@ -195,81 +195,90 @@ Eigen::VectorXd FoldScores::TimeResidual(const std::vector<int>& cols) const {
   return r;
 }
 
-SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layout,
-                             const SearchRules& rules) {
-  constexpr int kLevels = CalibrationReport::kHysteresis + 1;
-  std::array<Subset, kLevels> best{};
-  auto consider = [&](Subset s) {
-    s.fold_scores = scores.Scores(s.cols);
-    s.score = scores.Mean(s.fold_scores);
-    if (s.score < best[static_cast<size_t>(s.level)].score) best[static_cast<size_t>(s.level)] = s;
+namespace {
+
+constexpr int kLevels = CalibrationReport::kHysteresis + 1;
+using LevelBests = std::array<Subset, kLevels>;
+
+// The ladder's candidates scored, keeping the best subset of each level.
+class Ladder {
+ public:
+  Ladder(const FoldScores& scores, const DesignLayout& layout, const SearchRules& rules)
+      : scores_(scores), layout_(layout), rules_(rules) {}
+
+  // s scored, kept when it is the best of its level so far.
+  Subset Consider(Subset s) {
+    s.fold_scores = scores_.Scores(s.cols);
+    s.score = scores_.Mean(s.fold_scores);
+    if (s.score < best_[static_cast<size_t>(s.level)].score)
+      best_[static_cast<size_t>(s.level)] = s;
     return s;
-  };
-  SearchResult result;
-  // The constant, then static powers of every channel.
-  Subset constant;
-  result.constant = consider(constant);
-  for (int p = 1; p <= layout.static_powers; ++p) {
-    Subset s;
-    s.level = CalibrationReport::kStatic;
-    s.static_power = p;
-    for (int c = 0; c < layout.channels; ++c) {
-      for (int q = 1; q <= p; ++q) s.cols.push_back(layout.StaticColumn(c, q));
-    }
-    const Subset scored = consider(std::move(s));
-    if (p == layout.static_powers) result.static_cubic = scored;
   }
-  // One lag state's level powers; one or two lag states with their rates; each with or without
-  // the linear static term; with the hysteresis term of one of their states.
-  const int max_states = std::min(rules.max_states, layout.candidates);
-  std::vector<int> chosen;
-  auto visit = [&](auto&& self, int next) -> void {
-    if (!chosen.empty()) {
-      for (int with_linear : {0, 1}) {
-        for (bool rates : {false, true}) {
-          if (!rates && chosen.size() > 1) continue;
-          if (rules.one_direction && (chosen.size() > 1 || with_linear)) continue;
-          Subset s;
-          s.states = chosen;
-          s.static_power = with_linear;
-          s.rates = rates;
-          s.level = !rates               ? CalibrationReport::kLag
-                    : chosen.size() == 1 ? CalibrationReport::kOneState
-                                         : CalibrationReport::kTwoStates;
-          for (int c = 0; with_linear && c < layout.channels; ++c) {
-            s.cols.push_back(layout.StaticColumn(c, 1));
+
+  // Every set of at most `max_states` lag states from candidate `next` on, added to `chosen`.
+  void VisitStates(std::vector<int>& chosen, int next, int max_states) {
+    if (!chosen.empty()) ConsiderStates(chosen);
+    if (static_cast<int>(chosen.size()) == max_states) return;
+    for (int j = next; j < layout_.candidates; ++j) {
+      chosen.push_back(j);
+      VisitStates(chosen, j + 1, max_states);
+      chosen.pop_back();
+    }
+  }
+
+  const LevelBests& best() const { return best_; }
+
+ private:
+  // The lag states `chosen`: one state's level powers, or one or two states with their rates;
+  // each with or without the linear static term; with the hysteresis term of one of the states.
+  void ConsiderStates(const std::vector<int>& chosen) {
+    for (int with_linear : {0, 1}) {
+      for (bool rates : {false, true}) {
+        if (!rates && chosen.size() > 1) continue;
+        if (rules_.one_direction && (chosen.size() > 1 || with_linear)) continue;
+        Subset s;
+        s.states = chosen;
+        s.static_power = with_linear;
+        s.rates = rates;
+        s.level = !rates               ? CalibrationReport::kLag
+                  : chosen.size() == 1 ? CalibrationReport::kOneState
+                                       : CalibrationReport::kTwoStates;
+        for (int c = 0; with_linear && c < layout_.channels; ++c) {
+          s.cols.push_back(layout_.StaticColumn(c, 1));
+        }
+        for (int j : chosen) {
+          for (int p = 0; p < layout_.state_columns - (rates ? 0 : 1); ++p) {
+            s.cols.push_back(layout_.StateColumn(j, p));
           }
-          for (int j : chosen) {
-            for (int p = 0; p < layout.state_columns - (rates ? 0 : 1); ++p) {
-              s.cols.push_back(layout.StateColumn(j, p));
-            }
-          }
-          if (Condition(scores.gram(), s.cols) > rules.max_condition) continue;
-          consider(s);
-          // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
-          if (!rates || rules.one_direction) continue;
-          for (size_t k = 0; k < chosen.size(); ++k) {
-            for (int w = 0; w < layout.widths; ++w) {
-              Subset h = s;
-              h.level = CalibrationReport::kHysteresis;
-              h.hysteresis_state = static_cast<int>(k);
-              h.hysteresis_width = w;
-              h.cols.push_back(layout.WidthColumn(chosen[k], w));
-              consider(std::move(h));
-            }
+        }
+        if (Condition(scores_.gram(), s.cols) > rules_.max_condition) continue;
+        Consider(s);
+        // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
+        if (!rates || rules_.one_direction) continue;
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          for (int w = 0; w < layout_.widths; ++w) {
+            Subset h = s;
+            h.level = CalibrationReport::kHysteresis;
+            h.hysteresis_state = static_cast<int>(k);
+            h.hysteresis_width = w;
+            h.cols.push_back(layout_.WidthColumn(chosen[k], w));
+            Consider(std::move(h));
           }
         }
       }
     }
-    if (static_cast<int>(chosen.size()) == max_states) return;
-    for (int j = next; j < layout.candidates; ++j) {
-      chosen.push_back(j);
-      self(self, j + 1);
-      chosen.pop_back();
-    }
-  };
-  visit(visit, 0);
+  }
 
+  const FoldScores& scores_;
+  const DesignLayout& layout_;
+  const SearchRules& rules_;
+  LevelBests best_{};
+};
+
+// The best level and, by the one-standard-error rule, the simplest level not clearly worse than
+// it; the constant unless that beats the constant by a standard error.
+void ChooseLevel(const FoldScores& scores, const SearchRules& rules, const LevelBests& best,
+                 SearchResult& result) {
   std::array<bool, kLevels> eligible{};
   for (int l = 0; l < kLevels; ++l) {
     eligible[static_cast<size_t>(l)] = std::isfinite(best[static_cast<size_t>(l)].score);
@@ -283,7 +292,6 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
   }
   result.best_level = b;
   result.best_score = best[static_cast<size_t>(b)].score;
-  // The one-standard-error rule: the simplest level not clearly worse than the best.
   const Subset& top = best[static_cast<size_t>(b)];
   int pick = b;
   for (int l = 0; l < b; ++l) {
@@ -295,8 +303,6 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
     }
   }
   result.chosen = best[static_cast<size_t>(pick)];
-  // The guarantee: a structure that does not beat the constant by a standard error is the
-  // constant.
   if (pick > 0) {
     const Eigen::VectorXd d = result.chosen.fold_scores - result.constant.fold_scores;
     if (!(scores.Mean(d) < -rules.standard_errors * scores.StandardError(d))) {
@@ -304,6 +310,31 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
       result.fell_back_to_constant = true;
     }
   }
+}
+
+}  // namespace
+
+SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layout,
+                             const SearchRules& rules) {
+  Ladder ladder(scores, layout, rules);
+  SearchResult result;
+  // The constant, then static powers of every channel.
+  Subset constant;
+  result.constant = ladder.Consider(constant);
+  for (int p = 1; p <= layout.static_powers; ++p) {
+    Subset s;
+    s.level = CalibrationReport::kStatic;
+    s.static_power = p;
+    for (int c = 0; c < layout.channels; ++c) {
+      for (int q = 1; q <= p; ++q) s.cols.push_back(layout.StaticColumn(c, q));
+    }
+    const Subset scored = ladder.Consider(std::move(s));
+    if (p == layout.static_powers) result.static_cubic = scored;
+  }
+  // Then the lag states' subsets.
+  std::vector<int> chosen;
+  ladder.VisitStates(chosen, 0, std::min(rules.max_states, layout.candidates));
+  ChooseLevel(scores, rules, ladder.best(), result);
   return result;
 }
 

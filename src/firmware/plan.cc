@@ -26,81 +26,101 @@ std::string AxisLabel(size_t i, const LoadedModel& m) {
   return fmt::format("axis {} ({})", i, m.info.target_column);
 }
 
+namespace {
+
+// Model channel -> plan channel for the temperature columns `names`, adding those the plan lacks.
+std::vector<int> MapChannels(const std::vector<std::string>& names, Plan& plan) {
+  std::vector<int> global;
+  for (const std::string& name : names) {
+    const auto at = std::find(plan.channels.begin(), plan.channels.end(), name);
+    global.push_back(static_cast<int>(at - plan.channels.begin()));
+    if (at == plan.channels.end()) plan.channels.push_back(name);
+  }
+  return global;
+}
+
+// The lag state ts of t on plan channel `channel`, its coefficients read from k on (k advanced);
+// its chain (one per channel and time constant) found or added.
+State PlanState(const drift::ThermalRegression& t, const drift::ThermalState& ts, int channel,
+                Eigen::Index& k, Plan& plan) {
+  const auto cu = static_cast<size_t>(ts.channel);
+  const double dt_s = 1.0 / t.rate_hz;  // as ThermalRegression::Regressors
+  auto chain = std::find_if(plan.chains.begin(), plan.chains.end(), [&](const Chain& c) {
+    return c.channel == channel && c.tau_s == ts.tau_s;
+  });
+  if (chain == plan.chains.end()) {
+    plan.chains.push_back({channel, ts.tau_s, drift::FirstOrderLagGain(ts.tau_s, dt_s), 0, 0});
+    chain = plan.chains.end() - 1;
+  }
+  chain->stages = std::max(chain->stages, t.order);
+  State state;
+  state.chain = static_cast<int>(chain - plan.chains.begin());
+  state.order = t.order;
+  state.centre_c = t.centre_c[cu];
+  state.scale_k = t.scale_k[cu];
+  state.level_min = ts.level_min;
+  state.level_max = ts.level_max;
+  for (int p = 1; p <= t.max_power; ++p) state.powers.push_back(t.coefficients[k++]);
+  state.rate = t.coefficients[k++];
+  state.rate_min = ts.rate_min;
+  state.rate_max = ts.rate_max;
+  return state;
+}
+
+// The sub-model of thermal regression t, its channels mapped by `global`: the intercept, the
+// static powers, the lag states and the hysteresis term, in the order of t's coefficients; with
+// its estimate at equilibrium at reference_c unless that is NaN.
+Sub PlanSub(const std::string& name, const drift::ThermalRegression& t,
+            const std::vector<int>& global, double reference_c, Plan& plan) {
+  Sub s;
+  s.name = name;
+  plan.rate_hz = t.rate_hz;
+  Eigen::Index k = 0;
+  s.intercept = t.coefficients[k++];
+  for (int c = 0; c < t.channels(); ++c) {
+    const auto cu = static_cast<size_t>(c);
+    if (t.static_power[cu] == 0) continue;
+    Static st{global[cu], t.centre_c[cu], t.scale_k[cu], t.static_min[cu], t.static_max[cu], {}};
+    for (int p = 1; p <= t.static_power[cu]; ++p) st.powers.push_back(t.coefficients[k++]);
+    s.statics.push_back(std::move(st));
+  }
+  for (const drift::ThermalState& ts : t.states) {
+    s.states.push_back(PlanState(t, ts, global[static_cast<size_t>(ts.channel)], k, plan));
+    ++plan.states;
+  }
+  if (t.has_hysteresis()) {
+    s.hysteresis = {t.hysteresis_state, plan.plays++, t.hysteresis_width_k, t.coefficients[k++]};
+  }
+  if (!std::isnan(reference_c)) {
+    // The library's own estimate of a record in equilibrium at the reference.
+    s.reference_estimate = t.Estimate(Eigen::MatrixXd::Constant(1, t.channels(), reference_c))[0];
+  }
+  return s;
+}
+
+}  // namespace
+
 Plan MakePlan(const std::vector<LoadedModel>& axes) {
   RequireExportable(axes);
   Plan plan;
-  for (size_t a = 0; a < axes.size(); ++a) {
-    const LoadedModel& loaded = axes[a];
+  for (const LoadedModel& loaded : axes) {
     const drift::DriftModel& model = loaded.model;
-    const std::vector<std::string> names = SplitNames(loaded.info.temperature_column);
-    std::vector<int> global;  // model channel -> plan channel
-    for (const std::string& name : names) {
-      const auto at = std::find(plan.channels.begin(), plan.channels.end(), name);
-      global.push_back(static_cast<int>(at - plan.channels.begin()));
-      if (at == plan.channels.end()) plan.channels.push_back(name);
-    }
+    const std::vector<int> global = MapChannels(SplitNames(loaded.info.temperature_column), plan);
     Axis axis;
     axis.name = loaded.info.target_column;
     axis.summary = model.Summary();
     axis.source = loaded.info.source;
     axis.method = drift::ToString(model.options.method);
     axis.reference_c = model.options.reference_c.value_or(std::numeric_limits<double>::quiet_NaN());
-    const bool referenced = !std::isnan(axis.reference_c);
     for (const drift::SubModel& sub : model.sub_models) {
-      Sub s;
-      s.name = sub.name;
-      if (!sub.thermal) {
+      if (sub.thermal) {
+        axis.subs.push_back(PlanSub(sub.name, *sub.thermal, global, axis.reference_c, plan));
+      } else {
+        Sub s;
+        s.name = sub.name;
         s.zero = true;
         axis.subs.push_back(std::move(s));
-        continue;
       }
-      const drift::ThermalRegression& t = *sub.thermal;
-      plan.rate_hz = t.rate_hz;
-      Eigen::Index k = 0;
-      s.intercept = t.coefficients[k++];
-      for (int c = 0; c < t.channels(); ++c) {
-        const auto cu = static_cast<size_t>(c);
-        if (t.static_power[cu] == 0) continue;
-        Static st{global[cu], t.centre_c[cu], t.scale_k[cu], t.static_min[cu], t.static_max[cu], {}};
-        for (int p = 1; p <= t.static_power[cu]; ++p) st.powers.push_back(t.coefficients[k++]);
-        s.statics.push_back(std::move(st));
-      }
-      const double dt_s = 1.0 / t.rate_hz;  // as ThermalRegression::Regressors
-      for (const drift::ThermalState& ts : t.states) {
-        const auto cu = static_cast<size_t>(ts.channel);
-        const int channel = global[cu];
-        auto chain = std::find_if(plan.chains.begin(), plan.chains.end(), [&](const Chain& c) {
-          return c.channel == channel && c.tau_s == ts.tau_s;
-        });
-        if (chain == plan.chains.end()) {
-          plan.chains.push_back(
-              {channel, ts.tau_s, drift::FirstOrderLagGain(ts.tau_s, dt_s), 0, 0});
-          chain = plan.chains.end() - 1;
-        }
-        chain->stages = std::max(chain->stages, t.order);
-        State state;
-        state.chain = static_cast<int>(chain - plan.chains.begin());
-        state.order = t.order;
-        state.centre_c = t.centre_c[cu];
-        state.scale_k = t.scale_k[cu];
-        state.level_min = ts.level_min;
-        state.level_max = ts.level_max;
-        for (int p = 1; p <= t.max_power; ++p) state.powers.push_back(t.coefficients[k++]);
-        state.rate = t.coefficients[k++];
-        state.rate_min = ts.rate_min;
-        state.rate_max = ts.rate_max;
-        s.states.push_back(std::move(state));
-        ++plan.states;
-      }
-      if (t.has_hysteresis()) {
-        s.hysteresis = {t.hysteresis_state, plan.plays++, t.hysteresis_width_k, t.coefficients[k++]};
-      }
-      if (referenced) {
-        // The library's own estimate of a record in equilibrium at the reference.
-        s.reference_estimate =
-            t.Estimate(Eigen::MatrixXd::Constant(1, t.channels(), axis.reference_c))[0];
-      }
-      axis.subs.push_back(std::move(s));
     }
     plan.axes.push_back(std::move(axis));
   }

@@ -72,6 +72,109 @@ void RemoveStaleTemporaries(const std::vector<std::string>& targets) {
   }
 }
 
+// Removes each of `paths` that is not empty, ignoring failures (cleaning up after one).
+void RemoveAll(const std::vector<std::string>& paths) {
+  for (const auto& p : paths) {
+    if (!p.empty()) std::remove(p.c_str());
+  }
+}
+
+// Refuses what would fail half-way through the renames: a target named twice, or a directory.
+void CheckTargets(const std::vector<StreamedFile>& files) {
+  namespace fs = std::filesystem;
+  std::set<fs::path> targets;
+  for (const auto& [path, write] : files) {
+    std::error_code ec;
+    const fs::path key = fs::weakly_canonical(fs::path(path), ec);
+    if (!targets.insert(ec ? fs::path(path) : key).second) {
+      throw IoError(path + ": named twice among the files of one output set");
+    }
+    if (fs::is_directory(fs::path(path), ec)) {
+      throw IoError(path + ": is a directory, cannot write a file there");
+    }
+  }
+}
+
+// Each file written by its writer to its temporary "<path>.tmp<suffix>", in order; on a failure
+// the temporaries written so far are removed before the error is thrown.
+std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files,
+                                          const std::string& suffix) {
+  std::vector<std::string> temps;
+  for (const auto& [path, write] : files) {
+    const std::string temp = path + ".tmp" + suffix;
+    std::FILE* f = std::fopen(temp.c_str(), "wb");
+    if (!f) {
+      const std::string reason = std::strerror(errno);
+      RemoveAll(temps);
+      throw IoError(path + ": cannot open for writing (" + reason + ")");
+    }
+    temps.push_back(temp);
+    try {
+      write(f);
+    } catch (...) {
+      std::fclose(f);
+      RemoveAll(temps);
+      throw;
+    }
+    const bool ok = std::ferror(f) == 0;
+    if (std::fclose(f) != 0 || !ok) {
+      RemoveAll(temps);
+      throw IoError(path + ": write failed (disk full?)");
+    }
+  }
+  return temps;
+}
+
+// For a set, each existing target hard-linked (or copied) to "<path>.bak<suffix>", so that a
+// failed later rename can rename every earlier backup back over its new file; "" where there is
+// no target. On a failure the backups and `temps` are removed before the error is thrown.
+std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
+                                     const std::string& suffix,
+                                     const std::vector<std::string>& temps) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> backups(files.size());
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string& target = files[i].path;
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(target, ec))) continue;
+    const std::string backup = target + ".bak" + suffix;
+    if (::link(target.c_str(), backup.c_str()) != 0) {
+      fs::copy_file(target, backup, fs::copy_options::overwrite_existing, ec);
+      if (ec) {
+        RemoveAll(backups);
+        RemoveAll(temps);
+        throw IoError(target + ": cannot keep a copy of the existing file (" + ec.message() + ")");
+      }
+    }
+    backups[i] = backup;
+  }
+  return backups;
+}
+
+// Each temporary renamed over its target. When a rename fails, the targets placed before it are
+// restored from their backups (or removed where there was none) and the error thrown.
+void PlaceFiles(const std::vector<StreamedFile>& files, const std::vector<std::string>& temps,
+                const std::vector<std::string>& backups) {
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string& target = files[i].path;
+    if (std::rename(temps[i].c_str(), target.c_str()) == 0) continue;
+    const std::string reason = std::strerror(errno);
+    std::string restore_failed;
+    for (size_t j = 0; j < i; ++j) {
+      const std::string& placed = files[j].path;
+      const bool ok = backups[j].empty() ? std::remove(placed.c_str()) == 0
+                                         : std::rename(backups[j].c_str(), placed.c_str()) == 0;
+      if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + placed;
+    }
+    RemoveAll(backups);
+    RemoveAll(temps);
+    throw IoError(target + ": cannot rename the temporary file into place (" + reason + ")" +
+                  (restore_failed.empty()
+                       ? ""
+                       : "; could not restore the earlier state of " + restore_failed));
+  }
+}
+
 }  // namespace
 
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
@@ -86,98 +189,20 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
 }
 
 void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files) {
-  namespace fs = std::filesystem;
-  // Refuse what would fail half-way through the renames: a target named twice, or a directory.
-  std::set<fs::path> targets;
-  for (const auto& [path, write] : files) {
-    std::error_code ec;
-    const fs::path key = fs::weakly_canonical(fs::path(path), ec);
-    if (!targets.insert(ec ? fs::path(path) : key).second) {
-      throw IoError(path + ": named twice among the files of one output set");
-    }
-    if (fs::is_directory(fs::path(path), ec)) {
-      throw IoError(path + ": is a directory, cannot write a file there");
-    }
-  }
+  CheckTargets(files);
   const std::string suffix = "." + std::to_string(::getpid());
-  std::vector<std::string> temps;
-  auto remove_temps = [&] {
-    for (const auto& t : temps) std::remove(t.c_str());
-  };
   {
     std::vector<std::string> targets;
     for (const auto& file : files) targets.push_back(file.path);
     RemoveStaleTemporaries(targets);
   }
-  for (const auto& [path, write] : files) {
-    const std::string temp = path + ".tmp" + suffix;
-    std::FILE* f = std::fopen(temp.c_str(), "wb");
-    if (!f) {
-      const std::string reason = std::strerror(errno);
-      remove_temps();
-      throw IoError(path + ": cannot open for writing (" + reason + ")");
-    }
-    temps.push_back(temp);
-    try {
-      write(f);
-    } catch (...) {
-      std::fclose(f);
-      remove_temps();
-      throw;
-    }
-    const bool ok = std::ferror(f) == 0;
-    if (std::fclose(f) != 0 || !ok) {
-      remove_temps();
-      throw IoError(path + ": write failed (disk full?)");
-    }
-  }
+  const std::vector<std::string> temps = WriteTemporaries(files, suffix);
   // Each target is replaced by one atomic rename, so a reader sees the old file or the new one,
-  // never none. For a set, existing targets are first hard-linked (or copied) to backups, so that
-  // a failed later rename can rename every earlier backup back over its new file.
-  const bool set = files.size() > 1;
-  std::vector<std::string> backups(files.size());
-  auto remove_backups = [&] {
-    for (const auto& b : backups) {
-      if (!b.empty()) std::remove(b.c_str());
-    }
-  };
-  if (set) {
-    for (size_t i = 0; i < files.size(); ++i) {
-      const std::string& target = files[i].path;
-      std::error_code ec;
-      if (!fs::exists(fs::symlink_status(target, ec))) continue;
-      const std::string backup = target + ".bak" + suffix;
-      if (::link(target.c_str(), backup.c_str()) != 0) {
-        fs::copy_file(target, backup, fs::copy_options::overwrite_existing, ec);
-        if (ec) {
-          remove_backups();
-          remove_temps();
-          throw IoError(target + ": cannot keep a copy of the existing file (" + ec.message() +
-                        ")");
-        }
-      }
-      backups[i] = backup;
-    }
-  }
-  for (size_t i = 0; i < files.size(); ++i) {
-    const std::string& target = files[i].path;
-    if (std::rename(temps[i].c_str(), target.c_str()) == 0) continue;
-    const std::string reason = std::strerror(errno);
-    std::string restore_failed;
-    for (size_t j = 0; j < i; ++j) {
-      const std::string& placed = files[j].path;
-      const bool ok = backups[j].empty() ? std::remove(placed.c_str()) == 0
-                                         : std::rename(backups[j].c_str(), placed.c_str()) == 0;
-      if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + placed;
-    }
-    remove_backups();
-    remove_temps();
-    throw IoError(target + ": cannot rename the temporary file into place (" + reason + ")" +
-                  (restore_failed.empty()
-                       ? ""
-                       : "; could not restore the earlier state of " + restore_failed));
-  }
-  remove_backups();
+  // never none; a set keeps backups so that it is placed whole or not at all.
+  const std::vector<std::string> backups =
+      files.size() > 1 ? KeepBackups(files, suffix, temps) : std::vector<std::string>(files.size());
+  PlaceFiles(files, temps, backups);
+  RemoveAll(backups);
 }
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {

@@ -41,7 +41,6 @@ json Array(const Eigen::MatrixXd& m) {
 
 namespace {
 
-using nlohmann::json;
 using internal::Array;
 using internal::LearnerJson;
 using internal::Node;
@@ -51,6 +50,7 @@ using internal::ReadLearner;
 using internal::ReadOptions;
 using internal::ReadThermal;
 using internal::ThermalJson;
+using nlohmann::json;
 namespace dec = gyrodrift::decomposition;
 namespace sel = gyrodrift::selection;
 
@@ -59,8 +59,6 @@ constexpr int kLastModelFormatVersionWithThreads = 5;
 
 // ---------------------------------------------------------------------------------------------
 // Writing
-
-
 
 }  // namespace
 
@@ -88,8 +86,7 @@ json BaselineJson(const drift::Baseline& b) {
 json ModelJson(const drift::DriftModel& model) {
   json subs = json::array();
   for (const auto& sub : model.sub_models) {
-    if (!sub.learner && !sub.mean && !sub.baseline &&
-        model.options.mode == drift::Mode::kPredict) {
+    if (!sub.learner && !sub.mean && !sub.baseline && model.options.mode == drift::Mode::kPredict) {
       throw UsageError("sub-model '" + sub.name +
                        "' has no learner: a predict-mode model needs one per sub-model (or its "
                        "mean)");
@@ -131,7 +128,6 @@ std::string ChecksumText(const json& without_checksum) {
   return "fnv1a64:" + Hex64(Fnv1a64(Canonical(without_checksum)));
 }
 
-
 }  // namespace
 
 std::shared_ptr<const drift::Learner> internal::ReadLearner(const Node& n,
@@ -159,6 +155,82 @@ std::shared_ptr<const drift::Learner> internal::ReadLearner(const Node& n,
 
 namespace {
 
+// model.temperature_range_c, when the file has it (files written before the range was stored have
+// none: NaN, no extrapolation check).
+void ReadTemperatureRange(const Node& m, drift::DriftModel& model) {
+  if (!m.raw().contains("temperature_range_c")) return;
+  const std::vector<double> range = m["temperature_range_c"].Doubles();
+  const bool none = range.size() == 2 && std::isnan(range[0]) && std::isnan(range[1]);
+  if (range.size() != 2 ||
+      !(none || (std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] <= range[1]))) {
+    m["temperature_range_c"].Fail("must hold min <= max, finite (or both nan: no temperature)");
+  }
+  model.temperature_min_c = range[0];
+  model.temperature_max_c = range[1];
+}
+
+// A baseline method's parameters, checked by Baseline::Validate.
+std::shared_ptr<const drift::Baseline> ReadBaseline(const Node& n, drift::Method method) {
+  drift::Baseline b;
+  b.method = method;
+  b.constant = n["constant"].Double();
+  b.window = static_cast<int>(n["window"].Int(0, std::numeric_limits<int>::max()));
+  b.alpha = n["alpha"].Double();
+  b.level_var = n["level_var"].Double();
+  b.slope_var = n["slope_var"].Double();
+  b.noise_var = n["noise_var"].Double();
+  b.criterion = n["criterion"].Double();
+  try {
+    b.Validate();
+  } catch (const DataError& e) {
+    n.Fail(std::string("does not rebuild: ") + e.what());
+  }
+  return std::make_shared<const drift::Baseline>(b);
+}
+
+// One sub-model of `model` (its options and lags read already): what it holds must suit the
+// model's method and mode.
+drift::SubModel ReadSubModel(const Node& s, const drift::DriftModel& model) {
+  const bool predict = model.options.mode == drift::Mode::kPredict;
+  drift::SubModel sub;
+  sub.name = s["name"].String();
+  sub.imfs = s["imfs"].Ints();
+  for (int k : sub.imfs) {
+    if (k < 1) s["imfs"].Fail("holds IMF " + std::to_string(k) + ": IMF indices start at 1");
+  }
+  sub.has_residue = s["has_residue"].Bool();
+  const bool baseline = drift::IsBaseline(model.options.method);
+  if (baseline != s.raw().contains("baseline")) {
+    s.Fail(baseline ? "has no \"baseline\": method " +
+                          std::string(drift::ToString(model.options.method)) + " needs one"
+                    : "has a \"baseline\", which only a baseline method's model has");
+  }
+  if (baseline) sub.baseline = ReadBaseline(s["baseline"], model.options.method);
+  const Node learner = s["learner"];
+  if (s.raw().contains("mean")) {
+    const double mean = s["mean"].Double();
+    if (!std::isfinite(mean)) s["mean"].Fail("must be a finite number");
+    if (!predict || !learner.IsNull()) {
+      s["mean"].Fail("is for a predict-mode sub-model without a learner");
+    }
+    sub.mean = mean;
+  } else if (learner.IsNull()) {
+    if (predict && !baseline) {
+      learner.Fail("is null: a predict-mode sub-model needs a learner (or a mean)");
+    }
+  } else {
+    sub.learner = ReadLearner(learner, sub.name);
+    if (sub.learner->num_inputs() != model.num_inputs()) {
+      learner.Fail("takes " + std::to_string(sub.learner->num_inputs()) +
+                   " inputs, the model's options give " + std::to_string(model.num_inputs()));
+    }
+  }
+  if (s.raw().contains("thermal") && !s["thermal"].IsNull()) {
+    if (predict) s["thermal"].Fail("is a thermal model, which only a compensate-mode model has");
+    sub.thermal = ReadThermal(s["thermal"]);
+  }
+  return sub;
+}
 
 drift::DriftModel ReadModel(const Node& root) {
   drift::DriftModel model;
@@ -170,17 +242,7 @@ drift::DriftModel ReadModel(const Node& root) {
   model.decomposition_summary = m["decomposition_summary"].String();
   model.selection_summary = m["selection_summary"].String();
   model.lag_validation_rmse = m["lag_validation_rmse"].Doubles();
-  // Files written before the range was stored have none (NaN: no extrapolation check).
-  if (m.raw().contains("temperature_range_c")) {
-    const std::vector<double> range = m["temperature_range_c"].Doubles();
-    const bool none = range.size() == 2 && std::isnan(range[0]) && std::isnan(range[1]);
-    if (range.size() != 2 ||
-        !(none || (std::isfinite(range[0]) && std::isfinite(range[1]) && range[0] <= range[1]))) {
-      m["temperature_range_c"].Fail("must hold min <= max, finite (or both nan: no temperature)");
-    }
-    model.temperature_min_c = range[0];
-    model.temperature_max_c = range[1];
-  }
+  ReadTemperatureRange(m, model);
   const bool predict = model.options.mode == drift::Mode::kPredict;
   if (predict && (model.lags < 1 || model.lags > 256)) {
     m["lags"].Fail("= " + std::to_string(model.lags) +
@@ -188,63 +250,7 @@ drift::DriftModel ReadModel(const Node& root) {
   }
   const std::vector<Node> subs = m["sub_models"].Items();
   if (subs.empty()) m["sub_models"].Fail("is empty: a model needs at least one sub-model");
-  for (const Node& s : subs) {
-    drift::SubModel sub;
-    sub.name = s["name"].String();
-    sub.imfs = s["imfs"].Ints();
-    for (int k : sub.imfs) {
-      if (k < 1) s["imfs"].Fail("holds IMF " + std::to_string(k) + ": IMF indices start at 1");
-    }
-    sub.has_residue = s["has_residue"].Bool();
-    const bool baseline = drift::IsBaseline(model.options.method);
-    if (baseline != s.raw().contains("baseline")) {
-      s.Fail(baseline ? "has no \"baseline\": method " +
-                            std::string(drift::ToString(model.options.method)) + " needs one"
-                      : "has a \"baseline\", which only a baseline method's model has");
-    }
-    if (baseline) {
-      const Node n = s["baseline"];
-      drift::Baseline b;
-      b.method = model.options.method;
-      b.constant = n["constant"].Double();
-      b.window = static_cast<int>(n["window"].Int(0, std::numeric_limits<int>::max()));
-      b.alpha = n["alpha"].Double();
-      b.level_var = n["level_var"].Double();
-      b.slope_var = n["slope_var"].Double();
-      b.noise_var = n["noise_var"].Double();
-      b.criterion = n["criterion"].Double();
-      try {
-        b.Validate();
-      } catch (const DataError& e) {
-        n.Fail(std::string("does not rebuild: ") + e.what());
-      }
-      sub.baseline = std::make_shared<const drift::Baseline>(b);
-    }
-    const Node learner = s["learner"];
-    if (s.raw().contains("mean")) {
-      const double mean = s["mean"].Double();
-      if (!std::isfinite(mean)) s["mean"].Fail("must be a finite number");
-      if (!predict || !learner.IsNull()) {
-        s["mean"].Fail("is for a predict-mode sub-model without a learner");
-      }
-      sub.mean = mean;
-    } else if (learner.IsNull()) {
-      if (predict && !baseline) {
-        learner.Fail("is null: a predict-mode sub-model needs a learner (or a mean)");
-      }
-    } else {
-      sub.learner = ReadLearner(learner, sub.name);
-      if (sub.learner->num_inputs() != model.num_inputs()) {
-        learner.Fail("takes " + std::to_string(sub.learner->num_inputs()) +
-                     " inputs, the model's options give " + std::to_string(model.num_inputs()));
-      }
-    }
-    if (s.raw().contains("thermal") && !s["thermal"].IsNull()) {
-      if (predict) s["thermal"].Fail("is a thermal model, which only a compensate-mode model has");
-      sub.thermal = ReadThermal(s["thermal"]);
-    }
-    model.sub_models.push_back(std::move(sub));
-  }
+  for (const Node& s : subs) model.sub_models.push_back(ReadSubModel(s, model));
   int channels = 0;
   for (const drift::SubModel& sub : model.sub_models) {
     if (!sub.thermal) continue;
@@ -257,7 +263,6 @@ drift::DriftModel ReadModel(const Node& root) {
 }
 
 }  // namespace
-
 
 namespace {
 
@@ -345,7 +350,10 @@ std::string FirstUnknownField(const json& file, const json& known, const std::st
   return "";
 }
 
-std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source) {
+namespace {
+
+// The JSON of `text`, refused unless it is an object whose "format" is a model file's.
+json ParseModelJson(const std::string& text, const std::string& source) {
   json j;
   try {
     j = json::parse(text);
@@ -361,7 +369,11 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": not a gyrodrift model file (\"format\" must be \"" +
                     std::string(kModelFormat) + "\")");
   }
-  const Node root(j, "", source);
+  return j;
+}
+
+// The file's format_version, refused unless this version reads it.
+long long ReadFormatVersion(const Node& root, const std::string& source) {
   const long long version = root["format_version"].Int(0, std::numeric_limits<int>::max());
   if (version < kOldestReadableModelFormatVersion || version > kModelFormatVersion) {
     throw DataError(source + ": model format_version " + std::to_string(version) +
@@ -369,6 +381,11 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
                     std::to_string(kOldestReadableModelFormatVersion) + " to " +
                     std::to_string(kModelFormatVersion) + ")");
   }
+  return version;
+}
+
+// The stored checksum, refused unless the content (all but the checksum) gives it.
+std::string CheckChecksum(const json& j, const Node& root, const std::string& source) {
   const std::string stored = root["checksum"].String();
   json body = j;
   body.erase("checksum");
@@ -377,52 +394,49 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": checksum mismatch (file says " + stored + ", content gives " +
                     computed + "): the model file is damaged or was edited");
   }
-  const std::string tool_version = root["tool_version"].String();
-  std::vector<LoadedModel> axes;
-  auto read_axis = [&](const Node& at) {
-    LoadedModel out;
-    out.info.tool_version = tool_version;
-    const Node training = at["training"];
-    out.info.target_column = training["target_column"].String();
-    out.info.temperature_column = training["temperature_column"].String();
-    out.info.source = training["source"].String();
-    out.info.rate_unit = "";
-    if (version >= 4) {
-      out.info.rate_unit = training["rate_unit"].String();
-      if (!out.info.rate_unit.empty()) {
-        try {
-          (void)allan::RateUnitFromString(out.info.rate_unit);
-        } catch (const UsageError&) {
-          training["rate_unit"].Fail("= '" + out.info.rate_unit + "': must be dph, dps or rads");
-        }
+  return stored;
+}
+
+// The axis at `at` of a file of `version`; `earlier`: the axes read before it (one target each).
+LoadedModel ReadAxis(const Node& at, long long version, const std::string& tool_version,
+                     const std::vector<LoadedModel>& earlier) {
+  LoadedModel out;
+  out.info.tool_version = tool_version;
+  const Node training = at["training"];
+  out.info.target_column = training["target_column"].String();
+  out.info.temperature_column = training["temperature_column"].String();
+  out.info.source = training["source"].String();
+  out.info.rate_unit = "";
+  if (version >= 4) {
+    out.info.rate_unit = training["rate_unit"].String();
+    if (!out.info.rate_unit.empty()) {
+      try {
+        (void)allan::RateUnitFromString(out.info.rate_unit);
+      } catch (const UsageError&) {
+        training["rate_unit"].Fail("= '" + out.info.rate_unit + "': must be dph, dps or rads");
       }
     }
-    out.model = ReadModel(at);
-    if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
-      training["samples"].Fail("differs from model.training_samples");
-    }
-    if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
-      training["temperature_column"].Fail("is empty but the model uses temperature");
-    }
-    for (const LoadedModel& earlier : axes) {
-      if (earlier.info.target_column == out.info.target_column) {
-        training["target_column"].Fail("= '" + out.info.target_column +
-                                       "' is the target of an earlier axis too");
-      }
-    }
-    axes.push_back(std::move(out));
-  };
-  if (j.contains("axes")) {
-    const std::vector<Node> items = root["axes"].Items();
-    if (items.size() < 2 || static_cast<int>(items.size()) > kMaxModelAxes) {
-      root["axes"].Fail("holds " + std::to_string(items.size()) + " axes (2 to " +
-                        std::to_string(kMaxModelAxes) +
-                        " expected; a one-axis file keeps its fields at the top level)");
-    }
-    for (const Node& item : items) read_axis(item);
-  } else {
-    read_axis(root);
   }
+  out.model = ReadModel(at);
+  if (training["samples"].Int(0, 1LL << 40) != out.model.training_samples) {
+    training["samples"].Fail("differs from model.training_samples");
+  }
+  if (out.model.uses_temperature() && out.info.temperature_column.empty()) {
+    training["temperature_column"].Fail("is empty but the model uses temperature");
+  }
+  for (const LoadedModel& e : earlier) {
+    if (e.info.target_column == out.info.target_column) {
+      training["target_column"].Fail("= '" + out.info.target_column +
+                                     "' is the target of an earlier axis too");
+    }
+  }
+  return out;
+}
+
+// Refuses a field of the file `j` that `axes` (read from it) written back by this version lacks:
+// one that reading would silently ignore.
+void RejectUnknownFields(const json& j, const std::vector<LoadedModel>& axes,
+                         const std::string& stored, long long version, const std::string& source) {
   json known = ModelFileJson(axes);
   known["checksum"] = stored;
   if (version <= kLastModelFormatVersionWithThreads) {
@@ -448,6 +462,29 @@ std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::
     throw DataError(source + ": field '" + unknown +
                     "' is not part of a gyrodrift model file (misspelt, or from another tool)");
   }
+}
+
+}  // namespace
+
+std::vector<LoadedModel> ParseModelFileAxes(const std::string& text, const std::string& source) {
+  const json j = ParseModelJson(text, source);
+  const Node root(j, "", source);
+  const long long version = ReadFormatVersion(root, source);
+  const std::string stored = CheckChecksum(j, root, source);
+  const std::string tool_version = root["tool_version"].String();
+  std::vector<LoadedModel> axes;
+  if (j.contains("axes")) {
+    const std::vector<Node> items = root["axes"].Items();
+    if (items.size() < 2 || static_cast<int>(items.size()) > kMaxModelAxes) {
+      root["axes"].Fail("holds " + std::to_string(items.size()) + " axes (2 to " +
+                        std::to_string(kMaxModelAxes) +
+                        " expected; a one-axis file keeps its fields at the top level)");
+    }
+    for (const Node& item : items) axes.push_back(ReadAxis(item, version, tool_version, axes));
+  } else {
+    axes.push_back(ReadAxis(root, version, tool_version, axes));
+  }
+  RejectUnknownFields(j, axes, stored, version, source);
   return axes;
 }
 

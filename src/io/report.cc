@@ -283,17 +283,10 @@ Decimated DecimateMinMax(const Eigen::Ref<const Eigen::VectorXd>& x,
   return out;
 }
 
-HtmlReport::HtmlReport(std::string title) : title_(std::move(title)) {}
+namespace {
 
-void HtmlReport::AddHeading(const std::string& text) { body_ += "<h2>" + Escape(text) + "</h2>\n"; }
-
-void HtmlReport::AddParagraph(const std::string& text) { body_ += "<p>" + Escape(text) + "</p>\n"; }
-
-void HtmlReport::AddPreformatted(const std::string& text) {
-  body_ += "<pre>" + Escape(text) + "</pre>\n";
-}
-
-void HtmlReport::AddFigure(const ReportFigure& f) {
+// Refuses a figure that cannot be drawn (naming it); true when a series has a band.
+bool CheckFigure(const ReportFigure& f) {
   if (f.max_points < 16 || f.max_points > 1000000) {
     ThrowOption("max_points", std::to_string(f.max_points), "an integer in [16, 1000000]");
   }
@@ -309,7 +302,6 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
                       std::to_string(i + 1) + ")");
     }
   }
-  const Eigen::Index cols = static_cast<Eigen::Index>(f.series.size());
   bool bands = false;
   for (const auto& s : f.series) {
     if (s.values.size() != n) {
@@ -322,6 +314,14 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
     }
     bands = bands || s.lower.size() != 0;
   }
+  return bands;
+}
+
+// The figure's series as columns (and their bands, a series without one banded by itself when
+// another has one), reduced to at most f.max_points rows.
+Decimated DecimateFigure(const ReportFigure& f, bool bands) {
+  const Eigen::Index n = f.x.size();
+  const Eigen::Index cols = static_cast<Eigen::Index>(f.series.size());
   Eigen::MatrixXd values(n, cols), lower, upper;
   if (bands) {
     lower.resize(n, cols);
@@ -335,9 +335,11 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
       upper.col(c) = s.upper.size() ? s.upper : s.values;
     }
   }
-  const Decimated d = DecimateMinMax(f.x, values, lower, upper, f.max_points);
+  return DecimateMinMax(f.x, values, lower, upper, f.max_points);
+}
 
-  const std::string id = "fig" + std::to_string(++figures_);
+// The figure's data as the page's script reads it: labels, axes, series and shades.
+std::string FigureJson(const ReportFigure& f, const Decimated& d) {
   std::string json =
       "{\"title\":" + JsonString(f.title) + ",\"xlabel\":" + JsonString(f.x_label) +
       ",\"ylabel\":" + JsonString(f.y_label) + ",\"y2label\":" + JsonString(f.y2_label) +
@@ -346,20 +348,21 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
       ",\"intx\":" + (f.integer_x ? "true" : "false") + ",\"x\":";
   AppendArray(json, d.x);
   json += ",\"series\":[";
-  for (Eigen::Index c = 0; c < cols; ++c) {
-    const auto& s = f.series[static_cast<size_t>(c)];
+  for (size_t c = 0; c < f.series.size(); ++c) {
+    const auto& s = f.series[c];
+    const Eigen::Index col = static_cast<Eigen::Index>(c);
     if (c) json += ',';
     json += "{\"name\":" + JsonString(s.name) + ",\"dashed\":" + (s.dashed ? "true" : "false") +
             ",\"bold\":" + (s.emphasis ? "true" : "false") +
             (s.color.empty() ? std::string() : ",\"color\":" + JsonString(s.color)) +
             (s.markers_only ? ",\"markers\":true" : "") +
             ",\"right\":" + (s.right_axis ? "true" : "false") + ",\"y\":";
-    AppendArray(json, d.values.col(c));
+    AppendArray(json, d.values.col(col));
     if (s.lower.size()) {
       json += ",\"lo\":";
-      AppendArray(json, d.lower.col(c));
+      AppendArray(json, d.lower.col(col));
       json += ",\"hi\":";
-      AppendArray(json, d.upper.col(c));
+      AppendArray(json, d.upper.col(col));
     }
     json += '}';
   }
@@ -373,7 +376,25 @@ void HtmlReport::AddFigure(const ReportFigure& f) {
     json += ',' + JsonString(f.shades[i].label) + ']';
   }
   json += "]}";
+  return json;
+}
 
+}  // namespace
+
+HtmlReport::HtmlReport(std::string title) : title_(std::move(title)) {}
+
+void HtmlReport::AddHeading(const std::string& text) { body_ += "<h2>" + Escape(text) + "</h2>\n"; }
+
+void HtmlReport::AddParagraph(const std::string& text) { body_ += "<p>" + Escape(text) + "</p>\n"; }
+
+void HtmlReport::AddPreformatted(const std::string& text) {
+  body_ += "<pre>" + Escape(text) + "</pre>\n";
+}
+
+void HtmlReport::AddFigure(const ReportFigure& f) {
+  const Decimated d = DecimateFigure(f, CheckFigure(f));
+  const std::string id = "fig" + std::to_string(++figures_);
+  const std::string json = FigureJson(f, d);
   body_ += "<div class=\"fig\">\n<h3>" + Escape(f.title) + "</h3>\n";
   body_ += "<div id=\"" + id + "\" class=\"plot\" style=\"height:" + std::to_string(f.height_px) +
            "px\"></div>\n";

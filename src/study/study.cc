@@ -13,6 +13,8 @@
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/simulation/temperature_programme.h"
+#include "gyrodrift/tasks/compensate_task.h"
+#include "gyrodrift/tasks/evaluate_task.h"
 #include "gyrodrift/tasks/fit_task.h"
 #include "study_steps.h"
 
@@ -90,33 +92,42 @@ std::function<void(double, std::string_view)> TrialProgress(
 }
 
 // A compensate-mode model of `method` fitted on (y, temperature) through the fit task, as
-// `gyrodrift fit` fits it: the study's settings (StudyDriftOptions' as drift::FitSettings).
+// `gyrodrift fit` fits it.
 drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
                                   const Eigen::VectorXd& y, const Eigen::VectorXd& temperature) {
   tasks::FitRun run{.targets = {"y"}, .temperatures = {"temperature"}};
   Eigen::MatrixXd rows(y.size(), 2);
   rows << y, temperature;
   run.rows.Append(rows);
-  const StudyOptions& a = s.options;
-  const drift::FitSettings settings{
-      .mode = "compensate",
-      .method = std::string(drift::ToString(method)),
-      .rate_hz = s.rate_hz,
-      .ensemble = a.ensemble_size,
-      .realisations = a.realisations,
-      .seed = a.seed,
-      .threads = s.threads,
-      .reference_temperature = s.drift_options.reference_c,
-      .has_temperature = true};
+  drift::FitSettings settings = internal::StudyFitSettings(s, drift::Mode::kCompensate);
+  settings.method = std::string(drift::ToString(method));
   return tasks::RunFit(run, settings, "dph").axes.front().model;
 }
 
-drift::EvaluationOptions EvaluationFor(const StudyOptions& a, std::vector<drift::Method> methods) {
-  drift::EvaluationOptions e;
-  e.methods = std::move(methods);
-  e.causal.window = a.causal_window;
-  e.causal.ensemble_size = a.ensemble_size;
-  return e;
+// The study's evaluation of `methods` ("all" or a comma-separated list) with the models' settings
+// `fit`: the causal protocol's window and ensemble are the study's.
+tasks::EvaluateSettings EvaluationSettings(const StudyOptions& a, drift::FitSettings fit,
+                                           std::string methods) {
+  return {.fit = std::move(fit),
+          .methods = std::move(methods),
+          .window = a.causal_window,
+          .causal_ensemble = a.ensemble_size};
+}
+
+// `methods` scored in `mode` on the record through the evaluate task (against `truth` when not
+// empty), reporting to stage `stage` of the context.
+drift::EvaluationResult EvaluateStep(const StudyResult& s, drift::Mode mode,
+                                     const std::vector<drift::Method>& methods,
+                                     const Eigen::VectorXd& truth, const Notifier& notify,
+                                     int stage, const std::string& prefix) {
+  std::string list;
+  for (drift::Method m : methods)
+    list += (list.empty() ? "" : ",") + std::string(drift::ToString(m));
+  const tasks::EvaluateSettings settings =
+      EvaluationSettings(s.options, internal::StudyFitSettings(s, mode), list);
+  auto progress =
+      TrialProgress(notify, stage, drift::EvaluatedMethods(settings.Options()), mode, prefix);
+  return tasks::RunEvaluate(s.output, s.temperature, truth, settings, std::move(progress)).result;
 }
 
 void SimulateRuns(const StudyOptions& a, StudyResult& s) {
@@ -150,9 +161,9 @@ void TakeLog(const StudyOptions& a, const StudyLog& log, StudyResult& s) {
   s.rate_hz = log.rate_hz;
   s.rate_source = log.rate_source;
   s.time_note = log.time_note;
-  s.time_h = Eigen::VectorXd::LinSpaced(s.output.size(), 0.0,
-                                        static_cast<double>(s.output.size() - 1)) /
-             (3600.0 * s.rate_hz);
+  s.time_h =
+      Eigen::VectorXd::LinSpaced(s.output.size(), 0.0, static_cast<double>(s.output.size() - 1)) /
+      (3600.0 * s.rate_hz);
 }
 
 void DecomposeStep(StudyResult& s) {
@@ -175,8 +186,6 @@ void DecomposeStep(StudyResult& s) {
 }
 
 void PredictStep(StudyResult& s, const Notifier& notify) {
-  drift::DriftOptions o = s.drift_options;
-  o.mode = drift::Mode::kPredict;
   std::vector<drift::Method> methods;
   for (drift::Method m : s.options.methods) {
     if (drift::SupportsMode(m, drift::Mode::kPredict)) methods.push_back(m);
@@ -188,11 +197,7 @@ void PredictStep(StudyResult& s, const Notifier& notify) {
       methods.push_back(m);
     }
   }
-  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{.threads = s.threads,
-                            .progress = TrialProgress(notify, 2, drift::EvaluatedMethods(e),
-                                                      drift::Mode::kPredict, "predict: ")};
-  s.predict = drift::Evaluate(s.output, s.temperature, s.truth, o, e, execution);
+  s.predict = EvaluateStep(s, drift::Mode::kPredict, methods, s.truth, notify, 2, "predict: ");
 }
 
 void CompensateSimulated(StudyResult& s, const Notifier& notify) {
@@ -209,21 +214,23 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
                     "compensate: " + std::string(drift::ToString(methods[i])));
     StudyResult::CompensateRow row{methods[i], "train A test B", {}, 0.0, 0.0, 0.0, {}, {}};
     auto start = Clock::now();
-    const drift::DriftModel model =
-        FitCompensation(s, methods[i], s.run_a.rate_dph, s.run_a.temperature_c);
+    const io::LoadedModel loaded{
+        FitCompensation(s, methods[i], s.run_a.rate_dph, s.run_a.temperature_c),
+        {"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"}};
     row.train_s = Seconds(start);
     start = Clock::now();
-    row.estimate = drift::EstimateDrift(model, s.run_b.temperature_c);
+    // Through the compensate task, as `gyrodrift compensate` applies the model file to run B.
+    row.estimate =
+        tasks::CompensateAxis(loaded, s.run_b.rate_dph, s.run_b.temperature_c, {}, {}, {}).estimate;
     row.estimate_s = Seconds(start);
     row.metrics = drift::ComputeMetrics(s.compensate_reference - row.estimate);
     row.share_removed = 1.0 - row.metrics.rmse / reference_rms;
-    row.summary = model.Summary();
+    row.summary = loaded.model.Summary();
     row.slow_removed = drift::SlowVariationRemoved(s.compensate_reference, row.estimate, s.rate_hz);
     if (!drift::IsBaseline(methods[i])) {
-      io::ModelFileInfo info{"rate_dph", "temperature_c", "simulation run A (chamber)", "", "dph"};
       s.model_files.push_back(
           {"models/" + std::string(drift::ToString(methods[i])) + "_compensate.json",
-           io::RenderModelFile(model, info)});
+           io::RenderModelFile({loaded})});
     }
     s.compensate.push_back(std::move(row));
   }
@@ -231,22 +238,15 @@ void CompensateSimulated(StudyResult& s, const Notifier& notify) {
 
 void CompensateSplit(StudyResult& s, const Notifier& notify) {
   const std::vector<drift::Method>& methods = s.options.methods;
-  drift::DriftOptions base = s.drift_options;
-  base.mode = drift::Mode::kCompensate;
-  const drift::EvaluationOptions e = EvaluationFor(s.options, methods);
-  const Execution execution{.threads = s.threads,
-                            .progress = TrialProgress(notify, 3, drift::EvaluatedMethods(e),
-                                                      drift::Mode::kCompensate, "compensate: ")};
-  s.compensate_split =
-      drift::Evaluate(s.output, s.temperature, Eigen::VectorXd(), base, e, execution);
+  s.compensate_split = EvaluateStep(s, drift::Mode::kCompensate, methods, Eigen::VectorXd(), notify,
+                                    3, "compensate: ");
   const Eigen::Index split = s.compensate_split.split_index;
   s.compensate_reference = s.compensate_split.reference;
   s.compensate_output = s.output.tail(s.output.size() - split);
   s.compensate_time_h = s.time_h.tail(s.output.size() - split);
   // The measured output carries the sensor's constant bias, which any model removes; the share is
   // taken of the output's variation about its mean instead.
-  const double reference_rms =
-      Rms(s.compensate_reference.array() - s.compensate_reference.mean());
+  const double reference_rms = Rms(s.compensate_reference.array() - s.compensate_reference.mean());
   for (const auto& r : s.compensate_split.rows) {
     StudyResult::CompensateRow row{r.method,   std::string(drift::ToString(r.protocol)),
                                    {},         0.0,
@@ -328,84 +328,93 @@ void AllanStep(StudyResult& s) {
   if (s.simulated) fit(s.allan_noise, s.terms_noise);
 }
 
+// Refuses a log the study cannot analyse, before any work.
+void CheckLog(const StudyOptions& options, const StudyLog& log) {
+  ValidateAsSettings({{"features.rate_hz", "rate_hz"}},
+                     [&] { internal::StudyDriftOptions(options, log.rate_hz, false).Validate(); });
+  if (log.output.size() < kMinLogSamples) {
+    throw DataError(log.source + ": " + std::to_string(log.output.size()) +
+                    " samples; the study needs at least 64 (a 70/30 split with 32 training and "
+                    "16 test samples, and room for the decomposition)");
+  }
+  if (log.temperature.size() != log.output.size()) {
+    throw DataError(log.source + ": the temperature has " + std::to_string(log.temperature.size()) +
+                    " samples, the output " + std::to_string(log.output.size()) +
+                    ": one per output sample expected");
+  }
+}
+
+// Records how long the stage `name` took since t0 (plus extra_s spent before the study).
+void TimeStage(StudyResult& s, const std::string& name, Clock::time_point t0,
+               double extra_s = 0.0) {
+  s.stage_s.push_back({name, extra_s + Seconds(t0)});
+}
+
+// Stage 1: runs A and B simulated, or the log taken; then the study's drift options.
+void DataStage(StudyResult& s, const StudyLog* log, const Notifier& notify) {
+  notify.Progress(0, 0.0, s.simulated ? "simulating runs A and B" : "checking " + log->source);
+  const auto t0 = Clock::now();
+  if (s.simulated) {
+    SimulateRuns(s.options, s);
+  } else {
+    TakeLog(s.options, *log, s);
+  }
+  s.drift_options = internal::StudyDriftOptions(s.options, s.rate_hz, s.simulated);
+  TimeStage(s, s.simulated ? "simulate A and B" : "read", t0, log ? log->read_s : 0.0);
+  if (s.simulated) {
+    notify.StageDone(0, fmt::format("1. simulated run A: {}\n   simulated run B: {}\n",
+                                    s.run_a.Summary(), s.run_b.Summary()));
+  } else {
+    notify.StageDone(
+        0, fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", s.source, s.output.size(),
+                       s.target_name, RoundedText(s.rate_hz), s.rate_source) +
+               (s.time_note.empty() ? "" : "   " + s.time_note + "\n"));
+  }
+}
+
+// The study's steps in order, each reported to the context as it ends.
 StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyContext& context) {
   options.Validate();
   ValidateThreads(context.threads);
-  const bool simulated = log == nullptr;
-  if (log) {
-    ValidateAsSettings({{"features.rate_hz", "rate_hz"}}, [&] {
-      internal::StudyDriftOptions(options, log->rate_hz, false).Validate();
-    });
-    if (log->output.size() < kMinLogSamples) {
-      throw DataError(log->source + ": " + std::to_string(log->output.size()) +
-                      " samples; the study needs at least 64 (a 70/30 split with 32 training and "
-                      "16 test samples, and room for the decomposition)");
-    }
-    if (log->temperature.size() != log->output.size()) {
-      throw DataError(log->source + ": the temperature has " +
-                      std::to_string(log->temperature.size()) + " samples, the output " +
-                      std::to_string(log->output.size()) + ": one per output sample expected");
-    }
-  }
+  if (log) CheckLog(options, *log);
   const auto start = Clock::now();
   const double read_s = log ? log->read_s : 0.0;
   const Notifier notify{context};
   StudyResult s;
   s.options = options;
   s.threads = context.threads;
-  s.simulated = simulated;
-  auto time_stage = [&](const std::string& name, Clock::time_point t0, double extra_s = 0.0) {
-    s.stage_s.push_back({name, extra_s + Seconds(t0)});
-  };
-
-  notify.Progress(0, 0.0, simulated ? "simulating runs A and B" : "checking " + log->source);
-  auto t0 = Clock::now();
-  if (simulated) {
-    SimulateRuns(options, s);
-  } else {
-    TakeLog(options, *log, s);
-  }
-  s.drift_options = internal::StudyDriftOptions(options, s.rate_hz, simulated);
-  time_stage(simulated ? "simulate A and B" : "read", t0, read_s);
-  if (simulated) {
-    notify.StageDone(0, fmt::format("1. simulated run A: {}\n   simulated run B: {}\n",
-                                    s.run_a.Summary(), s.run_b.Summary()));
-  } else {
-    notify.StageDone(0, fmt::format("1. read {}: {} samples of {} at {} Hz ({})\n", s.source,
-                                    s.output.size(), s.target_name, RoundedText(s.rate_hz),
-                                    s.rate_source) +
-                            (s.time_note.empty() ? "" : "   " + s.time_note + "\n"));
-  }
+  s.simulated = log == nullptr;
+  DataStage(s, log, notify);
 
   notify.Progress(1, 0.0, "BEEMDAN decomposition and mode selection");
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   DecomposeStep(s);
-  time_stage("decompose + select", t0);
-  notify.StageDone(1, fmt::format("2. {}\n   {}\n", s.decomposition.report.Summary(),
-                                  s.selection.Summary()));
+  TimeStage(s, "decompose + select", t0);
+  notify.StageDone(
+      1, fmt::format("2. {}\n   {}\n", s.decomposition.report.Summary(), s.selection.Summary()));
 
   notify.Progress(2, 0.0, "predict mode");
   t0 = Clock::now();
   PredictStep(s, notify);
-  time_stage("predict mode (both protocols)", t0);
+  TimeStage(s, "predict mode (both protocols)", t0);
   internal::FillPredictTable(s);
   notify.StageDone(2, "3. " + s.predict_table.Text());
 
   notify.Progress(3, 0.0, "compensate mode");
   t0 = Clock::now();
-  if (simulated) {
+  if (s.simulated) {
     CompensateSimulated(s, notify);
   } else {
     CompensateSplit(s, notify);
   }
-  time_stage("compensate mode", t0);
+  TimeStage(s, "compensate mode", t0);
   internal::FillCompensateTable(s);
   notify.StageDone(3, "4. " + s.compensate_table.Text());
 
   notify.Progress(4, 0.0, "Allan deviation");
   t0 = Clock::now();
   AllanStep(s);
-  time_stage("Allan deviation + noise fits", t0);
+  TimeStage(s, "Allan deviation + noise fits", t0);
   internal::FillNoiseTermsTable(s);
   notify.StageDone(4, "5. " + s.terms_table.Text());
 
@@ -418,8 +427,7 @@ StudyResult Run(const StudyOptions& options, const StudyLog* log, const StudyCon
 
 namespace internal {
 
-drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz,
-                                      bool simulated) {
+drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz, bool simulated) {
   drift::DriftOptions o;
   o.decomposition.ensemble_size = options.ensemble_size;
   o.selection.monte_carlo.realisations = options.realisations;
@@ -427,6 +435,20 @@ drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_h
   o.seed = options.seed;
   if (simulated) o.reference_c = 20.0;
   return o;
+}
+
+drift::FitSettings StudyFitSettings(const StudyResult& s, drift::Mode mode) {
+  const StudyOptions& a = s.options;
+  const bool compensate = mode == drift::Mode::kCompensate;
+  return {.mode = std::string(drift::ToString(mode)),
+          .rate_hz = s.rate_hz,
+          .ensemble = a.ensemble_size,
+          .realisations = a.realisations,
+          .seed = a.seed,
+          .threads = s.threads,
+          // A compensate-mode setting: the estimate's reference (StudyDriftOptions).
+          .reference_temperature = compensate ? s.drift_options.reference_c : std::nullopt,
+          .has_temperature = compensate};
 }
 
 std::string GroupOf(const sel::SelectionResult& selection, int k) {
@@ -445,10 +467,12 @@ void StudyOptions::Validate() const {
   // refusal names the study's field that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
                       {"selection.monte_carlo.realisations", "realisations"},
-                      {"window", "causal_window"}},
+                      {"causal.window", "causal_window"}},
                      [&] {
                        internal::StudyDriftOptions(*this, 1.0, true).Validate();
-                       EvaluationFor(*this, methods).causal.Validate();
+                       // The causal protocol's settings; the study's method list is checked
+                       // below by its own rule.
+                       EvaluationSettings(*this, {.mode = "predict"}, "all").Validate();
                      });
   if (!(duration_s >= kMinDurationS)) {
     ThrowOption("duration_s", FormatValue(duration_s),

@@ -128,14 +128,8 @@ void AllanFigure(io::HtmlReport& report, const StudyResult& s) {
   report.AddFigure(f);
 }
 
-}  // namespace
-
-std::string RenderStudyReport(const StudyResult& s, const io::DygraphsAssets& assets) {
-  io::HtmlReport report(s.simulated ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
-                                    : "gyrodrift demo: " + s.source);
-  const double split_h = s.predict.split_index < s.time_h.size() ? s.time_h[s.predict.split_index]
-                                                                 : s.time_h[s.time_h.size() - 1];
-  const double end_h = s.time_h[s.time_h.size() - 1];
+// The opening: what was analysed and the method.
+void AddIntroduction(io::HtmlReport& report, const StudyResult& s) {
   report.AddParagraph(
       s.simulated
           ? "A navigation-grade fibre optic gyro (1 km coil, quadrupole winding) is simulated at " +
@@ -158,325 +152,375 @@ std::string RenderStudyReport(const StudyResult& s, const io::DygraphsAssets& as
       "machine per sub-series and sums them (Chen & Cui, Signal Processing 128, 2016). Baselines: "
       "a "
       "single ELM, EMD-ELM (one ELM per IMF), polynomial regression, SVR and a BP network.");
+}
 
-  report.AddHeading(s.simulated ? "1. The simulated runs" : "1. The record");
-  {
-    io::ReportFigure f;
-    f.title = s.simulated ? "Run A: gyro output and true thermal drift" : "Gyro output";
-    f.x_label = "time (h)";
-    f.y_label = s.target_name + " (" + s.unit + ")";
-    f.x = s.time_h;
-    f.series.push_back(Series("output", s.output));
-    if (s.simulated) f.series.push_back(Reference("true drift", s.truth));
-    f.shades.push_back({split_h, end_h, "predict-mode test block (last 30 %)"});
-    f.caption =
-        s.simulated
-            ? "The output is the drift plus white and bias-instability noise. The drift follows "
-              "the temperature ramps (Shupe effect: the rate of temperature change inside the "
-              "coil) "
-              "and the temperature level (stress and electronics bias). Zoom into a ramp to see "
-              "the "
-              "noise riding on it."
-            : "The analysed column. Shaded: the last 30 %, where every model is tested.";
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    f.title = s.simulated ? "Run A: temperatures" : "Temperature channel";
-    f.x_label = "time (h)";
-    // A user's temperature column may be in any unit (raw counts, for one): its name, not a unit.
-    f.y_label = s.simulated ? "temperature (degC)" : s.temperature_name;
-    f.x = s.time_h;
-    if (s.simulated) {
-      f.series.push_back(Series("chamber", s.run_a.chamber_c));
-      f.series.push_back(Series("case sensor (model input)", s.run_a.temperature_c));
-      f.series.push_back(Series("coil mean (truth)", s.run_a.coil_mean_c));
-    } else {
-      f.series.push_back(Series("temperature", s.temperature));
-    }
-    f.caption =
-        s.simulated
-            ? "The chamber programme, the case sensor a user logs (the only temperature the "
-              "models see) and the true mean coil temperature, which lags the case by minutes."
-            : "The temperature column the compensate-mode models use.";
-    report.AddFigure(f);
-  }
+// Section 1's first figure: the analysed output (and the truth), its predict-mode test block
+// shaded.
+io::ReportFigure OutputFigure(const StudyResult& s) {
+  const double split_h = s.predict.split_index < s.time_h.size() ? s.time_h[s.predict.split_index]
+                                                                 : s.time_h[s.time_h.size() - 1];
+  const double end_h = s.time_h[s.time_h.size() - 1];
+  io::ReportFigure f;
+  f.title = s.simulated ? "Run A: gyro output and true thermal drift" : "Gyro output";
+  f.x_label = "time (h)";
+  f.y_label = s.target_name + " (" + s.unit + ")";
+  f.x = s.time_h;
+  f.series.push_back(Series("output", s.output));
+  if (s.simulated) f.series.push_back(Reference("true drift", s.truth));
+  f.shades.push_back({split_h, end_h, "predict-mode test block (last 30 %)"});
+  f.caption =
+      s.simulated
+          ? "The output is the drift plus white and bias-instability noise. The drift follows "
+            "the temperature ramps (Shupe effect: the rate of temperature change inside the "
+            "coil) "
+            "and the temperature level (stress and electronics bias). Zoom into a ramp to see "
+            "the "
+            "noise riding on it."
+          : "The analysed column. Shaded: the last 30 %, where every model is tested.";
+  return f;
+}
+
+io::ReportFigure TemperatureFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = s.simulated ? "Run A: temperatures" : "Temperature channel";
+  f.x_label = "time (h)";
+  // A user's temperature column may be in any unit (raw counts, for one): its name, not a unit.
+  f.y_label = s.simulated ? "temperature (degC)" : s.temperature_name;
+  f.x = s.time_h;
   if (s.simulated) {
-    io::ReportFigure f;
-    f.title = "Run B: gyro output, true drift and temperature (test run for compensation)";
-    f.x_label = "time (h)";
-    f.y_label = "deg/h";
-    f.y2_label = "case sensor (degC)";
-    f.x = s.run_b.time_s / 3600.0;
-    f.series.push_back(Series("output", s.run_b.rate_dph));
-    f.series.push_back(Reference("true drift", s.run_b.drift_dph));
-    io::ReportSeries t = Series("case sensor (right axis)", s.run_b.temperature_c);
-    t.right_axis = true;
-    f.series.push_back(t);
-    f.caption =
-        "Run B uses a different programme (slower ramps, other levels), so a compensation "
-        "model trained on run A meets a thermal history it has not seen.";
-    report.AddFigure(f);
+    f.series.push_back(Series("chamber", s.run_a.chamber_c));
+    f.series.push_back(Series("case sensor (model input)", s.run_a.temperature_c));
+    f.series.push_back(Series("coil mean (truth)", s.run_a.coil_mean_c));
+  } else {
+    f.series.push_back(Series("temperature", s.temperature));
   }
+  f.caption =
+      s.simulated
+          ? "The chamber programme, the case sensor a user logs (the only temperature the "
+            "models see) and the true mean coil temperature, which lags the case by minutes."
+          : "The temperature column the compensate-mode models use.";
+  return f;
+}
 
+// Simulated studies only.
+io::ReportFigure RunBFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = "Run B: gyro output, true drift and temperature (test run for compensation)";
+  f.x_label = "time (h)";
+  f.y_label = "deg/h";
+  f.y2_label = "case sensor (degC)";
+  f.x = s.run_b.time_s / 3600.0;
+  f.series.push_back(Series("output", s.run_b.rate_dph));
+  f.series.push_back(Reference("true drift", s.run_b.drift_dph));
+  io::ReportSeries t = Series("case sensor (right axis)", s.run_b.temperature_c);
+  t.right_axis = true;
+  f.series.push_back(t);
+  f.caption =
+      "Run B uses a different programme (slower ramps, other levels), so a compensation "
+      "model trained on run A meets a thermal history it has not seen.";
+  return f;
+}
+
+void AddRecordSection(io::HtmlReport& report, const StudyResult& s) {
+  report.AddHeading(s.simulated ? "1. The simulated runs" : "1. The record");
+  report.AddFigure(OutputFigure(s));
+  report.AddFigure(TemperatureFigure(s));
+  if (s.simulated) report.AddFigure(RunBFigure(s));
+}
+
+io::ReportFigure SelectionCurvesFigure(const StudyResult& s) {
+  const int k_count = s.decomposition.num_imfs();
+  io::ReportFigure f;
+  f.title =
+      "Selection curves: distance of each IMF's PDF to the signal's (D_k) and to a Gaussian "
+      "(G_k)";
+  f.x_label = "IMF index k";
+  f.y_label = "L2 distance between densities";
+  f.draw_points = true;
+  f.integer_x = true;
+  f.x.resize(k_count);
+  for (int k = 0; k < k_count; ++k) f.x[k] = k + 1;
+  auto vec = [&](const std::vector<double>& v) {
+    Eigen::VectorXd out(k_count);
+    for (int k = 0; k < k_count; ++k) {
+      out[k] = k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)]
+                                              : std::numeric_limits<double>::quiet_NaN();
+    }
+    return out;
+  };
+  f.series.push_back(Series("D_k: PDF(IMF k) vs PDF(signal)", vec(s.selection.pdf_distance)));
+  f.y2_label = "G_k (right axis)";
+  f.series.push_back(
+      Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
+  f.series.push_back(
+      Series("family-wise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
+  f.series[1].right_axis = f.series[2].right_axis = true;
+  for (const auto& g : s.selection.groups) {
+    if (g.imfs.empty()) continue;
+    f.shades.push_back(
+        {g.imfs.front() - 0.45, g.imfs.back() + 0.45, std::string(sel::ToString(g.kind))});
+  }
+  f.caption =
+      "Shaded: the chosen groups. Noise = the leading IMFs whose G_k stays under the white-noise "
+      "level (k_N = " +
+      std::to_string(s.selection.k_noise) +
+      "); k* = argmax D_k = " + std::to_string(s.selection.k_star) +
+      " ends the mixed group; the rest plus the residue is the drift group. Look for the peak of "
+      "D_k: below it the IMFs look like noise, above it like the signal.";
+  // The rule above in general; the edge case this record met (no mixed group, say) in particular.
+  if (!s.selection.note.empty()) f.caption += " Here: " + s.selection.note + ".";
+  return f;
+}
+
+io::ReportFigure EnergyFigure(const StudyResult& s) {
+  const int k_count = s.decomposition.num_imfs();
+  io::ReportFigure f;
+  f.title = "IMF energies against the white-noise energy model";
+  f.x_label = "IMF index k";
+  f.y_label = "log2 energy";
+  f.draw_points = true;
+  f.integer_x = true;
+  f.x.resize(k_count);
+  Eigen::VectorXd e(k_count), band(k_count);
+  for (int k = 0; k < k_count; ++k) {
+    f.x[k] = k + 1;
+    e[k] = k < static_cast<int>(s.selection.log2_energy.size())
+               ? s.selection.log2_energy[static_cast<size_t>(k)]
+               : NAN;
+    band[k] = k < static_cast<int>(s.selection.energy_band_log2_upper.size())
+                  ? s.selection.energy_band_log2_upper[static_cast<size_t>(k)]
+                  : NAN;
+  }
+  f.series.push_back(Series("log2 energy of IMF k", e));
+  f.series.push_back(Series("99 % white-noise band, upper", band, true));
+  int above = 0;
+  for (int k = 0; k < k_count; ++k) above += e[k] > band[k];  // NaN compares false
+  f.caption =
+      "White noise gives IMF energies that halve with each k (Flandrin et al. 2004). IMFs above "
+      "the dashed band carry more than noise: that is where the thermal drift lives." +
+      std::string(above == 0
+                      ? " Here no IMF rises above the band: by energy alone, every IMF could be "
+                        "noise, and the drift hides in the slowest ones and the residue."
+                      : "");
+  return f;
+}
+
+io::ReportFigure GroupsFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = "The grouped sub-series (noise + mixed + drift = output)";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = s.time_h;
+  for (const auto& g : s.selection.groups) {
+    f.series.push_back(Series(std::string(sel::ToString(g.kind)), g.series));
+    // A user's log carries its sensor bias in the drift group, which would flatten the other
+    // groups to a line on a shared axis.
+    if (!s.simulated && g.kind == sel::GroupKind::kDrift) f.series.back().right_axis = true;
+  }
+  if (!s.simulated) f.y2_label = "drift group (" + s.unit + ", right axis)";
+  if (s.simulated) {
+    // Thick and dashed: a thin line of its own would vanish in the noise group's band.
+    f.series.push_back(Reference("true drift", s.truth));
+    f.series.back().dashed = true;
+  }
+  const sel::ModeGroup* drift_group = s.selection.Group(sel::GroupKind::kDrift);
+  const bool residue_only = drift_group && drift_group->imfs.empty();
+  f.caption = s.simulated
+                  ? "The drift group should follow the true drift (thick dashed); the noise group "
+                    "should look like the white noise. MS-ELM fits one ELM to each."
+                  : "MS-ELM fits one ELM to each of these series and sums the outputs. The drift "
+                    "group is on the right axis (it carries the sensor's bias).";
+  if (residue_only) {
+    f.caption +=
+        " Here the drift group is the residue alone: whatever slow structure the residue misses "
+        "(compare the last IMFs below with the temperature) is in the " +
+        std::string(s.selection.Group(sel::GroupKind::kMixed) ? "mixed" : "noise") + " group.";
+  }
+  return f;
+}
+
+// IMF k (0-based), captioned by its group.
+io::ReportFigure ImfFigure(const StudyResult& s, int k) {
+  io::ReportFigure f;
+  f.title =
+      "IMF " + std::to_string(k + 1) + " (" + internal::GroupOf(s.selection, k + 1) + " group)";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = s.time_h;
+  f.height_px = 150;
+  f.series.push_back(Series("imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)));
+  const std::string group = internal::GroupOf(s.selection, k + 1);
+  f.caption = group == "noise"
+                  ? "Noise group: should look like noise of steady amplitude, with no trace of the "
+                    "temperature programme."
+              : group == "mixed"
+                  ? "Mixed group: noise with slower structure in it; look for swings that line "
+                    "up with the temperature changes."
+                  : "Drift group: slow structure that should follow the temperature history.";
+  // Only a series longer than the plotted rows is decimated (io::DecimateMinMax).
+  const Eigen::Index n = s.time_h.size();
+  if (n > f.max_points) {
+    f.caption += " Plotted as the min and max of each run of " +
+                 RoundedText(static_cast<double>(n) / (f.max_points / 2), 3) + " samples.";
+  }
+  return f;
+}
+
+io::ReportFigure ResidueFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = "Residue";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = s.time_h;
+  f.height_px = 150;
+  f.series.push_back(Series("residue", s.decomposition.residue));
+  f.caption = "The slow trend left after the last IMF (part of the drift group).";
+  return f;
+}
+
+void AddDecompositionSection(io::HtmlReport& report, const StudyResult& s) {
   report.AddHeading("2. BEEMDAN decomposition and mode selection");
   report.AddParagraph(s.decomposition.report.Summary() + ". " + s.selection.Summary() + ".");
-  const int k_count = s.decomposition.num_imfs();
-  {
-    io::ReportFigure f;
-    f.title =
-        "Selection curves: distance of each IMF's PDF to the signal's (D_k) and to a Gaussian "
-        "(G_k)";
-    f.x_label = "IMF index k";
-    f.y_label = "L2 distance between densities";
-    f.draw_points = true;
-    f.integer_x = true;
-    f.x.resize(k_count);
-    for (int k = 0; k < k_count; ++k) f.x[k] = k + 1;
-    auto vec = [&](const std::vector<double>& v) {
-      Eigen::VectorXd out(k_count);
-      for (int k = 0; k < k_count; ++k) {
-        out[k] = k < static_cast<int>(v.size()) ? v[static_cast<size_t>(k)]
-                                                : std::numeric_limits<double>::quiet_NaN();
-      }
-      return out;
-    };
-    f.series.push_back(Series("D_k: PDF(IMF k) vs PDF(signal)", vec(s.selection.pdf_distance)));
-    f.y2_label = "G_k (right axis)";
-    f.series.push_back(
-        Series("G_k: standardised IMF k vs N(0,1) (right axis)", vec(s.selection.self_distance)));
-    f.series.push_back(
-        Series("family-wise 99 % level of G_k (right axis)", vec(s.selection.noise_level), true));
-    f.series[1].right_axis = f.series[2].right_axis = true;
-    for (const auto& g : s.selection.groups) {
-      if (g.imfs.empty()) continue;
-      f.shades.push_back(
-          {g.imfs.front() - 0.45, g.imfs.back() + 0.45, std::string(sel::ToString(g.kind))});
-    }
-    f.caption =
-        "Shaded: the chosen groups. Noise = the leading IMFs whose G_k stays under the white-noise "
-        "level (k_N = " +
-        std::to_string(s.selection.k_noise) +
-        "); k* = argmax D_k = " + std::to_string(s.selection.k_star) +
-        " ends the mixed group; the rest plus the residue is the drift group. Look for the peak of "
-        "D_k: below it the IMFs look like noise, above it like the signal.";
-    // The rule above in general; the edge case this record met (no mixed group, say) in particular.
-    if (!s.selection.note.empty()) f.caption += " Here: " + s.selection.note + ".";
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    f.title = "IMF energies against the white-noise energy model";
-    f.x_label = "IMF index k";
-    f.y_label = "log2 energy";
-    f.draw_points = true;
-    f.integer_x = true;
-    f.x.resize(k_count);
-    Eigen::VectorXd e(k_count), band(k_count);
-    for (int k = 0; k < k_count; ++k) {
-      f.x[k] = k + 1;
-      e[k] = k < static_cast<int>(s.selection.log2_energy.size())
-                 ? s.selection.log2_energy[static_cast<size_t>(k)]
-                 : NAN;
-      band[k] = k < static_cast<int>(s.selection.energy_band_log2_upper.size())
-                    ? s.selection.energy_band_log2_upper[static_cast<size_t>(k)]
-                    : NAN;
-    }
-    f.series.push_back(Series("log2 energy of IMF k", e));
-    f.series.push_back(Series("99 % white-noise band, upper", band, true));
-    int above = 0;
-    for (int k = 0; k < k_count; ++k) above += e[k] > band[k];  // NaN compares false
-    f.caption =
-        "White noise gives IMF energies that halve with each k (Flandrin et al. 2004). IMFs above "
-        "the dashed band carry more than noise: that is where the thermal drift lives." +
-        std::string(above == 0
-                        ? " Here no IMF rises above the band: by energy alone, every IMF could be "
-                          "noise, and the drift hides in the slowest ones and the residue."
-                        : "");
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    f.title = "The grouped sub-series (noise + mixed + drift = output)";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = s.time_h;
-    for (const auto& g : s.selection.groups) {
-      f.series.push_back(Series(std::string(sel::ToString(g.kind)), g.series));
-      // A user's log carries its sensor bias in the drift group, which would flatten the other
-      // groups to a line on a shared axis.
-      if (!s.simulated && g.kind == sel::GroupKind::kDrift) f.series.back().right_axis = true;
-    }
-    if (!s.simulated) f.y2_label = "drift group (" + s.unit + ", right axis)";
-    if (s.simulated) {
-      // Thick and dashed: a thin line of its own would vanish in the noise group's band.
-      f.series.push_back(Reference("true drift", s.truth));
-      f.series.back().dashed = true;
-    }
-    const sel::ModeGroup* drift_group = s.selection.Group(sel::GroupKind::kDrift);
-    const bool residue_only = drift_group && drift_group->imfs.empty();
-    f.caption =
-        s.simulated
-            ? "The drift group should follow the true drift (thick dashed); the noise group "
-              "should look like the white noise. MS-ELM fits one ELM to each."
-            : "MS-ELM fits one ELM to each of these series and sums the outputs. The drift "
-              "group is on the right axis (it carries the sensor's bias).";
-    if (residue_only) {
-      f.caption +=
-          " Here the drift group is the residue alone: whatever slow structure the residue misses "
-          "(compare the last IMFs below with the temperature) is in the " +
-          std::string(s.selection.Group(sel::GroupKind::kMixed) ? "mixed" : "noise") + " group.";
-    }
-    report.AddFigure(f);
-  }
-  for (int k = 0; k < k_count; ++k) {
-    io::ReportFigure f;
-    f.title = "IMF " + std::to_string(k + 1) + " (" + internal::GroupOf(s.selection, k + 1) + " group)";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = s.time_h;
-    f.height_px = 150;
-    f.series.push_back(Series("imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)));
-    const std::string group = internal::GroupOf(s.selection, k + 1);
-    f.caption =
-        group == "noise"
-            ? "Noise group: should look like noise of steady amplitude, with no trace of the "
-              "temperature programme."
-        : group == "mixed"
-            ? "Mixed group: noise with slower structure in it; look for swings that line "
-              "up with the temperature changes."
-            : "Drift group: slow structure that should follow the temperature history.";
-    // Only a series longer than the plotted rows is decimated (io::DecimateMinMax).
-    const Eigen::Index n = s.time_h.size();
-    if (n > f.max_points) {
-      f.caption += " Plotted as the min and max of each run of " +
-                   RoundedText(static_cast<double>(n) / (f.max_points / 2), 3) + " samples.";
-    }
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    f.title = "Residue";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = s.time_h;
-    f.height_px = 150;
-    f.series.push_back(Series("residue", s.decomposition.residue));
-    f.caption = "The slow trend left after the last IMF (part of the drift group).";
-    report.AddFigure(f);
-  }
+  report.AddFigure(SelectionCurvesFigure(s));
+  report.AddFigure(EnergyFigure(s));
+  report.AddFigure(GroupsFigure(s));
+  for (int k = 0; k < s.decomposition.num_imfs(); ++k) report.AddFigure(ImfFigure(s, k));
+  report.AddFigure(ResidueFigure(s));
+}
 
+// test_h: the times of the predict-mode test block.
+io::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
+  io::ReportFigure f;
+  f.title = "Predict mode: one-step-ahead predictions on the test block";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = test_h;
+  // MS-ELM under both protocols and the best method that does not decompose (a single model or
+  // a baseline); every row is in predict_estimates.csv.
+  if (!s.simulated) f.series.push_back(Measured("measured output", s.predict.reference));
+  const drift::EvaluationRow* best = nullptr;
+  for (const auto& r : s.predict.rows) {
+    if (r.method == drift::Method::kMsElm) {
+      f.series.push_back(Series("ms-elm " + std::string(drift::ToString(r.protocol)), r.estimate));
+    } else if (!drift::UsesDecomposition(r.method) && (!best || r.rmse < best->rmse)) {
+      best = &r;
+    }
+  }
+  if (best)
+    f.series.push_back(
+        Series(std::string(drift::ToString(best->method)) + " (best of the rest)", best->estimate));
+  if (s.simulated) f.series.push_back(Reference("true drift", s.predict.reference));
+  f.caption =
+      "Each model predicts the next output sample from the previous ones (MS-ELM under both "
+      "protocols and the best method that does not decompose; every method is in "
+      "predict_estimates.csv). Under the "
+      "paper protocol the sub-series were decomposed with the future in view. Predictions of a "
+      "noisy output are noisy: zoom into a few minutes to compare them with the " +
+      std::string(s.simulated ? "thick black true drift." : "grey measured output they predict.");
+  return f;
+}
+
+io::ReportFigure PredictResidualsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
+  io::ReportFigure f;
+  const Eigen::Index w =
+      std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1,
+                               std::max<Eigen::Index>(1, test_h.size() / 20));
+  f.title = "Predict mode: residuals (reference - prediction), trailing mean over " +
+            std::to_string(w) + " samples";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = test_h;
+  for (const auto& r : s.predict.rows) {
+    if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
+    std::string name = std::string(drift::ToString(r.method));
+    if (drift::UsesDecomposition(r.method)) name += " " + std::string(drift::ToString(r.protocol));
+    f.series.push_back(Series(name, TrailingMean(s.predict.reference - r.estimate, w)));
+  }
+  f.caption = "Averaged over " + RoundedText(static_cast<double>(w) / s.rate_hz) +
+              " s so that the sample-to-sample noise drops out: what remains is drift the model "
+              "missed or a bias it added. Near zero is good; single models are one curve (the same "
+              "under both protocols).";
+  return f;
+}
+
+void AddPredictSection(io::HtmlReport& report, const StudyResult& s) {
   report.AddHeading("3. Predict mode (the paper's task)");
   report.AddTable(s.predict_table.Report());
   const Eigen::Index split = s.predict.split_index;
   const Eigen::VectorXd test_h = s.time_h.tail(s.time_h.size() - split);
-  {
-    io::ReportFigure f;
-    f.title = "Predict mode: one-step-ahead predictions on the test block";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = test_h;
-    // MS-ELM under both protocols and the best method that does not decompose (a single model or
-    // a baseline); every row is in predict_estimates.csv.
-    if (!s.simulated) f.series.push_back(Measured("measured output", s.predict.reference));
-    const drift::EvaluationRow* best = nullptr;
-    for (const auto& r : s.predict.rows) {
-      if (r.method == drift::Method::kMsElm) {
-        f.series.push_back(
-            Series("ms-elm " + std::string(drift::ToString(r.protocol)), r.estimate));
-      } else if (!drift::UsesDecomposition(r.method) && (!best || r.rmse < best->rmse)) {
-        best = &r;
-      }
-    }
-    if (best)
-      f.series.push_back(Series(std::string(drift::ToString(best->method)) + " (best of the rest)",
-                                best->estimate));
-    if (s.simulated) f.series.push_back(Reference("true drift", s.predict.reference));
-    f.caption =
-        "Each model predicts the next output sample from the previous ones (MS-ELM under both "
-        "protocols and the best method that does not decompose; every method is in "
-        "predict_estimates.csv). Under the "
-        "paper protocol the sub-series were decomposed with the future in view. Predictions of a "
-        "noisy output are noisy: zoom into a few minutes to compare them with the " +
-        std::string(s.simulated ? "thick black true drift." : "grey measured output they predict.");
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    const Eigen::Index w =
-        std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1,
-                                 std::max<Eigen::Index>(1, test_h.size() / 20));
-    f.title = "Predict mode: residuals (reference - prediction), trailing mean over " +
-              std::to_string(w) + " samples";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = test_h;
-    for (const auto& r : s.predict.rows) {
-      if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
-      std::string name = std::string(drift::ToString(r.method));
-      if (drift::UsesDecomposition(r.method))
-        name += " " + std::string(drift::ToString(r.protocol));
-      f.series.push_back(Series(name, TrailingMean(s.predict.reference - r.estimate, w)));
-    }
-    f.caption =
-        "Averaged over " + RoundedText(static_cast<double>(w) / s.rate_hz) +
-        " s so that the sample-to-sample noise drops out: what remains is drift the model "
-        "missed or a bias it added. Near zero is good; single models are one curve (the same "
-        "under both protocols).";
-    report.AddFigure(f);
-  }
+  report.AddFigure(PredictionsFigure(s, test_h));
+  report.AddFigure(PredictResidualsFigure(s, test_h));
+}
 
+io::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = s.simulated
+                ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
+                : "Compensate mode: drift estimated from temperature vs the measured output";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = s.compensate_time_h;
+  if (!s.simulated) f.series.push_back(Measured("measured output", s.compensate_reference));
+  for (const auto& r : s.compensate) {
+    if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
+    const bool both = !s.simulated && drift::UsesDecomposition(r.method);
+    f.series.push_back(Series(
+        std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""), r.estimate));
+  }
+  if (s.simulated) f.series.push_back(Reference("true drift (run B)", s.compensate_reference));
+  f.caption =
+      s.simulated
+          ? "Only the temperature channel reaches these models, as on a navigation computer. A "
+            "good model tracks the thick black true drift through ramps it was not trained on."
+          : "Only the temperature channel reaches these models, as on a navigation computer. A "
+            "good model runs through the middle of the grey measured output over the test "
+            "block, which it never saw. Single models are drawn once (the same under both "
+            "protocols).";
+  return f;
+}
+
+io::ReportFigure CompensateResidualsFigure(const StudyResult& s) {
+  io::ReportFigure f;
+  f.title = "Compensate mode: residual drift (reference - estimate)";
+  f.x_label = "time (h)";
+  f.y_label = s.unit;
+  f.x = s.compensate_time_h;
+  for (const auto& r : s.compensate) {
+    if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
+    const bool both = !s.simulated && drift::UsesDecomposition(r.method);
+    f.series.push_back(
+        Series(std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""),
+               s.compensate_reference - r.estimate));
+  }
+  f.caption =
+      s.simulated
+          ? "What is left after compensation. Flat near zero is good; spikes at the ramps are "
+            "the Shupe part the temperature history did not explain."
+          : "The measured output minus the estimate, noise included. A band centred on zero "
+            "is good; a trend or a step is drift the temperature history did not explain, or "
+            "a bias the model added.";
+  return f;
+}
+
+void AddCompensateSection(io::HtmlReport& report, const StudyResult& s) {
   report.AddHeading(s.simulated ? "4. Compensate mode: trained on run A, tested on run B"
                                 : "4. Compensate mode: chronological split");
   report.AddTable(s.compensate_table.Report());
-  {
-    io::ReportFigure f;
-    f.title = s.simulated
-                  ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
-                  : "Compensate mode: drift estimated from temperature vs the measured output";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = s.compensate_time_h;
-    if (!s.simulated) f.series.push_back(Measured("measured output", s.compensate_reference));
-    for (const auto& r : s.compensate) {
-      if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
-      const bool both = !s.simulated && drift::UsesDecomposition(r.method);
-      f.series.push_back(Series(
-          std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""), r.estimate));
-    }
-    if (s.simulated) f.series.push_back(Reference("true drift (run B)", s.compensate_reference));
-    f.caption =
-        s.simulated
-            ? "Only the temperature channel reaches these models, as on a navigation computer. A "
-              "good model tracks the thick black true drift through ramps it was not trained on."
-            : "Only the temperature channel reaches these models, as on a navigation computer. A "
-              "good model runs through the middle of the grey measured output over the test "
-              "block, which it never saw. Single models are drawn once (the same under both "
-              "protocols).";
-    report.AddFigure(f);
-  }
-  {
-    io::ReportFigure f;
-    f.title = "Compensate mode: residual drift (reference - estimate)";
-    f.x_label = "time (h)";
-    f.y_label = s.unit;
-    f.x = s.compensate_time_h;
-    for (const auto& r : s.compensate) {
-      if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
-      const bool both = !s.simulated && drift::UsesDecomposition(r.method);
-      f.series.push_back(
-          Series(std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""),
-                 s.compensate_reference - r.estimate));
-    }
-    f.caption =
-        s.simulated
-            ? "What is left after compensation. Flat near zero is good; spikes at the ramps are "
-              "the Shupe part the temperature history did not explain."
-            : "The measured output minus the estimate, noise included. A band centred on zero "
-              "is good; a trend or a step is drift the temperature history did not explain, or "
-              "a bias the model added.";
-    report.AddFigure(f);
-  }
+  report.AddFigure(CompensateEstimatesFigure(s));
+  report.AddFigure(CompensateResidualsFigure(s));
+}
+
+}  // namespace
+
+// The report page built from its parts, in the order of the study's steps.
+std::string RenderStudyReport(const StudyResult& s, const io::DygraphsAssets& assets) {
+  io::HtmlReport report(s.simulated ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
+                                    : "gyrodrift demo: " + s.source);
+  AddIntroduction(report, s);
+  AddRecordSection(report, s);
+  AddDecompositionSection(report, s);
+  AddPredictSection(report, s);
+  AddCompensateSection(report, s);
 
   report.AddHeading("5. Allan deviation");
   AllanFigure(report, s);

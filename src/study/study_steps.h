@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "gyrodrift/drift/fit_settings.h"
 #include "gyrodrift/selection/selection.h"
 #include "gyrodrift/study/study.h"
 
@@ -12,8 +13,12 @@ namespace gyrodrift::study::internal {
 // estimate to equilibrium at 20 degC, where the simulator's truth is zero and its turn-on bias,
 // drawn anew for each run, is not (its convention, docs/drift.md 1.3); a log keeps the fitted
 // intercept, the library default.
-drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz,
-                                      bool simulated);
+drift::DriftOptions StudyDriftOptions(const StudyOptions& options, double rate_hz, bool simulated);
+
+// The study's models as the fit and evaluate tasks take them: StudyDriftOptions' settings in
+// `mode` (s.rate_hz, s.threads; a temperature channel and the reference in compensate mode only,
+// the predict-mode models being on the output alone). The method is left "auto".
+drift::FitSettings StudyFitSettings(const StudyResult& s, drift::Mode mode);
 
 // The group of IMF k (1-based): "noise", "mixed" or "drift" (beyond the listed IMFs: with the
 // residue, so drift).

@@ -85,6 +85,7 @@ drift::EvaluationOptions EvaluateSettings::Options(std::string_view methods_name
   e.methods = ParseMethods(methods, mode, methods_name);
   e.protocols = ParseProtocols(protocol);
   e.causal.window = window;
+  e.causal.ensemble_size = causal_ensemble;
   e.horizon = horizon;
   e.Validate();
   return e;

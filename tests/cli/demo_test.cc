@@ -64,8 +64,11 @@ const char* kMethods[] = {"ms-elm", "elm", "emd-elm", "poly", "svr", "bp"};
 TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   if (!HaveDygraphs()) GTEST_SKIP() << "libjs-dygraphs not installed";
   const std::string dir = test::TempDir("demo_sim") + "/out";
+  // --seed 2 with fewer ensemble members than realisations: the grouping's white-noise level
+  // draws its own realisations, from the study's seed (issue 25).
   const auto r = RunCli("demo -o " + dir +
-                        " --duration 2h --ensemble 10 --realisations 20 --window 64 --quiet");
+                        " --duration 2h --ensemble 10 --realisations 20 --window 64 --seed 2"
+                        " --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;  // --quiet
   EXPECT_TRUE(r.err.empty()) << r.err;  // no progress bar off a terminal
@@ -93,6 +96,10 @@ TEST(DemoCli, ReducedSimulatedStudyWritesAValidFolder) {
   for (const char* m : kMethods)
     EXPECT_TRUE(compensate.count(std::string(m) + "/train A test B")) << m;
   EXPECT_TRUE(compensate.count("thermal/train A test B"));
+  // The grouping was computed with seed 2 (the selection's summary names its level's seed).
+  const std::string record = io::ReadTextFile(dir + "/demo.json");
+  EXPECT_NE(record.find("(level R=20 seed=2)"), std::string::npos);
+  EXPECT_EQ(record.find("seed=1)"), std::string::npos);
   // Data: one row per simulated second.
   EXPECT_EQ(io::CsvTable::Read(dir + "/run_a.csv").rows(), 7200);
   EXPECT_EQ(io::CsvTable::Read(dir + "/imfs.csv").rows(), 7200);

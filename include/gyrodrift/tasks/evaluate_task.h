@@ -32,10 +32,13 @@ struct EvaluateSettings {
   int repeats = internal::kEvaluationDefaults.repeats;
   int window = internal::kEvaluationDefaults.causal.window;
   int horizon = internal::kEvaluationDefaults.horizon;
+  // Causal protocol: realisations of each window's decomposition, in [0, 100000]; 0 = the models'
+  // ensemble. The study sets it to its ensemble; the CLI and Python keep the library's default.
+  int causal_ensemble = internal::kEvaluationDefaults.causal.ensemble_size;
 
   // The evaluation's options, validated; `methods_name` names the method list in messages
   // ("methods", or the flag "--methods"). OptionError naming the field (split, repeats, protocol,
-  // causal.window, horizon, methods) or UsageError.
+  // causal.window, causal.ensemble_size, horizon, methods) or UsageError.
   drift::EvaluationOptions Options(std::string_view methods_name = "methods") const;
   void Validate(std::string_view methods_name = "methods") const;  // Options() and fit's
 };
