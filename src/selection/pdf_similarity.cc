@@ -83,7 +83,10 @@ void PdfSimilarityBoundaries(int length, const SelectionOptions& options,
   if (k_noise == 0) AppendNote(&result->note, "no IMF passes the white-noise test: no noise group");
   if (k_noise == result->k_star) {
     std::string text = "noise run reaches k*: no mixed group";
-    if (run_past_k_star > 0) {
+    if (run_past_k_star == 1) {
+      text += " (mode " + std::to_string(judged + 1) +
+              " also passes the white-noise test, left to the drift group)";
+    } else if (run_past_k_star > 1) {
       text += " (modes " + std::to_string(judged + 1) + ".." +
               std::to_string(judged + run_past_k_star) +
               " also pass the white-noise test, left to the drift group)";

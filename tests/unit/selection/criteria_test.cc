@@ -93,7 +93,7 @@ TEST(Criteria, PdfSimilarityRunEndsAtTheFirstImfAboveTheLevel) {
   EXPECT_EQ(r.k_noise, 1);
   EXPECT_EQ(r.mixed_end, 1);
   EXPECT_EQ(r.note,
-            "noise run reaches k*: no mixed group (modes 2..2 also pass the white-noise test, "
+            "noise run reaches k*: no mixed group (mode 2 also passes the white-noise test, "
             "left to the drift group)");
   r = Curves({0.1, 0.5, 0.1, 0.1, 0.1}, 2);
   PdfSimilarityBoundaries(100, o, {}, &r);
