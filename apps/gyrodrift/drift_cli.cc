@@ -61,6 +61,13 @@ void AddThermalOptions(CLI::App* cmd, DriftArgs* a) {
                               "docs/drift.md 4.7")
                   ->capture_default_str(),
               {"hysteresis"});
+  BindSetting(cmd->add_option("--standard-errors", a->settings.standard_errors,
+                              "compensate mode, identified methods: how many standard errors of "
+                              "the held-out fold scores a richer thermal structure must win by to "
+                              "be chosen, in [0, 10] (0: the least held-out error); docs/drift.md "
+                              "4.8")
+                  ->capture_default_str(),
+              {"standard_errors"});
 }
 
 // The model's other settings and how the fit runs.

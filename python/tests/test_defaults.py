@@ -13,6 +13,7 @@ gd.fit_defaults(), drift::FitSettings{} as JSON.
 
 import ast
 import inspect
+import json
 import math
 import os
 
@@ -154,7 +155,7 @@ def test_the_shown_settings_defaults_are_the_librarys(name):
     assert defaults["ensemble"] == 100 and defaults["hysteresis"] == "auto"
 
 
-def test_the_settings_defaults_are_the_ones_a_call_uses():
+def test_the_settings_defaults_are_the_ones_a_call_uses(tmp_path):
     # Every setting given at its shown default fits the model of no setting given, to the bit;
     # None is "the default" too.
     sim = gyrodrift.simulate(duration=3600, seed=7)
@@ -167,6 +168,10 @@ def test_the_settings_defaults_are_the_ones_a_call_uses():
         assert (m.estimate(t)[0] == plain.estimate(t)[0]).all()
     changed = gyrodrift.DriftModel().fit(y, t, method="poly")
     assert changed.method == "poly"
+    # A setting the bindings never name (standard_errors) reaches the fit and its model file.
+    gyrodrift.DriftModel().fit(y, t, standard_errors=0.5).save(tmp_path / "m.json")
+    with open(tmp_path / "m.json") as f:
+        assert json.load(f)["options"]["thermal"]["standard_errors"] == 0.5
 
 
 def test_an_unknown_setting_is_refused_naming_it():

@@ -123,13 +123,20 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
     ThrowOption("hysteresis", "'" + s.hysteresis + "'",
                 "auto unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
   }
+  o.thermal.standard_errors = s.standard_errors;
+  if (s.standard_errors != ThermalModelOptions{}.standard_errors && !IdentifiesThermalModel(o)) {
+    ThrowOption("standard_errors", FormatValue(s.standard_errors),
+                "left at its default unless mode is 'compensate' with method thermal, ms-elm or "
+                "emd-elm");
+  }
   // The fields of DriftOptions a setting sets: a refusal of one names the setting.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble"},
                       {"selection.monte_carlo.realisations", "realisations"},
                       {"features.lags", "lags"},
                       {"features.time_constants_s", "time_constants"},
                       {"features.rate_hz", "rate_hz"},
-                      {"learner.elm.hidden_units", "hidden"}},
+                      {"learner.elm.hidden_units", "hidden"},
+                      {"thermal.standard_errors", "standard_errors"}},
                      [&] { o.Validate(); });
   return o;
 }

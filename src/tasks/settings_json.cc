@@ -114,6 +114,8 @@ const std::vector<Field<FS>>& FitFields() {
        }},
       {"hysteresis", [](const FS& s) { return json(s.hysteresis); },
        [](const json& v, FS& s) { s.hysteresis = String("hysteresis", v); }},
+      {"standard_errors", [](const FS& s) { return json(s.standard_errors); },
+       [](const json& v, FS& s) { s.standard_errors = Number("standard_errors", v); }},
       {"has_temperature", [](const FS& s) { return json(s.has_temperature); },
        [](const json& v, FS& s) { s.has_temperature = Bool("has_temperature", v); }},
   };

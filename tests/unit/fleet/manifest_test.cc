@@ -86,7 +86,8 @@ TEST_F(ManifestTest, RefusalsNameTheLineAndTheKey) {
 TEST_F(ManifestTest, EveryFitSettingIsAKeyThroughItsOneMapping) {
   const Manifest m = Parse(
       "decomposition = \"emd\"\nensemble = 7\nrealisations = 30\nthermal_features = "
-      "\"classic\"\ntime_constants = [60, 600.5]\nseed = 18446744073709551\nmethod = \"auto\"\n");
+      "\"classic\"\ntime_constants = [60, 600.5]\nseed = 18446744073709551\nmethod = \"auto\"\n"
+      "standard_errors = 0.5\n");
   EXPECT_EQ(m.fit.decomposition, "emd");
   EXPECT_EQ(m.fit.ensemble, 7);
   EXPECT_EQ(m.fit.realisations, 30);
@@ -94,6 +95,7 @@ TEST_F(ManifestTest, EveryFitSettingIsAKeyThroughItsOneMapping) {
   EXPECT_EQ(m.fit.time_constants, (std::vector<double>{60.0, 600.5}));
   EXPECT_EQ(m.fit.seed, 18446744073709551u);
   EXPECT_EQ(m.FitMethod(), drift::Method::kThermal);
+  EXPECT_EQ(m.FitOptions().thermal.standard_errors, 0.5);
   EXPECT_EQ(m.fit.mode, "compensate");
   EXPECT_TRUE(m.fit.has_temperature);
   const drift::DriftOptions o = Parse("method = \"ms-elm\"\nhidden = 20\nnonlinear = true\n")
