@@ -367,7 +367,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
 
     ``methods`` is "all" or a list (or comma-separated string) of method names; the references
     "none" (a zero estimate) and "constant" (the training mean) are always scored first. The model
-    settings are ``DriftModel.fit``'s keywords but ``method`` (``fit_defaults()``); ``progress`` as for ``decompose``. Returns a dict:
+    settings are ``DriftModel.fit``'s settings keywords but ``method`` (``fit_defaults()``);
+    ``progress`` as for ``decompose``. Returns a dict:
     ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, rmse_measured
     (against the output itself), slow_removed (share of the slow variation, 10-min block means,
     removed; nan on a test block shorter than 10 min), train_s, predict_s, the last repeat's

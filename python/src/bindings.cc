@@ -159,7 +159,8 @@ drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings 
     if (!known.contains(key) || std::find(own.begin(), own.end(), key) != own.end()) {
       std::string names;
       for (const auto& [k, v] : known.items()) {
-        if (std::find(own.begin(), own.end(), k) == own.end()) names += (names.empty() ? "" : ", ") + k;
+        if (std::find(own.begin(), own.end(), k) != own.end()) continue;
+        names += (names.empty() ? "" : ", ") + k;
       }
       throw py::type_error(std::string(function) + "() got an unexpected keyword argument '" + key +
                            "' (its settings: " + names + ")");

@@ -41,7 +41,9 @@ bool ElmBased(Method method) {
 void ThermalSettings(const FitSettings& s, DriftOptions& o) {
   if (s.reference_temperature) {
     const std::string value = FormatValue(*s.reference_temperature);
-    if (o.mode != Mode::kCompensate) ThrowOption("reference_temperature", value, "unset in mode 'predict'");
+    if (o.mode != Mode::kCompensate) {
+      ThrowOption("reference_temperature", value, "unset in mode 'predict'");
+    }
     RequireInRange("reference_temperature", *s.reference_temperature, -100.0, 200.0);
     o.reference_c = *s.reference_temperature;
   }
