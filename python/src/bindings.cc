@@ -104,7 +104,10 @@ nlohmann::json KeywordJson(const std::string& key, const py::handle& value) {
   if (value.is_none()) return nullptr;
   if (PyBool_Check(value.ptr())) return value.cast<bool>();
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
-  if (py::isinstance(value, py::module_::import("numpy").attr("bool_"))) return value.cast<bool>();
+  // Looked up once and kept (released: never decref'd at interpreter exit).
+  static const py::handle numpy_bool =
+      py::object(py::module_::import("numpy").attr("bool_")).release();
+  if (py::isinstance(value, numpy_bool)) return value.cast<bool>();
   // Sequences before numbers: a numpy array also has __index__ and __float__ (of one element).
   if (!PyFloat_Check(value.ptr()) && !py::isinstance<py::dict>(value) &&
       py::isinstance<py::iterable>(value)) {
@@ -152,7 +155,7 @@ nlohmann::json FitKeywordDefaults() {
 
 drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings base,
                                  const char* function, const std::vector<std::string>& own) {
-  const nlohmann::json known = FitKeywordDefaults();
+  static const nlohmann::json known = FitKeywordDefaults();
   nlohmann::json given = nlohmann::json::object();
   for (const auto& [name, value] : keywords) {
     const std::string key = py::str(name).cast<std::string>();
