@@ -13,7 +13,10 @@
 #include "gyrodrift/drift/temperature_check.h"
 
 namespace gyrodrift::cli {
-void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
+namespace {
+
+// The log(s) and their columns.
+void AddInputOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
   if (split_records) {
     cmd->add_option("input", a->inputs,
                     "CSV file(s) with a header row; several calibration logs (same columns and "
@@ -35,6 +38,10 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
                   "temperature column(s), degC, comma-separated (needed by --mode compensate, "
                   "where the thermal, ms-elm and emd-elm methods take several; in predict mode "
                   "one column adds the thermal history to the lags)");
+}
+
+// The compensate-mode settings of the identified thermal models.
+void AddThermalOptions(CLI::App* cmd, DriftArgs* a) {
   a->reference_option = BindSetting(
       cmd->add_option(
           "--reference-temperature", a->reference_c,
@@ -54,6 +61,17 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
                               "docs/drift.md 4.7")
                   ->capture_default_str(),
               {"hysteresis"});
+  BindSetting(cmd->add_option("--standard-errors", a->settings.standard_errors,
+                              "compensate mode, identified methods: how many standard errors of "
+                              "the held-out fold scores a richer thermal structure must win by to "
+                              "be chosen, in [0, 10] (0: the least held-out error); docs/drift.md "
+                              "4.8")
+                  ->capture_default_str(),
+              {"standard_errors"});
+}
+
+// The model's other settings and how the fit runs.
+void AddModelOptions(CLI::App* cmd, DriftArgs* a) {
   BindSetting(cmd->add_option("--mode", a->settings.mode,
                               "predict (one-step-ahead from past samples) | compensate (drift "
                               "from temperature)")
@@ -103,6 +121,14 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
                               "worker threads (0 = all cores); results do not depend on it")
                   ->capture_default_str(),
               {"threads"});
+}
+
+}  // namespace
+
+void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
+  AddInputOptions(cmd, a, split_records);
+  AddThermalOptions(cmd, a);
+  AddModelOptions(cmd, a);
   AddLogOptions(cmd, &a->log);
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }

@@ -18,6 +18,7 @@ processed, a ValueError) and ``FileError`` (an OSError), with the library's one-
 See docs/python.md.
 """
 
+import inspect
 import os
 
 from . import _gyrodrift
@@ -25,8 +26,8 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "export", "noise_terms", "plan", "read_ulog", "select_modes",
-    "simulate", "temperature_warning", "ulog_columns",
+    "decompose", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_ulog",
+    "select_modes", "simulate", "temperature_warning", "ulog_columns",
 ]
 
 
@@ -175,22 +176,22 @@ class DriftModel:
     def __init__(self, _core=None):
         self._core = _core if _core is not None else _gyrodrift.DriftModel()
 
-    def fit(self, y, temperature=None, *, mode="compensate", method="auto",
-            decomposition="beemdan", lags=None, hidden="auto", rate_hz=1.0,
-            thermal_features="auto", time_constants=(), ensemble=100, realisations=100, seed=1,
-            threads=0, nonlinear=False, reference_temperature=None, hysteresis="auto",
-            target="rate_dph", temperature_columns=None, source="python", record_starts=(),
-            logged=None, progress=None):
+    def fit(self, y, temperature=None, *, mode="compensate", target="rate_dph",
+            temperature_columns=None, source="python", record_starts=(), logged=None,
+            progress=None, **settings):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
-        Options as ``gyrodrift fit``'s flags: ``lags`` an int or "auto" (predict mode only),
-        ``hidden`` "auto" or an int, ``time_constants`` seconds. ``method="auto"`` is ms-elm in
-        predict mode and thermal in compensate mode. ``hysteresis`` ("auto", "on" or "off") is
-        the thermal models' hysteresis term (auto: tried on calibrations of 12 h or more; the
-        fitted term is in ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the
-        library's options as the CLI's flags do, and a refusal names the keyword.
-        ``rate_hz`` is the sample rate (the CLI
-        reads it from a time_s column). ``target`` and ``temperature_columns`` are the column
+        ``settings``: the fit settings as keywords, named and defaulted as the library's
+        ``FitSettings`` (``fit_defaults()`` and this signature list them all; None keeps a
+        default), each as the ``gyrodrift fit`` flag of its name (``-`` as ``_``; docs/cli.md
+        says what each does). Among them: ``method`` ("auto": ms-elm in predict mode, thermal
+        in compensate mode), ``lags`` an int or "auto" (predict mode only), ``hidden`` "auto" or
+        an int, ``rate_hz`` the sample rate (the CLI reads it from a time_s column),
+        ``time_constants`` seconds, ``hysteresis`` ("auto", "on" or "off": the thermal models'
+        hysteresis term, tried on calibrations of 12 h or more; the fitted term is in
+        ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the library's
+        options as the CLI's flags do; a refusal names the keyword, and a keyword that names no
+        setting raises TypeError. ``target`` and ``temperature_columns`` are the column
         names written into the model file (the CLI's compensate reads those columns).
         Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
         one after the other with ``record_starts`` the first sample of each run after the first:
@@ -202,16 +203,11 @@ class DriftModel:
         the logged rows too. ``progress``: a callable given the fraction of the fit done, as for
         ``decompose`` (Ctrl-C stops the fit at its next report). Returns self.
         """
-        self._core.fit(y, temperature, mode=mode, method=method, decomposition=decomposition,
-                       lags=lags, hidden=hidden, rate_hz=rate_hz,
-                       thermal_features=thermal_features, time_constants=list(time_constants),
-                       ensemble=ensemble, realisations=realisations, seed=seed, threads=threads,
-                       nonlinear=nonlinear, reference_temperature=reference_temperature,
-                       hysteresis=hysteresis, target=target,
+        self._core.fit(y, temperature, mode=mode, target=target,
                        temperature_columns=temperature_columns, source=source,
                        record_starts=list(record_starts),
                        logged=[] if logged is None else [bool(v) for v in logged],
-                       progress=progress)
+                       progress=progress, **settings)
         return self
 
     def estimate(self, temperature, *, record_starts=()):
@@ -364,17 +360,15 @@ def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisatio
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
-             split=0.7, repeats=1, horizon=1, window=512, decomposition="beemdan", lags=None,
-             hidden="auto", rate_hz=1.0, thermal_features="auto", time_constants=(),
-             ensemble=100, realisations=100, seed=1, threads=0, nonlinear=False,
-             reference_temperature=None, hysteresis="auto", progress=None):
+             split=0.7, repeats=1, horizon=1, window=512, progress=None, **settings):
     """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
     paper and causal protocols (predict mode), against ``truth`` when given (else the output).
 
     ``methods`` is "all" or a list (or comma-separated string) of method names; the references
     "none" (a zero estimate) and "constant" (the training mean) are always scored first. The model
-    keywords are ``DriftModel.fit``'s; ``progress`` as for ``decompose``. Returns a dict:
+    settings are ``DriftModel.fit``'s settings keywords but ``method`` (``fit_defaults()``);
+    ``progress`` as for ``decompose``. Returns a dict:
     ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, rmse_measured
     (against the output itself), slow_removed (share of the slow variation, 10-min block means,
     removed; nan on a test block shorter than 10 min), train_s, predict_s, the last repeat's
@@ -390,11 +384,33 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     """
     return _gyrodrift.evaluate(
         y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,
-        repeats=repeats, horizon=horizon, window=window, decomposition=decomposition, lags=lags,
-        hidden=hidden, rate_hz=rate_hz, thermal_features=thermal_features,
-        time_constants=list(time_constants), ensemble=ensemble, realisations=realisations,
-        seed=seed, threads=threads, nonlinear=nonlinear,
-        reference_temperature=reference_temperature, hysteresis=hysteresis, progress=progress)
+        repeats=repeats, horizon=horizon, window=window, progress=progress, **settings)
+
+
+def fit_defaults():
+    """The fit settings ``DriftModel.fit`` and ``evaluate`` take as keywords, each with its
+    default: the library's own (``drift::FitSettings``), the one home of every default. A
+    setting added to the library is a keyword here with nothing else to edit.
+
+    >>> import gyrodrift as gd
+    >>> gd.fit_defaults()["ensemble"], gd.fit_defaults()["method"]
+    (100, 'auto')
+    """
+    return _gyrodrift.fit_defaults()
+
+
+def _show_settings(function, skip=()):
+    """Lists the fit settings, with the library's defaults, in ``function``'s signature (for
+    help() and IDEs; the call takes them through ``**settings``)."""
+    signature = inspect.signature(function)
+    params = [p for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD]
+    params += [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default)
+               for name, default in fit_defaults().items() if name not in skip]
+    function.__signature__ = signature.replace(parameters=params)
+
+
+_show_settings(DriftModel.fit)
+_show_settings(evaluate, skip=("method",))
 
 
 def calibrate(manifest_path, output_dir, *, force=False, threads=0):

@@ -64,21 +64,15 @@ def plan(
 
 class DriftModel:
     def __init__(self) -> None: ...
+    # **settings: the fit settings, fit_defaults()'s keys (named and defaulted by the library).
     def fit(
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *,
-        mode: Literal["compensate", "predict"] = ...,
-        method: Literal["auto", "ms-elm", "thermal", "elm", "emd-elm", "poly", "svr", "bp"] = ...,
-        decomposition: str = ..., lags: int | Literal["auto"] | None = ...,
-        hidden: int | Literal["auto"] = ..., rate_hz: float = ...,
-        thermal_features: Literal["auto", "ladder", "classic", "lag-bank"] = ...,
-        time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
-        seed: int = ..., threads: int = ..., nonlinear: bool = ...,
-        reference_temperature: float | None = ...,
-        hysteresis: Literal["auto", "on", "off"] = ..., target: str = ...,
+        mode: Literal["compensate", "predict"] = ..., target: str = ...,
         temperature_columns: Sequence[str] | None = ..., source: str = ...,
         record_starts: Sequence[int] = ...,
         logged: Sequence[bool] | None = ...,
         progress: Callable[[float], object] | None = ...,
+        **settings: Any,
     ) -> DriftModel: ...
     def estimate(
         self, temperature: ArrayLike, *, record_starts: Sequence[int] = ...
@@ -147,15 +141,12 @@ def evaluate(
     mode: Literal["predict", "compensate"] = ...,
     methods: Literal["all"] | str | Sequence[str] = ...,
     protocol: Literal["both", "paper", "causal"] = ..., split: float = ..., repeats: int = ...,
-    horizon: int = ..., window: int = ..., decomposition: str = ...,
-    lags: int | Literal["auto"] | None = ..., hidden: int | Literal["auto"] = ...,
-    rate_hz: float = ..., thermal_features: Literal["auto", "ladder", "classic", "lag-bank"] = ...,
-    time_constants: Sequence[float] = ..., ensemble: int = ..., realisations: int = ...,
-    seed: int = ..., threads: int = ..., nonlinear: bool = ...,
-    reference_temperature: float | None = ...,
-    hysteresis: Literal["auto", "on", "off"] = ...,
+    horizon: int = ..., window: int = ...,
     progress: Callable[[float], object] | None = ...,
+    **settings: Any,
 ) -> dict[str, Any]: ...
+
+def fit_defaults() -> dict[str, Any]: ...
 
 def calibrate(
     manifest_path: str | PathLike[str], output_dir: str | PathLike[str], *, force: bool = ...,

@@ -1,6 +1,8 @@
 // The shared helpers of the bindings (bindings.h).
 #include "bindings.h"
 
+#include "gyrodrift/tasks/settings_json.h"
+
 namespace gyrodrift::python {
 
 // A 1-D float64 copy of any array-like (lists, float32, strided views), checked under the GIL so
@@ -90,15 +92,86 @@ py::object ToPython(const nlohmann::json& j) {
   }
 }
 
-// A setting that takes "auto" or an integer (lags, hidden), as FitSettings holds it: None is
-// "not given", ints and strings pass as text.
-std::string AutoOrIntegerSetting(const char* name, const py::object& value) {
-  if (value.is_none()) return "";
-  if (py::isinstance<py::str>(value) ||
-      (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value))) {
-    return py::str(value).cast<std::string>();
+namespace {
+
+// A keyword's value as JSON for the settings' reader: None, bools, integers (numpy's too),
+// numbers, strings and sequences of them; anything else is refused naming the keyword.
+nlohmann::json KeywordJson(const std::string& key, const py::handle& value) {
+  const auto refuse = [&]() -> nlohmann::json {
+    throw OptionError(key, py::repr(value).cast<std::string>(),
+                      "a number, a string, true/false or a sequence of them");
+  };
+  if (value.is_none()) return nullptr;
+  if (PyBool_Check(value.ptr())) return value.cast<bool>();
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  // Looked up once and kept (released: never decref'd at interpreter exit).
+  static const py::handle numpy_bool =
+      py::object(py::module_::import("numpy").attr("bool_")).release();
+  if (py::isinstance(value, numpy_bool)) return value.cast<bool>();
+  // Sequences before numbers: a numpy array also has __index__ and __float__ (of one element).
+  if (!PyFloat_Check(value.ptr()) && !py::isinstance<py::dict>(value) &&
+      py::isinstance<py::iterable>(value)) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const py::handle item : value) {
+      if (item.is_none()) return refuse();
+      out.push_back(KeywordJson(key, item));
+    }
+    return out;
   }
-  throw OptionError(name, py::repr(value).cast<std::string>(), "auto or an integer");
+  if (PyIndex_Check(value.ptr())) {
+    const py::object i = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+    if (!i) throw py::error_already_set();
+    int overflow = 0;
+    const long long v = PyLong_AsLongLongAndOverflow(i.ptr(), &overflow);
+    if (overflow == 0) {
+      // Non-negative as unsigned: the reader takes a seed as a non-negative integer.
+      return v >= 0 ? nlohmann::json(static_cast<std::uint64_t>(v)) : nlohmann::json(v);
+    }
+    const unsigned long long u = PyLong_AsUnsignedLongLong(i.ptr());
+    if (PyErr_Occurred()) {
+      PyErr_Clear();
+      return refuse();
+    }
+    return static_cast<std::uint64_t>(u);
+  }
+  if (PyFloat_Check(value.ptr()) || py::hasattr(value, "__float__")) {
+    const double v = PyFloat_AsDouble(value.ptr());
+    if (PyErr_Occurred()) throw py::error_already_set();
+    return v;
+  }
+  return refuse();
+}
+
+// The settings no call takes as a keyword (FitKeywordDefaults).
+const std::vector<std::string> kNotKeywords = {"mode", "has_temperature"};
+
+}  // namespace
+
+nlohmann::json FitKeywordDefaults() {
+  nlohmann::json j = tasks::FitSettingsToJson(drift::FitSettings{});
+  for (const std::string& key : kNotKeywords) j.erase(key);
+  return j;
+}
+
+drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings base,
+                                 const char* function, const std::vector<std::string>& own) {
+  static const nlohmann::json known = FitKeywordDefaults();
+  nlohmann::json given = nlohmann::json::object();
+  for (const auto& [name, value] : keywords) {
+    const std::string key = py::str(name).cast<std::string>();
+    if (!known.contains(key) || std::find(own.begin(), own.end(), key) != own.end()) {
+      std::string names;
+      for (const auto& [k, v] : known.items()) {
+        if (std::find(own.begin(), own.end(), k) != own.end()) continue;
+        names += (names.empty() ? "" : ", ") + k;
+      }
+      throw py::type_error(std::string(function) + "() got an unexpected keyword argument '" + key +
+                           "' (its settings: " + names + ")");
+    }
+    if (!value.is_none()) given[key] = KeywordJson(key, value);
+  }
+  tasks::FitSettingsFromJson(given, &base);
+  return base;
 }
 
 std::vector<std::string> SplitColumns(const std::string& names) {

@@ -27,6 +27,7 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/execution.h"
+#include "gyrodrift/drift/fit_settings.h"
 
 namespace gyrodrift::python {
 
@@ -44,9 +45,18 @@ py::array_t<double, py::array::f_style> ToArray(const Eigen::MatrixXd& m);
 // A record of the task layer as Python objects: the dict the sidecar's JSON object would load as,
 // but with NaN kept as NaN (the JSON file writes null).
 py::object ToPython(const nlohmann::json& j);
-// A setting that takes "auto" or an integer (lags, hidden), as drift::FitSettings holds it: None
-// is "not given", ints and strings pass as text.
-std::string AutoOrIntegerSetting(const char* name, const py::object& value);
+// The fit settings of a call (DriftModel.fit, evaluate) from its keyword arguments, read by their
+// one reader (tasks::FitSettingsFromJson) onto `base`: every drift::FitSettings field is a keyword
+// of its name, so a field added there reaches Python with no edit here. None leaves a setting at
+// its default; a keyword that names no setting, or one the call sets itself (`own`: mode,
+// has_temperature, evaluate's method), raises TypeError naming it; a wrong value raises the
+// reader's OptionError (UsageError) naming it.
+drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings base,
+                                 const char* function, const std::vector<std::string>& own);
+// The settings keywords and their defaults, drift::FitSettings{} as JSON without the fields no
+// call takes as a keyword (mode: a keyword of its own; has_temperature: set from temperature):
+// gd.fit_defaults().
+nlohmann::json FitKeywordDefaults();
 // The comma-separated names of a model file's temperature_column.
 std::vector<std::string> SplitColumns(const std::string& names);
 

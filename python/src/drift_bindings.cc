@@ -296,34 +296,16 @@ class PyDriftModel {
   bool fitted_ = false;
 };
 
-// DriftModel.fit's keywords as drift::FitSettings (their defaults: BindDriftModel).
+// DriftModel.fit: its own keywords, then the fit settings as keywords (FitSettingsOf).
 void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
                  const std::optional<gp::Array>& temperature, const std::string& mode,
-                 const std::string& method, const std::string& decomposition,
-                 const py::object& lags, const py::object& hidden, double rate_hz,
-                 const std::string& thermal_features, const std::vector<double>& time_constants,
-                 int ensemble, int realisations, std::uint64_t seed, int threads, bool nonlinear,
-                 std::optional<double> reference_temperature, const std::string& hysteresis,
                  const std::string& target,
                  const std::optional<std::vector<std::string>>& temperature_columns,
                  const std::string& source, const std::vector<Eigen::Index>& record_starts,
-                 const std::vector<bool>& logged, const py::object& progress) {
-  const gyrodrift::drift::FitSettings s{.mode = mode,
-                                        .method = method,
-                                        .decomposition = decomposition,
-                                        .lags = gp::AutoOrIntegerSetting("lags", lags),
-                                        .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
-                                        .rate_hz = rate_hz,
-                                        .thermal_features = thermal_features,
-                                        .time_constants = time_constants,
-                                        .ensemble = ensemble,
-                                        .realisations = realisations,
-                                        .seed = seed,
-                                        .threads = threads,
-                                        .nonlinear = nonlinear,
-                                        .reference_temperature = reference_temperature,
-                                        .hysteresis = hysteresis,
-                                        .has_temperature = temperature.has_value()};
+                 const std::vector<bool>& logged, const py::object& progress,
+                 const py::kwargs& settings) {
+  const gyrodrift::drift::FitSettings s = gp::FitSettingsOf(
+      settings, {.mode = mode, .has_temperature = temperature.has_value()}, "fit", {});
   d.Fit(y, temperature, s, target, temperature_columns, source, record_starts, logged, progress);
 }
 
@@ -331,20 +313,14 @@ void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
 
 void BindDriftModel(py::module_& m) {
   using py::arg;
-  const gyrodrift::drift::FitSettings fd;
   const gyrodrift::tasks::PredictSettings pd;
+  // mode has no library default (fit --mode is required): compensate is Python's.
   py::class_<gp::PyDriftModel>(m, "DriftModel")
       .def(py::init<>())
       .def("fit", &FitKeywords, arg("y"), arg("temperature") = py::none(), py::kw_only(),
-           arg("mode") = "compensate", arg("method") = fd.method,
-           arg("decomposition") = fd.decomposition, arg("lags") = py::none(),
-           arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
-           arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
-           arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations,
-           arg("seed") = fd.seed, arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
-           arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
-           arg("target") = "rate_dph", arg("temperature_columns") = py::none(),
-           arg("source") = "python", arg("record_starts") = std::vector<Eigen::Index>{},
+           arg("mode") = "compensate", arg("target") = "rate_dph",
+           arg("temperature_columns") = py::none(), arg("source") = "python",
+           arg("record_starts") = std::vector<Eigen::Index>{},
            arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
@@ -393,6 +369,10 @@ void BindDriftModel(py::module_& m) {
         return gyrodrift::drift::TemperatureWarning(gp::ToVector(t, "temperature"), name);
       },
       arg("temperature"), arg("name") = "temperature");
+  m.def(
+      "fit_defaults", [] { return gp::ToPython(gp::FitKeywordDefaults()); },
+      "The fit settings DriftModel.fit and evaluate take as keywords, with their defaults (the "
+      "library's drift::FitSettings).");
 }
 
 void BindExport(py::module_& m) {

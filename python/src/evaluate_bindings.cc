@@ -90,54 +90,31 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
 void BindEvaluate(py::module_& m) {
   using py::arg;
   const gyrodrift::tasks::EvaluateSettings ed;
-  const gyrodrift::drift::FitSettings fd;
+  // The fit settings are keywords (FitSettingsOf) but method: evaluate compares `methods`.
   m.def(
       "evaluate",
       [](const gp::Array& y, const std::optional<gp::Array>& temperature,
          const std::optional<gp::Array>& truth, const std::string& mode, const py::object& methods,
          const std::string& protocol, double split, int repeats, int horizon, int window,
-         const std::string& decomposition, const py::object& lags, const py::object& hidden,
-         double rate_hz, const std::string& thermal_features,
-         const std::vector<double>& time_constants, int ensemble, int realisations,
-         std::uint64_t seed, int threads, bool nonlinear,
-         std::optional<double> reference_temperature, const std::string& hysteresis,
-         const py::object& progress) {
-        // The models' settings as fit's; the method is evaluate's list (ms-elm stands in).
-        const gyrodrift::drift::FitSettings fit{.mode = mode,
-                                              .method = "ms-elm",
-                                              .decomposition = decomposition,
-                                              .lags = gp::AutoOrIntegerSetting("lags", lags),
-                                              .hidden = gp::AutoOrIntegerSetting("hidden", hidden),
-                                              .rate_hz = rate_hz,
-                                              .thermal_features = thermal_features,
-                                              .time_constants = time_constants,
-                                              .ensemble = ensemble,
-                                              .realisations = realisations,
-                                              .seed = seed,
-                                              .threads = threads,
-                                              .nonlinear = nonlinear,
-                                              .reference_temperature = reference_temperature,
-                                              .hysteresis = hysteresis,
-                                              .has_temperature = temperature.has_value()};
-        const gyrodrift::tasks::EvaluateSettings s{.fit = fit,
-                                                   .methods = gp::MethodList(methods),
-                                                   .protocol = protocol,
-                                                   .split = split,
-                                                   .repeats = repeats,
-                                                   .window = window,
-                                                   .horizon = horizon};
+         const py::object& progress, const py::kwargs& settings) {
+        const gyrodrift::tasks::EvaluateSettings s{
+            .fit = gp::FitSettingsOf(settings,
+                                     {.mode = mode,
+                                      .method = "ms-elm",
+                                      .has_temperature = temperature.has_value()},
+                                     "evaluate", {"method"}),
+            .methods = gp::MethodList(methods),
+            .protocol = protocol,
+            .split = split,
+            .repeats = repeats,
+            .window = window,
+            .horizon = horizon};
         return gp::Evaluate(y, temperature, truth, s, progress);
       },
       arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
       arg("mode") = "predict", arg("methods") = ed.methods, arg("protocol") = ed.protocol,
       arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
-      arg("window") = ed.window, arg("decomposition") = fd.decomposition,
-      arg("lags") = py::none(), arg("hidden") = fd.hidden, arg("rate_hz") = fd.rate_hz,
-      arg("thermal_features") = fd.thermal_features, arg("time_constants") = fd.time_constants,
-      arg("ensemble") = fd.ensemble, arg("realisations") = fd.realisations, arg("seed") = fd.seed,
-      arg("threads") = fd.threads, arg("nonlinear") = fd.nonlinear,
-      arg("reference_temperature") = py::none(), arg("hysteresis") = fd.hysteresis,
-      arg("progress") = py::none());
+      arg("window") = ed.window, arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

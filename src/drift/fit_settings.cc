@@ -36,6 +36,30 @@ bool ElmBased(Method method) {
   return method == Method::kMsElm || method == Method::kEmdElm || method == Method::kElm;
 }
 
+// The settings of the compensation's reference and of the thermal identification (compensate
+// mode, identified methods), onto `o` (its mode and method set).
+void ThermalSettings(const FitSettings& s, DriftOptions& o) {
+  if (s.reference_temperature) {
+    const std::string value = FormatValue(*s.reference_temperature);
+    if (o.mode != Mode::kCompensate) {
+      ThrowOption("reference_temperature", value, "unset in mode 'predict'");
+    }
+    RequireInRange("reference_temperature", *s.reference_temperature, -100.0, 200.0);
+    o.reference_c = *s.reference_temperature;
+  }
+  o.thermal.hysteresis = Named("hysteresis", s.hysteresis, HysteresisTermFromString);
+  if (o.thermal.hysteresis != HysteresisTerm::kAuto && !IdentifiesThermalModel(o)) {
+    ThrowOption("hysteresis", "'" + s.hysteresis + "'",
+                "auto unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
+  }
+  o.thermal.standard_errors = s.standard_errors;
+  if (s.standard_errors != ThermalModelOptions{}.standard_errors && !IdentifiesThermalModel(o)) {
+    ThrowOption("standard_errors", FormatValue(s.standard_errors),
+                "left at its default unless mode is 'compensate' with method thermal, ms-elm or "
+                "emd-elm");
+  }
+}
+
 }  // namespace
 
 Execution MakeExecution(const FitSettings& s) {
@@ -112,24 +136,15 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
       o.learner.elm.hidden_units = hidden;
     }
   }
-  if (s.reference_temperature) {
-    const std::string value = FormatValue(*s.reference_temperature);
-    if (!compensate) ThrowOption("reference_temperature", value, "unset in mode 'predict'");
-    RequireInRange("reference_temperature", *s.reference_temperature, -100.0, 200.0);
-    o.reference_c = *s.reference_temperature;
-  }
-  o.thermal.hysteresis = Named("hysteresis", s.hysteresis, HysteresisTermFromString);
-  if (o.thermal.hysteresis != HysteresisTerm::kAuto && !IdentifiesThermalModel(o)) {
-    ThrowOption("hysteresis", "'" + s.hysteresis + "'",
-                "auto unless mode is 'compensate' with method thermal, ms-elm or emd-elm");
-  }
+  ThermalSettings(s, o);
   // The fields of DriftOptions a setting sets: a refusal of one names the setting.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble"},
                       {"selection.monte_carlo.realisations", "realisations"},
                       {"features.lags", "lags"},
                       {"features.time_constants_s", "time_constants"},
                       {"features.rate_hz", "rate_hz"},
-                      {"learner.elm.hidden_units", "hidden"}},
+                      {"learner.elm.hidden_units", "hidden"},
+                      {"thermal.standard_errors", "standard_errors"}},
                      [&] { o.Validate(); });
   return o;
 }

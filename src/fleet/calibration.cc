@@ -213,7 +213,7 @@ FittedUnit FitUnit(const Manifest& m, const UnitSpec& unit) {
   // runs on one thread: a decomposing method (ms-elm, emd-elm) would otherwise take every core
   // per unit, T units x every core on the machine, and a one-thread Dask worker would use them
   // all. The results do not depend on it: the model is the one `fit` writes with any --threads.
-  drift::FitSettings settings = m.Settings();
+  drift::FitSettings settings = m.fit;
   settings.threads = 1;
   FittedUnit fitted;
   for (const AxisSpec& axis : m.axes) {

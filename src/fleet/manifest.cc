@@ -174,26 +174,22 @@ std::vector<std::string> UnitSpec::Logs() const {
   return logs;
 }
 
-drift::DriftOptions Manifest::FitOptions() const { return drift::MakeDriftOptions(Settings()); }
+drift::DriftOptions Manifest::FitOptions() const { return drift::MakeDriftOptions(fit); }
 
-drift::FitSettings Manifest::Settings() const {
-  drift::FitSettings s;
-  s.mode = "compensate";
-  s.method = std::string(drift::ToString(method));
-  s.seed = seed;
-  s.nonlinear = nonlinear;
-  if (!std::isnan(reference_c)) s.reference_temperature = reference_c;
-  s.hysteresis = std::string(drift::ToString(hysteresis));
-  s.has_temperature = true;
-  return s;
+drift::Method Manifest::FitMethod() const {
+  return drift::ResolveMethod(fit.method, drift::Mode::kCompensate);
 }
 
 namespace {
 
-// A TOML value as JSON (strings, numbers, booleans and arrays of them), for the settings' reader.
+// A TOML value as JSON (strings, numbers, booleans and arrays of them), for the settings' reader
+// (a non-negative integer as unsigned, which the reader takes for a seed).
 nlohmann::json ToJson(const toml::node& n) {
   if (n.is_string()) return *n.value<std::string>();
-  if (n.is_integer()) return *n.value<std::int64_t>();
+  if (n.is_integer()) {
+    const std::int64_t v = *n.value<std::int64_t>();
+    return v >= 0 ? nlohmann::json(static_cast<std::uint64_t>(v)) : nlohmann::json(v);
+  }
   if (n.is_floating_point()) return *n.value<double>();
   if (n.is_boolean()) return *n.value<bool>();
   nlohmann::json out = nlohmann::json::array();
@@ -203,13 +199,27 @@ nlohmann::json ToJson(const toml::node& n) {
   return out;
 }
 
-// The manifest's top-level keys: the fleet's, the fit's and every log setting
-// (tasks::LogOptionsToJson's keys).
+// The manifest's key of the fit setting `setting` (drift::FitSettings), "" for those the fleet
+// sets: mode (compensate), has_temperature (the axes' columns), threads (calibrate --threads:
+// how it runs) and rate_hz (the fleet's own key, 0 = from each log). reference_temperature keeps
+// the spelling with its unit that manifests have always used.
+std::string FitKey(const std::string& setting) {
+  if (setting == "mode" || setting == "has_temperature" || setting == "threads" ||
+      setting == "rate_hz") {
+    return "";
+  }
+  return setting == "reference_temperature" ? "reference_temperature_c" : setting;
+}
+
+// The manifest's top-level keys: the fleet's, every fit setting's (FitKey) and every log
+// setting's (tasks::LogOptionsToJson's keys).
 std::set<std::string> TopKeys() {
-  std::set<std::string> keys = {"method", "rate_unit", "rate_hz", "seed", "nonlinear",
-                                "reference_temperature_c", "hysteresis", "drift_window_s",
-                                "limits", "axis", "unit"};
-  const nlohmann::json log = tasks::LogOptionsToJson({});
+  std::set<std::string> keys = {"rate_unit", "rate_hz", "drift_window_s", "limits", "axis", "unit"};
+  // Named first: items() of a temporary would outlive it.
+  const nlohmann::json fit = tasks::FitSettingsToJson({}), log = tasks::LogOptionsToJson({});
+  for (const auto& [setting, value] : fit.items()) {
+    if (!FitKey(setting).empty()) keys.insert(FitKey(setting));
+  }
   for (const auto& [key, value] : log.items()) keys.insert(key);
   return keys;
 }
@@ -228,47 +238,38 @@ void ReadLogKeys(const Table& top, const Context& c, Manifest& m) {
     c.Fail(*top.Find(e.option()), e.what());
   }
   if (const toml::node* n = top.Find("gaps")) {
-    if (m.log.gaps == io::GapPolicy::kSplit && m.method != drift::Method::kThermal) {
+    if (m.log.gaps == io::GapPolicy::kSplit && m.FitMethod() != drift::Method::kThermal) {
       c.Fail(*n, fmt::format("gaps = 'split' needs method = 'thermal', not '{}' (a "
                              "decomposition would run across the gaps)",
-                             drift::ToString(m.method)));
+                             drift::ToString(m.FitMethod())));
     }
-    if (m.log.gaps == io::GapPolicy::kCarry && drift::UsesDecomposition(m.method)) {
+    if (m.log.gaps == io::GapPolicy::kCarry && drift::UsesDecomposition(m.FitMethod())) {
       c.Fail(*n, fmt::format("gaps = 'carry' needs a method that fits on the logged "
                              "rows only (thermal or poly), not '{}' (a "
                              "decomposition would run across the made-up rows)",
-                             drift::ToString(m.method)));
+                             drift::ToString(m.FitMethod())));
     }
   }
 }
 
-// The fit keys, checked together as fit's flags are (drift::MakeDriftOptions); a refusal is
-// placed at the key it names.
+// The fit settings, read through their one mapping (tasks::FitSettingsFromJson) and checked
+// together as fit's flags are (drift::MakeDriftOptions); a refusal is placed at the key it names.
 void ReadFitKeys(const Table& top, const Context& c, Manifest& m) {
-  if (top.Find("method")) {
-    m.method = top.Enum("method", drift::MethodFromString);
-    if (!drift::SupportsMode(m.method, drift::Mode::kCompensate)) {
-      c.Fail(*top.Find("method"),
-             fmt::format("method = '{}' does not compensate", drift::ToString(m.method)));
-    }
+  nlohmann::json keys = nlohmann::json::object();
+  const nlohmann::json settings = tasks::FitSettingsToJson({});
+  for (const auto& [setting, value] : settings.items()) {
+    const std::string key = FitKey(setting);
+    if (!key.empty() && top.Find(key)) keys[setting] = ToJson(*top.Find(key));
   }
-  if (const toml::node* n = top.Find("seed")) {
-    if (!n->is_integer() || *n->value<std::int64_t>() < 0) {
-      c.Fail(*n, "'seed' must be a non-negative integer");
-    }
-    m.seed = static_cast<std::uint64_t>(*n->value<std::int64_t>());
-  }
-  m.nonlinear = top.Bool("nonlinear", false);
-  // Its range is the fit settings' (checked below, with the other fit keys).
-  m.reference_c = top.Number("reference_temperature_c", m.reference_c,
-                             -std::numeric_limits<double>::max(),
-                             std::numeric_limits<double>::max());
-  if (top.Find("hysteresis")) m.hysteresis = top.Enum("hysteresis", drift::HysteresisTermFromString);
   try {
+    tasks::FitSettingsFromJson(keys, &m.fit);
+    if (!drift::SupportsMode(m.FitMethod(), drift::Mode::kCompensate)) {
+      c.Fail(*top.Find("method"),
+             fmt::format("method = '{}' does not compensate", drift::ToString(m.FitMethod())));
+    }
     (void)m.FitOptions();
   } catch (const OptionError& e) {
-    const std::string key =
-        e.option() == "reference_temperature" ? "reference_temperature_c" : e.option();
+    const std::string key = FitKey(e.option()).empty() ? e.option() : FitKey(e.option());
     const std::string message = fmt::format("{} = {}: must be {}", key, e.value(), e.rule());
     if (const toml::node* n = top.Find(key)) c.Fail(*n, message);
     c.Fail(top.line(), message);
@@ -348,11 +349,11 @@ void ReadUnits(const toml::table& root, const Context& c, const std::string& pat
     for (const std::string& log : unit.Strings("calibration")) {
       u.calibration.push_back(Resolve(path, log));
     }
-    if (u.calibration.size() > 1 && m.method != drift::Method::kThermal) {
+    if (u.calibration.size() > 1 && m.FitMethod() != drift::Method::kThermal) {
       c.Fail(*unit.Find("calibration"),
              fmt::format("several calibration logs need method = 'thermal', not '{}' (its thermal "
                          "states restart with each log; a decomposition would run across them)",
-                         drift::ToString(m.method)));
+                         drift::ToString(m.FitMethod())));
     }
     for (const std::string& v : unit.Strings("verification")) {
       u.verification.push_back(Resolve(path, v));
@@ -463,7 +464,7 @@ nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
   for (const std::string& log : u.Logs()) {
     logs.push_back({{"path", log}, {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
-  return {{"settings", tasks::SettingsToJson(m.Settings(), m.log)},
+  return {{"settings", tasks::SettingsToJson(m.fit, m.log)},
           {"fleet",
            {{"rate_unit", allan::ToString(m.rate_unit)},
             {"rate_hz", m.rate_hz},

@@ -147,7 +147,7 @@ std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const Unit
   report.AddParagraph(fmt::format(
       "Unit {}: method {} (compensate mode), fitted on {} and verified on {}. Limits: {}. "
       "Result: {}.",
-      unit.serial, drift::ToString(m.method),
+      unit.serial, drift::ToString(m.FitMethod()),
       calibration, verification,
       LimitsText(m.limits), unit.pass() ? "PASS" : "FAIL"));
   for (const AxisResult& a : unit.axes) {

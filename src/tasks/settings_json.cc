@@ -42,6 +42,13 @@ std::vector<double> Numbers(const char* key, const json& v) {
   }
   return out;
 }
+// A setting that takes "auto" or an integer (lags, hidden), held as its text: a string as given,
+// an integer as its digits (Python's lags=8, a manifest's hidden = 20).
+std::string AutoOrInteger(const char* key, const json& v) {
+  if (v.is_number_integer()) return v.dump();
+  if (!v.is_string()) Wrong(key, v, "auto or an integer");
+  return v.get<std::string>();
+}
 double Number(const char* key, const json& v) {
   if (!v.is_number()) Wrong(key, v, "a number");
   return v.get<double>();
@@ -77,9 +84,9 @@ const std::vector<Field<FS>>& FitFields() {
       {"decomposition", [](const FS& s) { return json(s.decomposition); },
        [](const json& v, FS& s) { s.decomposition = String("decomposition", v); }},
       {"lags", [](const FS& s) { return json(s.lags); },
-       [](const json& v, FS& s) { s.lags = String("lags", v); }},
+       [](const json& v, FS& s) { s.lags = AutoOrInteger("lags", v); }},
       {"hidden", [](const FS& s) { return json(s.hidden); },
-       [](const json& v, FS& s) { s.hidden = String("hidden", v); }},
+       [](const json& v, FS& s) { s.hidden = AutoOrInteger("hidden", v); }},
       {"rate_hz", [](const FS& s) { return json(s.rate_hz); },
        [](const json& v, FS& s) { s.rate_hz = Number("rate_hz", v); }},
       {"thermal_features", [](const FS& s) { return json(s.thermal_features); },
@@ -107,6 +114,8 @@ const std::vector<Field<FS>>& FitFields() {
        }},
       {"hysteresis", [](const FS& s) { return json(s.hysteresis); },
        [](const json& v, FS& s) { s.hysteresis = String("hysteresis", v); }},
+      {"standard_errors", [](const FS& s) { return json(s.standard_errors); },
+       [](const json& v, FS& s) { s.standard_errors = Number("standard_errors", v); }},
       {"has_temperature", [](const FS& s) { return json(s.has_temperature); },
        [](const json& v, FS& s) { s.has_temperature = Bool("has_temperature", v); }},
   };

@@ -119,6 +119,21 @@ TEST_F(FitCli, ThermalFeatureSetAndTimeConstantsAreStoredAndUsed) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// --standard-errors (drift::FitSettings::standard_errors) reaches the identification and the
+// model file, and the model file reads it back.
+TEST_F(FitCli, StandardErrorsAreStoredAndReadBack) {
+  const std::string model = dir_ + "/se.json";
+  auto r = Fit("-t rate_dph -T temperature_c --mode compensate --standard-errors 0", model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto json = nlohmann::json::parse(io::ReadTextFile(model));
+  EXPECT_EQ(json["options"]["thermal"]["standard_errors"], 0.0);
+  EXPECT_EQ(io::ReadModelFile(model).model.options.thermal.standard_errors, 0.0);
+  r = Fit("-t rate_dph -T temperature_c --mode compensate", model);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(io::ReadModelFile(model).model.options.thermal.standard_errors,
+            drift::ThermalModelOptions{}.standard_errors);
+}
+
 TEST_F(FitCli, SaysWhenTheTimeAxisHasGaps) {
   // Rows 101.. shifted by 300 s: a logging gap the models cannot see. Refused by default, naming
   // the row; filled by linear interpolation when asked, and said so.
@@ -302,6 +317,12 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"hysteresis for poly",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate -m poly --hysteresis off", 2,
        "--hysteresis = 'off': must be auto unless mode is 'compensate'"},
+      {"standard errors out of range",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate --standard-errors 11", 2,
+       "--standard-errors = 11: must be in [0, 10]"},
+      {"standard errors for poly",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate -m poly --standard-errors 2", 2,
+       "--standard-errors = 2: must be left at its default unless mode is 'compensate'"},
       {"zero ensemble", "fit %IN% -t rate_dph --mode predict -I 0", 2, "--ensemble = 0"},
       {"few realisations", "fit %IN% -t rate_dph --mode predict --realisations 5", 2,
        "--realisations = 5"},

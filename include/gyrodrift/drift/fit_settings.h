@@ -47,6 +47,10 @@ struct FitSettings {
   // Compensate mode, identified methods: the thermal models' hysteresis term, a HysteresisTerm
   // name ("auto": for calibration runs of at least kHysteresisAutoMinDurationS).
   std::string hysteresis = "auto";
+  // Compensate mode, identified methods: the one-standard-error rule's multiple, in [0, 10]: a
+  // richer thermal structure must beat a simpler one by this many standard errors of the paired
+  // fold scores to be chosen (0: the least held-out error; docs/drift.md 4.8).
+  double standard_errors = ThermalModelOptions{}.standard_errors;
   bool has_temperature = false;  // a temperature channel is given (needed by compensate mode)
 
   // Every check of MakeDriftOptions and MakeExecution, before any data is read: OptionError

@@ -14,10 +14,13 @@
 //   skip_rows = 0                 # (tasks::LogOptionsFromJson: names, skip_rows, bad_lines,
 //   bad_lines = "error"           # ulog_topic, ulog_axes, ulog_temperature, ulog_units,
 //                                 # ulog_instance), as the flags of the same names
-//   seed = 1                      # optional
-//   nonlinear = false             # optional, fit --nonlinear
-//   reference_temperature_c = 20  # optional, fit --reference-temperature
-//   hysteresis = "auto"           # optional, fit --hysteresis: auto | on | off
+//   seed = 1                      # optional, and every other fit setting as its key
+//   nonlinear = false             # (drift::FitSettings through tasks::FitSettingsFromJson:
+//   hysteresis = "auto"           # decomposition, hidden, thermal_features, time_constants,
+//                                 # ensemble, realisations, seed, nonlinear, hysteresis, ...), as
+//                                 # fit's flags of the same names; not mode (compensate),
+//                                 # threads (calibrate --threads) or rate_hz (the fleet's key)
+//   reference_temperature_c = 20  # optional: the setting reference_temperature, with its unit
 //   drift_window_s = 100          # optional: residual drift = RMS of block means this long
 //
 //   [limits]                      # optional; a limit left out is not checked
@@ -80,24 +83,22 @@ struct UnitSpec {
 
 struct Manifest {
   std::string path;  // the manifest file
-  drift::Method method = drift::Method::kThermal;
   allan::RateUnit rate_unit = allan::RateUnit::kDegPerHour;
   double rate_hz = 0.0;  // 0 = from each log
   io::LogOptions log;  // how every log is read (every field a key)
-  std::uint64_t seed = 1;
-  bool nonlinear = false;
-  double reference_c = std::numeric_limits<double>::quiet_NaN();
-  drift::HysteresisTerm hysteresis = drift::HysteresisTerm::kAuto;
+  // How every axis is fitted (every field a key but those the fleet sets: compensate mode, a
+  // temperature, calibrate's threads, the sample rate of each log).
+  drift::FitSettings fit{.mode = "compensate", .method = "thermal", .has_temperature = true};
   double drift_window_s = 100.0;  // in [1, 1e5]
   Limits limits;
   std::vector<AxisSpec> axes;  // 1 to io::kMaxModelAxes
   std::vector<UnitSpec> units;  // at least one
 
-  // The drift options every axis is fitted with (compensate mode; drift::MakeDriftOptions, as
-  // fit's flags); rate_hz is settled per log.
+  // The drift options every axis is fitted with (drift::MakeDriftOptions of `fit`, as fit's
+  // flags); rate_hz is settled per log.
   drift::DriftOptions FitOptions() const;
-  // The fit settings of those options (drift::FitSettings, compensate mode).
-  drift::FitSettings Settings() const;
+  // The method `fit` names ("auto": thermal).
+  drift::Method FitMethod() const;
 };
 
 // Parses a manifest's text; `path` names it in messages and anchors relative log paths. Checks

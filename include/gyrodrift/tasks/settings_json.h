@@ -1,9 +1,10 @@
 // The settings as JSON: one writer and one reader of the fit settings (drift::FitSettings) and
 // the log settings (io::LogOptions), key = field name (the log's ULog conversion flattened as
 // ulog_topic, ulog_axes, ulog_temperature, ulog_units). A fleet manifest takes the log settings
-// as keys through this mapping, and a unit's fingerprint is the settings' JSON with its version
-// (fleet/manifest.h), so a field added to either struct and to its entry here reaches the CLI's
-// sidecars, the manifest and the fingerprint at once.
+// and the fit settings as keys through this mapping, Python's DriftModel.fit and evaluate take
+// the fit settings as keywords through it (python/src/bindings.h, FitSettingsOf), and a unit's
+// fingerprint is the settings' JSON with its version (fleet/manifest.h), so a field added to
+// either struct and to its entry here reaches the manifest, Python and the fingerprint at once.
 //
 //   {"version": 1, "fit": {"mode": "compensate", "method": "thermal", ...},
 //    "log": {"gaps": "error", "delimiter": "auto", "names": [], "skip_rows": 0, ...}}

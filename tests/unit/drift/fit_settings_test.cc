@@ -43,7 +43,11 @@ TEST(FitSettings, MapOntoTheOptions) {
   s.hysteresis = "off";
   s.ensemble = 30;
   s.seed = 9;
+  s.standard_errors = 0.5;
   const DriftOptions o = MakeDriftOptions(s);
+  EXPECT_EQ(o.thermal.standard_errors, 0.5);
+  EXPECT_EQ(MakeDriftOptions(Compensate()).thermal.standard_errors,
+            ThermalModelOptions{}.standard_errors);
   EXPECT_EQ(o.method, Method::kThermal);  // auto in compensate mode
   EXPECT_EQ(o.reference_c, 20.0);
   EXPECT_FALSE(o.linear_compensation);
@@ -86,7 +90,13 @@ TEST(FitSettings, RefusalsNameTheSetting) {
               s.nonlinear = true;
             }),
             "nonlinear");
+  EXPECT_EQ(refused([](FitSettings& s) {
+              s.method = "poly";
+              s.standard_errors = 2.0;
+            }),
+            "standard_errors");
   // Ranges DriftOptions::Validate owns, named by the setting that set the field.
+  EXPECT_EQ(refused([](FitSettings& s) { s.standard_errors = -1.0; }), "standard_errors");
   EXPECT_EQ(refused([](FitSettings& s) { s.ensemble = 0; }), "ensemble");
   EXPECT_EQ(refused([](FitSettings& s) { s.realisations = 5; }), "realisations");
   EXPECT_EQ(refused([](FitSettings& s) { s.time_constants = {0.5}; }), "time_constants");

@@ -81,6 +81,45 @@ TEST_F(ManifestTest, RefusalsNameTheLineAndTheKey) {
             file + "1: reference_temperature_c = 500: must be in [-100, 200]");
 }
 
+// Every drift::FitSettings field is a key through the settings' one reader
+// (tasks::FitSettingsFromJson), but those the fleet sets (mode, has_temperature, threads, rate_hz).
+TEST_F(ManifestTest, EveryFitSettingIsAKeyThroughItsOneMapping) {
+  const Manifest m = Parse(
+      "decomposition = \"emd\"\nensemble = 7\nrealisations = 30\nthermal_features = "
+      "\"classic\"\ntime_constants = [60, 600.5]\nseed = 18446744073709551\nmethod = \"auto\"\n"
+      "standard_errors = 0.5\n");
+  EXPECT_EQ(m.fit.decomposition, "emd");
+  EXPECT_EQ(m.fit.ensemble, 7);
+  EXPECT_EQ(m.fit.realisations, 30);
+  EXPECT_EQ(m.fit.thermal_features, "classic");
+  EXPECT_EQ(m.fit.time_constants, (std::vector<double>{60.0, 600.5}));
+  EXPECT_EQ(m.fit.seed, 18446744073709551u);
+  EXPECT_EQ(m.FitMethod(), drift::Method::kThermal);
+  EXPECT_EQ(m.FitOptions().thermal.standard_errors, 0.5);
+  EXPECT_EQ(m.fit.mode, "compensate");
+  EXPECT_TRUE(m.fit.has_temperature);
+  const drift::DriftOptions o = Parse("method = \"ms-elm\"\nhidden = 20\nnonlinear = true\n")
+                                    .FitOptions();
+  EXPECT_EQ(o.learner.elm.hidden_units, 20);
+  const std::string file = dir_ + "/fleet.toml:";
+  EXPECT_EQ(Refusal("seed = 1\nensemble = \"many\"\n"),
+            file + "2: ensemble = \"many\": must be an integer in [1, 100000]");
+  EXPECT_EQ(Refusal("seed = -1\n"), file + "1: seed = -1: must be a non-negative integer");
+  EXPECT_EQ(Refusal("ensemble = 0\n"), file + "1: ensemble = 0: must be an integer in [1, 100000]");
+  EXPECT_EQ(Refusal("lags = 4\n"),
+            file + "1: lags = 4: must be left unset in mode 'compensate' (a compensate-mode model "
+                   "sees temperature only; lags apply to mode 'predict')");
+  EXPECT_EQ(Refusal("method = \"ms-elm\"\nhidden = 0\n"),
+            file + "2: hidden = '0': must be auto or an integer in [1, 100000]");
+  for (const char* fleet_set : {"threads = 2\n", "mode = \"predict\"\n",
+                                "has_temperature = true\n", "reference_temperature = 20\n"}) {
+    EXPECT_NE(Refusal(fleet_set).find("unknown key"), std::string::npos) << fleet_set;
+  }
+  EXPECT_NE(Refusal("method = \"persistence\"\n")
+                .find("1: method = 'persistence' does not compensate"),
+            std::string::npos);
+}
+
 TEST_F(ManifestTest, TheFingerprintFollowsTheHysteresisSetting) {
   const Manifest a = Parse("");
   const Manifest off = Parse("hysteresis = \"off\"\n");
@@ -118,6 +157,7 @@ TEST_F(ManifestTest, EverySettingChangesTheFingerprint) {
   EXPECT_EQ(FingerprintJson(a, a.units[0])["settings"]["version"], 1);
   for (const char* top : {"hysteresis = \"off\"\n", "seed = 2\n", "method = \"poly\"\n",
                           "nonlinear = true\n", "reference_temperature_c = 20\n",
+                          "ensemble = 50\n", "time_constants = [60]\n",
                           "skip_rows = 1\n", "bad_lines = \"skip\"\n", "delimiter = \"comma\"\n",
                           "gaps = \"interpolate\"\n", "ulog_instance = 1\n", "rate_hz = 2\n",
                           "drift_window_s = 50\n", "rate_unit = \"dps\"\n",

@@ -26,6 +26,7 @@ TEST(SettingsJson, EveryFieldRoundTrips) {
                                .nonlinear = true,
                                .reference_temperature = 21.5,
                                .hysteresis = "off",
+                               .standard_errors = 2.5,
                                .has_temperature = true};
   const io::LogOptions log{.gaps = io::GapPolicy::kCarry,
                            .delimiter = io::Delimiter::kTab,
@@ -45,10 +46,21 @@ TEST(SettingsJson, EveryFieldRoundTrips) {
   EXPECT_EQ(SettingsToJson(fit2, log2), j);
   EXPECT_EQ(fit2.reference_temperature, 21.5);
   EXPECT_EQ(fit2.seed, fit.seed);
+  EXPECT_EQ(fit2.standard_errors, 2.5);
   EXPECT_EQ(log2, log);  // gaps_name is how a front end spells gaps, not a setting
   // Unset reference: null, read back unset.
   SettingsFromJson(SettingsToJson({}, {}), "d.json", &fit2, &log2);
   EXPECT_FALSE(fit2.reference_temperature.has_value());
+}
+
+// lags and hidden ("auto" or an integer) are held as text: an integer is read as its digits.
+TEST(SettingsJson, AutoOrIntegerSettingsTakeAnInteger) {
+  drift::FitSettings fit;
+  FitSettingsFromJson({{"lags", 8}, {"hidden", "auto"}}, &fit);
+  EXPECT_EQ(fit.lags, "8");
+  EXPECT_EQ(fit.hidden, "auto");
+  EXPECT_THROW(FitSettingsFromJson({{"hidden", true}}, &fit), OptionError);
+  EXPECT_THROW(FitSettingsFromJson({{"lags", 2.5}}, &fit), OptionError);
 }
 
 TEST(SettingsJson, RefusalsNameTheKeyOrTheSource) {
