@@ -26,13 +26,13 @@ struct FitSettings {
   std::string decomposition = "beemdan";  // a decomposition::Method name (ms-elm, emd-elm)
   // Predict mode: the sub-models' own lags, "auto" (chosen among 1, 2, 4, 8, 16 on the last 20 %
   // of the training record) or p in [1, 256]; "" = not given (4).
-  std::string lags;
+  std::string lags = {};
   // The ELM methods: hidden units, "auto" (leave-one-out choice of L <= 50 and C) or L in
   // [1, 100000]; "" = not given (auto).
   std::string hidden = "auto";
   double rate_hz = 1.0;                 // sample rate, Hz
   std::string thermal_features = "auto";  // a ThermalSet name (learners on thermal features)
-  std::vector<double> time_constants;   // of those features, s; empty: the library's
+  std::vector<double> time_constants = {};  // of those features, s; empty: the library's
   int ensemble = 100;                   // decomposition ensemble size
   int realisations = 100;               // white-noise realisations of the grouping's level
   std::uint64_t seed = 1;
@@ -43,7 +43,7 @@ struct FitSettings {
   bool nonlinear = false;
   // Compensate mode: reference the estimate to equilibrium at this temperature, degC, in
   // [-100, 200]; unset keeps the fitted intercept (the unit's repeatable bias).
-  std::optional<double> reference_temperature;
+  std::optional<double> reference_temperature = {};
   // Compensate mode, identified methods: the thermal models' hysteresis term, a HysteresisTerm
   // name ("auto": for calibration runs of at least kHysteresisAutoMinDurationS).
   std::string hysteresis = "auto";

@@ -24,15 +24,15 @@ namespace gyrodrift::tasks {
 // The run a fit learns from: the target columns, then the temperature columns, of every log one
 // after the other, as records of one run (drift::RecordRows).
 struct FitRun {
-  std::vector<std::string> targets;       // column names: one model per target
-  std::vector<std::string> temperatures;  // column names, the same for every target; may be empty
-  drift::RecordRows rows;
+  std::vector<std::string> targets = {};  // column names: one model per target
+  std::vector<std::string> temperatures = {};  // column names, the same for every target; may be empty
+  drift::RecordRows rows = {};
   double rate_hz = 0.0;  // of the logs; 0 = the settings' rate_hz (arrays without a time axis)
-  std::string rate_how;  // how the first log's rate was settled (TaskLog::rate_how)
-  std::string source;    // the logs, comma-separated (informative, kept in the model file)
-  std::string ulog;      // the first log that is a PX4 ULog (io::IsUlogFile), or ""
+  std::string rate_how = {};  // how the first log's rate was settled (TaskLog::rate_how)
+  std::string source = {};    // the logs, comma-separated (informative, kept in the model file)
+  std::string ulog = {};      // the first log that is a PX4 ULog (io::IsUlogFile), or ""
   size_t logs = 1;       // how many logs were appended (messages)
-  std::string temperature_spec;  // the temperature columns as the user gave them (messages)
+  std::string temperature_spec = {};  // the temperature columns as the user gave them (messages)
 };
 
 // The run of `logs` (read by ReadTaskLog; at least one): the columns of `target` and
