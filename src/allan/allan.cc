@@ -422,8 +422,7 @@ AllanResult ComputeOnPhase(const double* x, Eigen::Index n_samples, const AllanO
   // Tasks, handed out in order: the noise identification of every factor (two sweeps over the
   // phase, IdentifyAlphas), then the estimators' (TaskBoundaries).
   const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
-  const std::vector<int> task_begin =
-      TaskBoundaries(dev, ms, n, ResolveThreads(execution.threads));
+  const std::vector<int> task_begin = TaskBoundaries(dev, ms, n, ResolveThreads(execution.threads));
   const int first_run = want_alpha ? 1 : 0;
   const int tasks = first_run + static_cast<int>(task_begin.size()) - 1;
   ParallelFor(tasks, execution.threads, [&](int task, int) {

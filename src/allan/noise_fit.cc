@@ -137,8 +137,8 @@ std::vector<Eigen::Index> ThinToHalfOctaves(const std::vector<Eigen::Index>& use
 }
 
 // Indices of the points fitted: positive finite deviations inside the options' tau range, thinned.
-std::vector<Eigen::Index> FittedPoints(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& adev_dph,
-                                       const Eigen::VectorXd& edf,
+std::vector<Eigen::Index> FittedPoints(const Eigen::VectorXd& tau_s,
+                                       const Eigen::VectorXd& adev_dph, const Eigen::VectorXd& edf,
                                        const NoiseFitOptions& options) {
   if (tau_s.size() != adev_dph.size() || tau_s.size() != edf.size())
     throw UsageError("IdentifyNoise: tau_s, adev_dph and edf must have the same length");
@@ -161,8 +161,8 @@ std::vector<Eigen::Index> FittedPoints(const Eigen::VectorXd& tau_s, const Eigen
 // The fitted points, n of them, with their model columns.
 struct Points {
   Eigen::VectorXd tau, dev, var, edf;
-  Eigen::VectorXd m;      // averaging factor tau / tau0
-  Eigen::VectorXd terms;  // terms of each estimate (at least 1), or empty when not known
+  Eigen::VectorXd m;        // averaging factor tau / tau0
+  Eigen::VectorXd terms;    // terms of each estimate (at least 1), or empty when not known
   Eigen::MatrixXd columns;  // n x 5
 };
 
@@ -202,7 +202,7 @@ SubsetFits FitSubsets(const Points& p) {
   return internal::FitAllSubsets(internal::MakeLogCurve(p.columns, p.var, p.edf), a, b, p.var);
 }
 
-// The selected model with the covariance of its coefficients (from that of ln c: d c_j = c_j d u_j).
+// The selected model and the covariance of its coefficients (from ln c's: d c_j = c_j d u_j).
 NnlsFit SelectedFit(const SubsetFits& fits, unsigned selected, const Evidence& evidence) {
   NnlsFit fit;
   fit.ok = true;

@@ -10,20 +10,20 @@
 
 namespace gyrodrift::allan::internal {
 
-// The log-variance misfit of the subset fits treats the points as independent, but neighbouring points share most of their
-// data (for white rate noise the OADEV variances at tau and 2 tau are correlated at about 0.7), so
-// its differences between nested models are not chi-square with 1 degree of freedom, and the
-// model-based covariance of the fit is several times too small. Both are corrected with the
-// correlation rho of the points for Gaussian noise with the fitted spectrum (avar_correlation.h):
-// the covariance of ln c is the sandwich (J'J)^-1 J' rho J (J'J)^-1, and the rise of the misfit
-// when term j is removed is divided by the design effect delta_j = sandwich_jj / (J'J)^-1_jj (the
-// first-order Rao-Scott correction: under the smaller model the rise is delta_j chi2_1). When the
-// reduced chi-square exceeds 1 (the model misses something: a drift, filtering, a noise type
-// outside the five) the covariance is widened, and the rise divided, by it, so that a poor fit
-// does not make every term look significant. (Generalised least squares, whitening the residuals
-// with rho, would make the misfit chi-square directly, but it amplifies every departure of a real
-// curve from the five-term shape: it reduced the KVH 1750 X curve to white rate noise alone, which
-// leaves the published band at four taus.)
+// The log-variance misfit of the subset fits treats the points as independent, but neighbouring
+// points share most of their data (for white rate noise the OADEV variances at tau and 2 tau are
+// correlated at about 0.7), so its differences between nested models are not chi-square with 1
+// degree of freedom, and the model-based covariance of the fit is several times too small. Both are
+// corrected with the correlation rho of the points for Gaussian noise with the fitted spectrum
+// (avar_correlation.h): the covariance of ln c is the sandwich (J'J)^-1 J' rho J (J'J)^-1, and the
+// rise of the misfit when term j is removed is divided by the design effect delta_j = sandwich_jj /
+// (J'J)^-1_jj (the first-order Rao-Scott correction: under the smaller model the rise is delta_j
+// chi2_1). When the reduced chi-square exceeds 1 (the model misses something: a drift, filtering, a
+// noise type outside the five) the covariance is widened, and the rise divided, by it, so that a
+// poor fit does not make every term look significant. (Generalised least squares, whitening the
+// residuals with rho, would make the misfit chi-square directly, but it amplifies every departure
+// of a real curve from the five-term shape: it reduced the KVH 1750 X curve to white rate noise
+// alone, which leaves the published band at four taus.)
 class Evidence {
  public:
   // `rho`: the correlation of the points (avar_correlation.h).

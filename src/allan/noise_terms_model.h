@@ -11,7 +11,7 @@
 
 namespace gyrodrift::allan::internal {
 
-constexpr int kTerms = 5;                                               // Q, N, B, K, R
+constexpr int kTerms = 5;  // Q, N, B, K, R
 constexpr unsigned kAllTerms = (1u << kTerms) - 1;
 inline const double kBiasFactor = 2.0 * std::numbers::ln2 / std::numbers::pi;  // (0.664)^2
 

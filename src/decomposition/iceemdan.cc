@@ -37,8 +37,8 @@ struct NoiseLookahead {
   }
 
   // Takes every realisation's next row.
-  void Fetch(const Job& job, int stage, Eigen::Index n, std::vector<std::optional<NoiseRows>>& noise,
-             std::vector<Worker>& workers) {
+  void Fetch(const Job& job, int stage, Eigen::Index n,
+             std::vector<std::optional<NoiseRows>>& noise, std::vector<Worker>& workers) {
     ParallelFor(static_cast<int>(rows.size()), job.threads(), [&](int i, int w) {
       const size_t slot = static_cast<size_t>(i);
       if (rows[slot].size() != n) rows[slot].resize(n);
@@ -103,8 +103,7 @@ Decomposition RunIceemdanStages(const Eigen::Ref<const Eigen::VectorXd>& x, cons
   const int ensemble = EnsembleSize(job);
   const double sx = SampleStd(x.data(), n);
   const Eigen::VectorXd xn = x / sx;
-  const StageSettings settings{
-      xn, o.noise_strength, o.noise_scaling == NoiseScaling::kConstantSnr};
+  const StageSettings settings{xn, o.noise_strength, o.noise_scaling == NoiseScaling::kConstantSnr};
   auto workers = MakeWorkers(ensemble, job, n);
   std::vector<std::optional<NoiseRows>> noise(static_cast<size_t>(ensemble));
   DecompositionReport report = EnsembleReport(o.method, job, workers);
