@@ -121,7 +121,6 @@ std::string NoiseTerms::Summary() const {
   return s.str();
 }
 
-
 namespace {
 
 // Keeps points at least a factor sqrt(2) apart in tau (the first of each cluster): dense grids
