@@ -25,6 +25,26 @@ double Trigamma(double x) {
          x2 / x * (1.0 / 6.0 - x2 * (1.0 / 30.0 - x2 * (1.0 / 42.0 - x2 / 30.0)));
 }
 
+// Standardised residuals of the log fit at u = ln c of the active terms, into residual, and with
+// kJacobian their Jacobian d residual / d u; returns the cost. A template, not a flag, so that the
+// trial steps' evaluations compile without the Jacobian whatever the inliner decides.
+template <bool kJacobian>
+double EvaluateLog(const LogCurve& d, const std::vector<int>& active, const Eigen::VectorXd& u,
+                   Eigen::VectorXd& residual, Eigen::MatrixXd* jacobian) {
+  const Eigen::Index n = d.target.size();
+  const auto k = static_cast<Eigen::Index>(active.size());
+  const Eigen::VectorXd coef = u.array().exp();
+  for (Eigen::Index r = 0; r < n; ++r) {
+    double model = 0.0;
+    for (Eigen::Index c = 0; c < k; ++c) model += coef[c] * d.columns(r, active[c]);
+    residual[r] = (d.target[r] - std::log(model)) / d.sd[r];
+    if constexpr (kJacobian)
+      for (Eigen::Index c = 0; c < k; ++c)
+        (*jacobian)(r, c) = coef[c] * d.columns(r, active[c]) / model / d.sd[r];
+  }
+  return residual.squaredNorm();
+}
+
 // Levenberg-Marquardt on u_j = ln c_j (so every coefficient stays positive) for the terms in
 // `mask`, from `start`. A term whose optimum is zero drifts towards it (and is then removed by the
 // selection, where it changes nothing).
@@ -34,23 +54,10 @@ SubsetFit FitLog(const LogCurve& d, unsigned mask, const std::array<double, kTer
   const auto k = static_cast<Eigen::Index>(active.size());
   Eigen::VectorXd u(k);
   for (Eigen::Index c = 0; c < k; ++c) u[c] = std::log(start[static_cast<size_t>(active[c])]);
-  auto evaluate = [&](const Eigen::VectorXd& at, Eigen::VectorXd* residual,
-                      Eigen::MatrixXd* jacobian) {
-    const Eigen::VectorXd coef = at.array().exp();
-    for (Eigen::Index r = 0; r < n; ++r) {
-      double model = 0.0;
-      for (Eigen::Index c = 0; c < k; ++c) model += coef[c] * d.columns(r, active[c]);
-      (*residual)[r] = (d.target[r] - std::log(model)) / d.sd[r];
-      if (jacobian)
-        for (Eigen::Index c = 0; c < k; ++c)
-          (*jacobian)(r, c) = coef[c] * d.columns(r, active[c]) / model / d.sd[r];
-    }
-    return residual->squaredNorm();
-  };
   SubsetFit fit;
   Eigen::VectorXd residual(n), trial_residual(n);
   Eigen::MatrixXd jacobian(n, k);
-  double cost = evaluate(u, &residual, &jacobian);
+  double cost = EvaluateLog<true>(d, active, u, residual, &jacobian);
   if (!std::isfinite(cost)) return fit;
   double lambda = 1e-3;
   for (int iteration = 0; iteration < 200; ++iteration) {
@@ -58,12 +65,12 @@ SubsetFit FitLog(const LogCurve& d, unsigned mask, const std::array<double, kTer
     damped.diagonal() *= 1.0 + lambda;
     const Eigen::VectorXd step = damped.ldlt().solve(jacobian.transpose() * residual);
     const Eigen::VectorXd trial = u + step;
-    const double trial_cost = evaluate(trial, &trial_residual, nullptr);
+    const double trial_cost = EvaluateLog<false>(d, active, trial, trial_residual, nullptr);
     if (std::isfinite(trial_cost) && trial_cost <= cost) {
       const bool converged =
           cost - trial_cost <= 1e-14 * (1.0 + cost) && step.cwiseAbs().maxCoeff() < 1e-9;
       u = trial;
-      cost = evaluate(u, &residual, &jacobian);
+      cost = EvaluateLog<true>(d, active, u, residual, &jacobian);
       lambda = std::max(lambda / 10.0, 1e-12);
       if (converged) break;
     } else {
