@@ -431,14 +431,15 @@ void Sweep(std::vector<AlphaScan>& scans, Eigen::Index n, bool rate, Take&& take
   }
 }
 
-// PolyFit's sums over points [sc.next, to) of the scan's series of the phase x.
-void AddTrendSums(const double* x, bool rate, AlphaScan& sc, Eigen::Index to) {
+// PolyFit's sums over points [sc.next, to) of the scan's series of the phase x (kRate: rate data).
+template <bool kRate>
+void AddTrendSums(const double* x, AlphaScan& sc, Eigen::Index to) {
   const std::int64_t m = sc.m;
   const double inv_c = 1.0 / (0.5 * (static_cast<double>(sc.k) - 1.0));  // as PolyFit
   double s0 = sc.s0, s1 = sc.s1, s2 = sc.s2;
   for (Eigen::Index i = sc.next; i < to; ++i) {
     const double t = static_cast<double>(i) * inv_c - 1.0;
-    const double v = rate ? x[(i + 1) * m] - x[i * m] : x[i * m];
+    const double v = kRate ? x[(i + 1) * m] - x[i * m] : x[i * m];
     s0 += v;
     s1 += t * v;
     s2 += t * t * v;
@@ -448,13 +449,14 @@ void AddTrendSums(const double* x, bool rate, AlphaScan& sc, Eigen::Index to) {
 }
 
 // Lag1OfResidual's sums over points [sc.next, to) of the residual from the scan's trend sc.poly.
-void AddLagSums(const double* x, bool rate, AlphaScan& sc, Eigen::Index to) {
+template <bool kRate>
+void AddLagSums(const double* x, AlphaScan& sc, Eigen::Index to) {
   const std::int64_t m = sc.m;
   const Eigen::Vector3d& p = sc.poly;
   const double inv_c = 2.0 / static_cast<double>(sc.k - 1);  // as Lag1OfResidual
   auto r = [&](Eigen::Index i) {
     const double t = static_cast<double>(i) * inv_c - 1.0;
-    return (rate ? x[(i + 1) * m] - x[i * m] : x[i * m]) - (p[0] + t * (p[1] + t * p[2]));
+    return (kRate ? x[(i + 1) * m] - x[i * m] : x[i * m]) - (p[0] + t * (p[1] + t * p[2]));
   };
   Eigen::Index i = sc.next;
   if (i >= to) return;
@@ -498,13 +500,20 @@ std::vector<std::optional<int>> IdentifyAlphas(const Eigen::Ref<const Eigen::Vec
     scans.push_back({.m = ms[j], .k = k});
     index.push_back(j);
   }
-  Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddTrendSums(x, rate, sc, to); });
+  // The data type as a template argument: each sweep's loops compile for one type.
+  if (rate)
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddTrendSums<true>(x, sc, to); });
+  else
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddTrendSums<false>(x, sc, to); });
   for (AlphaScan& sc : scans) {
     sc.poly = PolyFromSums(sc.k, rate ? 1 : 2, sc.s0, sc.s1, sc.s2);
     sc.next = 0;
     sc.s1 = sc.s2 = 0.0;
   }
-  Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddLagSums(x, rate, sc, to); });
+  if (rate)
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddLagSums<true>(x, sc, to); });
+  else
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddLagSums<false>(x, sc, to); });
   for (size_t j = 0; j < scans.size(); ++j) {
     const AlphaScan& sc = scans[j];
     const double r1 = Lag1FromSums(sc.k, sc.s1, sc.s2, sc.lag, sc.first, sc.prev);
