@@ -10,6 +10,7 @@
 #include <sstream>
 #include <utility>
 
+#include "allan/allan_steps.h"
 #include "allan/kernels.h"
 #include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
@@ -52,13 +53,10 @@ constexpr EnumNames<TauGrid, 4> kGridNames{{
     {TauGrid::kList, "list"},
 }};
 
-// Angle (phase) samples the estimators work on, in rate unit x seconds, written into `x`
-// (n + 1 points for rate data, n for angle data). `x` may be the samples' own storage (grown by
-// one for rate data): every sample is read before its slot is written. The mean rate (or the
-// straight line through the end angles) is removed first: every estimator here is blind to a
-// constant rate, and without it the integrated angle of a biased gyro grows to values whose
-// rounding would swamp the short-tau differences.
-// `mean` is the samples' mean (rate data; unused for angle data).
+}  // namespace
+
+namespace internal {
+
 void InternalPhase(const double* data, Eigen::Index n, double mean, const AllanOptions& o,
                    double* x) {
   const double tau0 = o.tau0_s();
@@ -83,6 +81,48 @@ void InternalPhase(const double* data, Eigen::Index n, double mean, const AllanO
   }
 }
 
+Eigen::Index PhaseLength(Eigen::Index n, const AllanOptions& o) {
+  return o.data_type == DataType::kRate ? n + 1 : n;
+}
+
+int DifferenceOrder(Deviation d) {
+  return (d == Deviation::kHdev || d == Deviation::kOhdev) ? 3 : 2;
+}
+
+int FirstIdentified(const std::vector<std::optional<int>>& alpha) {
+  for (const std::optional<int>& a : alpha)
+    if (a) return *a;
+  return 0;
+}
+
+void SetInterval(const AllanOptions& options, const std::optional<int>& alpha,
+                 Eigen::Index edf_phase_points, int& carried, AllanPoint& p) {
+  if (!options.confidence_intervals) {
+    p.edf = p.dev_lo = p.dev_hi = std::numeric_limits<double>::quiet_NaN();
+    return;
+  }
+  if (options.forced_alpha) {
+    p.alpha = *options.forced_alpha;
+  } else if (alpha) {
+    p.alpha = carried = *alpha;
+    p.alpha_identified = true;
+  } else {
+    p.alpha = carried;
+  }
+  p.edf = EquivalentDof(options.deviation, p.alpha, p.m, edf_phase_points);
+  ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
+}
+
+}  // namespace internal
+
+namespace {
+
+using internal::DifferenceOrder;
+using internal::FirstIdentified;
+using internal::InternalPhase;
+using internal::PhaseLength;
+using internal::SetInterval;
+
 // Storage of the phase of a record handed by reference. Not zero-filled, and on Linux in 2 MiB
 // pages when large: faulting in 4 KiB pages cost about 5 ns a sample here (more than the
 // integration), 2 MiB pages about 1 ns, and the strided sweeps miss the TLB less.
@@ -106,10 +146,6 @@ std::unique_ptr<double[], FreeDeleter> PhaseStorage(Eigen::Index n) {
   return std::unique_ptr<double[], FreeDeleter>(p);
 }
 
-Eigen::Index PhaseLength(Eigen::Index n, const AllanOptions& o) {
-  return o.data_type == DataType::kRate ? n + 1 : n;
-}
-
 void CheckComputeInput(const Eigen::VectorXd& data, const AllanOptions& options,
                        const Execution& execution) {
   options.Validate();
@@ -119,10 +155,6 @@ void CheckComputeInput(const Eigen::VectorXd& data, const AllanOptions& options,
 
 AllanResult ComputeOnPhase(const double* x, Eigen::Index n_samples, const AllanOptions& options,
                            const Execution& execution);
-
-int DifferenceOrder(Deviation d) {
-  return (d == Deviation::kHdev || d == Deviation::kOhdev) ? 3 : 2;
-}
 
 }  // namespace
 
@@ -305,6 +337,67 @@ AllanResult Compute(Eigen::VectorXd&& data, const AllanOptions& options,
 
 namespace {
 
+// Task boundaries over the factors (indices into ms, ending with ms.size()): OADEV's factors in
+// contiguous runs of about equal work, one sweep each (a run per worker, two when several share
+// the work, so the noise identification's worker can take the last), or one factor per task for
+// the other estimators.
+std::vector<int> TaskBoundaries(Deviation dev, const std::vector<std::int64_t>& ms, std::int64_t n,
+                                int workers) {
+  const int count = static_cast<int>(ms.size());
+  std::vector<int> task_begin;
+  if (dev == Deviation::kOadev) {
+    const int runs = std::min(count, workers == 1 ? 1 : 2 * workers);
+    double total = 0.0;
+    for (std::int64_t m : ms) total += static_cast<double>(n - 2 * m);
+    double done = 0.0;
+    for (int k = 0; k < count; ++k) {
+      if (done >= total * static_cast<double>(task_begin.size()) / runs) task_begin.push_back(k);
+      done += static_cast<double>(n - 2 * ms[static_cast<size_t>(k)]);
+    }
+  } else {
+    for (int k = 0; k < count; ++k) task_begin.push_back(k);
+  }
+  task_begin.push_back(count);
+  return task_begin;
+}
+
+// The variances of factors ms[begin, end) of the phase x (n points) into variance[begin, end).
+// `extended`: ExtendForTotdev's series for TOTDEV, else unused.
+void EstimateVariances(Deviation dev, const double* x, std::int64_t n,
+                       const std::vector<std::int64_t>& ms, int begin, int end, double tau0,
+                       const std::vector<double>& extended, std::vector<double>& variance) {
+  if (dev == Deviation::kOadev) {
+    internal::OverlappingSecondDifferenceSums(x, n, ms.data() + begin, end - begin,
+                                              variance.data() + begin);
+  }
+  for (int k = begin; k < end; ++k) {
+    const std::int64_t m = ms[static_cast<size_t>(k)];
+    const double tau = static_cast<double>(m) * tau0;
+    double& v = variance[static_cast<size_t>(k)];
+    switch (dev) {
+      case Deviation::kOadev:
+        v /= 2.0 * static_cast<double>(n - 2 * m) * tau * tau;
+        break;
+      case Deviation::kAdev:
+        v = internal::AdevVariance(x, n, m, tau);
+        break;
+      case Deviation::kMdev:
+      case Deviation::kTdev:
+        v = internal::MdevVariance(x, n, m, tau);
+        break;
+      case Deviation::kHdev:
+        v = internal::HdevVariance(x, n, m, tau);
+        break;
+      case Deviation::kOhdev:
+        v = internal::OhdevVariance(x, n, m, tau);
+        break;
+      case Deviation::kTotdev:
+        v = internal::TotdevVariance(extended, n, m, tau);
+        break;
+    }
+  }
+}
+
 // Compute on the phase x (PhaseLength(n_samples) points) of n_samples checked samples.
 AllanResult ComputeOnPhase(const double* x, Eigen::Index n_samples, const AllanOptions& options,
                            const Execution& execution) {
@@ -321,246 +414,41 @@ AllanResult ComputeOnPhase(const double* x, Eigen::Index n_samples, const AllanO
                     " angle points (" + std::to_string(n) + " given)");
   }
   const double tau0 = options.tau0_s();
-  const int count = static_cast<int>(ms.size());
   std::vector<double> variance(ms.size());
   std::vector<std::optional<int>> alpha(ms.size());
   const std::vector<double> extended =
       dev == Deviation::kTotdev ? internal::ExtendForTotdev(x, n) : std::vector<double>{};
 
   // Tasks, handed out in order: the noise identification of every factor (two sweeps over the
-  // phase, IdentifyAlphas), then OADEV's factors in contiguous runs of about equal work, one sweep
-  // each (a run per worker, two when several share the work, so the identification's worker can
-  // take the last), or one factor per task for the other estimators.
-  const int dmax = DifferenceOrder(dev);
+  // phase, IdentifyAlphas), then the estimators' (TaskBoundaries).
   const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
-  const int workers = ResolveThreads(execution.threads);
-  std::vector<int> task_begin;
-  if (dev == Deviation::kOadev) {
-    const int runs = std::min(count, workers == 1 ? 1 : 2 * workers);
-    double total = 0.0;
-    for (std::int64_t m : ms) total += static_cast<double>(n - 2 * m);
-    double done = 0.0;
-    for (int k = 0; k < count; ++k) {
-      if (done >= total * static_cast<double>(task_begin.size()) / runs) task_begin.push_back(k);
-      done += static_cast<double>(n - 2 * ms[static_cast<size_t>(k)]);
-    }
-  } else {
-    for (int k = 0; k < count; ++k) task_begin.push_back(k);
-  }
-  task_begin.push_back(count);
+  const std::vector<int> task_begin = TaskBoundaries(dev, ms, n, ResolveThreads(execution.threads));
   const int first_run = want_alpha ? 1 : 0;
   const int tasks = first_run + static_cast<int>(task_begin.size()) - 1;
   ParallelFor(tasks, execution.threads, [&](int task, int) {
     if (task < first_run) {
       const Eigen::Map<const Eigen::VectorXd> xm(x, n);
-      alpha = internal::IdentifyAlphas(xm, ms, options.data_type, dmax);
+      alpha = internal::IdentifyAlphas(xm, ms, options.data_type, DifferenceOrder(dev));
       return;
     }
-    const int begin = task_begin[static_cast<size_t>(task - first_run)];
-    const int end = task_begin[static_cast<size_t>(task - first_run) + 1];
-    if (dev == Deviation::kOadev) {
-      internal::OverlappingSecondDifferenceSums(x, n, ms.data() + begin, end - begin,
-                                                variance.data() + begin);
-    }
-    for (int k = begin; k < end; ++k) {
-      const std::int64_t m = ms[static_cast<size_t>(k)];
-      const double tau = static_cast<double>(m) * tau0;
-      double& v = variance[static_cast<size_t>(k)];
-      switch (dev) {
-        case Deviation::kOadev:
-          v /= 2.0 * static_cast<double>(n - 2 * m) * tau * tau;
-          break;
-        case Deviation::kAdev:
-          v = internal::AdevVariance(x, n, m, tau);
-          break;
-        case Deviation::kMdev:
-        case Deviation::kTdev:
-          v = internal::MdevVariance(x, n, m, tau);
-          break;
-        case Deviation::kHdev:
-          v = internal::HdevVariance(x, n, m, tau);
-          break;
-        case Deviation::kOhdev:
-          v = internal::OhdevVariance(x, n, m, tau);
-          break;
-        case Deviation::kTotdev:
-          v = internal::TotdevVariance(extended, n, m, tau);
-          break;
-      }
-    }
+    const size_t run = static_cast<size_t>(task - first_run);
+    EstimateVariances(dev, x, n, ms, task_begin[run], task_begin[run + 1], tau0, extended,
+                      variance);
   });
 
-  // Noise type where fewer than 30 points remain: carry the last identified one forward (the
-  // curve's noise type changes slowly with tau); before any identification, white rate noise.
-  int carried = 0;
-  for (int k = 0; k < count; ++k) {
-    if (alpha[static_cast<size_t>(k)]) {
-      carried = *alpha[static_cast<size_t>(k)];
-      break;
-    }
-  }
+  int carried = FirstIdentified(alpha);
   result.points.resize(ms.size());
-  for (int k = 0; k < count; ++k) {
-    AllanPoint& p = result.points[static_cast<size_t>(k)];
-    const std::int64_t m = ms[static_cast<size_t>(k)];
-    p.m = m;
-    p.tau_s = static_cast<double>(m) * tau0;
-    p.dev = std::sqrt(std::max(0.0, variance[static_cast<size_t>(k)]));
-    if (dev == Deviation::kTdev) p.dev *= p.tau_s / std::sqrt(3.0);
-    p.n_terms = TermCount(dev, n, m);
-    if (!options.confidence_intervals) {
-      p.edf = p.dev_lo = p.dev_hi = std::numeric_limits<double>::quiet_NaN();
-      continue;
-    }
-    if (options.forced_alpha) {
-      p.alpha = *options.forced_alpha;
-    } else if (alpha[static_cast<size_t>(k)]) {
-      p.alpha = carried = *alpha[static_cast<size_t>(k)];
-      p.alpha_identified = true;
-    } else {
-      p.alpha = carried;
-    }
-    p.edf = EquivalentDof(dev, p.alpha, m, n);
-    ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
-  }
-  return result;
-}
-
-// First sample and length of the longest run of logged samples.
-std::pair<Eigen::Index, Eigen::Index> LongestLoggedRun(const std::vector<bool>& logged) {
-  Eigen::Index best_begin = 0, best = 0, begin = 0;
-  for (Eigen::Index i = 0; i <= static_cast<Eigen::Index>(logged.size()); ++i) {
-    if (i < static_cast<Eigen::Index>(logged.size()) && logged[static_cast<size_t>(i)]) continue;
-    if (i - begin > best) {
-      best = i - begin;
-      best_begin = begin;
-    }
-    begin = i + 1;
-  }
-  return {best_begin, best};
-}
-
-}  // namespace
-
-AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>& logged,
-                            const AllanOptions& options, const Execution& execution) {
-  options.Validate();
-  execution.Validate();
-  const Deviation dev = options.deviation;
-  if (dev != Deviation::kOadev && dev != Deviation::kOhdev) {
-    ThrowOption("deviation", ToString(dev),
-                "oadev or ohdev for a record with gaps (the overlapping estimators skip the "
-                "cluster pairs that hold a made-up sample)");
-  }
-  if (options.data_type != DataType::kRate) {
-    ThrowOption("data_type", ToString(options.data_type),
-                "rate for a record with gaps (a made-up rate sample spoils the spans over it)");
-  }
-  if (static_cast<Eigen::Index>(logged.size()) != data.size()) {
-    throw DataError("the mask of logged samples has " + std::to_string(logged.size()) +
-                    " flags for " + std::to_string(data.size()) + " samples: they must match");
-  }
-  Eigen::VectorXd kept(data.size());
-  Eigen::Index count = 0;
-  for (Eigen::Index i = 0; i < data.size(); ++i) {
-    if (logged[static_cast<size_t>(i)]) kept[count++] = data[i];
-  }
-  RequireFiniteSignal("input (logged samples)", kept.head(count), 2);
-  // The missing values are never used: they become the logged mean, which adds nothing to the
-  // phase, so a NaN gap is as good as a filled one.
-  const double mean = kept.head(count).mean();
-  Eigen::VectorXd y = data;
-  for (Eigen::Index i = 0; i < y.size(); ++i) {
-    if (!logged[static_cast<size_t>(i)]) y[i] = mean;
-  }
-  std::vector<double> x(static_cast<size_t>(PhaseLength(y.size(), options)));
-  InternalPhase(y.data(), y.size(), y.mean(), options, x.data());
-  const std::int64_t n = static_cast<std::int64_t>(x.size());
-  // made_up[k]: made-up samples among the first k; the span of phase points i..i+d*m is clean
-  // when made_up[i + d*m] == made_up[i].
-  std::vector<std::int64_t> made_up(static_cast<size_t>(n), 0);
-  for (std::int64_t k = 1; k < n; ++k) {
-    made_up[static_cast<size_t>(k)] =
-        made_up[static_cast<size_t>(k - 1)] + (logged[static_cast<size_t>(k - 1)] ? 0 : 1);
-  }
-  const int order = DifferenceOrder(dev);
-  const std::vector<std::int64_t> ms = AveragingFactors(options, n);
-  const double tau0 = options.tau0_s();
-  std::vector<double> variance(ms.size(), 0.0);
-  std::vector<std::int64_t> terms(ms.size(), 0);
-  ParallelFor(static_cast<int>(ms.size()), execution.threads, [&](int k, int) {
-    const std::int64_t m = ms[static_cast<size_t>(k)];
-    double acc = 0.0;
-    std::int64_t used = 0;
-    const double* p = x.data();
-    for (std::int64_t i = 0; i + order * m < n; ++i) {
-      if (made_up[static_cast<size_t>(i + order * m)] != made_up[static_cast<size_t>(i)]) continue;
-      const double d = order == 2 ? p[i + 2 * m] - 2.0 * p[i + m] + p[i]
-                                  : p[i + 3 * m] - 3.0 * p[i + 2 * m] + 3.0 * p[i + m] - p[i];
-      acc += d * d;
-      ++used;
-    }
-    const double tau = static_cast<double>(m) * tau0;
-    terms[static_cast<size_t>(k)] = used;
-    if (used > 0) variance[static_cast<size_t>(k)] = acc / ((order == 2 ? 2.0 : 6.0) *
-                                                            static_cast<double>(used) * tau * tau);
-  });
-  const auto [run_begin, run_length] = LongestLoggedRun(logged);
-  AllanResult result;
-  result.options = options;
-  result.n_samples = data.size();
-  result.n_phase = n;
-  const bool want_alpha = options.confidence_intervals && !options.forced_alpha;
-  const Eigen::Map<const Eigen::VectorXd> run_phase(x.data() + run_begin, run_length + 1);
-  std::vector<std::optional<int>> alpha(ms.size());
-  int carried = 0;  // as Compute: the first identified type stands in before it
-  bool found = false;
-  for (size_t k = 0; k < ms.size() && want_alpha; ++k) {
-    if (terms[k] == 0) continue;
-    alpha[k] = IdentifyAlpha(run_phase, ms[k], options.data_type, order);
-    if (alpha[k] && !found) {
-      carried = *alpha[k];
-      found = true;
-    }
-  }
   for (size_t k = 0; k < ms.size(); ++k) {
-    if (terms[k] == 0) {
-      if (options.grid == TauGrid::kList) {
-        throw DataError("tau " + FormatValue(static_cast<double>(ms[k]) * tau0) +
-                        " s has no cluster pair of logged samples: " + ToString(dev) + " needs " +
-                        std::to_string(order * ms[k]) + " logged samples in a row, the longest "
-                        "run is " + std::to_string(run_length));
-      }
-      continue;
-    }
-    AllanPoint p;
+    AllanPoint& p = result.points[k];
     p.m = ms[k];
     p.tau_s = static_cast<double>(p.m) * tau0;
     p.dev = std::sqrt(std::max(0.0, variance[k]));
-    p.n_terms = terms[k];
-    if (!options.confidence_intervals) {
-      p.edf = p.dev_lo = p.dev_hi = std::numeric_limits<double>::quiet_NaN();
-      result.points.push_back(p);
-      continue;
-    }
-    if (options.forced_alpha) {
-      p.alpha = *options.forced_alpha;
-    } else if (alpha[k]) {
-      p.alpha = carried = *alpha[k];
-      p.alpha_identified = true;
-    } else {
-      p.alpha = carried;
-    }
-    p.edf = EquivalentDof(dev, p.alpha, p.m, static_cast<Eigen::Index>(p.n_terms + order * p.m));
-    ConfidenceInterval(p.dev, p.edf, options.confidence, &p.dev_lo, &p.dev_hi);
-    result.points.push_back(p);
-  }
-  if (result.points.empty()) {
-    throw DataError(ToString(dev) + " of a record with gaps: no tau has a cluster pair of logged "
-                    "samples (" + std::to_string(order) + " logged samples in a row needed at the "
-                    "shortest tau, the longest run is " + std::to_string(run_length) + ")");
+    if (dev == Deviation::kTdev) p.dev *= p.tau_s / std::sqrt(3.0);
+    p.n_terms = TermCount(dev, n, p.m);
+    SetInterval(options, alpha[k], n, carried, p);
   }
   return result;
 }
 
+}  // namespace
 }  // namespace gyrodrift::allan

@@ -407,6 +407,78 @@ std::optional<int> IdentifyAlpha(const Eigen::Ref<const Eigen::VectorXd>& phase,
 }
 
 namespace internal {
+namespace {
+
+// One factor's state in IdentifyAlphas' sweeps: its next point and its running sums.
+struct AlphaScan {
+  std::int64_t m;
+  Eigen::Index k;  // points
+  Eigen::Index next = 0;
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // PolyFit's sums, then Lag1OfResidual's
+  double lag = 0.0, first = 0.0, prev = 0.0;
+  Eigen::Vector3d poly = Eigen::Vector3d::Zero();
+};
+
+// Calls take(scan, to) for every scan after each chunk of the phase (n points), `to` being the
+// number of the scan's points whose last phase index, (i + 1) m (rate) or i m (angle), lies in
+// the chunks so far.
+template <class Take>
+void Sweep(std::vector<AlphaScan>& scans, Eigen::Index n, bool rate, Take&& take) {
+  for (Eigen::Index end = std::min(n, kScanChunk);; end = std::min(n, end + kScanChunk)) {
+    for (AlphaScan& sc : scans)
+      take(sc, std::min<Eigen::Index>(sc.k, (end - 1) / sc.m + (rate ? 0 : 1)));
+    if (end == n) break;
+  }
+}
+
+// PolyFit's sums over points [sc.next, to) of the scan's series of the phase x (kRate: rate data).
+template <bool kRate>
+void AddTrendSums(const double* x, AlphaScan& sc, Eigen::Index to) {
+  const std::int64_t m = sc.m;
+  const double inv_c = 1.0 / (0.5 * (static_cast<double>(sc.k) - 1.0));  // as PolyFit
+  double s0 = sc.s0, s1 = sc.s1, s2 = sc.s2;
+  for (Eigen::Index i = sc.next; i < to; ++i) {
+    const double t = static_cast<double>(i) * inv_c - 1.0;
+    const double v = kRate ? x[(i + 1) * m] - x[i * m] : x[i * m];
+    s0 += v;
+    s1 += t * v;
+    s2 += t * t * v;
+  }
+  sc.s0 = s0, sc.s1 = s1, sc.s2 = s2;
+  sc.next = to;
+}
+
+// Lag1OfResidual's sums over points [sc.next, to) of the residual from the scan's trend sc.poly.
+template <bool kRate>
+void AddLagSums(const double* x, AlphaScan& sc, Eigen::Index to) {
+  const std::int64_t m = sc.m;
+  const Eigen::Vector3d& p = sc.poly;
+  const double inv_c = 2.0 / static_cast<double>(sc.k - 1);  // as Lag1OfResidual
+  auto r = [&](Eigen::Index i) {
+    const double t = static_cast<double>(i) * inv_c - 1.0;
+    return (kRate ? x[(i + 1) * m] - x[i * m] : x[i * m]) - (p[0] + t * (p[1] + t * p[2]));
+  };
+  Eigen::Index i = sc.next;
+  if (i >= to) return;
+  double s1 = sc.s1, s2 = sc.s2, lag = sc.lag, prev = sc.prev;
+  if (i == 0) {
+    prev = sc.first = r(0);
+    s1 += prev;
+    s2 += prev * prev;
+    ++i;
+  }
+  for (; i < to; ++i) {
+    const double v = r(i);
+    s1 += v;
+    s2 += v * v;
+    lag += prev * v;
+    prev = v;
+  }
+  sc.s1 = s1, sc.s2 = s2, sc.lag = lag, sc.prev = prev;
+  sc.next = to;
+}
+
+}  // namespace
 
 std::vector<std::optional<int>> IdentifyAlphas(const Eigen::Ref<const Eigen::VectorXd>& phase,
                                                const std::vector<std::int64_t>& ms, DataType type,
@@ -419,16 +491,8 @@ std::vector<std::optional<int>> IdentifyAlphas(const Eigen::Ref<const Eigen::Vec
   const Eigen::Index n = phase.size();
   const bool rate = type == DataType::kRate;
   const double* x = phase.data();
-  struct Scan {
-    std::int64_t m;
-    Eigen::Index k;
-    Eigen::Index next = 0;
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // PolyFit's sums, then Lag1OfResidual's
-    double lag = 0.0, first = 0.0, prev = 0.0;
-    Eigen::Vector3d poly = Eigen::Vector3d::Zero();
-  };
   std::vector<std::optional<int>> alpha(ms.size());
-  std::vector<Scan> scans;
+  std::vector<AlphaScan> scans;
   std::vector<size_t> index;  // scans[j] is factor ms[index[j]]
   for (size_t j = 0; j < ms.size(); ++j) {
     const Eigen::Index k = rate ? (n - 1) / ms[j] : (n - 1) / ms[j] + 1;
@@ -436,64 +500,22 @@ std::vector<std::optional<int>> IdentifyAlphas(const Eigen::Ref<const Eigen::Vec
     scans.push_back({.m = ms[j], .k = k});
     index.push_back(j);
   }
-  // Points i of a scan whose last phase index, (i + 1) m (rate) or i m (angle), is below `end`.
-  auto stop = [&](const Scan& sc, Eigen::Index end) {
-    return std::min<Eigen::Index>(sc.k, (end - 1) / sc.m + (rate ? 0 : 1));
-  };
-  auto sweep = [&](auto&& take) {
-    for (Eigen::Index end = std::min(n, kScanChunk);; end = std::min(n, end + kScanChunk)) {
-      for (Scan& sc : scans) take(sc, stop(sc, end));
-      if (end == n) break;
-    }
-  };
-  sweep([&](Scan& sc, Eigen::Index to) {
-    const std::int64_t m = sc.m;
-    const double inv_c = 1.0 / (0.5 * (static_cast<double>(sc.k) - 1.0));  // as PolyFit
-    double s0 = sc.s0, s1 = sc.s1, s2 = sc.s2;
-    for (Eigen::Index i = sc.next; i < to; ++i) {
-      const double t = static_cast<double>(i) * inv_c - 1.0;
-      const double v = rate ? x[(i + 1) * m] - x[i * m] : x[i * m];
-      s0 += v;
-      s1 += t * v;
-      s2 += t * t * v;
-    }
-    sc.s0 = s0, sc.s1 = s1, sc.s2 = s2;
-    sc.next = to;
-  });
-  for (Scan& sc : scans) {
+  // The data type as a template argument: each sweep's loops compile for one type.
+  if (rate)
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddTrendSums<true>(x, sc, to); });
+  else
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddTrendSums<false>(x, sc, to); });
+  for (AlphaScan& sc : scans) {
     sc.poly = PolyFromSums(sc.k, rate ? 1 : 2, sc.s0, sc.s1, sc.s2);
     sc.next = 0;
     sc.s1 = sc.s2 = 0.0;
   }
-  sweep([&](Scan& sc, Eigen::Index to) {
-    const std::int64_t m = sc.m;
-    const Eigen::Vector3d& p = sc.poly;
-    const double inv_c = 2.0 / static_cast<double>(sc.k - 1);  // as Lag1OfResidual
-    auto r = [&](Eigen::Index i) {
-      const double t = static_cast<double>(i) * inv_c - 1.0;
-      return (rate ? x[(i + 1) * m] - x[i * m] : x[i * m]) - (p[0] + t * (p[1] + t * p[2]));
-    };
-    Eigen::Index i = sc.next;
-    if (i >= to) return;
-    double s1 = sc.s1, s2 = sc.s2, lag = sc.lag, prev = sc.prev;
-    if (i == 0) {
-      prev = sc.first = r(0);
-      s1 += prev;
-      s2 += prev * prev;
-      ++i;
-    }
-    for (; i < to; ++i) {
-      const double v = r(i);
-      s1 += v;
-      s2 += v * v;
-      lag += prev * v;
-      prev = v;
-    }
-    sc.s1 = s1, sc.s2 = s2, sc.lag = lag, sc.prev = prev;
-    sc.next = to;
-  });
+  if (rate)
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddLagSums<true>(x, sc, to); });
+  else
+    Sweep(scans, n, rate, [&](AlphaScan& sc, Eigen::Index to) { AddLagSums<false>(x, sc, to); });
   for (size_t j = 0; j < scans.size(); ++j) {
-    const Scan& sc = scans[j];
+    const AlphaScan& sc = scans[j];
     const double r1 = Lag1FromSums(sc.k, sc.s1, sc.s2, sc.lag, sc.first, sc.prev);
     const double rho = r1 / (1.0 + r1);
     // Strongly correlated: the differencing stages, rare at most factors of a gyro's curve.

@@ -80,6 +80,180 @@ int CountZeroCrossings(const double* x, Eigen::Index n) {
   return static_cast<int>(zeros ? changes + ZeroRuns(x, n) : changes);
 }
 
+// Index lists are short (<= nbsym + 1); fliplr(ind(from:to)) in 0-based half-open form.
+struct NodeList {
+  int v[kNbSym + 2] = {};
+  int size = 0;
+  void Clear() { size = 0; }
+  void Push(int i) { v[size++] = i; }
+  void PushReversed(const int* ind, int from, int to) {
+    for (int k = to - 1; k >= from; --k) Push(ind[k]);
+  }
+};
+
+// The extrema of a sift (FindExtrema): 0-based indices in increasing order.
+struct ExtremaIndices {
+  const int* imin;
+  int nmin;
+  const int* imax;
+  int nmax;
+};
+
+// The extrema mirrored at one end of the signal, and the sample they are mirrored about.
+struct EndNodes {
+  NodeList min, max;
+  int sym;
+};
+
+// Times are t = index + 1; a node mirrored about sample s sits at 2 t(s) - t(node).
+double Mirrored(int sym, int node) { return 2.0 * (sym + 1) - (node + 1); }
+
+// emd.m's nbsym extrema at the start, mirrored about the first extremum or the first sample.
+// e has at least one extremum of each kind.
+EndNodes LeftEnd(const double* h, const ExtremaIndices& e) {
+  const int *imin = e.imin, *imax = e.imax;
+  const int nmin = e.nmin, nmax = e.nmax;
+  EndNodes l;
+  if (imax[0] < imin[0]) {
+    if (h[0] > h[imin[0]]) {
+      l.max.PushReversed(imax, 1, std::min(nmax, kNbSym + 1));
+      l.min.PushReversed(imin, 0, std::min(nmin, kNbSym));
+      l.sym = imax[0];
+    } else {
+      l.max.PushReversed(imax, 0, std::min(nmax, kNbSym));
+      l.min.PushReversed(imin, 0, std::min(nmin, kNbSym - 1));
+      l.min.Push(0);
+      l.sym = 0;
+    }
+  } else {
+    if (h[0] < h[imax[0]]) {
+      l.max.PushReversed(imax, 0, std::min(nmax, kNbSym));
+      l.min.PushReversed(imin, 1, std::min(nmin, kNbSym + 1));
+      l.sym = imin[0];
+    } else {
+      l.max.PushReversed(imax, 0, std::min(nmax, kNbSym - 1));
+      l.max.Push(0);
+      l.min.PushReversed(imin, 0, std::min(nmin, kNbSym));
+      l.sym = 0;
+    }
+  }
+  return l;
+}
+
+// The same at the end, sample `last`.
+EndNodes RightEnd(const double* h, const ExtremaIndices& e, int last) {
+  const int *imin = e.imin, *imax = e.imax;
+  const int nmin = e.nmin, nmax = e.nmax;
+  EndNodes r;
+  if (imax[nmax - 1] < imin[nmin - 1]) {
+    if (h[last] < h[imax[nmax - 1]]) {
+      r.max.PushReversed(imax, std::max(nmax - kNbSym, 0), nmax);
+      r.min.PushReversed(imin, std::max(nmin - kNbSym - 1, 0), nmin - 1);
+      r.sym = imin[nmin - 1];
+    } else {
+      r.max.Push(last);
+      r.max.PushReversed(imax, std::max(nmax - kNbSym + 1, 0), nmax);
+      r.min.PushReversed(imin, std::max(nmin - kNbSym, 0), nmin);
+      r.sym = last;
+    }
+  } else {
+    if (h[last] > h[imin[nmin - 1]]) {
+      r.max.PushReversed(imax, std::max(nmax - kNbSym - 1, 0), nmax - 1);
+      r.min.PushReversed(imin, std::max(nmin - kNbSym, 0), nmin);
+      r.sym = imax[nmax - 1];
+    } else {
+      r.max.PushReversed(imax, std::max(nmax - kNbSym, 0), nmax);
+      r.min.Push(last);
+      r.min.PushReversed(imin, std::max(nmin - kNbSym + 1, 0), nmin);
+      r.sym = last;
+    }
+  }
+  return r;
+}
+
+// emd.m: "in case symmetrized parts do not extend enough": where the mirrored nodes do not reach
+// back to the first sample, mirror about the first sample instead. Indexing an empty list there is
+// an error in MATLAB (caught as "stop sifting"), hence the returns of false.
+bool CoverLeft(const ExtremaIndices& e, EndNodes& l) {
+  constexpr double kTFirst = 1.0;
+  if (l.min.size == 0) return false;
+  bool short_of_end = Mirrored(l.sym, l.min.v[0]) > kTFirst;
+  if (!short_of_end) {
+    if (l.max.size == 0) return false;
+    short_of_end = Mirrored(l.sym, l.max.v[0]) > kTFirst;
+  }
+  if (!short_of_end) return true;
+  if (l.sym == e.imax[0]) {
+    l.max.Clear();
+    l.max.PushReversed(e.imax, 0, std::min(e.nmax, kNbSym));
+  } else {
+    l.min.Clear();
+    l.min.PushReversed(e.imin, 0, std::min(e.nmin, kNbSym));
+  }
+  if (l.sym == 0) return false;
+  l.sym = 0;
+  return true;
+}
+
+// The same at the end, sample `last` (time last + 1).
+bool CoverRight(const ExtremaIndices& e, int last, EndNodes& r) {
+  const double t_last = static_cast<double>(last + 1);
+  if (r.min.size == 0) return false;
+  bool short_of_end = Mirrored(r.sym, r.min.v[r.min.size - 1]) < t_last;
+  if (!short_of_end) {
+    if (r.max.size == 0) return false;
+    short_of_end = Mirrored(r.sym, r.max.v[r.max.size - 1]) < t_last;
+  }
+  if (!short_of_end) return true;
+  if (r.sym == e.imax[e.nmax - 1]) {
+    r.max.Clear();
+    r.max.PushReversed(e.imax, std::max(e.nmax - kNbSym, 0), e.nmax);
+  } else {
+    r.min.Clear();
+    r.min.PushReversed(e.imin, std::max(e.nmin - kNbSym, 0), e.nmin);
+  }
+  if (r.sym == last) return false;
+  r.sym = last;
+  return true;
+}
+
+// One envelope's nodes (t, z): the left mirrored nodes, the interior extrema, the right mirrored
+// nodes. False where interp1 would refuse them (fewer than 2, or not increasing).
+bool AssembleNodes(const double* h, const NodeList& left, int lsym, const int* interior, int count,
+                   const NodeList& right, int rsym, std::vector<double>& t,
+                   std::vector<double>& z) {
+  const size_t total = static_cast<size_t>(left.size + count + right.size);
+  assert(total <= t.capacity() && total <= z.capacity());  // the sift loop allocates nothing
+  t.resize(total);  // within the reserved capacity: no allocation
+  z.resize(total);
+  size_t k = 0;
+  for (int j = 0; j < left.size; ++j, ++k) {
+    t[k] = Mirrored(lsym, left.v[j]);
+    z[k] = h[left.v[j]];
+  }
+  double* tk = t.data() + k;
+  double* zk = z.data() + k;
+  for (int j = 0; j < count; ++j) {
+    tk[j] = interior[j] + 1.0;
+    zk[j] = h[interior[j]];
+  }
+  k += static_cast<size_t>(count);
+  for (int j = 0; j < right.size; ++j, ++k) {
+    t[k] = Mirrored(rsym, right.v[j]);
+    z[k] = h[right.v[j]];
+  }
+  if (total < 2) return false;
+  // interp1 needs distinct increasing nodes; the interior ones are, by construction.
+  const size_t edge = static_cast<size_t>(left.size);
+  for (size_t j = 1; j <= edge && j < total; ++j) {
+    if (!(t[j] > t[j - 1])) return false;
+  }
+  for (size_t j = total - static_cast<size_t>(right.size); j < total; ++j) {
+    if (j > 0 && !(t[j] > t[j - 1])) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 ExtremaCounts CountExtrema(const double* x, Eigen::Index n) {
@@ -186,148 +360,15 @@ ExtremaCounts Sifter::FindExtrema(const double* h, bool count_zero_crossings) {
 
 bool Sifter::BoundaryConditions(const double* h) {
   // Counts are the current FindExtrema result, stored by the caller in nmin_/nmax_.
-  const int nmin = nmin_, nmax = nmax_;
-  if (nmin + nmax < 3 || nmin == 0 || nmax == 0) return false;
-  const int* imin = indmin_.data();
-  const int* imax = indmax_.data();
+  const ExtremaIndices e{indmin_.data(), nmin_, indmax_.data(), nmax_};
+  if (e.nmin + e.nmax < 3 || e.nmin == 0 || e.nmax == 0) return false;
   const int last = static_cast<int>(n_) - 1;
-
-  // Index lists are short (<= nbsym + 1); fliplr(ind(from:to)) in 0-based half-open form.
-  struct List {
-    int v[kNbSym + 2];
-    int size = 0;
-    void Clear() { size = 0; }
-    void Push(int i) { v[size++] = i; }
-    void PushReversed(const int* ind, int from, int to) {
-      for (int k = to - 1; k >= from; --k) Push(ind[k]);
-    }
-  };
-  List lmin, lmax, rmin, rmax;
-  int lsym, rsym;
-
-  if (imax[0] < imin[0]) {
-    if (h[0] > h[imin[0]]) {
-      lmax.PushReversed(imax, 1, std::min(nmax, kNbSym + 1));
-      lmin.PushReversed(imin, 0, std::min(nmin, kNbSym));
-      lsym = imax[0];
-    } else {
-      lmax.PushReversed(imax, 0, std::min(nmax, kNbSym));
-      lmin.PushReversed(imin, 0, std::min(nmin, kNbSym - 1));
-      lmin.Push(0);
-      lsym = 0;
-    }
-  } else {
-    if (h[0] < h[imax[0]]) {
-      lmax.PushReversed(imax, 0, std::min(nmax, kNbSym));
-      lmin.PushReversed(imin, 1, std::min(nmin, kNbSym + 1));
-      lsym = imin[0];
-    } else {
-      lmax.PushReversed(imax, 0, std::min(nmax, kNbSym - 1));
-      lmax.Push(0);
-      lmin.PushReversed(imin, 0, std::min(nmin, kNbSym));
-      lsym = 0;
-    }
-  }
-  if (imax[nmax - 1] < imin[nmin - 1]) {
-    if (h[last] < h[imax[nmax - 1]]) {
-      rmax.PushReversed(imax, std::max(nmax - kNbSym, 0), nmax);
-      rmin.PushReversed(imin, std::max(nmin - kNbSym - 1, 0), nmin - 1);
-      rsym = imin[nmin - 1];
-    } else {
-      rmax.Push(last);
-      rmax.PushReversed(imax, std::max(nmax - kNbSym + 1, 0), nmax);
-      rmin.PushReversed(imin, std::max(nmin - kNbSym, 0), nmin);
-      rsym = last;
-    }
-  } else {
-    if (h[last] > h[imin[nmin - 1]]) {
-      rmax.PushReversed(imax, std::max(nmax - kNbSym - 1, 0), nmax - 1);
-      rmin.PushReversed(imin, std::max(nmin - kNbSym, 0), nmin);
-      rsym = imax[nmax - 1];
-    } else {
-      rmax.PushReversed(imax, std::max(nmax - kNbSym, 0), nmax);
-      rmin.Push(last);
-      rmin.PushReversed(imin, std::max(nmin - kNbSym + 1, 0), nmin);
-      rsym = last;
-    }
-  }
-
-  // Times are t = index + 1; a node mirrored about sample s sits at 2 t(s) - t(node).
-  auto mirrored = [](int sym, int node) { return 2.0 * (sym + 1) - (node + 1); };
-  const double t_first = 1.0, t_last = static_cast<double>(n_);
-
-  // emd.m: "in case symmetrized parts do not extend enough". Indexing an empty list there is an
-  // error in MATLAB (caught as "stop sifting"), hence the early returns.
-  if (lmin.size == 0) return false;
-  bool left_short = mirrored(lsym, lmin.v[0]) > t_first;
-  if (!left_short) {
-    if (lmax.size == 0) return false;
-    left_short = mirrored(lsym, lmax.v[0]) > t_first;
-  }
-  if (left_short) {
-    if (lsym == imax[0]) {
-      lmax.Clear();
-      lmax.PushReversed(imax, 0, std::min(nmax, kNbSym));
-    } else {
-      lmin.Clear();
-      lmin.PushReversed(imin, 0, std::min(nmin, kNbSym));
-    }
-    if (lsym == 0) return false;
-    lsym = 0;
-  }
-  if (rmin.size == 0) return false;
-  bool right_short = mirrored(rsym, rmin.v[rmin.size - 1]) < t_last;
-  if (!right_short) {
-    if (rmax.size == 0) return false;
-    right_short = mirrored(rsym, rmax.v[rmax.size - 1]) < t_last;
-  }
-  if (right_short) {
-    if (rsym == imax[nmax - 1]) {
-      rmax.Clear();
-      rmax.PushReversed(imax, std::max(nmax - kNbSym, 0), nmax);
-    } else {
-      rmin.Clear();
-      rmin.PushReversed(imin, std::max(nmin - kNbSym, 0), nmin);
-    }
-    if (rsym == last) return false;
-    rsym = last;
-  }
-
-  auto assemble = [&](const List& left, const int* interior, int count, const List& right,
-                      std::vector<double>& t, std::vector<double>& z) {
-    const size_t total = static_cast<size_t>(left.size + count + right.size);
-    assert(total <= t.capacity() && total <= z.capacity());  // the sift loop allocates nothing
-    t.resize(total);  // within the reserved capacity: no allocation
-    z.resize(total);
-    size_t k = 0;
-    for (int j = 0; j < left.size; ++j, ++k) {
-      t[k] = mirrored(lsym, left.v[j]);
-      z[k] = h[left.v[j]];
-    }
-    double* tk = t.data() + k;
-    double* zk = z.data() + k;
-    for (int j = 0; j < count; ++j) {
-      tk[j] = interior[j] + 1.0;
-      zk[j] = h[interior[j]];
-    }
-    k += static_cast<size_t>(count);
-    for (int j = 0; j < right.size; ++j, ++k) {
-      t[k] = mirrored(rsym, right.v[j]);
-      z[k] = h[right.v[j]];
-    }
-    if (total < 2) return false;
-    // interp1 needs distinct increasing nodes; the interior ones are, by construction.
-    const size_t edge = static_cast<size_t>(left.size);
-    for (size_t j = 1; j <= edge && j < total; ++j) {
-      if (!(t[j] > t[j - 1])) return false;
-    }
-    for (size_t j = total - static_cast<size_t>(right.size); j < total; ++j) {
-      if (j > 0 && !(t[j] > t[j - 1])) return false;
-    }
-    return true;
-  };
-  return assemble(lmin, imin, nmin, rmin, lower_.t(), lower_.y()) &&
-         assemble(lmax, imax, nmax, rmax, upper_.t(), upper_.y());
+  EndNodes left = LeftEnd(h, e), right = RightEnd(h, e, last);
+  if (!CoverLeft(e, left) || !CoverRight(e, last, right)) return false;
+  return AssembleNodes(h, left.min, left.sym, e.imin, e.nmin, right.min, right.sym, lower_.t(),
+                       lower_.y()) &&
+         AssembleNodes(h, left.max, left.sym, e.imax, e.nmax, right.max, right.sym, upper_.t(),
+                       upper_.y());
 }
 
 bool Sifter::EnvelopeNodes(const double* x, std::vector<double>* tmin, std::vector<double>* zmin,

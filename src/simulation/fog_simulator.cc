@@ -168,39 +168,43 @@ std::string SimulationResult::Summary() const {
   return buffer;
 }
 
-SimulationResult Simulate(const TemperatureProgramme& programme, const FogParameters& params,
-                          const SimulationOptions& options) {
-  params.Validate();
-  options.Validate();
+namespace {
+
+// The result's description of the run (everything but the series), with its n-sample series
+// allocated.
+SimulationResult DescribeRun(const TemperatureProgramme& programme, const FogParameters& params,
+                             const SimulationOptions& options, const RadialConduction& pack) {
   const Eigen::Index n = options.Samples();
   const double dt = 1.0 / options.rate_hz;
-  const auto& coil = params.coil;
-
-  RadialConduction pack(coil.inner_radius_m(), coil.outer_radius_m(), coil.layers, params.thermal);
-  // Same number of turns in every layer: the fibre a layer holds grows with its radius.
-  const WindingMap winding = BuildWinding(coil.winding, coil.layers, coil.fibre_length_m,
-                                          coil.winding_asymmetry, pack.cell_radius_m());
-  const double shupe_scale = coil.Shupe().Scale() * kDegPerHourPerRadPerSecond;
-  const double stress_per_k = params.StressCoefficientDphPerK();
-  const double tau_case = params.thermal.case_time_constant_s;
-
   SimulationResult r;
   r.programme = programme.name();
   r.seed = options.seed;
   r.samples = n;
-  r.layers = coil.layers;
+  r.layers = params.coil.layers;
   r.substeps_per_sample =
       static_cast<int>(std::ceil(dt / params.thermal.max_step_s * (1.0 - 1e-12)));
   r.conduction_step_s = dt / r.substeps_per_sample;
-  r.shupe_scale_dph_per_km2s = shupe_scale;
-  r.stress_coefficient_dph_per_k = stress_per_k;
-  r.coil_lag_s = tau_case + pack.RampLagSeconds();
+  r.shupe_scale_dph_per_km2s = params.coil.Shupe().Scale() * kDegPerHourPerRadPerSecond;
+  r.stress_coefficient_dph_per_k = params.StressCoefficientDphPerK();
+  r.coil_lag_s = params.thermal.case_time_constant_s + pack.RampLagSeconds();
   for (Eigen::VectorXd* v : {&r.time_s, &r.rate_dph, &r.temperature_c, &r.drift_dph, &r.shupe_dph,
                              &r.stress_dph, &r.bias_dph, &r.noise_dph, &r.chamber_c, &r.case_c,
                              &r.coil_mean_c, &r.coil_inner_c, &r.coil_outer_c}) {
     v->resize(n);
   }
+  return r;
+}
 
+// The chamber, case and coil temperatures sample by sample, and the drift they cause (Shupe,
+// stress, bias), into r (sized by DescribeRun).
+void SimulateThermalDrift(const TemperatureProgramme& programme, const FogParameters& params,
+                          const WindingMap& winding, double dt, RadialConduction& pack,
+                          SimulationResult& r) {
+  const Eigen::Index n = r.samples;
+  const int layers = params.coil.layers;
+  const double shupe_scale = r.shupe_scale_dph_per_km2s;
+  const double stress_per_k = r.stress_coefficient_dph_per_k;
+  const double tau_case = params.thermal.case_time_constant_s;
   // The run starts in equilibrium with the chamber. The pack is solved for the deviation from
   // that start temperature, so a constant chamber leaves it at exactly zero (no round-off drift).
   double chamber = programme.TemperatureAt(0.0);
@@ -226,7 +230,7 @@ SimulationResult Simulate(const TemperatureProgramme& programme, const FogParame
     const Eigen::VectorXd& layer_t = pack.temperature_c();
     // Shupe integral of the mean layer rates over the interval: sum w_l (T_l - T_l_prev) / dt.
     double integral = 0.0;
-    for (int l = 0; l < coil.layers; ++l) integral += weights[l] * (layer_t[l] - previous[l]);
+    for (int l = 0; l < layers; ++l) integral += weights[l] * (layer_t[l] - previous[l]);
     previous = layer_t;
     const double mean_change = pack.MeanTemperature();
     r.time_s[k] = static_cast<double>(k + 1) * dt;
@@ -237,10 +241,16 @@ SimulationResult Simulate(const TemperatureProgramme& programme, const FogParame
     r.case_c[k] = case_c;
     r.coil_mean_c[k] = start_c + mean_change;
     r.coil_inner_c[k] = start_c + layer_t[0];
-    r.coil_outer_c[k] = start_c + layer_t[coil.layers - 1];
+    r.coil_outer_c[k] = start_c + layer_t[layers - 1];
   }
   r.drift_dph = r.shupe_dph + r.stress_dph + r.bias_dph;
+}
 
+// The gyro's noise and the temperature sensor's reading (ideal ones without noise), then the
+// logged rate.
+void AddNoiseAndReadings(const FogParameters& params, const SimulationOptions& options, double dt,
+                         SimulationResult& r) {
+  const Eigen::Index n = r.samples;
   if (options.include_noise) {
     r.noise_dph = GenerateNoise(params.noise, dt, n, options.seed);
     r.temperature_c = SenseTemperature(params.sensor, r.case_c, dt, options.seed);
@@ -256,10 +266,27 @@ SimulationResult Simulate(const TemperatureProgramme& programme, const FogParame
   }
   r.rate_dph = r.drift_dph + r.noise_dph;
   r.rate_dph.array() += options.input_rate_dph;
+}
 
+}  // namespace
+
+SimulationResult Simulate(const TemperatureProgramme& programme, const FogParameters& params,
+                          const SimulationOptions& options) {
+  params.Validate();
+  options.Validate();
+  const double dt = 1.0 / options.rate_hz;
+  const auto& coil = params.coil;
+  RadialConduction pack(coil.inner_radius_m(), coil.outer_radius_m(), coil.layers, params.thermal);
+  // Same number of turns in every layer: the fibre a layer holds grows with its radius.
+  const WindingMap winding = BuildWinding(coil.winding, coil.layers, coil.fibre_length_m,
+                                          coil.winding_asymmetry, pack.cell_radius_m());
+  SimulationResult r = DescribeRun(programme, params, options, pack);
+  SimulateThermalDrift(programme, params, winding, dt, pack, r);
+  AddNoiseAndReadings(params, options, dt, r);
+  const double n = static_cast<double>(r.samples);
   r.max_abs_shupe_dph = r.shupe_dph.cwiseAbs().maxCoeff();
-  r.rms_drift_dph = std::sqrt(r.drift_dph.squaredNorm() / static_cast<double>(n));
-  r.rms_noise_dph = std::sqrt(r.noise_dph.squaredNorm() / static_cast<double>(n));
+  r.rms_drift_dph = std::sqrt(r.drift_dph.squaredNorm() / n);
+  r.rms_noise_dph = std::sqrt(r.noise_dph.squaredNorm() / n);
   return r;
 }
 

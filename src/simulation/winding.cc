@@ -61,8 +61,11 @@ int WindingMap::LayerAt(double z_m) const {
   ThrowOption("z_m", FormatValue(z_m), "in [0, " + FormatValue(fibre_length_m) + "]");
 }
 
-WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m, double asymmetry,
-                        const Eigen::VectorXd& layer_capacity) {
+namespace {
+
+// The checked capacity of each layer (ones when none is given).
+Eigen::VectorXd CheckedCapacity(WindingPattern pattern, int layers, double fibre_length_m,
+                                double asymmetry, const Eigen::VectorXd& layer_capacity) {
   const int period = PatternPeriod(pattern);
   if (layers < 1 || layers > 100000 || layers % period != 0) {
     ThrowOption("coil.layers", std::to_string(layers),
@@ -85,58 +88,87 @@ WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_
                   "a finite number > 0");
     }
   }
+  return capacity;
+}
 
+// Conventional: the fibre from one end, layer after layer, each its share of the capacity.
+void WindConventional(const Eigen::VectorXd& capacity, WindingMap& map) {
+  const double length = map.fibre_length_m, total_capacity = capacity.sum();
+  const int layers = static_cast<int>(capacity.size());
+  double z = 0.0;
+  for (int l = 0; l < layers; ++l) {
+    const double end = l + 1 == layers ? length : z + length * capacity[l] / total_capacity;
+    map.pieces[static_cast<size_t>(l)].push_back({z, end});
+    z = end;
+  }
+}
+
+// Symmetric: both halves from the midpoint together, each layer holding a piece of each.
+void WindSymmetric(const Eigen::VectorXd& capacity, WindingMap& map) {
+  const double length = map.fibre_length_m, total_capacity = capacity.sum();
+  const int layers = static_cast<int>(capacity.size());
+  const double mid = 0.5 * length;
+  double s = 0.0;  // distance from the midpoint already wound
+  for (int l = 0; l < layers; ++l) {
+    const double next = l + 1 == layers ? mid : s + mid * capacity[l] / total_capacity;
+    map.pieces[static_cast<size_t>(l)].push_back({mid - next, mid - s});
+    map.pieces[static_cast<size_t>(l)].push_back({length - (mid - s), length - (mid - next)});
+    s = next;
+  }
+}
+
+// Dipole, quadrupole, octupole: layers take turns from the two halves by the pattern's roles,
+// half A (towards z = 0) holding (1 + asymmetry) / 2 of the fibre.
+void WindPattern(WindingPattern pattern, const Eigen::VectorXd& capacity, WindingMap& map) {
+  const std::string_view roles = PatternRoles(pattern);
+  const size_t period = roles.size();
+  const double length = map.fibre_length_m;
+  const int layers = static_cast<int>(capacity.size());
+  const double length_a = 0.5 * (1.0 + map.asymmetry) * length;
+  double capacity_a = 0.0, capacity_b = 0.0;
+  int last_a = -1, last_b = -1;
+  for (int l = 0; l < layers; ++l) {
+    if (roles[static_cast<size_t>(l) % period] == 'A') {
+      capacity_a += capacity[l];
+      last_a = l;
+    } else {
+      capacity_b += capacity[l];
+      last_b = l;
+    }
+  }
+  double z_a = length_a, z_b = length_a;  // both halves start at the fibre midpoint
+  for (int l = 0; l < layers; ++l) {
+    if (roles[static_cast<size_t>(l) % period] == 'A') {
+      const double start = l == last_a ? 0.0 : z_a - length_a * capacity[l] / capacity_a;
+      map.pieces[static_cast<size_t>(l)].push_back({start, z_a});
+      z_a = start;
+    } else {
+      const double end =
+          l == last_b ? length : z_b + (length - length_a) * capacity[l] / capacity_b;
+      map.pieces[static_cast<size_t>(l)].push_back({z_b, end});
+      z_b = end;
+    }
+  }
+}
+
+}  // namespace
+
+WindingMap BuildWinding(WindingPattern pattern, int layers, double fibre_length_m, double asymmetry,
+                        const Eigen::VectorXd& layer_capacity) {
+  const Eigen::VectorXd capacity =
+      CheckedCapacity(pattern, layers, fibre_length_m, asymmetry, layer_capacity);
   const double length = fibre_length_m;
   WindingMap map;
   map.fibre_length_m = length;
   map.pattern = pattern;
   map.asymmetry = asymmetry;
   map.pieces.assign(static_cast<size_t>(layers), {});
-  const double total_capacity = capacity.sum();
-
   if (pattern == WindingPattern::kConventional) {
-    double z = 0.0;
-    for (int l = 0; l < layers; ++l) {
-      const double end = l + 1 == layers ? length : z + length * capacity[l] / total_capacity;
-      map.pieces[static_cast<size_t>(l)].push_back({z, end});
-      z = end;
-    }
+    WindConventional(capacity, map);
   } else if (pattern == WindingPattern::kSymmetric) {
-    const double mid = 0.5 * length;
-    double s = 0.0;  // distance from the midpoint already wound
-    for (int l = 0; l < layers; ++l) {
-      const double next = l + 1 == layers ? mid : s + mid * capacity[l] / total_capacity;
-      map.pieces[static_cast<size_t>(l)].push_back({mid - next, mid - s});
-      map.pieces[static_cast<size_t>(l)].push_back({length - (mid - s), length - (mid - next)});
-      s = next;
-    }
+    WindSymmetric(capacity, map);
   } else {
-    const std::string_view roles = PatternRoles(pattern);
-    const double length_a = 0.5 * (1.0 + asymmetry) * length;
-    double capacity_a = 0.0, capacity_b = 0.0;
-    int last_a = -1, last_b = -1;
-    for (int l = 0; l < layers; ++l) {
-      if (roles[static_cast<size_t>(l % period)] == 'A') {
-        capacity_a += capacity[l];
-        last_a = l;
-      } else {
-        capacity_b += capacity[l];
-        last_b = l;
-      }
-    }
-    double z_a = length_a, z_b = length_a;  // both halves start at the fibre midpoint
-    for (int l = 0; l < layers; ++l) {
-      if (roles[static_cast<size_t>(l % period)] == 'A') {
-        const double start = l == last_a ? 0.0 : z_a - length_a * capacity[l] / capacity_a;
-        map.pieces[static_cast<size_t>(l)].push_back({start, z_a});
-        z_a = start;
-      } else {
-        const double end =
-            l == last_b ? length : z_b + (length - length_a) * capacity[l] / capacity_b;
-        map.pieces[static_cast<size_t>(l)].push_back({z_b, end});
-        z_b = end;
-      }
-    }
+    WindPattern(pattern, capacity, map);
   }
 
   map.layer_length_m = Eigen::VectorXd::Zero(layers);
