@@ -29,66 +29,6 @@ constexpr double kQuadraticCentreC = 20.0;
 
 double FirstOrderLagGain(double tau_s, double dt_s) { return -std::expm1(-dt_s / tau_s); }
 
-void RecordRows::Append(const Eigen::Ref<const Eigen::MatrixXd>& block,
-                        const std::vector<Eigen::Index>& block_starts,
-                        const std::vector<bool>& block_logged) {
-  const Eigen::Index offset = rows.rows();
-  if (offset > 0 && block.cols() != rows.cols()) {
-    throw DataError("records of " + std::to_string(rows.cols()) + " and " +
-                    std::to_string(block.cols()) + " columns cannot be joined");
-  }
-  if (!block_logged.empty() || !logged.empty()) {
-    CheckLogged(block_logged, block.rows());
-    logged.resize(static_cast<size_t>(offset), true);
-    if (block_logged.empty()) {
-      logged.resize(static_cast<size_t>(offset + block.rows()), true);
-    } else {
-      logged.insert(logged.end(), block_logged.begin(), block_logged.end());
-    }
-  }
-  if (offset > 0) record_starts.push_back(offset);
-  for (const Eigen::Index start : block_starts) record_starts.push_back(offset + start);
-  rows.conservativeResize(offset + block.rows(), block.cols());
-  rows.bottomRows(block.rows()) = block;
-}
-
-void CheckRecordStarts(const std::vector<Eigen::Index>& record_starts, Eigen::Index n) {
-  Eigen::Index previous = 0;
-  for (const Eigen::Index start : record_starts) {
-    if (!(start > previous && start < n)) {
-      throw DataError("record starts must increase strictly within (0, " + std::to_string(n) +
-                      "): got " + std::to_string(start) + " after " + std::to_string(previous));
-    }
-    previous = start;
-  }
-}
-
-void CheckLogged(const std::vector<bool>& logged, Eigen::Index n) {
-  if (logged.empty()) return;
-  if (static_cast<Eigen::Index>(logged.size()) != n) {
-    throw DataError("the mask of logged rows has " + std::to_string(logged.size()) +
-                    " flags for " + std::to_string(n) + " rows: they must match");
-  }
-  if (CountLogged(logged, n) == 0) throw DataError("the mask of logged rows marks no row logged");
-}
-
-Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n) {
-  if (logged.empty()) return n;
-  return static_cast<Eigen::Index>(std::count(logged.begin(), logged.end(), true));
-}
-
-Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,
-                           const std::vector<bool>& logged) {
-  if (logged.empty()) return m;
-  CheckLogged(logged, m.rows());
-  Eigen::MatrixXd out(CountLogged(logged, m.rows()), m.cols());
-  Eigen::Index k = 0;
-  for (Eigen::Index r = 0; r < m.rows(); ++r) {
-    if (logged[static_cast<size_t>(r)]) out.row(k++) = m.row(r);
-  }
-  return out;
-}
-
 void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, double tau_s,
                    double dt_s, Eigen::Ref<Eigen::VectorXd> out) {
   const double gain = FirstOrderLagGain(tau_s, dt_s);

@@ -15,7 +15,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
-#include "gyrodrift/drift/features.h"
+#include "gyrodrift/drift/records.h"
 #include "gyrodrift/drift/thermal_model.h"
 #include "gyrodrift/elm/elm.h"
 #include "thermal_columns.h"

@@ -8,7 +8,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "../common/format.h"
-#include "gyrodrift/drift/features.h"
+#include "gyrodrift/drift/records.h"
 #include "thermal_columns.h"
 
 namespace gyrodrift::drift {

@@ -8,7 +8,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
-#include "gyrodrift/drift/features.h"
+#include "gyrodrift/drift/records.h"
 
 namespace gyrodrift::tasks {
 namespace {

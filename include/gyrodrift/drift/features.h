@@ -26,6 +26,8 @@
 #include <string_view>
 #include <vector>
 
+#include "gyrodrift/drift/records.h"
+
 namespace gyrodrift::drift {
 
 enum class ThermalSet { kAuto, kLadder, kClassic, kLagBank };
@@ -73,44 +75,6 @@ void FirstOrderLag(const Eigen::Ref<const Eigen::VectorXd>& temperature_c, doubl
 // Its gain 1 - exp(-dt/tau), the one formula every lag uses (firmware export prints it as a
 // literal so that generated C code runs the same recursion).
 double FirstOrderLagGain(double tau_s, double dt_s);
-
-// Several records (calibration runs, or a log split at its gaps) given one after the other, as
-// one N-sample series: record_starts holds the first sample of every record after the first, and
-// every lag restarts there. CheckRecordStarts throws DataError unless they increase strictly
-// within (0, n); ForEachRecord calls f(begin, length) for each record in order.
-void CheckRecordStarts(const std::vector<Eigen::Index>& record_starts, Eigen::Index n);
-template <class F>
-void ForEachRecord(Eigen::Index n, const std::vector<Eigen::Index>& record_starts, F&& f) {
-  Eigen::Index begin = 0;
-  for (const Eigen::Index start : record_starts) {
-    f(begin, start - begin);
-    begin = start;
-  }
-  f(begin, n - begin);
-}
-
-// Records appended one after another: each block of rows (N_i x C, the same C) below the earlier
-// ones, record_starts gaining the block's first row (after the first block) and its own record
-// starts shifted into place (the gaps of a log split at them), and logged its mask of logged rows
-// (empty: every row; logged stays empty while every block's is).
-struct RecordRows {
-  Eigen::MatrixXd rows;
-  std::vector<Eigen::Index> record_starts;
-  std::vector<bool> logged;
-  void Append(const Eigen::Ref<const Eigen::MatrixXd>& block,
-              const std::vector<Eigen::Index>& block_starts = {},
-              const std::vector<bool>& block_logged = {});
-};
-
-// Which rows of a record were logged (a log whose gaps were filled, io::GapPolicy::kCarry): one
-// flag per row, true where the row was logged; empty = every row. The thermal states run over
-// every row; fits and scores use the logged ones. CheckLogged throws DataError unless the mask is
-// empty or has n flags with at least one set; LoggedRows keeps the rows of m where it is set.
-void CheckLogged(const std::vector<bool>& logged, Eigen::Index n);
-Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,
-                           const std::vector<bool>& logged);
-// Rows logged: n when the mask is empty.
-Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n);
 
 // Rows of lags: row r holds s[t-1], ..., s[t-p] for t = first + r, r = 0..count-1 (first >= p).
 Eigen::MatrixXd LagRows(const Eigen::Ref<const Eigen::VectorXd>& s, int p, Eigen::Index first,

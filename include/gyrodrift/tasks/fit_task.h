@@ -14,8 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "gyrodrift/drift/features.h"
 #include "gyrodrift/drift/fit_settings.h"
+#include "gyrodrift/drift/records.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/tasks/task_log.h"
 
