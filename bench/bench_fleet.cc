@@ -10,6 +10,7 @@
 
 #include "bench_util.h"
 #include "gyrodrift/fleet/calibration.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/simulation/fog_simulator.h"
@@ -17,6 +18,7 @@
 namespace {
 
 namespace fleet = gyrodrift::fleet;
+namespace html = gyrodrift::html;
 namespace io = gyrodrift::io;
 namespace simulation = gyrodrift::simulation;
 
@@ -54,7 +56,7 @@ void BM_CalibrateUnit(benchmark::State& state) {
                       std::string("drift_") + a, 0});
   }
   m.units.push_back({"SN-1", {dir + "/cal.csv"}, {dir + "/ver.csv"}, 0});
-  const io::DygraphsAssets assets = io::LoadDygraphs();
+  const html::DygraphsAssets assets = html::LoadDygraphs();
   for (auto _ : state) {
     const fleet::UnitOutputs out = fleet::CalibrateUnit(m, m.units[0], assets);
     if (!out.result.error.empty()) state.SkipWithError(out.result.error.c_str());

@@ -21,10 +21,10 @@
 #include "drift_cli.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
-#include "gyrodrift/io/report.h"
-#include "gyrodrift/study/study_files.h"
 #include "gyrodrift/study/study.h"
+#include "gyrodrift/study/study_files.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -145,7 +145,7 @@ void Run(const DemoArgs& a) {
   }
   const study::StudyOptions options = MakeStudyOptions(a);
   // The report needs dygraphs and the files need their folder; find out now, not after the work.
-  const io::DygraphsAssets assets = io::LoadDygraphs();
+  const html::DygraphsAssets assets = html::LoadDygraphs();
   study::RequireUsableOutputFolder(a.output);
 
   // Stage weights: seconds the stages took in the measured runs (docs/demo.md); the last stage,

@@ -13,15 +13,15 @@
 #include "gyrodrift/firmware/export.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/model_file.h"
-#include "gyrodrift/io/report.h"
 #include "gyrodrift/selection/selection.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/compensate_task.h"
 #include "gyrodrift/tasks/decompose_task.h"
 #include "gyrodrift/tasks/fit_task.h"
-#include "gyrodrift/tasks/compensate_task.h"
 #include "gyrodrift/tasks/predict_task.h"
 
 namespace gyrodrift::python {

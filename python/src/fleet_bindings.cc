@@ -11,8 +11,8 @@
 #include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/fleet/calibration.h"
 #include "gyrodrift/fleet/manifest.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/model_file.h"
-#include "gyrodrift/io/report.h"
 #include "gyrodrift/selection/selection.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
@@ -91,7 +91,7 @@ py::dict CalibrateUnit(const std::string& manifest_path, int index, const std::s
                         "in [0, " + std::to_string(m.units.size()) + ")");
     }
     run = fleet::RunUnit(m, m.units[static_cast<size_t>(index)], output_dir, force,
-                         io::LoadDygraphs());
+                         html::LoadDygraphs());
   }
   std::vector<std::vector<std::string>> rows;
   for (const auto& row : run.rows) rows.push_back(row.cells);
@@ -118,7 +118,7 @@ py::dict FinishFleet(const std::string& manifest_path, const std::string& output
   {
     py::gil_scoped_release release;
     const fleet::Manifest m = fleet::ReadManifest(manifest_path);
-    r = fleet::FinishFleet(m, output_dir, runs, seconds, io::LoadDygraphs());
+    r = fleet::FinishFleet(m, output_dir, runs, seconds, html::LoadDygraphs());
   }
   return FleetDict(r);
 }

@@ -276,7 +276,7 @@ std::string VerifyLog(const Manifest& m, const UnitSpec& spec, size_t k,
 }
 
 // Everything CalibrateUnit does, throwing on the unit's own errors.
-UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const io::DygraphsAssets& assets) {
+UnitOutputs Calibrate(const Manifest& m, const UnitSpec& unit, const html::DygraphsAssets& assets) {
   UnitOutputs out;
   UnitResult& r = out.result;
   r.serial = unit.serial;
@@ -348,7 +348,7 @@ bool UnitResult::pass() const {
 }
 
 UnitOutputs CalibrateUnit(const Manifest& manifest, const UnitSpec& unit,
-                          const io::DygraphsAssets& assets) {
+                          const html::DygraphsAssets& assets) {
   const auto start = std::chrono::steady_clock::now();
   UnitOutputs out;
   try {
@@ -370,7 +370,7 @@ std::string FleetResult::Summary() const {
 }
 
 UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& output_dir,
-                bool force, const io::DygraphsAssets& assets) {
+                bool force, const html::DygraphsAssets& assets) {
   const std::string folder = (fs::path(output_dir) / unit.serial).string();
   const std::string summary = (fs::path(folder) / kSummaryFile).string();
   UnitRun run;
@@ -420,7 +420,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
 
 FleetResult FinishFleet(const Manifest& m, const std::string& output_dir,
                         const std::vector<UnitRun>& units, double seconds,
-                        const io::DygraphsAssets& assets) {
+                        const html::DygraphsAssets& assets) {
   if (units.size() != m.units.size()) {
     throw UsageError("FinishFleet: " + std::to_string(units.size()) + " unit runs for a manifest of " +
                      std::to_string(m.units.size()) + " units");
@@ -472,7 +472,7 @@ FleetResult RunFleet(const Manifest& m, const FleetOptions& o, const FleetContex
   if (!fs::is_directory(o.output_dir, ec)) {
     throw IoError(o.output_dir + ": cannot create the output folder");
   }
-  const io::DygraphsAssets assets = io::LoadDygraphs();
+  const html::DygraphsAssets assets = html::LoadDygraphs();
   const int n = static_cast<int>(m.units.size());
   std::vector<UnitRun> runs(static_cast<size_t>(n));
   std::mutex mutex;

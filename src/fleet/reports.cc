@@ -33,8 +33,8 @@ std::string LimitsText(const Limits& l) {
   return out.empty() ? "no limits set" : out.substr(0, out.size() - 2);
 }
 
-io::ReportSeries Line(std::string name, Eigen::VectorXd v, const char* color, bool dashed = false) {
-  io::ReportSeries s;
+html::ReportSeries Line(std::string name, Eigen::VectorXd v, const char* color, bool dashed = false) {
+  html::ReportSeries s;
   s.name = std::move(name);
   s.values = std::move(v);
   s.color = color;
@@ -55,7 +55,7 @@ const std::string& Text(const FleetRow& row, const std::string& column) {
 }
 
 // An axis's model and verification table on its unit's page.
-void AddAxisSummary(io::HtmlReport& report, const Manifest& m, const AxisResult& a,
+void AddAxisSummary(html::HtmlReport& report, const Manifest& m, const AxisResult& a,
                     const std::string& unit_name) {
   report.AddHeading(fmt::format("Axis {} ({})", a.target, a.pass() ? "pass" : "fail"));
   std::string model = a.model_summary + "\nregressors: ";
@@ -68,7 +68,7 @@ void AddAxisSummary(io::HtmlReport& report, const Manifest& m, const AxisResult&
   }
   for (const std::string& w : a.warnings) model += "\nwarning: " + w;
   report.AddPreformatted(model);
-  io::ReportTable table;
+  html::ReportTable table;
   table.title = "Verification of " + a.target;
   table.header = {"log", "samples", "mean before", "mean after", "std before", "std after",
                   "residual drift before",
@@ -95,11 +95,11 @@ void AddAxisSummary(io::HtmlReport& report, const Manifest& m, const AxisResult&
 
 // An axis's figures on its unit's page: per verification log, the block means and the Allan
 // deviation before and after.
-void AddAxisFigures(io::HtmlReport& report, const Manifest& m, const AxisResult& a,
+void AddAxisFigures(html::HtmlReport& report, const Manifest& m, const AxisResult& a,
                     const std::string& unit_name) {
   for (size_t k = 0; k < a.verification.size(); ++k) {
     const VerificationResult& v = a.verification[k];
-    io::ReportFigure drift;
+    html::ReportFigure drift;
     drift.title = fmt::format("{}: verification log {} ({:g}-s means)", a.target, k + 1,
                               m.drift_window_s);
     drift.caption = "The output before and after compensation, and the model's estimate"
@@ -115,7 +115,7 @@ void AddAxisFigures(io::HtmlReport& report, const Manifest& m, const AxisResult&
       drift.series.push_back(Line("true drift", v.truth_means, "#2ca02c"));
     }
     report.AddFigure(drift);
-    io::ReportFigure adev;
+    html::ReportFigure adev;
     adev.title = fmt::format("{}: Allan deviation, verification log {}", a.target, k + 1);
     adev.caption = "Overlapping Allan deviation before and after compensation: the thermal "
                    "drift lifts the long-tau end; compensation should bring it down.";
@@ -133,9 +133,9 @@ void AddAxisFigures(io::HtmlReport& report, const Manifest& m, const AxisResult&
 }  // namespace
 
 std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const UnitResult& unit,
-                             const io::DygraphsAssets& assets) {
+                             const html::DygraphsAssets& assets) {
   const std::string unit_name(allan::ToString(m.rate_unit));
-  io::HtmlReport report("gyrodrift calibration: " + unit.serial);
+  html::HtmlReport report("gyrodrift calibration: " + unit.serial);
   auto names = [](const std::vector<std::string>& logs) {
     std::string out;
     for (const std::string& log : logs) {
@@ -160,7 +160,7 @@ std::string RenderUnitReport(const Manifest& m, const UnitSpec& spec, const Unit
 namespace {
 
 // The fleet page's findings: the unit axes whose model was not identified, and the outliers.
-void AddFindings(io::HtmlReport& report, const FleetResult& fleet) {
+void AddFindings(html::HtmlReport& report, const FleetResult& fleet) {
   std::vector<std::string> outliers;
   for (const FleetRow& row : fleet.rows) {
     if (!Text(row, "outliers").empty()) {
@@ -199,11 +199,11 @@ void AddFindings(io::HtmlReport& report, const FleetResult& fleet) {
 
 // Distributions: one point per unit (x = its row in the table below), one series per axis, the
 // limit as a dashed line.
-void AddDistributions(io::HtmlReport& report, const Manifest& m, const FleetResult& fleet,
+void AddDistributions(html::HtmlReport& report, const Manifest& m, const FleetResult& fleet,
                       const std::vector<std::string>& serials, const std::string& unit_name) {
   auto distribution = [&](const std::string& column, const std::string& title,
                           const std::string& y_label, double limit, double scale) {
-    io::ReportFigure f;
+    html::ReportFigure f;
     f.title = title;
     f.caption = std::string("One point per unit (x: the unit's number in the table below), one "
                             "colour per axis") +
@@ -225,7 +225,7 @@ void AddDistributions(io::HtmlReport& report, const Manifest& m, const FleetResu
         if (std::isnan(v[i]) || (column == "truth_removed" ? x < v[i] : x > v[i])) v[i] = x;
         any |= !std::isnan(x);
       }
-      io::ReportSeries s;
+      html::ReportSeries s;
       s.name = axis.target;
       s.values = v;
       s.markers_only = true;
@@ -234,7 +234,7 @@ void AddDistributions(io::HtmlReport& report, const Manifest& m, const FleetResu
     }
     if (!any || n == 0) return;
     if (!std::isnan(limit)) {
-      io::ReportSeries s;
+      html::ReportSeries s;
       s.name = "limit";
       s.values = Eigen::VectorXd::Constant(n, scale * limit);
       s.dashed = true;
@@ -260,10 +260,10 @@ void AddDistributions(io::HtmlReport& report, const Manifest& m, const FleetResu
 }
 
 // The table of every unit, axis and verification log, with links to the units' pages.
-void AddUnitsTable(io::HtmlReport& report, const FleetResult& fleet,
+void AddUnitsTable(html::HtmlReport& report, const FleetResult& fleet,
                    const std::vector<std::string>& serials, const std::string& unit_name) {
   report.AddHeading("Units");
-  io::ReportTable table;
+  html::ReportTable table;
   table.title = "Every unit, axis and verification log (fleet.csv)";
   table.header = {"#", "serial", "axis", "log", "status", "residual drift before",
                   "residual drift after", "true drift removed", "B after (deg/h)",
@@ -293,9 +293,9 @@ void AddUnitsTable(io::HtmlReport& report, const FleetResult& fleet,
 }  // namespace
 
 std::string RenderFleetReport(const Manifest& m, const FleetResult& fleet,
-                              const io::DygraphsAssets& assets) {
+                              const html::DygraphsAssets& assets) {
   const std::string unit_name(allan::ToString(m.rate_unit));
-  io::HtmlReport report("gyrodrift fleet calibration");
+  html::HtmlReport report("gyrodrift fleet calibration");
   report.AddParagraph(fleet.Summary() + ". Limits: " + LimitsText(m.limits) + ".");
   std::vector<std::string> serials;
   for (const FleetRow& row : fleet.rows) {

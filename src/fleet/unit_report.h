@@ -11,7 +11,7 @@ namespace gyrodrift::fleet {
 // the true drift when there is one), the Allan deviation before and after, and the figures that
 // go into fleet.csv, with the limits each breaks.
 std::string RenderUnitReport(const Manifest& manifest, const UnitSpec& spec,
-                             const UnitResult& unit, const io::DygraphsAssets& assets);
+                             const UnitResult& unit, const html::DygraphsAssets& assets);
 
 // Flags, per axis across the fleet, the rows whose figures are outliers (fleet_rows.cc).
 void FlagOutliers(std::vector<FleetRow>& rows);

@@ -110,7 +110,7 @@ std::string AllanCsv(const StudyResult& s) {
 
 }  // namespace
 
-std::vector<StudyFile> RenderStudyFiles(const StudyResult& s, const io::DygraphsAssets& assets) {
+std::vector<StudyFile> RenderStudyFiles(const StudyResult& s, const html::DygraphsAssets& assets) {
   std::vector<StudyFile> files;
   if (s.simulated) {
     files.push_back({"run_a.csv", SimulationCsv(s.run_a)});

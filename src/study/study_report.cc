@@ -1,4 +1,4 @@
-// The study's HTML report: the text, tables and figures of io::HtmlReport, each figure with a
+// The study's HTML report: the text, tables and figures of html::HtmlReport, each figure with a
 // caption saying what to look at.
 #include <algorithm>
 #include <cmath>
@@ -15,24 +15,24 @@ namespace {
 namespace sim = gyrodrift::simulation;
 namespace sel = gyrodrift::selection;
 
-io::ReportSeries Series(std::string name, Eigen::VectorXd v, bool dashed = false) {
-  io::ReportSeries s;
+html::ReportSeries Series(std::string name, Eigen::VectorXd v, bool dashed = false) {
+  html::ReportSeries s;
   s.name = std::move(name);
   s.values = std::move(v);
   s.dashed = dashed;
   return s;
 }
 
-io::ReportSeries Reference(std::string name, Eigen::VectorXd v) {
-  io::ReportSeries s = Series(std::move(name), std::move(v));
+html::ReportSeries Reference(std::string name, Eigen::VectorXd v) {
+  html::ReportSeries s = Series(std::move(name), std::move(v));
   s.emphasis = true;
   return s;
 }
 
 // A user's measured output is as noisy as the predictions: drawn thick and black on top it hides
 // them, so it goes first (underneath) in light grey.
-io::ReportSeries Measured(std::string name, Eigen::VectorXd v) {
-  io::ReportSeries s = Series(std::move(name), std::move(v));
+html::ReportSeries Measured(std::string name, Eigen::VectorXd v) {
+  html::ReportSeries s = Series(std::move(name), std::move(v));
   s.color = "#aaaaaa";
   return s;
 }
@@ -56,9 +56,9 @@ Eigen::VectorXd TrailingMean(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::
   return out;
 }
 
-void AllanFigure(io::HtmlReport& report, const StudyResult& s) {
+void AllanFigure(html::HtmlReport& report, const StudyResult& s) {
   if (s.allan_raw.points.empty()) return;
-  io::ReportFigure f;
+  html::ReportFigure f;
   f.title = "Allan deviation before and after compensation (" +
             std::string(s.simulated ? "run B" : "test block") + ")";
   f.x_label = "tau (s)";
@@ -69,7 +69,7 @@ void AllanFigure(io::HtmlReport& report, const StudyResult& s) {
   f.x = s.allan_raw.tau_s();
   auto add = [&](const std::string& name, const allan::AllanResult& r, const char* colour) {
     if (r.points.size() != s.allan_raw.points.size()) return;
-    io::ReportSeries series = Series(name, r.dev());
+    html::ReportSeries series = Series(name, r.dev());
     series.color = colour;
     series.lower.resize(f.x.size());
     series.upper.resize(f.x.size());
@@ -129,7 +129,7 @@ void AllanFigure(io::HtmlReport& report, const StudyResult& s) {
 }
 
 // The opening: what was analysed and the method.
-void AddIntroduction(io::HtmlReport& report, const StudyResult& s) {
+void AddIntroduction(html::HtmlReport& report, const StudyResult& s) {
   report.AddParagraph(
       s.simulated
           ? "A navigation-grade fibre optic gyro (1 km coil, quadrupole winding) is simulated at " +
@@ -156,11 +156,11 @@ void AddIntroduction(io::HtmlReport& report, const StudyResult& s) {
 
 // Section 1's first figure: the analysed output (and the truth), its predict-mode test block
 // shaded.
-io::ReportFigure OutputFigure(const StudyResult& s) {
+html::ReportFigure OutputFigure(const StudyResult& s) {
   const double split_h = s.predict.split_index < s.time_h.size() ? s.time_h[s.predict.split_index]
                                                                  : s.time_h[s.time_h.size() - 1];
   const double end_h = s.time_h[s.time_h.size() - 1];
-  io::ReportFigure f;
+  html::ReportFigure f;
   f.title = s.simulated ? "Run A: gyro output and true thermal drift" : "Gyro output";
   f.x_label = "time (h)";
   f.y_label = s.target_name + " (" + s.unit + ")";
@@ -180,8 +180,8 @@ io::ReportFigure OutputFigure(const StudyResult& s) {
   return f;
 }
 
-io::ReportFigure TemperatureFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure TemperatureFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = s.simulated ? "Run A: temperatures" : "Temperature channel";
   f.x_label = "time (h)";
   // A user's temperature column may be in any unit (raw counts, for one): its name, not a unit.
@@ -203,8 +203,8 @@ io::ReportFigure TemperatureFigure(const StudyResult& s) {
 }
 
 // Simulated studies only.
-io::ReportFigure RunBFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure RunBFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = "Run B: gyro output, true drift and temperature (test run for compensation)";
   f.x_label = "time (h)";
   f.y_label = "deg/h";
@@ -212,7 +212,7 @@ io::ReportFigure RunBFigure(const StudyResult& s) {
   f.x = s.run_b.time_s / 3600.0;
   f.series.push_back(Series("output", s.run_b.rate_dph));
   f.series.push_back(Reference("true drift", s.run_b.drift_dph));
-  io::ReportSeries t = Series("case sensor (right axis)", s.run_b.temperature_c);
+  html::ReportSeries t = Series("case sensor (right axis)", s.run_b.temperature_c);
   t.right_axis = true;
   f.series.push_back(t);
   f.caption =
@@ -221,16 +221,16 @@ io::ReportFigure RunBFigure(const StudyResult& s) {
   return f;
 }
 
-void AddRecordSection(io::HtmlReport& report, const StudyResult& s) {
+void AddRecordSection(html::HtmlReport& report, const StudyResult& s) {
   report.AddHeading(s.simulated ? "1. The simulated runs" : "1. The record");
   report.AddFigure(OutputFigure(s));
   report.AddFigure(TemperatureFigure(s));
   if (s.simulated) report.AddFigure(RunBFigure(s));
 }
 
-io::ReportFigure SelectionCurvesFigure(const StudyResult& s) {
+html::ReportFigure SelectionCurvesFigure(const StudyResult& s) {
   const int k_count = s.decomposition.num_imfs();
-  io::ReportFigure f;
+  html::ReportFigure f;
   f.title =
       "Selection curves: distance of each IMF's PDF to the signal's (D_k) and to a Gaussian "
       "(G_k)";
@@ -272,9 +272,9 @@ io::ReportFigure SelectionCurvesFigure(const StudyResult& s) {
   return f;
 }
 
-io::ReportFigure EnergyFigure(const StudyResult& s) {
+html::ReportFigure EnergyFigure(const StudyResult& s) {
   const int k_count = s.decomposition.num_imfs();
-  io::ReportFigure f;
+  html::ReportFigure f;
   f.title = "IMF energies against the white-noise energy model";
   f.x_label = "IMF index k";
   f.y_label = "log2 energy";
@@ -305,8 +305,8 @@ io::ReportFigure EnergyFigure(const StudyResult& s) {
   return f;
 }
 
-io::ReportFigure GroupsFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure GroupsFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = "The grouped sub-series (noise + mixed + drift = output)";
   f.x_label = "time (h)";
   f.y_label = s.unit;
@@ -340,8 +340,8 @@ io::ReportFigure GroupsFigure(const StudyResult& s) {
 }
 
 // IMF k (0-based), captioned by its group.
-io::ReportFigure ImfFigure(const StudyResult& s, int k) {
-  io::ReportFigure f;
+html::ReportFigure ImfFigure(const StudyResult& s, int k) {
+  html::ReportFigure f;
   f.title =
       "IMF " + std::to_string(k + 1) + " (" + internal::GroupOf(s.selection, k + 1) + " group)";
   f.x_label = "time (h)";
@@ -357,7 +357,7 @@ io::ReportFigure ImfFigure(const StudyResult& s, int k) {
                   ? "Mixed group: noise with slower structure in it; look for swings that line "
                     "up with the temperature changes."
                   : "Drift group: slow structure that should follow the temperature history.";
-  // Only a series longer than the plotted rows is decimated (io::DecimateMinMax).
+  // Only a series longer than the plotted rows is decimated (html::DecimateMinMax).
   const Eigen::Index n = s.time_h.size();
   if (n > f.max_points) {
     f.caption += " Plotted as the min and max of each run of " +
@@ -366,8 +366,8 @@ io::ReportFigure ImfFigure(const StudyResult& s, int k) {
   return f;
 }
 
-io::ReportFigure ResidueFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure ResidueFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = "Residue";
   f.x_label = "time (h)";
   f.y_label = s.unit;
@@ -378,7 +378,7 @@ io::ReportFigure ResidueFigure(const StudyResult& s) {
   return f;
 }
 
-void AddDecompositionSection(io::HtmlReport& report, const StudyResult& s) {
+void AddDecompositionSection(html::HtmlReport& report, const StudyResult& s) {
   report.AddHeading("2. BEEMDAN decomposition and mode selection");
   report.AddParagraph(s.decomposition.report.Summary() + ". " + s.selection.Summary() + ".");
   report.AddFigure(SelectionCurvesFigure(s));
@@ -389,8 +389,8 @@ void AddDecompositionSection(io::HtmlReport& report, const StudyResult& s) {
 }
 
 // test_h: the times of the predict-mode test block.
-io::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
-  io::ReportFigure f;
+html::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
+  html::ReportFigure f;
   f.title = "Predict mode: one-step-ahead predictions on the test block";
   f.x_label = "time (h)";
   f.y_label = s.unit;
@@ -420,8 +420,8 @@ io::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd& 
   return f;
 }
 
-io::ReportFigure PredictResidualsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
-  io::ReportFigure f;
+html::ReportFigure PredictResidualsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
+  html::ReportFigure f;
   const Eigen::Index w =
       std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1,
                                std::max<Eigen::Index>(1, test_h.size() / 20));
@@ -443,7 +443,7 @@ io::ReportFigure PredictResidualsFigure(const StudyResult& s, const Eigen::Vecto
   return f;
 }
 
-void AddPredictSection(io::HtmlReport& report, const StudyResult& s) {
+void AddPredictSection(html::HtmlReport& report, const StudyResult& s) {
   report.AddHeading("3. Predict mode (the paper's task)");
   report.AddTable(s.predict_table.Report());
   const Eigen::Index split = s.predict.split_index;
@@ -452,8 +452,8 @@ void AddPredictSection(io::HtmlReport& report, const StudyResult& s) {
   report.AddFigure(PredictResidualsFigure(s, test_h));
 }
 
-io::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = s.simulated
                 ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
                 : "Compensate mode: drift estimated from temperature vs the measured output";
@@ -479,8 +479,8 @@ io::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
   return f;
 }
 
-io::ReportFigure CompensateResidualsFigure(const StudyResult& s) {
-  io::ReportFigure f;
+html::ReportFigure CompensateResidualsFigure(const StudyResult& s) {
+  html::ReportFigure f;
   f.title = "Compensate mode: residual drift (reference - estimate)";
   f.x_label = "time (h)";
   f.y_label = s.unit;
@@ -502,7 +502,7 @@ io::ReportFigure CompensateResidualsFigure(const StudyResult& s) {
   return f;
 }
 
-void AddCompensateSection(io::HtmlReport& report, const StudyResult& s) {
+void AddCompensateSection(html::HtmlReport& report, const StudyResult& s) {
   report.AddHeading(s.simulated ? "4. Compensate mode: trained on run A, tested on run B"
                                 : "4. Compensate mode: chronological split");
   report.AddTable(s.compensate_table.Report());
@@ -513,8 +513,8 @@ void AddCompensateSection(io::HtmlReport& report, const StudyResult& s) {
 }  // namespace
 
 // The report page built from its parts, in the order of the study's steps.
-std::string RenderStudyReport(const StudyResult& s, const io::DygraphsAssets& assets) {
-  io::HtmlReport report(s.simulated ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
+std::string RenderStudyReport(const StudyResult& s, const html::DygraphsAssets& assets) {
+  html::HtmlReport report(s.simulated ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
                                     : "gyrodrift demo: " + s.source);
   AddIntroduction(report, s);
   AddRecordSection(report, s);

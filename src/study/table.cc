@@ -61,6 +61,6 @@ std::string Table::Text() const {
   return out;
 }
 
-io::ReportTable Table::Report() const { return {title, caption, header, shown, {}}; }
+html::ReportTable Table::Report() const { return {title, caption, header, shown, {}}; }
 
 }  // namespace gyrodrift::study

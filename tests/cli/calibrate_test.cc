@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
-#include "gyrodrift/io/report.h"
 #include "regression/allan/allan_fixtures.h"
 #include "support/report_check.h"
 #include "support/test_support.h"

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/io/report.h"
 #include "support/report_check.h"
 #include "support/test_support.h"
 
@@ -20,7 +20,7 @@ namespace {
 using test::RunCli;
 
 bool HaveDygraphs() {
-  return std::filesystem::exists(std::string(io::kDygraphsDir) + "/dygraph.min.js");
+  return std::filesystem::exists(std::string(html::kDygraphsDir) + "/dygraph.min.js");
 }
 
 int Lines(const std::string& text) {

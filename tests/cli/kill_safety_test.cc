@@ -30,8 +30,8 @@
 #include <thread>
 #include <vector>
 
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/files.h"
-#include "gyrodrift/io/report.h"
 #include "support/test_support.h"
 
 extern char** environ;
@@ -262,7 +262,7 @@ TEST_F(KillSafety, Fit) {
 }
 
 TEST_F(KillSafety, Demo) {
-  if (!fs::exists(std::string(io::kDygraphsDir) + "/dygraph.min.js")) {
+  if (!fs::exists(std::string(html::kDygraphsDir) + "/dygraph.min.js")) {
     GTEST_SKIP() << "libjs-dygraphs not installed";
   }
   const std::string log = dir_ + "/log.csv";

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 namespace gyrodrift::test {
 
@@ -167,7 +167,7 @@ ReportCheck CheckReportHtml(const std::string& html) {
                                "> has an unquoted attribute");
     }
     for (const auto& a : attributes) {
-      const bool local_anchor = name == "a" && a.name == "href" && io::IsLocalLink(a.value);
+      const bool local_anchor = name == "a" && a.name == "href" && html::IsLocalLink(a.value);
       if ((a.name == "src" || a.name == "href" || a.name == "action") && External(a.value) &&
           !local_anchor) {
         check.problems.push_back("line " + line_of(lt) + ": <" + name + " " + a.name + "=\"" +

@@ -1,4 +1,4 @@
-// A structural check of an HTML report of io::HtmlReport (balanced tags outside <script>/<style>,
+// A structural check of an HTML report of html::HtmlReport (balanced tags outside <script>/<style>,
 // figure data present and non-empty, dygraphs inlined, no external resource; an <a href> may point
 // to a relative path beside or below the report). Test code: the study, fleet and CLI tests check
 // every report they write with it. Cost: O(bytes).

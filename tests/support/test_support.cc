@@ -134,7 +134,7 @@ std::string ThermalLogCsv(int n, std::uint64_t seed, double step_s) {
   return csv;
 }
 
-io::DygraphsAssets FakeDygraphs() {
+html::DygraphsAssets FakeDygraphs() {
   return {"var Dygraph = function () {};" + std::string(60000, ' '), ".x{}"};
 }
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 namespace gyrodrift::test {
 
@@ -61,6 +61,6 @@ void ExpectCleanFailure(const CommandResult& result, int exit_code, const std::s
 
 // Stand-in for dygraphs (the size of the real script, no function): for tests of a page's
 // composition, not of the package.
-io::DygraphsAssets FakeDygraphs();
+html::DygraphsAssets FakeDygraphs();
 
 }  // namespace gyrodrift::test

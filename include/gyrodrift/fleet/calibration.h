@@ -32,7 +32,7 @@
 
 #include "gyrodrift/allan/noise_fit.h"
 #include "gyrodrift/fleet/manifest.h"
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 namespace gyrodrift::fleet {
 
@@ -98,7 +98,7 @@ struct UnitOutputs {
 // Calibrates one unit (never throws for the unit's own data: the error goes into result.error and
 // files is empty). `assets` inline dygraphs into the report.
 UnitOutputs CalibrateUnit(const Manifest& manifest, const UnitSpec& unit,
-                          const io::DygraphsAssets& assets);
+                          const html::DygraphsAssets& assets);
 
 // One row of fleet.csv: unit, axis, verification log and every figure above, as text.
 struct FleetRow {
@@ -142,14 +142,14 @@ struct UnitRun {
   double seconds = -1.0;  // wall time when calibrated in this run, else -1
 };
 UnitRun RunUnit(const Manifest& manifest, const UnitSpec& unit, const std::string& output_dir,
-                bool force, const io::DygraphsAssets& assets);
+                bool force, const html::DygraphsAssets& assets);
 
 // The end of RunFleet: the totals of every unit's run (manifest order, one per unit; UsageError
 // otherwise), outliers flagged, and output_dir/fleet.csv and fleet.html written. `seconds` is the
 // fleet's wall time as the caller measured it.
 FleetResult FinishFleet(const Manifest& manifest, const std::string& output_dir,
                         const std::vector<UnitRun>& units, double seconds,
-                        const io::DygraphsAssets& assets);
+                        const html::DygraphsAssets& assets);
 
 // Calibrates every unit of the manifest into options.output_dir (see the header comment).
 // Throws UsageError / IoError for the fleet as a whole (no output folder, no dygraphs, threads
@@ -161,6 +161,6 @@ FleetResult RunFleet(const Manifest& manifest, const FleetOptions& options,
 // share removed, the bias and the noise terms across units, the rows with outliers flagged and a
 // link to each unit's report.
 std::string RenderFleetReport(const Manifest& manifest, const FleetResult& fleet,
-                              const io::DygraphsAssets& assets);
+                              const html::DygraphsAssets& assets);
 
 }  // namespace gyrodrift::fleet

@@ -1,5 +1,5 @@
 // The study's files: every CSV table and data file at full precision, the fitted compensation
-// models, and one self-contained HTML report (io::HtmlReport, figures with captions saying what
+// models, and one self-contained HTML report (html::HtmlReport, figures with captions saying what
 // to look at), rendered from a StudyResult and written to a folder as one atomic set.
 //
 // Files (names relative to the output folder; docs/demo.md describes each):
@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/study/study.h"
 
 namespace gyrodrift::study {
@@ -23,12 +23,12 @@ namespace gyrodrift::study {
 inline constexpr std::string_view kStudyReportFile = "report.html";
 
 // The whole report: the data, the decomposition and grouping, both modes' tables and figures, the
-// Allan deviations, the settings and the timing. `assets`: io::LoadDygraphs().
-std::string RenderStudyReport(const StudyResult& result, const io::DygraphsAssets& assets);
+// Allan deviations, the settings and the timing. `assets`: html::LoadDygraphs().
+std::string RenderStudyReport(const StudyResult& result, const html::DygraphsAssets& assets);
 
 // Every file listed above, the report last.
 std::vector<StudyFile> RenderStudyFiles(const StudyResult& result,
-                                        const io::DygraphsAssets& assets);
+                                        const html::DygraphsAssets& assets);
 
 // What a record of the run needs beyond the caller's own options: drift_options, the
 // decomposition and selection summaries, stages_s (wall seconds per stage) and compensated_by.

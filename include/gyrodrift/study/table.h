@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 namespace gyrodrift::study {
 
@@ -39,8 +39,8 @@ struct Table {
   // The title, then the rounded rows in aligned columns: the first two left-aligned (names), the
   // rest right-aligned (numbers).
   std::string Text() const;
-  // The rounded rows for io::HtmlReport::AddTable.
-  io::ReportTable Report() const;
+  // The rounded rows for html::HtmlReport::AddTable.
+  html::ReportTable Report() const;
 };
 
 }  // namespace gyrodrift::study

@@ -17,10 +17,10 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
-#include "gyrodrift/io/report.h"
 #include "gyrodrift/simulation/fog_simulator.h"
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "support/report_check.h"
@@ -39,7 +39,7 @@ constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
 bool HaveDygraphs() {
   try {
-    io::LoadDygraphs();
+    html::LoadDygraphs();
     return true;
   } catch (const IoError&) {
     return false;

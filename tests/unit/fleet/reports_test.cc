@@ -15,8 +15,8 @@
 
 #include "fleet/unit_report.h"  // private to src/fleet
 #include "gyrodrift/fleet/calibration.h"
+#include "gyrodrift/html/report.h"
 #include "gyrodrift/io/csv.h"
-#include "gyrodrift/io/report.h"
 #include "support/report_check.h"
 #include "support/test_support.h"
 

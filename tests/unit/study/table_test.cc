@@ -38,7 +38,7 @@ TEST(StudyTable, KeepsFullPrecisionForCsvAndRoundsForDisplay) {
             "  method protocol   rmse train_s\n"
             "  ms-elm paper    0.1235     1.5\n"
             "  poly   causal        -    12.3\n");
-  const io::ReportTable r = t.Report();
+  const html::ReportTable r = t.Report();
   EXPECT_EQ(r.title, "Scores");
   EXPECT_EQ(r.header, t.header);
   EXPECT_EQ(r.rows, t.shown);
@@ -119,7 +119,7 @@ TEST(StudyTable, AHeaderWithoutRowsRendersItsHeader) {
   t.header = {"method", "rmse"};
   EXPECT_EQ(t.Csv(), "method,rmse\n");
   EXPECT_EQ(t.Text(), "Empty\n  method rmse\n");
-  const io::ReportTable r = t.Report();
+  const html::ReportTable r = t.Report();
   EXPECT_EQ(r.caption, "nothing ran");
   EXPECT_TRUE(r.rows.empty());
   EXPECT_TRUE(r.links.empty());  // the study's tables link nothing

@@ -1,4 +1,4 @@
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 #include <algorithm>
 #include <cctype>
@@ -13,7 +13,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
-namespace gyrodrift::io {
+namespace gyrodrift::html {
 namespace {
 
 std::string Escape(std::string_view text) {
@@ -470,4 +470,4 @@ bool IsLocalLink(const std::string& url) {
   return ("/" + url + "/").find("/../") == std::string::npos;
 }
 
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::html

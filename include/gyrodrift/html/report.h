@@ -22,7 +22,7 @@
 #include <string_view>
 #include <vector>
 
-namespace gyrodrift::io {
+namespace gyrodrift::html {
 
 // Where scripts/setup-deps.sh (Debian package libjs-dygraphs) installs dygraphs.
 inline constexpr std::string_view kDygraphsDir = "/usr/share/javascript/dygraphs";
@@ -121,4 +121,4 @@ Decimated DecimateMinMax(const Eigen::Ref<const Eigen::VectorXd>& x,
 // absolute, no "..". Such a link loads nothing when the report opens, so an <a href> may use it.
 bool IsLocalLink(const std::string& url);
 
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::html

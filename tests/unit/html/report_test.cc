@@ -1,6 +1,6 @@
 // The HTML report writer: a small report renders and passes the structural check; the check
 // itself catches each kind of broken report; the min/max decimation keeps the envelope.
-#include "gyrodrift/io/report.h"
+#include "gyrodrift/html/report.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include "support/report_check.h"
 #include "support/test_support.h"
 
-namespace gyrodrift::io {
+namespace gyrodrift::html {
 namespace {
 
 bool HaveDygraphs() {
@@ -84,7 +84,7 @@ TEST(Report, RealDygraphsIsInlinedWithoutItsSourceMap) {
   const test::ReportCheck check = test::CheckReportHtml(html);
   EXPECT_TRUE(check.ok()) << check.Summary();
   const std::string out = test::TempDir("report_small") + "/small.html";
-  WriteFileAtomically(out, html);  // for a look in a browser
+  io::WriteFileAtomically(out, html);  // for a look in a browser
 }
 
 TEST(Report, MissingDygraphsNamesThePackage) {
@@ -163,9 +163,9 @@ TEST(Report, DecimationKeepsTheEnvelopeAndOrder) {
 }
 
 }  // namespace
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::html
 
-namespace gyrodrift::io {
+namespace gyrodrift::html {
 namespace {
 
 // A fleet page links its unit pages: relative paths beside or below the report become <a href>
@@ -192,4 +192,4 @@ TEST(HtmlReport, TableCellsLinkLocalPagesOnly) {
 }
 
 }  // namespace
-}  // namespace gyrodrift::io
+}  // namespace gyrodrift::html
