@@ -25,6 +25,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/study/study.h"
 #include "gyrodrift/study/study_files.h"
+#include "gyrodrift/tasks/evaluate_task.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -64,7 +65,7 @@ study::StudyOptions MakeStudyOptions(const DemoArgs& a) {
   } catch (const UsageError&) {
     ThrowOption("--units", a.units, "one of dph, dps, rads");
   }
-  o.methods = ParseMethods(a.methods, drift::Mode::kCompensate);
+  o.methods = tasks::ParseMethods(a.methods, drift::Mode::kCompensate, "--methods");
   o.duration_s = ParseDuration(a.duration);
   o.ensemble_size = a.ensemble;
   o.realisations = a.realisations;

@@ -165,32 +165,4 @@ std::string InputWarnings(const std::string& path, const std::string& rate_how,
   return out;
 }
 
-// "all" or a comma-separated list; an empty item (a trailing comma) or a repeat is an error: a
-// repeated method would give two model files of one name in the demo.
-std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode) {
-  if (text == "all") return drift::AllMethods(mode);
-  std::vector<drift::Method> methods;
-  size_t start = 0;
-  while (start <= text.size()) {
-    const size_t comma = text.find(',', start);
-    std::string name =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    name.erase(0, name.find_first_not_of(' '));
-    name.erase(name.find_last_not_of(' ') + 1);
-    drift::Method m;
-    try {
-      m = drift::MethodFromString(name);
-    } catch (const UsageError& e) {
-      throw UsageError("--methods = '" + text + "': " + e.what());
-    }
-    if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
-      ThrowOption("--methods", "'" + text + "'", "a list without repeats");
-    }
-    methods.push_back(m);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return methods;
-}
-
 }  // namespace gyrodrift::cli

@@ -61,10 +61,6 @@ std::string InputWarnings(const std::string& path, const std::string& rate_how,
 
 using tasks::RequireModelColumns;
 
-// --methods: "all" (every drift::Method of `mode`) or a comma-separated list without repeats or
-// empty items. Throws UsageError naming --methods.
-std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mode);
-
 using tasks::ReadColumns;
 using tasks::SelectedColumns;
 using tasks::SplitColumns;

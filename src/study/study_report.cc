@@ -341,15 +341,14 @@ html::ReportFigure GroupsFigure(const StudyResult& s) {
 
 // IMF k (0-based), captioned by its group.
 html::ReportFigure ImfFigure(const StudyResult& s, int k) {
+  const std::string group = internal::GroupOf(s.selection, k + 1);
   html::ReportFigure f;
-  f.title =
-      "IMF " + std::to_string(k + 1) + " (" + internal::GroupOf(s.selection, k + 1) + " group)";
+  f.title = "IMF " + std::to_string(k + 1) + " (" + group + " group)";
   f.x_label = "time (h)";
   f.y_label = s.unit;
   f.x = s.time_h;
   f.height_px = 150;
   f.series.push_back(Series("imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)));
-  const std::string group = internal::GroupOf(s.selection, k + 1);
   f.caption = group == "noise"
                   ? "Noise group: should look like noise of steady amplitude, with no trace of the "
                     "temperature programme."
