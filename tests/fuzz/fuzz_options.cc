@@ -13,6 +13,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/gyro_log.h"
 #include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/evaluate_task.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace cli = gyrodrift::cli;
@@ -28,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   for (auto mode : {gyrodrift::drift::Mode::kPredict, gyrodrift::drift::Mode::kCompensate}) {
     try {
-      (void)cli::ParseMethods(text, mode);
+      (void)gyrodrift::tasks::ParseMethods(text, mode, "--methods");
     } catch (const gyrodrift::Error&) {
     }
   }
