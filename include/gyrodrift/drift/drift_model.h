@@ -123,17 +123,17 @@ struct DriftOptions {
 
 // One sub-series and its learner.
 struct SubModel {
-  std::string name;          // "noise", "mixed", "drift", "imf3", "residue", "signal"
-  std::vector<int> imfs;     // IMF indices (1-based) of the training decomposition it sums
-  bool has_residue = false;  // it also holds the residue (and any IMF beyond the last listed)
+  std::string name = {};       // "noise", "mixed", "drift", "imf3", "residue", "signal"
+  std::vector<int> imfs = {};  // IMF indices (1-based) of the training decomposition it sums
+  bool has_residue = false;    // it also holds the residue (and any IMF beyond the last listed)
   // Null for identified compensate-mode sub-models, which have `thermal` instead (and in model
   // files written before identification, the zero function of a noise group).
-  std::shared_ptr<const Learner> learner;
-  std::shared_ptr<const ThermalRegression> thermal;
+  std::shared_ptr<const Learner> learner = {};
+  std::shared_ptr<const ThermalRegression> thermal = {};
   // Predict mode, MS-ELM's noise group (white by the selection's test): its training mean, which
   // predicts it (learner null) when its learner did not beat that mean on held-out data.
-  std::optional<double> mean;
-  std::shared_ptr<const Baseline> baseline;  // a baseline method's one sub-model ("signal")
+  std::optional<double> mean = {};
+  std::shared_ptr<const Baseline> baseline = {};  // a baseline method's one sub-model ("signal")
 };
 
 struct DriftModel {

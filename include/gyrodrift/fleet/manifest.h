@@ -67,9 +67,9 @@ struct Limits {
 };
 
 struct AxisSpec {
-  std::string target;                    // gyro output column
-  std::vector<std::string> temperature;  // temperature column(s), degC
-  std::string truth;                     // "" = none
+  std::string target = {};                    // gyro output column
+  std::vector<std::string> temperature = {};  // temperature column(s), degC
+  std::string truth = {};                     // "" = none
   int line = 0;                          // in the manifest
 };
 

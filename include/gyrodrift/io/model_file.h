@@ -71,11 +71,11 @@ inline constexpr int kOldestReadableModelFormatVersion = 1;
 
 // What the model was trained on, beside the model itself.
 struct ModelFileInfo {
-  std::string target_column;       // CSV column of the gyro output the model was fitted on
+  std::string target_column = {};  // CSV column of the gyro output the model was fitted on
   // CSV column(s) of the temperature, comma-separated in channel order; "" when the model has none
-  std::string temperature_column;
-  std::string source;              // training file, informative only
-  std::string tool_version;        // ignored on writing (the running version is written)
+  std::string temperature_column = {};
+  std::string source = {};        // training file, informative only
+  std::string tool_version = {};  // ignored on writing (the running version is written)
   // Unit of the target column and of every estimate: "dph", "dps" or "rads" (allan::RateUnit
   // names); "" in files written before format 4, which did not record it.
   std::string rate_unit = "dph";

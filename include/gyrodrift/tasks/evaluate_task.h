@@ -68,7 +68,8 @@ std::string EvaluateTableCsv(const drift::EvaluationResult& result);
 
 // What the record was read from, for the sidecar.
 struct EvaluateInput {
-  std::string input, target_column, temperature_column, truth_column, rate_hz_from;
+  std::string input = {}, target_column = {}, temperature_column = {}, truth_column = {},
+      rate_hz_from = {};
   Eigen::Index samples = 0;
 };
 

@@ -233,7 +233,9 @@ TEST(AllanGaps, EveryFlagSetIsComputeAndALongGapOnlyLosesTerms) {
   const AllanResult gapped = ComputeWithGaps(holed, logged, {});
   for (const AllanPoint& p : gapped.points) {
     for (const AllanPoint& q : plain.points) {
-      if (q.m == p.m && p.m <= 16) EXPECT_NEAR(p.dev / q.dev, 1.0, 0.1) << "m = " << p.m;
+      if (q.m == p.m && p.m <= 16) {
+        EXPECT_NEAR(p.dev / q.dev, 1.0, 0.1) << "m = " << p.m;
+      }
     }
   }
 }

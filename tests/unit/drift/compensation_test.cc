@@ -71,7 +71,9 @@ TEST(DriftModel, CompensateModeIdentifiesEveryGroupReferencesOnRequestAndIsThrea
     // (tried wherever there is a regressor beside the intercept)
     EXPECT_EQ(std::isnan(r.cv_rmse_nonlinear), sub.thermal->coefficients.size() == 1) << sub.name;
     EXPECT_EQ(sub.thermal->correction != nullptr, r.nonlinear_units > 0) << sub.name;
-    if (sub.thermal->correction) EXPECT_LT(r.cv_rmse_nonlinear, r.cv_rmse) << sub.name;
+    if (sub.thermal->correction) {
+      EXPECT_LT(r.cv_rmse_nonlinear, r.cv_rmse) << sub.name;
+    }
   }
   o.reference_c = 300.0;
   EXPECT_THROW(o.Validate(), UsageError);
