@@ -30,6 +30,7 @@ struct AllanArgs {
   tasks::AllanSettings settings;  // the defaults are the library's
   LogArgs log;                    // --gaps, --delimiter
   bool quiet = false;
+  CLI::Option* rate_option = nullptr;  // not given: the rate is read from time_s
 };
 
 std::string Num(double v) { return std::isfinite(v) ? fmt::format("{:.4g}", v) : "-"; }
@@ -89,7 +90,12 @@ Eigen::VectorXd JoinRecords(const Eigen::VectorXd& column, const std::vector<Eig
 
 void Run(const AllanArgs& a) {
   RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
-  a.settings.Validate();  // every option error before any file is read
+  // Every option error before any file is read; without --rate-hz the rate, and what depends on
+  // it (taus a whole number of samples), is checked once time_s gave it.
+  const bool rate_given = a.rate_option->count() > 0;
+  tasks::AllanSettings settings = a.settings;
+  if (rate_given) settings.Validate();
+  std::string rate_how = "given";
 
   // Only the analysed column is read as values (time_s as its steps, io::TimeAxis, unless they
   // show a gap or a fault); the column is moved out of the table before the analysis, which
@@ -102,6 +108,14 @@ void Run(const AllanArgs& a) {
     std::vector<Eigen::Index> starts;
     io::CsvTable table = ReadLog(a.input, a.log, &notes, &starts, {a.column}, &logged);
     if (!a.quiet) time_note = NonUniformTimeNote(table);
+    if (!rate_given) {
+      settings.rate_hz = io::ResolveSampleRate(table, 0.0, &rate_how);
+      if (rate_how != "time_s") {
+        throw UsageError("--rate-hz is required: " + a.input +
+                         " has no time_s column to read the sample rate from");
+      }
+      settings.Validate();
+    }
     Eigen::VectorXd column = table.TakeColumn(a.column);
     RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", column,
                          "its Allan deviation is zero at every tau (a logging fault?)");
@@ -109,7 +123,7 @@ void Run(const AllanArgs& a) {
     return JoinRecords(column, starts, &logged);
   }();
   if (a.log.gaps == "interpolate") logged.clear();  // the made-up rows are analysed as data
-  const tasks::AllanRun r = tasks::RunAllan(std::move(data), logged, a.settings);
+  const tasks::AllanRun r = tasks::RunAllan(std::move(data), logged, settings);
 
   std::vector<io::CsvColumn> columns(5);
   const char* names[] = {"tau_s", "dev", "dev_lo", "dev_hi", "n_terms"};
@@ -127,10 +141,11 @@ void Run(const AllanArgs& a) {
     columns[4].values[k] = static_cast<double>(p.n_terms);
   }
   nlohmann::json sidecar = SidecarHeader("allan");
-  sidecar.update(tasks::AllanRecord(r, a.settings, logged));
+  sidecar.update(tasks::AllanRecord(r, settings, logged));
   sidecar["options"]["input"] = a.input;
   sidecar["options"]["column"] = a.column;
   sidecar["options"]["gaps"] = a.log.gaps;
+  sidecar["options"]["rate_hz_from"] = rate_how;  // "given" (--rate-hz) or "time_s"
   io::WriteFilesAtomically(
       {{a.output, io::RenderCsv(columns)}, {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (a.quiet) return;
@@ -142,6 +157,9 @@ void Run(const AllanArgs& a) {
   }
   if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("{}", notes);
+  if (!rate_given) {
+    fmt::print("sample rate: {} Hz (from the median step of time_s)\n", settings.rate_hz);
+  }
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));
 }
 
@@ -166,9 +184,10 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
       ->required()
       ->check(kInputFile);
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
-  BindSetting(
-      cmd->add_option("--rate-hz", args->settings.rate_hz, "sample rate in Hz (tau0 = 1 / rate)")
-          ->required(),
+  args->rate_option = BindSetting(
+      cmd->add_option("--rate-hz", args->settings.rate_hz,
+                      "sample rate in Hz (tau0 = 1 / rate); not given: 1 / the median step of the "
+                      "time_s column (a log without one needs it)"),
       {"rate_hz"});
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();

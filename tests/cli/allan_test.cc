@@ -86,6 +86,35 @@ TEST(CliAllan, ListGridIndexColumnAndOtherEstimators) {
   EXPECT_EQ(test::ReadCsvMatrix(dir + "/all.csv").rows(), 1500);
 }
 
+// Without --rate-hz the rate is 1 / the median step of time_s: the same numbers as given, said.
+TEST(CliAllan, RateFromTimeColumnWhenNotGiven) {
+  const std::string dir = test::TempDir("cli-allan-rate");
+  const Eigen::Index n = 4000;
+  Rng white(9, StreamId("arw"));
+  Eigen::VectorXd rate(n), time(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    rate[i] = 0.3 * white.Normal();
+    time[i] = 1000.0 + 0.5 * static_cast<double>(i);  // 2 Hz
+  }
+  const std::string log = dir + "/imu.csv";
+  io::WriteCsv(log, {{"time_s", time}, {"rate_dph", rate}});
+  const auto read = test::RunCli("allan " + Q(log) + " -c rate_dph -o " + Q(dir + "/read.csv"));
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  EXPECT_NE(read.out.find("sample rate: 2 Hz (from the median step of time_s)"),
+            std::string::npos)
+      << read.out;
+  const auto given =
+      test::RunCli("allan " + Q(log) + " -c rate_dph --rate-hz 2 -o " + Q(dir + "/given.csv"));
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  EXPECT_EQ(given.out.find("sample rate:"), std::string::npos) << given.out;
+  EXPECT_EQ(io::ReadTextFile(dir + "/read.csv"), io::ReadTextFile(dir + "/given.csv"));
+  const auto j = nlohmann::json::parse(io::ReadTextFile(dir + "/read.csv.json"));
+  EXPECT_EQ(j["options"]["rate_hz"], 2.0);
+  EXPECT_EQ(j["options"]["rate_hz_from"], "time_s");
+  const auto g = nlohmann::json::parse(io::ReadTextFile(dir + "/given.csv.json"));
+  EXPECT_EQ(g["options"]["rate_hz_from"], "given");
+}
+
 TEST(CliAllan, HelpShowsAWorkedExample) {
   const auto r = test::RunCli("allan --help");
   EXPECT_EQ(r.exit_code, 0);
@@ -109,6 +138,7 @@ TEST(CliAllan, BadInputGivesOneLineErrorAndNoOutput) {
     std::ofstream(dir + "/inf.csv") << "rate_dph\n1.0\ninf\n2.0\n";
     std::ofstream(dir + "/short.csv") << "rate_dph\n1.0\n";
     std::ofstream(dir + "/constant.csv") << "rate_dph\n3\n3\n3\n3\n";
+    std::ofstream(dir + "/untimed.csv") << "rate_dph\n1\n2\n3\n1\n2\n";
   }
   const BadCase cases[] = {
       {"no file", "$DIR/missing.csv -c rate_dph --rate-hz 1 -o $OUT", 2, "no such file"},
@@ -121,7 +151,8 @@ TEST(CliAllan, BadInputGivesOneLineErrorAndNoOutput) {
       {"tau beyond record", "$LOG -c rate_dph --rate-hz 1 --taus 1,150 -o $OUT", 3, "tau 150"},
       {"rate zero", "$LOG -c rate_dph --rate-hz 0 -o $OUT", 2, "--rate-hz = 0"},
       {"rate negative", "$LOG -c rate_dph --rate-hz -5 -o $OUT", 2, "--rate-hz"},
-      {"rate missing", "$LOG -c rate_dph -o $OUT", 2, "rate-hz"},
+      {"rate missing, no time_s", "$DIR/untimed.csv -c rate_dph -o $OUT", 2,
+       "--rate-hz is required: " + dir + "/untimed.csv has no time_s column"},
       {"non-positive tau", "$LOG -c rate_dph --rate-hz 1 --taus 1,0,10 -o $OUT", 2, "--taus"},
       {"negative tau", "$LOG -c rate_dph --rate-hz 1 --taus -3 -o $OUT", 2, "--taus"},
       {"junk tau", "$LOG -c rate_dph --rate-hz 1 --taus 1,x -o $OUT", 2, "--taus"},
