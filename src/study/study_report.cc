@@ -37,10 +37,26 @@ html::ReportSeries Measured(std::string name, Eigen::VectorXd v) {
   return s;
 }
 
+// A figure over time in hours: every figure's frame but its series and caption.
+html::ReportFigure TimeFigure(std::string title, std::string y_label, Eigen::VectorXd x_h) {
+  html::ReportFigure f;
+  f.title = std::move(title);
+  f.x_label = "time (h)";
+  f.y_label = std::move(y_label);
+  f.x = std::move(x_h);
+  return f;
+}
+
 // The paper and causal rows of a single model are one computation (it never decomposes): a figure
 // draws one of them.
 bool DuplicateRow(drift::Method method, const std::string& protocol) {
   return !drift::UsesDecomposition(method) && protocol == drift::ToString(drift::Protocol::kCausal);
+}
+
+// A compensate row's curve: the method, and its protocol where a log's evaluation has two.
+std::string CompensateRowName(const StudyResult& s, const StudyResult::CompensateRow& r) {
+  const bool both = !s.simulated && drift::UsesDecomposition(r.method);
+  return std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : "");
 }
 
 // Trailing mean over w samples (the first w - 1 use what exists): shows the slow structure of a
@@ -160,11 +176,9 @@ html::ReportFigure OutputFigure(const StudyResult& s) {
   const double split_h = s.predict.split_index < s.time_h.size() ? s.time_h[s.predict.split_index]
                                                                  : s.time_h[s.time_h.size() - 1];
   const double end_h = s.time_h[s.time_h.size() - 1];
-  html::ReportFigure f;
-  f.title = s.simulated ? "Run A: gyro output and true thermal drift" : "Gyro output";
-  f.x_label = "time (h)";
-  f.y_label = s.target_name + " (" + s.unit + ")";
-  f.x = s.time_h;
+  html::ReportFigure f =
+      TimeFigure(s.simulated ? "Run A: gyro output and true thermal drift" : "Gyro output",
+                 s.target_name + " (" + s.unit + ")", s.time_h);
   f.series.push_back(Series("output", s.output));
   if (s.simulated) f.series.push_back(Reference("true drift", s.truth));
   f.shades.push_back({split_h, end_h, "predict-mode test block (last 30 %)"});
@@ -181,12 +195,10 @@ html::ReportFigure OutputFigure(const StudyResult& s) {
 }
 
 html::ReportFigure TemperatureFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = s.simulated ? "Run A: temperatures" : "Temperature channel";
-  f.x_label = "time (h)";
   // A user's temperature column may be in any unit (raw counts, for one): its name, not a unit.
-  f.y_label = s.simulated ? "temperature (degC)" : s.temperature_name;
-  f.x = s.time_h;
+  html::ReportFigure f =
+      TimeFigure(s.simulated ? "Run A: temperatures" : "Temperature channel",
+                 s.simulated ? "temperature (degC)" : s.temperature_name, s.time_h);
   if (s.simulated) {
     f.series.push_back(Series("chamber", s.run_a.chamber_c));
     f.series.push_back(Series("case sensor (model input)", s.run_a.temperature_c));
@@ -204,12 +216,10 @@ html::ReportFigure TemperatureFigure(const StudyResult& s) {
 
 // Simulated studies only.
 html::ReportFigure RunBFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = "Run B: gyro output, true drift and temperature (test run for compensation)";
-  f.x_label = "time (h)";
-  f.y_label = "deg/h";
+  html::ReportFigure f =
+      TimeFigure("Run B: gyro output, true drift and temperature (test run for compensation)",
+                 "deg/h", s.run_b.time_s / 3600.0);
   f.y2_label = "case sensor (degC)";
-  f.x = s.run_b.time_s / 3600.0;
   f.series.push_back(Series("output", s.run_b.rate_dph));
   f.series.push_back(Reference("true drift", s.run_b.drift_dph));
   html::ReportSeries t = Series("case sensor (right axis)", s.run_b.temperature_c);
@@ -306,11 +316,8 @@ html::ReportFigure EnergyFigure(const StudyResult& s) {
 }
 
 html::ReportFigure GroupsFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = "The grouped sub-series (noise + mixed + drift = output)";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = s.time_h;
+  html::ReportFigure f =
+      TimeFigure("The grouped sub-series (noise + mixed + drift = output)", s.unit, s.time_h);
   for (const auto& g : s.selection.groups) {
     f.series.push_back(Series(std::string(sel::ToString(g.kind)), g.series));
     // A user's log carries its sensor bias in the drift group, which would flatten the other
@@ -342,11 +349,8 @@ html::ReportFigure GroupsFigure(const StudyResult& s) {
 // IMF k (0-based), captioned by its group.
 html::ReportFigure ImfFigure(const StudyResult& s, int k) {
   const std::string group = internal::GroupOf(s.selection, k + 1);
-  html::ReportFigure f;
-  f.title = "IMF " + std::to_string(k + 1) + " (" + group + " group)";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = s.time_h;
+  html::ReportFigure f =
+      TimeFigure("IMF " + std::to_string(k + 1) + " (" + group + " group)", s.unit, s.time_h);
   f.height_px = 150;
   f.series.push_back(Series("imf" + std::to_string(k + 1), s.decomposition.imfs.col(k)));
   f.caption = group == "noise"
@@ -366,11 +370,7 @@ html::ReportFigure ImfFigure(const StudyResult& s, int k) {
 }
 
 html::ReportFigure ResidueFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = "Residue";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = s.time_h;
+  html::ReportFigure f = TimeFigure("Residue", s.unit, s.time_h);
   f.height_px = 150;
   f.series.push_back(Series("residue", s.decomposition.residue));
   f.caption = "The slow trend left after the last IMF (part of the drift group).";
@@ -389,11 +389,8 @@ void AddDecompositionSection(html::HtmlReport& report, const StudyResult& s) {
 
 // test_h: the times of the predict-mode test block.
 html::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
-  html::ReportFigure f;
-  f.title = "Predict mode: one-step-ahead predictions on the test block";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = test_h;
+  html::ReportFigure f =
+      TimeFigure("Predict mode: one-step-ahead predictions on the test block", s.unit, test_h);
   // MS-ELM under both protocols and the best method that does not decompose (a single model or
   // a baseline); every row is in predict_estimates.csv.
   if (!s.simulated) f.series.push_back(Measured("measured output", s.predict.reference));
@@ -420,15 +417,13 @@ html::ReportFigure PredictionsFigure(const StudyResult& s, const Eigen::VectorXd
 }
 
 html::ReportFigure PredictResidualsFigure(const StudyResult& s, const Eigen::VectorXd& test_h) {
-  html::ReportFigure f;
   const Eigen::Index w =
       std::clamp<Eigen::Index>(static_cast<Eigen::Index>(std::lround(300.0 * s.rate_hz)), 1,
                                std::max<Eigen::Index>(1, test_h.size() / 20));
-  f.title = "Predict mode: residuals (reference - prediction), trailing mean over " +
-            std::to_string(w) + " samples";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = test_h;
+  html::ReportFigure f =
+      TimeFigure("Predict mode: residuals (reference - prediction), trailing mean over " +
+                     std::to_string(w) + " samples",
+                 s.unit, test_h);
   for (const auto& r : s.predict.rows) {
     if (!drift::UsesDecomposition(r.method) && r.protocol == drift::Protocol::kCausal) continue;
     std::string name = std::string(drift::ToString(r.method));
@@ -452,19 +447,14 @@ void AddPredictSection(html::HtmlReport& report, const StudyResult& s) {
 }
 
 html::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = s.simulated
-                ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
-                : "Compensate mode: drift estimated from temperature vs the measured output";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = s.compensate_time_h;
+  html::ReportFigure f = TimeFigure(
+      s.simulated ? "Compensate mode: drift estimated from temperature on run B vs the true drift"
+                  : "Compensate mode: drift estimated from temperature vs the measured output",
+      s.unit, s.compensate_time_h);
   if (!s.simulated) f.series.push_back(Measured("measured output", s.compensate_reference));
   for (const auto& r : s.compensate) {
     if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
-    const bool both = !s.simulated && drift::UsesDecomposition(r.method);
-    f.series.push_back(Series(
-        std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""), r.estimate));
+    f.series.push_back(Series(CompensateRowName(s, r), r.estimate));
   }
   if (s.simulated) f.series.push_back(Reference("true drift (run B)", s.compensate_reference));
   f.caption =
@@ -479,17 +469,11 @@ html::ReportFigure CompensateEstimatesFigure(const StudyResult& s) {
 }
 
 html::ReportFigure CompensateResidualsFigure(const StudyResult& s) {
-  html::ReportFigure f;
-  f.title = "Compensate mode: residual drift (reference - estimate)";
-  f.x_label = "time (h)";
-  f.y_label = s.unit;
-  f.x = s.compensate_time_h;
+  html::ReportFigure f = TimeFigure("Compensate mode: residual drift (reference - estimate)",
+                                    s.unit, s.compensate_time_h);
   for (const auto& r : s.compensate) {
     if (!s.simulated && DuplicateRow(r.method, r.protocol)) continue;
-    const bool both = !s.simulated && drift::UsesDecomposition(r.method);
-    f.series.push_back(
-        Series(std::string(drift::ToString(r.method)) + (both ? " " + r.protocol : ""),
-               s.compensate_reference - r.estimate));
+    f.series.push_back(Series(CompensateRowName(s, r), s.compensate_reference - r.estimate));
   }
   f.caption =
       s.simulated
@@ -513,8 +497,9 @@ void AddCompensateSection(html::HtmlReport& report, const StudyResult& s) {
 
 // The report page built from its parts, in the order of the study's steps.
 std::string RenderStudyReport(const StudyResult& s, const html::DygraphsAssets& assets) {
-  html::HtmlReport report(s.simulated ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
-                                    : "gyrodrift demo: " + s.source);
+  html::HtmlReport report(s.simulated
+                              ? "gyrodrift demo: thermal drift of a simulated navigation FOG"
+                              : "gyrodrift demo: " + s.source);
   AddIntroduction(report, s);
   AddRecordSection(report, s);
   AddDecompositionSection(report, s);
