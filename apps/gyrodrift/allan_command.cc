@@ -158,7 +158,7 @@ void Run(const AllanArgs& a) {
   if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("{}", notes);
   if (!rate_given) {
-    fmt::print("sample rate: {} Hz (from the median step of time_s)\n", settings.rate_hz);
+    fmt::print("sample rate: {} Hz ({})\n", settings.rate_hz, RateSourceText(rate_how));
   }
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));
 }

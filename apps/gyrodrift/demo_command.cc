@@ -96,9 +96,7 @@ study::StudyLog ReadStudyLog(const DemoArgs& a) {
   // A given rate is taken as given (the study checks its range), never replaced by time_s's.
   std::string how = "given";
   log.rate_hz = a.rate_option->count() > 0 ? a.rate_hz : ResolveSampleRate(table, 0.0, &how);
-  log.rate_source = how == "given"    ? "given by --rate-hz"
-                    : how == "time_s" ? "from the median step of time_s"
-                                      : "assumed 1 Hz (no --rate-hz, no time_s column)";
+  log.rate_source = RateSourceText(how);
   log.time_note = notes + NonUniformTimeNote(table);
   if (!log.time_note.empty() && log.time_note.back() == '\n') log.time_note.pop_back();
   log.read_s = Seconds(start);

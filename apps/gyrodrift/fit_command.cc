@@ -170,8 +170,7 @@ void Run(const FitArgs& a) {
     PrintModel(axis, fit.options);
   }
   fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", fit.options.features.rate_hz,
-             run.rate_how == "time_s" ? "from the median step of time_s" : run.rate_how, notes,
-             a.output);
+             RateSourceText(run.rate_how), notes, a.output);
 }
 
 const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {

@@ -231,7 +231,9 @@ TEST_F(FitCli, WarnsUpFrontOfAnAssumedRateAndATemperatureInCounts) {
                         "-o '" + model + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.rfind(rate_warning, 0), 0u) << r.out;  // the first line, before the model
-  EXPECT_NE(r.out.find("sample rate: 1 Hz (default)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("sample rate: 1 Hz (assumed: no --rate-hz and no time_s column)"),
+            std::string::npos)
+      << r.out;
   // Given, the rate is no assumption.
   r = test::RunCli("fit '" + untimed + "' -t rate_dph -T temperature_c --mode compensate "
                    "--rate-hz 1 -o '" + model + "'");
