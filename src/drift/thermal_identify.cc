@@ -39,6 +39,12 @@ constexpr int kLeastSkillBlocks = 4;
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
 constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
 constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
+// A log of which at most this share of rows was logged (a duty-cycled log: 5 s of every 300 s
+// leaves 480 samples of 8 h) has every coefficient but the intercept shrunk by a ridge worth
+// kSparsePriorSamples logged samples at the regressor's mean square, in the fold fits and the
+// final fit [choice, docs/drift.md 4.8: on duty-cycled family units no unit worse than raw].
+constexpr double kSparseLoggedShare = 0.5;
+constexpr double kSparsePriorSamples = 16.0;
 
 // Standard deviation about the mean (population).
 double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
@@ -259,7 +265,7 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   for (int c = 0; c < channels; ++c) {
     for (double tau : options.Grid(report.duration_s)) search.candidates.push_back({c, tau});
   }
-  report.hysteresis_tried = options.TriesHysteresis(report.duration_s);
+  report.hysteresis_tried = options.TriesHysteresis(weight.sum() / model.rate_hz);
   if (report.hysteresis_tried) search.widths_k = options.hysteresis_widths_k;
   search.layout = {channels, options.max_power, static_cast<int>(search.candidates.size()),
                    options.max_power + 1, static_cast<int>(search.widths_k.size())};
@@ -269,10 +275,12 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                              search.layout, search.widths_k, heating, cooling, search.candidates);
   const double mean = y.dot(weight) / weight.sum();
   search.yc = ((y.array() - mean) * weight.array()).matrix();
+  report.prior_samples =
+      weight.sum() <= kSparseLoggedShare * static_cast<double>(n) ? kSparsePriorSamples : 0.0;
   // The choice is scored on the time blocks; the held-out regimes and range ends are reported
   // (scoring or gating on them chose worse models on the family: docs/drift.md 4.8).
-  search.scores = std::make_unique<internal::FoldScores>(search.x, search.yc, weight, folds,
-                                                         1u << internal::kTimeBlocks);
+  search.scores = std::make_unique<internal::FoldScores>(
+      search.x, search.yc, weight, folds, 1u << internal::kTimeBlocks, report.prior_samples);
   search.result = internal::SearchStructure(
       *search.scores, search.layout,
       {options.max_states, options.max_condition, options.standard_errors, heating != cooling});
@@ -308,8 +316,8 @@ void ReportHeldOut(const Search& search, CalibrationReport& report) {
   report.regime_rmse_static = regimes(s.static_cubic);
 }
 
-// The chosen columns refitted on the logged samples (QR of the unit-scaled design), in the
-// model's coefficient slots (a state whose rate did not enter keeps a rate coefficient of 0), with
+// The chosen columns refitted on the logged samples (QR of the unit-scaled design, below it the
+// rows of the report's ridge on every column but the intercept), in the model's coefficient slots (a state whose rate did not enter keeps a rate coefficient of 0), with
 // their covariance: the residual variance inflated by its correlation (batch means over
 // kBlockS). Returns the residual at every row (0 where not logged).
 Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
@@ -331,8 +339,15 @@ Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
     scale[i] = 1.0 / std::max(xs.col(i).norm(), std::numeric_limits<double>::min());
   }
   const Eigen::MatrixXd xn = xs * scale.asDiagonal();
+  const Eigen::Index prior_rows = model.report.prior_samples > 0.0 ? p - 1 : 0;
+  Eigen::MatrixXd xa = Eigen::MatrixXd::Zero(rows + prior_rows, p);
+  Eigen::VectorXd ya = Eigen::VectorXd::Zero(rows + prior_rows);
+  xa.topRows(rows) = xn;
+  ya.head(rows) = ys;
+  const double prior = std::sqrt(model.report.prior_samples / static_cast<double>(rows));
+  for (Eigen::Index i = 1; i <= prior_rows; ++i) xa(rows + i - 1, i) = prior;
   const Eigen::VectorXd fitted =
-      scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xn).solve(ys);
+      scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xa).solve(ya);
   // Where each fitted column sits among the model's m regressors.
   std::vector<Eigen::Index> slot;
   Eigen::Index k = 1 + best.static_power * model.channels();

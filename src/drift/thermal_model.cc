@@ -59,7 +59,7 @@ void ThermalModelOptions::Validate() const {
   RequireInRange("standard_errors", standard_errors, 0.0, 10.0);
 }
 
-bool ThermalModelOptions::TriesHysteresis(double duration_s) const {
+bool ThermalModelOptions::TriesHysteresis(double logged_s) const {
   if (hysteresis_widths_k.empty()) return false;
   switch (hysteresis) {
     case HysteresisTerm::kOn:
@@ -69,7 +69,7 @@ bool ThermalModelOptions::TriesHysteresis(double duration_s) const {
     case HysteresisTerm::kAuto:
       break;
   }
-  return duration_s >= kHysteresisAutoMinDurationS;
+  return logged_s >= kHysteresisAutoMinDurationS;
 }
 
 std::string_view ToString(HysteresisTerm term) {

@@ -270,6 +270,10 @@ std::string CalibrationReport::Summary() const {
              gain(regime_rmse, regime_rmse_constant).c_str(),
              gain(regime_rmse, regime_rmse_static).c_str(), cv_rmse, cv_rmse_constant,
              skill_text.c_str(), condition, hysteresis_tried ? "tried" : "not tried") +
+         (prior_samples > 0.0 ? Format("; coefficients shrunk by a ridge worth %g logged samples "
+                                       "(most rows made up across gaps)",
+                                       prior_samples)
+                              : std::string()) +
          (std::isnan(cv_rmse_nonlinear) ? std::string()
           : nonlinear_units > 0
               ? Format("; nonlinear correction %d units, C %g (cross-validated RMSE %.4g)",

@@ -26,9 +26,12 @@ void ForLoggedRuns(const Eigen::VectorXd& weight, Eigen::Index begin, Eigen::Ind
 }
 
 // Least squares on the columns `cols` of Gram G and moment b, solved with unit-diagonal scaling
-// and a tiny ridge (the subsets' columns can be close to collinear).
+// and a tiny ridge (the subsets' columns can be close to collinear), plus the ridge of
+// `prior_samples` samples on every column but the intercept (column 0, whose Gram entry counts
+// the samples).
 Eigen::VectorXd SolveSubset(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
-                            const std::vector<int>& cols) {
+                            const std::vector<int>& cols, double prior_samples) {
+  const double prior = prior_samples / std::max(g(0, 0), 1.0);
   const Eigen::Index m = static_cast<Eigen::Index>(cols.size());
   Eigen::MatrixXd a(m, m);
   Eigen::VectorXd rhs(m), d(m);
@@ -38,7 +41,7 @@ Eigen::VectorXd SolveSubset(const Eigen::MatrixXd& g, const Eigen::VectorXd& b,
   for (Eigen::Index i = 0; i < m; ++i) {
     rhs[i] = b[cols[i]] * d[i];
     for (Eigen::Index j = 0; j < m; ++j) a(i, j) = g(cols[i], cols[j]) * d[i] * d[j];
-    a(i, i) += kRelativeRidge;
+    a(i, i) += kRelativeRidge + (cols[i] != 0 ? prior : 0.0);
   }
   Eigen::VectorXd w = a.ldlt().solve(rhs);
   return w.cwiseProduct(d);
@@ -62,8 +65,8 @@ double Condition(const Eigen::MatrixXd& g, const std::vector<int>& cols) {
 
 FoldScores::FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
                        const Eigen::VectorXd& weight, const std::vector<FoldRows>& folds,
-                       unsigned scored)
-    : x_(x), yc_(yc), weight_(weight) {
+                       unsigned scored, double prior_samples)
+    : x_(x), yc_(yc), weight_(weight), prior_samples_(prior_samples) {
   const Eigen::Index m = x.cols();
   g_total_ = Eigen::MatrixXd::Zero(m, m);
   b_total_ = Eigen::VectorXd::Zero(m);
@@ -101,7 +104,7 @@ FoldScores::FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
 }
 
 Eigen::VectorXd FoldScores::Weights(const Fold& f, const std::vector<int>& cols) const {
-  return SolveSubset(f.g_train, f.b_train, cols);
+  return SolveSubset(f.g_train, f.b_train, cols, prior_samples_);
 }
 
 Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols, bool every_fold) const {

@@ -38,9 +38,11 @@ class FoldScores {
 
   // x: N x M design; yc: the centred target (0 where not logged); weight: 1 logged, 0 made up.
   // Only the folds of `scored` schemes enter Mean and StandardError (the others serve
-  // SchemeMean).
+  // SchemeMean). prior_samples: the fits' ridge on every column but the intercept, in training
+  // samples at the column's mean square (CalibrationReport::prior_samples).
   FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc, const Eigen::VectorXd& weight,
-             const std::vector<FoldRows>& folds, unsigned scored = 1u << kTimeBlocks);
+             const std::vector<FoldRows>& folds, unsigned scored = 1u << kTimeBlocks,
+             double prior_samples = 0.0);
 
   const std::vector<Fold>& folds() const { return folds_; }
   const Eigen::MatrixXd& gram() const { return g_total_; }  // of every logged row
@@ -64,6 +66,7 @@ class FoldScores {
   const Eigen::MatrixXd& x_;
   const Eigen::VectorXd& yc_;
   const Eigen::VectorXd& weight_;
+  double prior_samples_;
   Eigen::MatrixXd g_total_;
   Eigen::VectorXd b_total_;
   std::vector<Fold> folds_;

@@ -96,6 +96,7 @@ json ThermalJson(const drift::ThermalRegression& t) {
             {"cv_rmse_constant", Number(r.cv_rmse_constant)},
             {"skill", Number(r.skill)},
             {"condition", Number(r.condition)},
+            {"prior_samples", Number(r.prior_samples)},
             {"level", r.level},
             {"best_level", r.best_level},
             {"regime_folds", r.regime_folds},
@@ -162,6 +163,7 @@ drift::CalibrationReport ReadReport(const Node& r) {
   report.cv_rmse_constant = r["cv_rmse_constant"].Double();
   report.skill = r["skill"].Double();
   report.condition = r["condition"].Double();
+  report.prior_samples = r.raw().contains("prior_samples") ? r["prior_samples"].Double() : 0.0;
   if (r.raw().contains("level")) {  // version 7
     report.level = static_cast<int>(r["level"].Int(0, drift::CalibrationReport::kHysteresis));
     report.best_level =

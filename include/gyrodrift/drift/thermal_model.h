@@ -76,7 +76,7 @@ namespace gyrodrift::drift {
 
 // Whether the identification tries the hysteresis term H_w (header comment).
 enum class HysteresisTerm {
-  kAuto,  // for calibration runs of at least kHysteresisAutoMinDurationS
+  kAuto,  // for calibration runs of at least kHysteresisAutoMinDurationS of logged samples
   kOn,    // always
   kOff,   // never
 };
@@ -86,7 +86,8 @@ HysteresisTerm HysteresisTermFromString(std::string_view name);  // "auto", "on"
 // kAuto's shortest calibration run, s [choice, measured on the independent gyro family,
 // docs/drift.md 4.7]: on 16-h and 12-h calibrations the term lowered the error on the median and
 // the worst units; on 8-h ones it fitted slow noise on units without hysteresis and lost more in
-// the worst tenth than it won.
+// the worst tenth than it won. The logged samples count, not the span: on duty-cycled 16-h logs
+// (5 s of every 300 s) the term made unit 2 worse than raw (docs/drift.md 4.8).
 inline constexpr double kHysteresisAutoMinDurationS = 12.0 * 3600.0;
 
 struct ThermalModelOptions {
@@ -123,8 +124,8 @@ struct ThermalModelOptions {
   void Validate() const;  // throws OptionError naming the field
   // The candidate constants for a run of `duration_s` seconds.
   std::vector<double> Grid(double duration_s) const;
-  // Whether a run of `duration_s` seconds tries the hysteresis term.
-  bool TriesHysteresis(double duration_s) const;
+  // Whether a run of `logged_s` seconds of logged samples tries the hysteresis term.
+  bool TriesHysteresis(double logged_s) const;
 };
 
 // One thermal state: `order` cascaded first-order lags of channel `channel` with constant tau_s.
@@ -182,6 +183,9 @@ struct CalibrationReport {
   // NaN when the run is shorter than 4 such blocks (not measured).
   double skill = 0.0;
   double condition = 0.0;                      // of the chosen regressors' scaled Gram matrix
+  // The ridge on every coefficient but the intercept, in logged samples at the regressor's mean
+  // square (0: none; a log most of whose rows were made up across gaps gets one).
+  double prior_samples = 0.0;
   // Nonlinear option: the correction's hidden units (0 = none kept) and ridge C, and the
   // cross-validated RMSE with it (NaN when not tried).
   int nonlinear_units = 0;
@@ -275,11 +279,11 @@ struct ThermalIdentification {
   // (CheckRecordStarts): the lag states restart at each (from the record's first temperature, as
   // at the start of a run), so no state runs across the break, and no ramp or dwell spans two
   // records; the regressors of all records are fitted together.
-  std::vector<Eigen::Index> record_starts;
+  std::vector<Eigen::Index> record_starts = {};
   // Empty, or one flag per sample: false marks a sample made up across a gap of a duty-cycled
   // log (interpolated temperature, so the lag states run across the gap); the fit, the folds and
   // every figure of the report use the logged samples only, and y is not read elsewhere.
-  std::vector<bool> logged;
+  std::vector<bool> logged = {};
   // Also try the correction of the header comment, its hidden weights drawn from a seed derived
   // from `seed` through the named stream "thermal-correction".
   bool nonlinear = false;
