@@ -57,7 +57,8 @@ void AddThermalOptions(CLI::App* cmd, DriftArgs* a) {
   BindSetting(cmd->add_option("--hysteresis", a->settings.hysteresis,
                               "compensate mode, identified methods: the thermal models' "
                               "hysteresis term (a bias that differs between heating and "
-                              "cooling), auto (tried on calibrations with 12 h or more of logged samples) | on | off; "
+                              "cooling), auto (tried on calibrations with 12 h or more of logged "
+                              "samples) | on | off; "
                               "docs/drift.md 4.7")
                   ->capture_default_str(),
               {"hysteresis"});

@@ -317,9 +317,10 @@ void ReportHeldOut(const Search& search, CalibrationReport& report) {
 }
 
 // The chosen columns refitted on the logged samples (QR of the unit-scaled design, below it the
-// rows of the report's ridge on every column but the intercept), in the model's coefficient slots (a state whose rate did not enter keeps a rate coefficient of 0), with
-// their covariance: the residual variance inflated by its correlation (batch means over
-// kBlockS). Returns the residual at every row (0 where not logged).
+// rows of the report's ridge on every column but the intercept), in the model's coefficient slots
+// (a state whose rate did not enter keeps a rate coefficient of 0), with their covariance: the
+// residual variance inflated by its correlation (batch means over kBlockS). Returns the residual at
+// every row (0 where not logged).
 Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
                             const Eigen::VectorXd& weight, const Search& search,
                             ThermalRegression& model, Eigen::MatrixXd& gram) {

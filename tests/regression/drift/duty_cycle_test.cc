@@ -133,7 +133,8 @@ TEST(DutyCycledUnit, NoShippedUnitIsMadeWorse) {
     const io::CsvTable train = ReadUnitFile(u + "_train16h.csv.gz");
     const Eigen::VectorXd mission_t =
         ReadUnitFile(u + "_test8h_mission.csv.gz").Column("temperature_c");
-    const Eigen::VectorXd truth = ReadUnitFile(u + "_test8h_mission_truth.csv.gz").Column("drift_dph");
+    const Eigen::VectorXd truth =
+        ReadUnitFile(u + "_test8h_mission_truth.csv.gz").Column("drift_dph");
     const std::string bursts =
         WriteBursts(train, 5.0, 300.0, test::TempDir("duty_cycle") + "/" + u + "_bursts.csv");
     std::vector<bool> logged;

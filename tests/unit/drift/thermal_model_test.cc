@@ -397,6 +397,37 @@ TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
                DataError);
 }
 
+// A log of which at most half the rows were logged (duty-cycled) gets the ridge worth 16 logged
+// samples and, its logged samples short of 12 h, no hysteresis term; a continuous 16-h log gets
+// neither ridge nor the rule (docs/drift.md 4.8).
+TEST(ThermalModel, AMostlyUnloggedRunIsShrunkAndTriesNoHysteresis) {
+  const Eigen::VectorXd t = Programme(16.0);
+  const Eigen::VectorXd s = State(t, 480.0);
+  Rng rng(12, 0);
+  Eigen::VectorXd y(t.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i)
+    y[i] = 0.1 + 3e-3 * (s[i] - 20.0) + 0.02 * rng.Normal();
+  auto logged_where = [&](auto keep) {
+    std::vector<bool> logged(static_cast<size_t>(t.size()));
+    for (Eigen::Index i = 0; i < t.size(); ++i) logged[static_cast<size_t>(i)] = keep(i);
+    return logged;
+  };
+  const ThermalRegression bursts =
+      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{},
+                           {.logged = logged_where([](Eigen::Index i) { return i % 300 < 5; })});
+  EXPECT_EQ(bursts.report.prior_samples, 16.0);
+  EXPECT_FALSE(bursts.report.hysteresis_tried);
+  EXPECT_NE(bursts.report.Summary().find("ridge worth 16 logged samples"), std::string::npos);
+  const ThermalRegression most =
+      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{},
+                           {.logged = logged_where([](Eigen::Index i) { return i % 10 < 6; })});
+  EXPECT_EQ(most.report.prior_samples, 0.0);
+  EXPECT_EQ(most.report.Summary().find("ridge"), std::string::npos);
+  const ThermalRegression all = IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{});
+  EXPECT_EQ(all.report.prior_samples, 0.0);
+  EXPECT_TRUE(all.report.hysteresis_tried);
+}
+
 TEST(ThermalModel, GridFollowsTheRunLength) {
   const ThermalModelOptions o;
   const std::vector<double> grid16 = o.Grid(16 * 3600.0);

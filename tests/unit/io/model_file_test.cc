@@ -263,9 +263,15 @@ TEST(ModelFile, AHysteresisTermComesBackExactlyAndOlderFilesReadWithout) {
   j["options"]["thermal"].erase("hysteresis_widths_k");
   j["model"]["sub_models"][0]["thermal"].erase("hysteresis");
   j["model"]["sub_models"][0]["thermal"]["report"].erase("hysteresis_tried");
+  j["model"]["sub_models"][0]["thermal"]["report"].erase("prior_samples");
   const LoadedModel old = ParseModelFile(Reseal(j), "v4.json");
   EXPECT_EQ(old.model.options.thermal.hysteresis, drift::HysteresisTerm::kOff);
   EXPECT_FALSE(old.model.sub_models[0].thermal->has_hysteresis());
+  EXPECT_EQ(old.model.sub_models[0].thermal->report.prior_samples, 0.0);  // no ridge before it
+  // The sparse-log ridge's strength comes back as written.
+  j["model"]["sub_models"][0]["thermal"]["report"]["prior_samples"] = 16.0;
+  EXPECT_EQ(ParseModelFile(Reseal(j), "v4.json").model.sub_models[0].thermal->report.prior_samples,
+            16.0);
 }
 
 TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
