@@ -1,6 +1,7 @@
 // Allan-variance benchmarks: overlapping ADEV of a white-noise rate record, octave grid and every
 // averaging factor, with noise identification, EDF and confidence intervals (the defaults of
-// allan::Compute), on all cores and on one; and the IEEE 952 noise fit of an octave curve.
+// allan::Compute), on all cores and on one, and the octave deviation alone on one; and the
+// IEEE 952 noise fit of an octave curve.
 //   build-*/bench/bench_allan --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -51,6 +52,11 @@ void BM_OadevOctave(benchmark::State& s) { Run(s, TauGrid::kOctave, Deviation::k
 void BM_OadevOctave1Thread(benchmark::State& s) {
   Run(s, TauGrid::kOctave, Deviation::kOadev, 1, true);
 }
+// The deviation alone (no noise identification, EDF or intervals): what allantools' oadev
+// computes, for the side-by-side table of docs/performance.md.
+void BM_OadevOctaveNoIntervals1Thread(benchmark::State& s) {
+  Run(s, TauGrid::kOctave, Deviation::kOadev, 1, false);
+}
 void BM_OadevAll(benchmark::State& s) { Run(s, TauGrid::kAll, Deviation::kOadev, 0, true); }
 void BM_OadevAllNoIntervals(benchmark::State& s) {
   Run(s, TauGrid::kAll, Deviation::kOadev, 0, false);
@@ -82,6 +88,11 @@ void Register() {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
     benchmark::RegisterBenchmark("BM_OadevOctave1Thread", BM_OadevOctave1Thread)
+        ->Arg(n)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark("BM_OadevOctaveNoIntervals1Thread",
+                                 BM_OadevOctaveNoIntervals1Thread)
         ->Arg(n)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
