@@ -39,10 +39,11 @@ constexpr int kLeastSkillBlocks = 4;
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
 constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
 constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
-// A log of which at most this share of rows was logged (a duty-cycled log: 5 s of every 300 s
-// leaves 480 samples of 8 h) has every coefficient but the intercept shrunk by a ridge worth
-// kSparsePriorSamples logged samples at the regressor's mean square, in the fold fits and the
-// final fit [choice, docs/drift.md 4.8: on duty-cycled family units no unit worse than raw].
+// A log of which less than this share of rows was logged (most rows made up, as io's
+// kMostlyMadeUpShare words it; a duty-cycled log: 5 s of every 300 s leaves 480 samples of 8 h)
+// has every coefficient but the intercept shrunk by a ridge worth kSparsePriorSamples logged
+// samples at the regressor's mean square, in the fold fits and the final fit [choice,
+// docs/drift.md 4.8: on duty-cycled family units no unit worse than raw].
 constexpr double kSparseLoggedShare = 0.5;
 constexpr double kSparsePriorSamples = 16.0;
 
@@ -276,7 +277,7 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   const double mean = y.dot(weight) / weight.sum();
   search.yc = ((y.array() - mean) * weight.array()).matrix();
   report.prior_samples =
-      weight.sum() <= kSparseLoggedShare * static_cast<double>(n) ? kSparsePriorSamples : 0.0;
+      weight.sum() < kSparseLoggedShare * static_cast<double>(n) ? kSparsePriorSamples : 0.0;
   // The choice is scored on the time blocks; the held-out regimes and range ends are reported
   // (scoring or gating on them chose worse models on the family: docs/drift.md 4.8).
   search.scores = std::make_unique<internal::FoldScores>(

@@ -397,7 +397,7 @@ TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
                DataError);
 }
 
-// A log of which at most half the rows were logged (duty-cycled) gets the ridge worth 16 logged
+// A log of which fewer than half the rows were logged (duty-cycled) gets the ridge worth 16 logged
 // samples and, its logged samples short of 12 h, no hysteresis term; a continuous 16-h log gets
 // neither ridge nor the rule (docs/drift.md 4.8).
 TEST(ThermalModel, AMostlyUnloggedRunIsShrunkAndTriesNoHysteresis) {
