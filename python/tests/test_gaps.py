@@ -2,6 +2,8 @@
 the model file ``gyrodrift fit --gaps carry`` writes, and ``allan(..., logged=...)`` gives
 ``gyrodrift allan --gaps carry``'s deviations."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -9,13 +11,14 @@ import gyrodrift as gd
 from conftest import read_csv, write_csv
 
 
-def test_carry_matches_cli(cli, tmp_path):
+@pytest.mark.parametrize("method", ["poly", "thermal"])
+def test_carry_matches_cli(cli, tmp_path, method):
     sim = gd.simulate(duration=4 * 3600, seed=6)
     keep = (sim["time_s"] % 300.0) < 30.0  # 30 s of every 300 s
     write_csv(tmp_path / "bursts.csv",
               {k: sim[k][keep] for k in ("time_s", "rate_dph", "temperature_c")})
     cli("fit", tmp_path / "bursts.csv", "-t", "rate_dph", "-T", "temperature_c", "--mode",
-        "compensate", "-m", "poly", "--gaps", "carry", "-q", "-o", tmp_path / "cli.json")
+        "compensate", "-m", method, "--gaps", "carry", "-q", "-o", tmp_path / "cli.json")
     # The filled log as the CLI reads it, with the made-up rows marked.
     cli("compensate", tmp_path / "cli.json", tmp_path / "bursts.csv", "--gaps", "interpolate", "-q",
         "-o", tmp_path / "filled.csv")
@@ -23,10 +26,14 @@ def test_carry_matches_cli(cli, tmp_path):
     logged = filled["interpolated"] == 0
     assert logged.sum() == keep.sum()
     y = np.where(logged, filled["rate_dph"], np.nan)  # the made-up rows are never read
-    m = gd.DriftModel().fit(y, filled["temperature_c"], mode="compensate", method="poly",
+    m = gd.DriftModel().fit(y, filled["temperature_c"], mode="compensate", method=method,
                             logged=logged, source=str(tmp_path / "bursts.csv"))
     m.save(tmp_path / "py.json")
     assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    if method == "thermal":  # 10 % of the rows logged: the sparse-log ridge (docs/drift.md 4.8)
+        report = json.loads((tmp_path / "py.json").read_text())["model"]["sub_models"][0][
+            "thermal"]["report"]
+        assert report["prior_samples"] == 16.0
 
     cli("allan", tmp_path / "bursts.csv", "-c", "rate_dph", "--rate-hz", "1", "--gaps", "carry",
         "-q", "-o", tmp_path / "adev.csv")

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <string>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
@@ -206,7 +207,13 @@ Eigen::VectorXd CheckedWeights(const Eigen::Ref<const Eigen::MatrixXd>& temperat
     weight[static_cast<Eigen::Index>(i)] = run.logged[i];
   }
   const double n_logged = weight.sum();
-  RequireFiniteSignal("target", y, 2 * kShortestFold);
+  // Only the logged samples are read: a made-up one may be anything, NaN included.
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (weight[i] > 0.0 && !std::isfinite(y[i])) {
+      throw DataError("target sample " + std::to_string(i + 1) + " is " + FormatValue(y[i]) +
+                      ": every logged sample must be finite");
+    }
+  }
   if (n_logged < 2 * kShortestFold) {
     throw DataError("calibration run of " + std::to_string(static_cast<long>(n_logged)) +
                     " logged samples is too short to cross-validate a thermal model (at least " +
@@ -525,10 +532,12 @@ void AddCorrection(const Eigen::VectorXd& residual, std::uint64_t seed, const Se
 }  // namespace
 
 ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
-                                       const Eigen::Ref<const Eigen::VectorXd>& y, double rate_hz,
-                                       const ThermalModelOptions& options,
+                                       const Eigen::Ref<const Eigen::VectorXd>& y_given,
+                                       double rate_hz, const ThermalModelOptions& options,
                                        const ThermalIdentification& run) {
-  const Eigen::VectorXd weight = CheckedWeights(temperatures_c, y, rate_hz, options, run);
+  const Eigen::VectorXd weight = CheckedWeights(temperatures_c, y_given, rate_hz, options, run);
+  // The target with its made-up samples at 0, so that no product over every row reads them.
+  const Eigen::VectorXd y = (weight.array() > 0.0).select(y_given.array(), 0.0).matrix();
   ThermalRegression model;
   model.rate_hz = rate_hz;
   model.order = options.state_order;

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
@@ -388,6 +390,22 @@ TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
   const ThermalRegression g =
       IdentifyThermalModel(t, garbage, 1.0, ThermalModelOptions{}, {.logged = logged});
   EXPECT_EQ(g.coefficients, m.coefficients);
+  // Not read at all: NaN there gives the same model; NaN at a logged sample is refused, by name.
+  Eigen::VectorXd holes = y;
+  for (Eigen::Index i = 0; i < t.size(); ++i) {
+    if (!logged[static_cast<size_t>(i)]) holes[i] = std::numeric_limits<double>::quiet_NaN();
+  }
+  EXPECT_EQ(
+      IdentifyThermalModel(t, holes, 1.0, ThermalModelOptions{}, {.logged = logged}).coefficients,
+      m.coefficients);
+  holes[300] = std::numeric_limits<double>::quiet_NaN();  // logged: 300 % 300 < 5
+  try {
+    IdentifyThermalModel(t, holes, 1.0, ThermalModelOptions{}, {.logged = logged});
+    ADD_FAILURE() << "a NaN at a logged sample was accepted";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("target sample 301 is nan"), std::string::npos)
+        << e.what();
+  }
   const double rms =
       std::sqrt((m.Estimate(t) - drift).squaredNorm() / static_cast<double>(t.size()));
   EXPECT_LT(rms, 0.02) << m.Summary();
