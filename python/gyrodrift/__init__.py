@@ -188,8 +188,8 @@ class DriftModel:
         in compensate mode), ``lags`` an int or "auto" (predict mode only), ``hidden`` "auto" or
         an int, ``rate_hz`` the sample rate (the CLI reads it from a time_s column),
         ``time_constants`` seconds, ``hysteresis`` ("auto", "on" or "off": the thermal models'
-        hysteresis term, tried on calibrations with 12 h or more of logged samples; the fitted term is in
-        ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the library's
+        hysteresis term, tried on calibrations with 12 h or more of logged samples; the fitted
+        term is in ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the library's
         options as the CLI's flags do; a refusal names the keyword, and a keyword that names no
         setting raises TypeError. ``target`` and ``temperature_columns`` are the column
         names written into the model file (the CLI's compensate reads those columns).
