@@ -207,13 +207,9 @@ Eigen::VectorXd CheckedWeights(const Eigen::Ref<const Eigen::MatrixXd>& temperat
     weight[static_cast<Eigen::Index>(i)] = run.logged[i];
   }
   const double n_logged = weight.sum();
-  // Only the logged samples are read: a made-up one may be anything, NaN included.
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (weight[i] > 0.0 && !std::isfinite(y[i])) {
-      throw DataError("target sample " + std::to_string(i + 1) + " is " + FormatValue(y[i]) +
-                      ": every logged sample must be finite");
-    }
-  }
+  // Only the logged samples are read (as FitDriftModel checks them): a made-up one may be
+  // anything, NaN included.
+  RequireFiniteSignal("target", LoggedRows(y, run.logged), 1);
   if (n_logged < 2 * kShortestFold) {
     throw DataError("calibration run of " + std::to_string(static_cast<long>(n_logged)) +
                     " logged samples is too short to cross-validate a thermal model (at least " +
@@ -273,7 +269,8 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   for (int c = 0; c < channels; ++c) {
     for (double tau : options.Grid(report.duration_s)) search.candidates.push_back({c, tau});
   }
-  report.hysteresis_tried = options.TriesHysteresis(weight.sum() / model.rate_hz);
+  const double logged = weight.sum();
+  report.hysteresis_tried = options.TriesHysteresis(logged / model.rate_hz);
   if (report.hysteresis_tried) search.widths_k = options.hysteresis_widths_k;
   search.layout = {channels, options.max_power, static_cast<int>(search.candidates.size()),
                    options.max_power + 1, static_cast<int>(search.widths_k.size())};
@@ -281,10 +278,10 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   const bool cooling = report.max_cooling_k_per_min >= 2.0 * options.ramp_rate_k_per_min;
   search.x = CandidateDesign(temperatures_c, model.rate_hz, run.record_starts, model,
                              search.layout, search.widths_k, heating, cooling, search.candidates);
-  const double mean = y.dot(weight) / weight.sum();
+  const double mean = y.dot(weight) / logged;
   search.yc = ((y.array() - mean) * weight.array()).matrix();
   report.prior_samples =
-      weight.sum() < kSparseLoggedShare * static_cast<double>(n) ? kSparsePriorSamples : 0.0;
+      logged < kSparseLoggedShare * static_cast<double>(n) ? kSparsePriorSamples : 0.0;
   // The choice is scored on the time blocks; the held-out regimes and range ends are reported
   // (scoring or gating on them chose worse models on the family: docs/drift.md 4.8).
   search.scores = std::make_unique<internal::FoldScores>(
@@ -324,11 +321,25 @@ void ReportHeldOut(const Search& search, CalibrationReport& report) {
   report.regime_rmse_static = regimes(s.static_cubic);
 }
 
-// The chosen columns refitted on the logged samples (QR of the unit-scaled design, below it the
-// rows of the report's ridge on every column but the intercept), in the model's coefficient slots
-// (a state whose rate did not enter keeps a rate coefficient of 0), with their covariance: the
-// residual variance inflated by its correlation (batch means over kBlockS). Returns the residual at
-// every row (0 where not logged).
+// Least squares of ys on the unit-scaled columns xn (the intercept first) by QR, with the ridge
+// of `prior_samples` samples on every column but the intercept as rows below the design.
+Eigen::VectorXd SolveWithPrior(const Eigen::MatrixXd& xn, const Eigen::VectorXd& ys,
+                               double prior_samples) {
+  if (prior_samples <= 0.0) return Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xn).solve(ys);
+  const Eigen::Index rows = xn.rows(), p = xn.cols();
+  Eigen::MatrixXd xa = Eigen::MatrixXd::Zero(rows + p - 1, p);
+  Eigen::VectorXd ya = Eigen::VectorXd::Zero(rows + p - 1);
+  xa.topRows(rows) = xn;
+  ya.head(rows) = ys;
+  const double prior = std::sqrt(prior_samples / static_cast<double>(rows));
+  for (Eigen::Index i = 1; i < p; ++i) xa(rows + i - 1, i) = prior;
+  return Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xa).solve(ya);
+}
+
+// The chosen columns refitted on the logged samples (SolveWithPrior, the report's ridge), in the
+// model's coefficient slots (a state whose rate did not enter keeps a rate coefficient of 0), with
+// their covariance: the residual variance inflated by its correlation (batch means over kBlockS).
+// Returns the residual at every row (0 where not logged).
 Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
                             const Eigen::VectorXd& weight, const Search& search,
                             ThermalRegression& model, Eigen::MatrixXd& gram) {
@@ -348,15 +359,8 @@ Eigen::VectorXd RefitChosen(const Eigen::Ref<const Eigen::VectorXd>& y,
     scale[i] = 1.0 / std::max(xs.col(i).norm(), std::numeric_limits<double>::min());
   }
   const Eigen::MatrixXd xn = xs * scale.asDiagonal();
-  const Eigen::Index prior_rows = model.report.prior_samples > 0.0 ? p - 1 : 0;
-  Eigen::MatrixXd xa = Eigen::MatrixXd::Zero(rows + prior_rows, p);
-  Eigen::VectorXd ya = Eigen::VectorXd::Zero(rows + prior_rows);
-  xa.topRows(rows) = xn;
-  ya.head(rows) = ys;
-  const double prior = std::sqrt(model.report.prior_samples / static_cast<double>(rows));
-  for (Eigen::Index i = 1; i <= prior_rows; ++i) xa(rows + i - 1, i) = prior;
   const Eigen::VectorXd fitted =
-      scale.asDiagonal() * Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(xa).solve(ya);
+      scale.asDiagonal() * SolveWithPrior(xn, ys, model.report.prior_samples);
   // Where each fitted column sits among the model's m regressors.
   std::vector<Eigen::Index> slot;
   Eigen::Index k = 1 + best.static_power * model.channels();
