@@ -51,8 +51,8 @@ void HysteresisColumns(const Eigen::Ref<const Eigen::VectorXd>& level,
 }
 
 // Columns of one state: its standardised level to the powers 1..max_power (the powers >= 2
-// continued along their tangent beyond [s.level_min, s.level_max]), its rate (K/s; held within
-// [s.rate_min, s.rate_max] with `hold_rate`), then H_w of its level for each of widths_k. With
+// continued along their tangent beyond [s.level_min, s.level_max]), its rate (K/s; with
+// `hold_rate`, beyond [s.rate_min, s.rate_max] at s.rate_beyond times its slope), then H_w of its level for each of widths_k. With
 // `learn_range` the ranges are first set to the state's own (the calibration run). `level`
 // receives the state's level (degC).
 void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
@@ -71,7 +71,12 @@ void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, i
     s.rate_min = rate.minCoeff();
     s.rate_max = rate.maxCoeff();
   }
-  if (hold_rate) rate = rate.cwiseMax(s.rate_min).cwiseMin(s.rate_max);
+  if (hold_rate) {
+    for (Eigen::Index i = 0; i < rate.size(); ++i) {
+      const double edge = std::clamp(rate[i], s.rate_min, s.rate_max);
+      rate[i] = edge + s.rate_beyond * (rate[i] - edge);
+    }
+  }
   out.col(0) = z.matrix();
   for (int p = 2; p <= max_power; ++p) {
     auto col = out.col(p - 1);

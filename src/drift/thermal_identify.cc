@@ -47,6 +47,11 @@ constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
 // docs/drift.md 4.8: on duty-cycled family units no unit worse than raw].
 constexpr double kSparseLoggedShare = 0.5;
 constexpr double kSparsePriorSamples = 16.0;
+// Beyond the rates of a direction the run never showed (a heat-up's cooling), a state's rate moves
+// at this share of its slope: midway between no response (held) and the shown direction's (the
+// Shupe and gradient terms are linear in the rate), which bounds the error by half either way
+// [choice, docs/drift.md 4.8: heat-up units 1-20, from 0, 0.25, 0.5, 0.75 and 1].
+constexpr double kUnshownRateShare = 0.5;
 
 // Standard deviation about the mean (population).
 double Sd(const Eigen::Ref<const Eigen::VectorXd>& x) {
@@ -105,9 +110,10 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
                               layout.state_columns + layout.widths),
                  level);
     // The rates' support is their sign: a direction the run showed extrapolates (the Shupe and
-    // gradient terms are linear in the rates), one it never showed is held at the edge.
+    // gradient terms are linear in the rates), one it never showed moves at a share of its slope.
     if (heating) candidates[j].rate_max = std::numeric_limits<double>::infinity();
     if (cooling) candidates[j].rate_min = -std::numeric_limits<double>::infinity();
+    candidates[j].rate_beyond = kUnshownRateShare;
   }
   return x;
 }

@@ -261,9 +261,10 @@ void ThermalRegression::Validate() const {
     if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) ||
         !std::isfinite(s.tau_s) || !(s.level_min <= s.level_max) || !std::isfinite(s.level_min) ||
         !std::isfinite(s.level_max) || !(s.rate_min <= s.rate_max) || std::isnan(s.rate_min) ||
-        std::isnan(s.rate_max)) {
+        std::isnan(s.rate_max) || !(s.rate_beyond >= 0.0 && s.rate_beyond <= 1.0)) {
       throw DataError(
-          "thermal model: a state names a channel, time constant or level range out of range");
+          "thermal model: a state names a channel, time constant, level or rate range out of "
+          "range");
     }
   }
   if (hysteresis_state < -1 || hysteresis_state >= static_cast<int>(states.size()) ||

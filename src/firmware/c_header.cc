@@ -78,6 +78,11 @@ class CWriter {
     return single_ ? s + "f" : s;
   }
 
+  // Whether a state's rate has a finite edge (a direction the calibration never showed).
+  static bool Bounded(const State& s) {
+    return std::isfinite(s.rate_min) || std::isfinite(s.rate_max);
+  }
+
   std::string StateName(const State& s) const {
     const Chain& c = plan_.chains[static_cast<size_t>(s.chain)];
     return fmt::format("L{}({}; {:.4g} s)", s.order, plan_.channels[static_cast<size_t>(c.channel)],
@@ -117,11 +122,12 @@ class CWriter {
         " * thermal states are cascaded first-order lags started in equilibrium at the first\n"
         " * sample; a state's standardised level z has its powers continued along their tangent\n"
         " * beyond the calibration's range, as are the static powers of a channel; its rate is\n"
-        " * (input - output of its last lag) / tau, K/s, held within the rates the calibration\n"
-        " * showed; a hysteresis term is the play operator (backlash) of half-width w on a state's\n"
-        " * level, (level - play) / w, started with no direction. The lags run on each stage's\n"
-        " * deviation u below its input, the same recursion rewritten so that a slow lag's small\n"
-        " * increments do not vanish against T in float.\n"
+        " * (input - output of its last lag) / tau, K/s; beyond the rates the calibration showed\n"
+        " * it moves at a share of its slope (0: held at the edge); a hysteresis term is the\n"
+        " * play operator (backlash) of half-width w on a state's level, (level - play) / w,\n"
+        " * started with no direction. The lags run on each stage's deviation u below its input,\n"
+        " * the same recursion rewritten so that a slow lag's small increments do not vanish\n"
+        " * against T in float.\n"
         " * See docs/firmware.md.\n"
         " * Arithmetic: {}. No allocation, no libm (the lag gains 1 - exp(-dt/tau) are\n"
         " * precomputed literals), no other header: C99, also valid C++.\n"
@@ -227,7 +233,7 @@ class CWriter {
       for (const Sub& s : a.subs) {
         any_estimate = any_estimate || !s.zero;
         any_z = any_z || !s.states.empty() || !s.statics.empty();
-        for (const State& st : s.states) any_held = any_held || std::isfinite(st.rate_min);
+        for (const State& st : s.states) any_held = any_held || Bounded(st);
       }
     }
     if (!plan_.chains.empty()) out_ += fmt::format("  {} d, w;\n", real_);
@@ -309,14 +315,24 @@ class CWriter {
       out_ += fmt::format("  /* {} */\n", CommentText(StateName(st)));
       out_ += fmt::format("  z = ({}) / {};\n", LevelLessCentre(st), Literal(st.scale_k));
       Powers(st.powers, st.level_min, st.level_max);
-      if (std::isfinite(st.rate_min)) {
-        // The rate held within the calibration's, as the library holds it.
-        out_ += fmt::format(
-            "  r = s->lag[{i}] / {tau};\n  r = r < {lo} ? {lo} : ({hi} < r ? {hi} : r);\n"
-            "  e += {c} * r;\n",
-            fmt::arg("i", chain.first + st.order - 1), fmt::arg("tau", Literal(chain.tau_s)),
-            fmt::arg("lo", Literal(st.rate_min)), fmt::arg("hi", Literal(st.rate_max)),
-            fmt::arg("c", Literal(st.rate)));
+      if (Bounded(st)) {
+        // Beyond the calibration's rates (an infinite edge: a direction it showed), a share of
+        // the slope, as the library continues it.
+        auto beyond = [&](double edge) {
+          return st.rate_beyond == 0.0 ? Literal(edge)
+                                       : fmt::format("{0} + {1} * (r - {0})", Literal(edge),
+                                                     Literal(st.rate_beyond));
+        };
+        std::string rate = "r";
+        if (std::isfinite(st.rate_max)) {
+          rate = fmt::format("({} < r ? {} : r)", Literal(st.rate_max), beyond(st.rate_max));
+        }
+        if (std::isfinite(st.rate_min)) {
+          rate = fmt::format("r < {} ? {} : {}", Literal(st.rate_min), beyond(st.rate_min), rate);
+        }
+        out_ += fmt::format("  r = s->lag[{}] / {};\n  r = {};\n  e += {} * r;\n",
+                            chain.first + st.order - 1, Literal(chain.tau_s), rate,
+                            Literal(st.rate));
       } else {
         out_ += fmt::format("  e += {} * (s->lag[{}] / {});\n", Literal(st.rate),
                             chain.first + st.order - 1, Literal(chain.tau_s));

@@ -15,7 +15,8 @@ constexpr std::string_view kCoefficientsFormat = "gyrodrift-coefficients";
 // 2: a sub-model may hold a hysteresis term.
 // 3: "static" (powers of a channel with their range) replaces "linear"; a state's rate holds
 // within [rate_min, rate_max] (null: unheld, models of format 6 and older).
-constexpr int kCoefficientsFormatVersion = 3;
+// 4: beyond [rate_min, rate_max] a state's rate moves at rate_beyond times its slope (0: held).
+constexpr int kCoefficientsFormatVersion = 4;
 
 }  // namespace
 
@@ -52,7 +53,8 @@ std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                           {"powers", st.powers},
                           {"rate", st.rate},
                           {"rate_min", finite(st.rate_min)},
-                          {"rate_max", finite(st.rate_max)}});
+                          {"rate_max", finite(st.rate_max)},
+                          {"rate_beyond", st.rate_beyond}});
       }
       const Hysteresis& h = sub.hysteresis;
       subs.push_back({{"name", sub.name},

@@ -64,6 +64,7 @@ State PlanState(const drift::ThermalRegression& t, const drift::ThermalState& ts
   state.rate = t.coefficients[k++];
   state.rate_min = ts.rate_min;
   state.rate_max = ts.rate_max;
+  state.rate_beyond = ts.rate_beyond;
   return state;
 }
 

@@ -30,8 +30,10 @@ struct State {
   double level_min = 0.0, level_max = 0.0;
   std::vector<double> powers;  // coefficients of the level's powers 1..max_power
   double rate = 0.0;           // coefficient of the level's rate, per K/s
-  double rate_min = -std::numeric_limits<double>::infinity();  // the rate is held within
+  // The rate's range; beyond an edge it moves at rate_beyond times its slope (0: held).
+  double rate_min = -std::numeric_limits<double>::infinity();
   double rate_max = std::numeric_limits<double>::infinity();
+  double rate_beyond = 0.0;
 };
 
 // Static powers of one channel's standardised level, continued along their tangent beyond

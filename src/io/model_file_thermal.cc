@@ -60,7 +60,8 @@ json ThermalJson(const drift::ThermalRegression& t) {
     states.push_back({{"channel", s.channel},
                       {"tau_s", Number(s.tau_s)},
                       {"level_range", Numbers({s.level_min, s.level_max})},
-                      {"rate_range", Numbers({s.rate_min, s.rate_max})}});
+                      {"rate_range", Numbers({s.rate_min, s.rate_max})},
+                      {"rate_beyond", Number(s.rate_beyond)}});
   }
   json static_range = json::array();
   for (size_t c = 0; c < t.static_min.size(); ++c) {
@@ -222,6 +223,8 @@ std::shared_ptr<const drift::ThermalRegression> ReadThermal(const Node& n) {
     std::tie(state.level_min, state.level_max) = pair(s["level_range"]);
     // Before version 7 the rates ran unheld.
     if (s.raw().contains("rate_range")) std::tie(state.rate_min, state.rate_max) = pair(s["rate_range"]);
+    // Before version 9 a rate was held at the edges of its range.
+    if (s.raw().contains("rate_beyond")) state.rate_beyond = s["rate_beyond"].Double();
     t->states.push_back(state);
   }
   if (n.raw().contains("hysteresis") && !n["hysteresis"].IsNull()) {

@@ -133,13 +133,15 @@ struct ThermalModelOptions {
 // powers >= 2 continue along their tangent at the nearer end (a model does not extrapolate a
 // curvature it never saw: a cubic fitted over 40 K, evaluated 20 K beyond, is what made a short
 // calibration's estimate absurd; docs/drift.md 4.5).
-// Its rate spanned [rate_min, rate_max] K/s; beyond that it is held at the edge.
+// Its rate spanned [rate_min, rate_max] K/s; beyond an edge it moves at rate_beyond times its
+// own slope (0: held at the edge, as in model files before format 9).
 struct ThermalState {
   int channel = 0;
   double tau_s = 0.0;
   double level_min = 0.0, level_max = 0.0;
   double rate_min = -std::numeric_limits<double>::infinity();
   double rate_max = std::numeric_limits<double>::infinity();
+  double rate_beyond = 0.0;
   bool operator==(const ThermalState&) const = default;
 };
 

@@ -65,7 +65,9 @@ inline constexpr std::string_view kModelFormat = "gyrodrift-model";
 // learner. Older files have none of these.
 // Version 8 (issue 26): a thermal model's autopilot form ("autopilot": degree, tref_c, tmin_c,
 // tmax_c, coefficients of dT^0..3, share_kept); older files read without one (not fitted).
-inline constexpr int kModelFormatVersion = 8;
+// Version 9 (issue 22): each state's "rate_beyond", the share of its rate's slope kept beyond its
+// rate range (older files: 0, held at the edges).
+inline constexpr int kModelFormatVersion = 9;
 inline constexpr int kMaxModelAxes = 64;
 inline constexpr int kOldestReadableModelFormatVersion = 1;
 

@@ -297,10 +297,11 @@ HeatUp HeatUpRun(const Eigen::VectorXd& t) {
 }
 
 // What a one-way calibration cannot identify stays out: no lag difference (two states, or a state
-// beside the static term), and a rate of the sign it never saw (cooling) is held at the edge of
-// the rates it did see, with the standard deviation widened by what the hold left out. The run
-// gets its advice. On a mission that cools, the estimate is no worse than doing nothing.
-TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHoldsCoolingRates) {
+// beside the static term), and a rate of the sign it never saw (cooling) moves beyond the edge of
+// the rates it did see at half its slope, with the standard deviation widened by what that left
+// out. The run gets its advice. On a mission that cools, the estimate is no worse than doing
+// nothing.
+TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHalvesCoolingRates) {
   const Eigen::Index n = 8 * 3600;
   Eigen::VectorXd cal(n);
   for (Eigen::Index i = 0; i < n; ++i) cal[i] = std::min(60.0, -20.0 + 0.01 * std::max<Eigen::Index>(0, i - 2700));
@@ -325,14 +326,23 @@ TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHoldsCoolingRates) {
   const double none = std::sqrt(truth.squaredNorm() / static_cast<double>(truth.size()));
   const double after = std::sqrt((e.col(0) - truth).squaredNorm() / static_cast<double>(truth.size()));
   EXPECT_LT(after, none) << m.Summary();
-  // Where the mission cools, the state's rate column sits at the calibration's edge, and the
-  // unheld rates would have gone below it.
+  // Where the mission cools beyond the calibration's edge, the state's rate column moves at half
+  // the free rate's slope; within the rates the run showed, it is the free rate.
   ASSERT_EQ(m.states.size(), 1u) << m.Summary();
+  const ThermalState& s = m.states[0];
+  EXPECT_EQ(s.rate_beyond, 0.5);
   const Eigen::Index rate = 1 + m.static_power[0] + m.max_power;
-  const Eigen::MatrixXd held = m.Regressors(mission);
-  const Eigen::MatrixXd free = m.Regressors(mission, {}, /*within_support=*/false);
-  EXPECT_DOUBLE_EQ(held.col(rate).minCoeff(), m.states[0].rate_min);
-  EXPECT_LT(free.col(rate).minCoeff(), m.states[0].rate_min);
+  const Eigen::VectorXd kept = m.Regressors(mission).col(rate);
+  const Eigen::VectorXd free = m.Regressors(mission, {}, /*within_support=*/false).col(rate);
+  EXPECT_LT(free.minCoeff(), s.rate_min);
+  for (Eigen::Index i = 0; i < free.size(); ++i) {
+    const double want = free[i] < s.rate_min ? s.rate_min + 0.5 * (free[i] - s.rate_min) : free[i];
+    ASSERT_NEAR(kept[i], want, 1e-15) << "sample " << i;
+  }
+  // The standard deviation holds what the half left out, either way.
+  const Eigen::VectorXd unheld = m.Regressors(mission, {}, false) * m.coefficients -
+                                 m.Regressors(mission) * m.coefficients;
+  EXPECT_TRUE((e.col(1).array() >= unheld.array().abs() - 1e-12).all());
 }
 
 // The guarantee: a gyro without temperature dependence gets the constant, whatever the

@@ -62,6 +62,23 @@ Log MakeLog(Eigen::Index n, std::uint64_t seed, double offset_c = 0.0,
   return log;
 }
 
+// A heat-up of the same gyro: a cold soak, one ramp up, a hold (a run that never cools, so its
+// model's cooling rates have a finite edge).
+Log MakeHeatUp(Eigen::Index n, std::uint64_t seed) {
+  Log log{Eigen::VectorXd(n), Eigen::MatrixXd(n, 2)};
+  Rng rng(seed, 0);
+  double lagged = 0.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    const double x = static_cast<double>(t) / static_cast<double>(n);
+    log.temperature(t, 0) = 40.0 * std::clamp((x - 0.1) / 0.6, 0.0, 1.0);
+    const double previous = lagged;
+    lagged += (log.temperature(t, 0) - lagged) / 40.0;
+    log.rate[t] = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous) + 0.02 * rng.Normal();
+  }
+  log.temperature.col(1) = log.temperature.col(0).array() + 5.0;
+  return log;
+}
+
 drift::DriftOptions Compensate(Method method) {
   drift::DriftOptions o;
   o.mode = Mode::kCompensate;
@@ -85,7 +102,7 @@ LoadedModel Fit(const Log& log, drift::DriftOptions o, int channels = 1,
 // The estimate of every axis from the coefficients JSON, with the equation of docs/firmware.md:
 // per sub-model b0 + sum_c sum_p a_cp P_p(z_c) + sum_j [sum_p g_jp P_p(zs_j) + r_j R(ds_j/dt)]
 // + h H_w(s_k) - reference_estimate, P_p the power continued along its tangent beyond the range and
-// R the rate held within [rate_min, rate_max] (null: unbounded).
+// R the rate within [rate_min, rate_max] (null: unbounded), beyond at rate_beyond times its slope.
 Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& temperature_c) {
   const Eigen::Index n = temperature_c.rows();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(j["axes"].size()));
@@ -133,8 +150,9 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
           }
           level[t] = input;
           const double z = (input - s["centre_c"].get<double>()) / s["scale_k"].get<double>();
-          const double rate = std::clamp((before_last - input) / tau, bound(s["rate_min"], -kInf),
-                                         bound(s["rate_max"], kInf));
+          const double free = (before_last - input) / tau;
+          const double edge = std::clamp(free, bound(s["rate_min"], -kInf), bound(s["rate_max"], kInf));
+          const double rate = edge + s["rate_beyond"].get<double>() * (free - edge);
           e[t] += tangent_powers(powers, z, lo, hi) + s["rate"].get<double>() * rate;
         }
       }
@@ -186,21 +204,35 @@ class FirmwareExport : public ::testing::Test {
     hyst.thermal.max_states = 1;  // no pair of nearly collinear states, whose float rounding
                                   // the other models already exercise
     hysteresis_ = new LoadedModel(Fit(MakeLog(3000, 3, 0.0, 0.3), hyst));
+    heat_up_ = new LoadedModel(Fit(MakeHeatUp(3000, 3), Compensate(Method::kThermal)));
   }
   static void TearDownTestSuite() {
-    for (LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_}) delete m;
+    for (LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_}) delete m;
   }
   static LoadedModel* thermal_;
   static LoadedModel* two_;
   static LoadedModel* ms_;
   static LoadedModel* referenced_;
   static LoadedModel* hysteresis_;  // with a hysteresis term
+  static LoadedModel* heat_up_;     // a state whose cooling rates have a finite edge
 };
 LoadedModel* FirmwareExport::thermal_ = nullptr;
 LoadedModel* FirmwareExport::two_ = nullptr;
 LoadedModel* FirmwareExport::ms_ = nullptr;
 LoadedModel* FirmwareExport::referenced_ = nullptr;
 LoadedModel* FirmwareExport::hysteresis_ = nullptr;
+LoadedModel* FirmwareExport::heat_up_ = nullptr;
+
+// Whether a model has a state whose rate has a finite edge (its calibration never showed a
+// direction), so that exporting it exercises the rate beyond that edge.
+bool HasBoundedRate(const LoadedModel& m) {
+  for (const auto& sub : m.model.sub_models) {
+    for (const auto& s : sub.thermal->states) {
+      if (std::isfinite(s.rate_min) || std::isfinite(s.rate_max)) return true;
+    }
+  }
+  return false;
+}
 
 const ExportOptions kJson{.format = ExportFormat::kCoefficientsJson};
 
@@ -209,10 +241,11 @@ TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
   const Log test = MakeLog(2000, 4, 8.0);
   ASSERT_TRUE(hysteresis_->model.sub_models[0].thermal->has_hysteresis())
       << hysteresis_->model.Summary();
-  for (const LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_}) {
+  ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
+  for (const LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_}) {
     const json j = json::parse(RenderCoefficientsJson({*m}, kJson));
     EXPECT_EQ(j["format"], "gyrodrift-coefficients");
-    EXPECT_EQ(j["format_version"], 3);
+    EXPECT_EQ(j["format_version"], 4);
     EXPECT_EQ(j["rate_hz"], 1.0);
     const int channels = m->model.temperature_channels();
     const Eigen::MatrixXd t = test.temperature.leftCols(channels);
@@ -274,17 +307,18 @@ TEST_F(FirmwareExport, AxesShareTheChannelsAndLagsTheyHaveInCommon) {
 }
 
 // The header is C: the only test of its text is a compiler (the system's, as a user's would be).
-// Several axes with two channels, ms-elm, a reference, a hysteresis term and a model without
-// states (no lag stage) in one header, and that last model alone (a state struct without lags),
-// double and float.
+// Several axes with two channels, ms-elm, a reference, a hysteresis term, a heat-up's model (a
+// cooling rate beyond its edge) and a model without states (no lag stage) in one header, and that
+// last model alone (a state struct without lags), double and float.
 TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
   drift::DriftOptions flat = Compensate(Method::kThermal);
   flat.thermal.max_states = 0;
   const LoadedModel stateless = Fit(MakeLog(3000, 3), flat, 2, "rate_z_dph");
   ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
+  ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
   const std::vector<LoadedModel> axes{*thermal_, *two_, *ms_, *referenced_, *hysteresis_,
-                                      stateless};
+                                      *heat_up_, stateless};
   const Log test = MakeLog(2000, 4, 8.0);
   const std::string dir = test::TempDir("firmware_header");
   for (const bool single : {false, true}) {

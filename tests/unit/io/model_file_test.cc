@@ -274,6 +274,47 @@ TEST(ModelFile, AHysteresisTermComesBackExactlyAndOlderFilesReadWithout) {
             16.0);
 }
 
+// A heat-up's model continues its cooling rates beyond the run's at a share of their slope
+// (rate_beyond, version 9); it comes back exactly, a file before version 9 holds them at the
+// edge, and a share outside [0, 1] is refused.
+TEST(ModelFile, TheShareOfAnUnshownRateComesBackAndOlderFilesHoldTheRate) {
+  const Eigen::Index n = 4000;
+  Log heat{Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  Rng rng(21, 0);
+  double lagged = 0.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    heat.temperature[t] = 40.0 * std::clamp((static_cast<double>(t) / n - 0.1) / 0.6, 0.0, 1.0);
+    const double previous = lagged;
+    lagged += (heat.temperature[t] - lagged) / 40.0;
+    heat.rate[t] = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous) + 0.02 * rng.Normal();
+  }
+  const drift::DriftModel model =
+      drift::FitDriftModel(heat.rate, heat.temperature, Small(Mode::kCompensate, Method::kThermal));
+  const auto& states = model.sub_models[0].thermal->states;
+  ASSERT_FALSE(states.empty()) << model.Summary();
+  ASSERT_TRUE(std::isfinite(states[0].rate_min)) << model.Summary();
+  EXPECT_EQ(states[0].rate_beyond, 0.5);
+  const std::string text = RenderModelFile(model, Info());
+  const LoadedModel loaded = ParseModelFile(text, "m.json");
+  EXPECT_EQ(RenderModelFile(loaded.model, loaded.info), text);
+  const Eigen::VectorXd cooling = MakeLog(2000, 22).temperature;  // cools at up to 1.4 K/min
+  EXPECT_EQ(drift::EstimateDrift(model, cooling), drift::EstimateDrift(loaded.model, cooling));
+  json j = json::parse(text);
+  j["format_version"] = 8;
+  j["model"]["sub_models"][0]["thermal"]["states"][0].erase("rate_beyond");
+  const LoadedModel old = ParseModelFile(Reseal(j), "v8.json");
+  EXPECT_EQ(old.model.sub_models[0].thermal->states[0].rate_beyond, 0.0);
+  drift::DriftModel held = model;
+  auto thermal = std::make_shared<drift::ThermalRegression>(*model.sub_models[0].thermal);
+  thermal->states[0].rate_beyond = 0.0;
+  held.sub_models[0].thermal = thermal;
+  EXPECT_EQ(drift::EstimateDrift(old.model, cooling), drift::EstimateDrift(held, cooling));
+  EXPECT_NE(drift::EstimateDrift(old.model, cooling), drift::EstimateDrift(model, cooling));
+  j = json::parse(text);
+  j["model"]["sub_models"][0]["thermal"]["states"][0]["rate_beyond"] = 2.0;
+  ExpectRefused(Reseal(j), "rate range out of range");
+}
+
 TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
   drift::DriftOptions o;
   o.mode = Mode::kCompensate;
