@@ -258,8 +258,8 @@ void ThermalRegression::Validate() const {
     throw DataError("thermal model: rate_hz, order or max_power out of range");
   }
   for (const ThermalState& s : states) {
-    if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) ||
-        !std::isfinite(s.tau_s) || !(s.level_min <= s.level_max) || !std::isfinite(s.level_min) ||
+    if (s.channel < 0 || s.channel >= channels() || !(s.tau_s >= 1e-9) || !std::isfinite(s.tau_s) ||
+        !(s.level_min <= s.level_max) || !std::isfinite(s.level_min) ||
         !std::isfinite(s.level_max) || !(s.rate_min <= s.rate_max) || std::isnan(s.rate_min) ||
         std::isnan(s.rate_max) || !(s.rate_beyond >= 0.0 && s.rate_beyond <= 1.0)) {
       throw DataError(

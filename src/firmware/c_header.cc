@@ -319,9 +319,9 @@ class CWriter {
         // Beyond the calibration's rates (an infinite edge: a direction it showed), a share of
         // the slope, as the library continues it.
         auto beyond = [&](double edge) {
-          return st.rate_beyond == 0.0 ? Literal(edge)
-                                       : fmt::format("{0} + {1} * (r - {0})", Literal(edge),
-                                                     Literal(st.rate_beyond));
+          return st.rate_beyond == 0.0
+                     ? Literal(edge)
+                     : fmt::format("{0} + {1} * (r - {0})", Literal(edge), Literal(st.rate_beyond));
         };
         std::string rate = "r";
         if (std::isfinite(st.rate_max)) {
@@ -330,9 +330,9 @@ class CWriter {
         if (std::isfinite(st.rate_min)) {
           rate = fmt::format("r < {} ? {} : {}", Literal(st.rate_min), beyond(st.rate_min), rate);
         }
-        out_ += fmt::format("  r = s->lag[{}] / {};\n  r = {};\n  e += {} * r;\n",
-                            chain.first + st.order - 1, Literal(chain.tau_s), rate,
-                            Literal(st.rate));
+        out_ +=
+            fmt::format("  r = s->lag[{}] / {};\n  r = {};\n  e += {} * r;\n",
+                        chain.first + st.order - 1, Literal(chain.tau_s), rate, Literal(st.rate));
       } else {
         out_ += fmt::format("  e += {} * (s->lag[{}] / {});\n", Literal(st.rate),
                             chain.first + st.order - 1, Literal(chain.tau_s));

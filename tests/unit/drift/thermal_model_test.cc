@@ -340,8 +340,8 @@ TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHalvesCoolingRates) {
     ASSERT_NEAR(kept[i], want, 1e-15) << "sample " << i;
   }
   // The standard deviation holds what the half left out, either way.
-  const Eigen::VectorXd unheld = m.Regressors(mission, {}, false) * m.coefficients -
-                                 m.Regressors(mission) * m.coefficients;
+  const Eigen::VectorXd unheld =
+      m.Regressors(mission, {}, false) * m.coefficients - m.Regressors(mission) * m.coefficients;
   EXPECT_TRUE((e.col(1).array() >= unheld.array().abs() - 1e-12).all());
 }
 

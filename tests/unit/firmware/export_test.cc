@@ -151,7 +151,8 @@ Eigen::MatrixXd EvaluateCoefficients(const json& j, const Eigen::MatrixXd& tempe
           level[t] = input;
           const double z = (input - s["centre_c"].get<double>()) / s["scale_k"].get<double>();
           const double free = (before_last - input) / tau;
-          const double edge = std::clamp(free, bound(s["rate_min"], -kInf), bound(s["rate_max"], kInf));
+          const double edge =
+              std::clamp(free, bound(s["rate_min"], -kInf), bound(s["rate_max"], kInf));
           const double rate = edge + s["rate_beyond"].get<double>() * (free - edge);
           e[t] += tangent_powers(powers, z, lo, hi) + s["rate"].get<double>() * rate;
         }
@@ -317,8 +318,8 @@ TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   const LoadedModel stateless = Fit(MakeLog(3000, 3), flat, 2, "rate_z_dph");
   ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
   ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
-  const std::vector<LoadedModel> axes{*thermal_, *two_, *ms_, *referenced_, *hysteresis_,
-                                      *heat_up_, stateless};
+  const std::vector<LoadedModel> axes{*thermal_,    *two_,     *ms_,     *referenced_,
+                                      *hysteresis_, *heat_up_, stateless};
   const Log test = MakeLog(2000, 4, 8.0);
   const std::string dir = test::TempDir("firmware_header");
   for (const bool single : {false, true}) {
