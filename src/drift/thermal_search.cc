@@ -200,8 +200,6 @@ Eigen::VectorXd FoldScores::TimeResidual(const std::vector<int>& cols) const {
 
 namespace {
 
-constexpr int kLevels = CalibrationReport::kHysteresis + 1;
-using LevelBests = std::array<Subset, kLevels>;
 
 // The ladder's candidates scored, keeping the best subset of each level.
 class Ladder {
@@ -278,8 +276,10 @@ class Ladder {
   LevelBests best_{};
 };
 
-// The best level and, by the one-standard-error rule, the simplest level not clearly worse than
-// it; the constant unless that beats the constant by a standard error.
+}  // namespace
+
+// A level within reach of the best that does not beat the constant (one bad fold can do that)
+// passes the choice to the next richer one, not to the constant.
 void ChooseLevel(const FoldScores& scores, const SearchRules& rules, const LevelBests& best,
                  SearchResult& result) {
   std::array<bool, kLevels> eligible{};
@@ -296,26 +296,28 @@ void ChooseLevel(const FoldScores& scores, const SearchRules& rules, const Level
   result.best_level = b;
   result.best_score = best[static_cast<size_t>(b)].score;
   const Subset& top = best[static_cast<size_t>(b)];
-  int pick = b;
-  for (int l = 0; l < b; ++l) {
-    if (!eligible[static_cast<size_t>(l)]) continue;
-    const Eigen::VectorXd d = best[static_cast<size_t>(l)].fold_scores - top.fold_scores;
-    if (scores.Mean(d) <= rules.standard_errors * scores.StandardError(d)) {
-      pick = l;
+  const double k = rules.standard_errors;
+  // Not clearly worse than the best, and clearly better than the constant.
+  auto within_best = [&](const Subset& s) {
+    const Eigen::VectorXd d = s.fold_scores - top.fold_scores;
+    return scores.Mean(d) <= k * scores.StandardError(d);
+  };
+  auto beats_constant = [&](const Subset& s) {
+    const Eigen::VectorXd d = s.fold_scores - result.constant.fold_scores;
+    return scores.Mean(d) < -k * scores.StandardError(d);
+  };
+  result.chosen = result.constant;
+  for (int l = 0; l <= b; ++l) {
+    const Subset& s = best[static_cast<size_t>(l)];
+    if (eligible[static_cast<size_t>(l)] && within_best(s) && (l == 0 || beats_constant(s))) {
+      result.chosen = s;
       break;
     }
   }
-  result.chosen = best[static_cast<size_t>(pick)];
-  if (pick > 0) {
-    const Eigen::VectorXd d = result.chosen.fold_scores - result.constant.fold_scores;
-    if (!(scores.Mean(d) < -rules.standard_errors * scores.StandardError(d))) {
-      result.chosen = result.constant;
-      result.fell_back_to_constant = true;
-    }
-  }
+  // The constant although a richer level scored best: that level did not beat it clearly (the
+  // constant within reach of the best and the best beating the constant are complements).
+  result.fell_back_to_constant = result.chosen.level == CalibrationReport::kConstant && b > 0;
 }
-
-}  // namespace
 
 SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layout,
                              const SearchRules& rules) {

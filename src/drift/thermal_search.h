@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -106,7 +107,7 @@ struct SearchResult {
   Subset constant, static_cubic;
   int best_level = 0;
   double best_score = 0.0;             // of the best level
-  bool fell_back_to_constant = false;  // the rule's choice did not beat the constant
+  bool fell_back_to_constant = false;  // the constant, although a richer level scored best
 };
 
 struct SearchRules {
@@ -118,6 +119,17 @@ struct SearchRules {
   // hysteresis term, which tells the directions apart.
   bool one_direction = false;
 };
+
+// The best subset of each level of the ladder (CalibrationReport's levels, the constant first).
+inline constexpr int kLevels = CalibrationReport::kHysteresis + 1;
+using LevelBests = std::array<Subset, kLevels>;
+
+// The rule of thermal_model.h's "Structure" on the levels' bests (unscored levels have an infinite
+// score): result.best_level and best_score, and as result.chosen the simplest level that is not
+// clearly worse than the best and clearly better than result.constant (by rules.standard_errors
+// standard errors of the paired fold differences each); the constant when none is.
+void ChooseLevel(const FoldScores& scores, const SearchRules& rules, const LevelBests& best,
+                 SearchResult& result);
 
 // The nested search of thermal_model.h's "Structure" over the design's subsets.
 SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layout,

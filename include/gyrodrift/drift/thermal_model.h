@@ -25,9 +25,9 @@
 // (2) the powers of one lag state's level, (3) with its rate, (4) two lag states with their rates,
 // (5) a hysteresis term (a state without its rate term has a rate coefficient of exactly 0). Within each level the subset of least
 // cross-validated error wins; across levels the simplest whose error is within one standard error
-// of the best level's stands (the one-standard-error rule on the paired scores of the held-out
-// time blocks), and a model that does not beat the constant by a standard error is the constant
-// (thermal_search.h). Every thermal regime (ramp or dwell) held out in turn, and the top and the
+// of the best level's and that beats the constant by a standard error stands (the
+// one-standard-error rule on the paired scores of the held-out time blocks); the constant when
+// the best level does not beat it by a standard error (thermal_search.h, ChooseLevel). Every thermal regime (ramp or dwell) held out in turn, and the top and the
 // bottom fifth of the temperature range held out, are scored and reported beside (choosing or
 // gating on them chose worse models on the family's one-way heat-ups: docs/drift.md 4.8). Columns
 // that are nearly collinear (condition of the scaled Gram above max_condition: two states of
