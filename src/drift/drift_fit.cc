@@ -213,8 +213,8 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
         " mode needs one uniform record (decompositions and lags run across a break)");
   }
   CheckLogged(logged, y.size());
+  RequireFiniteLogged("target", y, logged, 32);
   const Eigen::VectorXd y_logged = LoggedRows(y, logged);
-  RequireFiniteSignal("target", y_logged, 32);
   CheckRecordStarts(record_starts, y.size());
   RequireVaryingSignal("target", y_logged, "there is nothing to model");
   if (options.uses_temperature()) {

@@ -2,8 +2,10 @@
 #include "gyrodrift/drift/records.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::drift {
@@ -54,6 +56,26 @@ void CheckLogged(const std::vector<bool>& logged, Eigen::Index n) {
 Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n) {
   if (logged.empty()) return n;
   return static_cast<Eigen::Index>(std::count(logged.begin(), logged.end(), true));
+}
+
+void RequireFiniteLogged(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
+                         const std::vector<bool>& logged, Eigen::Index min_samples) {
+  if (logged.empty()) {
+    RequireFiniteSignal(what, x, min_samples);
+    return;
+  }
+  CheckLogged(logged, x.size());
+  const Eigen::Index n = CountLogged(logged, x.size());
+  if (n < min_samples) {
+    throw DataError(std::string(what) + " has " + std::to_string(n) + " logged samples: at least " +
+                    std::to_string(min_samples) + " are needed");
+  }
+  for (Eigen::Index r = 0; r < x.size(); ++r) {
+    if (logged[static_cast<size_t>(r)] && !std::isfinite(x[r])) {
+      throw DataError(std::string(what) + " sample " + std::to_string(r + 1) + " (logged) is " +
+                      FormatValue(x[r]) + ": every logged sample must be finite");
+    }
+  }
 }
 
 Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,

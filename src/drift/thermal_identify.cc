@@ -215,7 +215,7 @@ Eigen::VectorXd CheckedWeights(const Eigen::Ref<const Eigen::MatrixXd>& temperat
   const double n_logged = weight.sum();
   // Only the logged samples are read (as FitDriftModel checks them): a made-up one may be
   // anything, NaN included.
-  RequireFiniteSignal("target", LoggedRows(y, run.logged), 1);
+  RequireFiniteLogged("target", y, run.logged, 1);
   if (n_logged < 2 * kShortestFold) {
     throw DataError("calibration run of " + std::to_string(static_cast<long>(n_logged)) +
                     " logged samples is too short to cross-validate a thermal model (at least " +

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string_view>
 #include <vector>
 
 namespace gyrodrift::drift {
@@ -46,5 +47,10 @@ Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,
                            const std::vector<bool>& logged);
 // Rows logged: n when the mask is empty.
 Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n);
+// RequireFiniteSignal (check.h) over the logged rows of x: at least min_samples of them, each
+// finite; one that is not is named by its row of the record ("<what> sample <row> (logged) is
+// nan"), a made-up row may hold anything. With an empty mask, RequireFiniteSignal itself.
+void RequireFiniteLogged(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
+                         const std::vector<bool>& logged, Eigen::Index min_samples);
 
 }  // namespace gyrodrift::drift

@@ -408,12 +408,13 @@ TEST(ThermalModel, SamplesNotLoggedAreNotFitted) {
   EXPECT_EQ(
       IdentifyThermalModel(t, holes, 1.0, ThermalModelOptions{}, {.logged = logged}).coefficients,
       m.coefficients);
-  holes[300] = std::numeric_limits<double>::quiet_NaN();  // the 6th logged: 300 % 300 < 5
+  holes[300] = std::numeric_limits<double>::quiet_NaN();  // row 301, the 6th logged
   try {
     IdentifyThermalModel(t, holes, 1.0, ThermalModelOptions{}, {.logged = logged});
     ADD_FAILURE() << "a NaN at a logged sample was accepted";
   } catch (const DataError& e) {
-    EXPECT_NE(std::string(e.what()).find("target sample 6 is nan"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("target sample 301 (logged) is nan"), std::string::npos)
+        << e.what();
   }
   const double rms =
       std::sqrt((m.Estimate(t) - drift).squaredNorm() / static_cast<double>(t.size()));
