@@ -23,24 +23,27 @@
 //
 // Structure: nested models from simple to rich, (0) the constant, (1) static powers of T,
 // (2) the powers of one lag state's level, (3) with its rate, (4) two lag states with their rates,
-// (5) a hysteresis term (a state without its rate term has a rate coefficient of exactly 0). Within each level the subset of least
-// cross-validated error wins; across levels the simplest whose error is within one standard error
-// of the best level's and that beats the constant by a standard error stands (the
-// one-standard-error rule on the paired scores of the held-out time blocks); the constant when
-// the best level does not beat it by a standard error (thermal_search.h, ChooseLevel). Every thermal regime (ramp or dwell) held out in turn, and the top and the
-// bottom fifth of the temperature range held out, are scored and reported beside (choosing or
-// gating on them chose worse models on the family's one-way heat-ups: docs/drift.md 4.8). Columns
-// that are nearly collinear (condition of the scaled Gram above max_condition: two states of
-// close time constants) never enter together. A run that showed one direction of temperature
-// change only (no cooling ramp, or no heating ramp) takes no lag difference (two states, or a
-// state beside the static term: its sign follows the direction) and no hysteresis term.
+// (5) a hysteresis term (a state without its rate term has a rate coefficient of exactly 0).
+// Within each level the subset of least cross-validated error wins; across levels the simplest
+// whose error is within one standard error of the best level's and that beats the constant by a
+// standard error stands (the one-standard-error rule on the paired scores of the held-out time
+// blocks); the constant when the best level does not beat it by a standard error
+// (thermal_search.h, ChooseLevel). Every thermal regime (ramp or dwell) held out in turn, and the
+// top and the bottom fifth of the temperature range held out, are scored and reported beside
+// (choosing or gating on them chose worse models on the family's one-way heat-ups:
+// docs/drift.md 4.8). Columns that are nearly collinear (condition of the scaled Gram above
+// max_condition: two states of close time constants) never enter together. A run that showed one
+// direction of temperature change only (no cooling ramp, or no heating ramp) takes no lag
+// difference (two states, or a state beside the static term: its sign follows the direction) and
+// no hysteresis term.
 //
 // Support: the model keeps the calibration's range of every static level, state level and state
 // rate. Beyond a level's range its powers >= 2 continue along their tangent (a model does not
 // extrapolate a curvature it never saw). A rate extrapolates linearly in a direction the run
-// showed (a heating or cooling ramp: the Shupe and gradient terms are linear in rates), and is held
-// at the edge in one it never showed (a run that only heated says nothing of cooling); the
-// estimate's standard deviation grows by what the held rate leaves out.
+// showed (a heating or cooling ramp: the Shupe and gradient terms are linear in rates); beyond
+// the edge of one it never showed (a run that only heated says nothing of cooling) it moves at
+// half its slope (ThermalState::rate_beyond), midway between no response and the mirrored one;
+// the estimate's standard deviation grows by what that leaves out either way.
 //
 // Uncertainty: each estimate comes with a standard deviation sqrt(s_cv^2 + x' V x + e^2): s_cv is
 // the slow part of the cross-validated residual (its 10-min block means, less what the fast noise
@@ -254,7 +257,8 @@ struct ThermalRegression {
   // every record start (see IdentifyThermalModel).
   Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                              const std::vector<Eigen::Index>& record_starts = {}) const;
-  // Without `within_support`, the rates run unheld (what the held rates leave out).
+  // Without `within_support`, the rates run free beyond their ranges (what the support rule
+  // leaves out).
   Eigen::MatrixXd Regressors(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                              const std::vector<Eigen::Index>& record_starts,
                              bool within_support) const;
