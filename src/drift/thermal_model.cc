@@ -189,7 +189,7 @@ Eigen::MatrixXd ThermalRegression::EstimateWithSd(
   Eigen::ArrayXd variance =
       (xv.cwiseProduct(x)).rowwise().sum().array().max(0.0) + cv_slow_sd * cv_slow_sd;
   if (!states.empty()) {
-    // What holding the rates at the edge of their support left out: the model cannot tell.
+    // What the rates' share beyond their range left out (the run cannot tell the share).
     const Eigen::VectorXd unheld =
         (Regressors(temperatures_c, record_starts, /*within_support=*/false) - x) * coefficients;
     variance += unheld.array().square();
@@ -263,8 +263,8 @@ void ThermalRegression::Validate() const {
         !std::isfinite(s.level_max) || !(s.rate_min <= s.rate_max) || std::isnan(s.rate_min) ||
         std::isnan(s.rate_max) || !(s.rate_beyond >= 0.0 && s.rate_beyond <= 1.0)) {
       throw DataError(
-          "thermal model: a state names a channel, time constant, level or rate range out of "
-          "range");
+          "thermal model: a state names a channel, time constant, level or rate range, or a "
+          "rate_beyond outside [0, 1]");
     }
   }
   if (hysteresis_state < -1 || hysteresis_state >= static_cast<int>(states.size()) ||

@@ -125,9 +125,10 @@ inline constexpr int kLevels = CalibrationReport::kHysteresis + 1;
 using LevelBests = std::array<Subset, kLevels>;
 
 // The rule of thermal_model.h's "Structure" on the levels' bests (unscored levels have an infinite
-// score): result.best_level and best_score, and as result.chosen the simplest level that is not
+// score): result.best_level and best_score, and as result.chosen the constant when it is within
+// reach of the best (then the best does not beat it), else the simplest level that is not
 // clearly worse than the best and clearly better than result.constant (by rules.standard_errors
-// standard errors of the paired fold differences each); the constant when none is.
+// standard errors of the paired fold differences each; the best always qualifies then).
 void ChooseLevel(const FoldScores& scores, const SearchRules& rules, const LevelBests& best,
                  SearchResult& result);
 

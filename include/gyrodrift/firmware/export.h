@@ -69,7 +69,7 @@ void RequireExportable(const std::vector<LoadedModel>& axes);
 // Validate, and UsageError for a constant beyond float's range with single_precision.
 std::string RenderFirmwareC(const std::vector<LoadedModel>& axes, const ExportOptions& options);
 
-// The coefficients as plain JSON (format "gyrodrift-coefficients", version 1; schema in
+// The coefficients as plain JSON (format "gyrodrift-coefficients", version 4; schema in
 // docs/firmware.md), with every double written as the shortest text that reads back to it.
 std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                                    const ExportOptions& options);

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <numeric>
 #include <memory>
 #include <numbers>
 
@@ -63,14 +64,16 @@ Log MakeLog(Eigen::Index n, std::uint64_t seed, double offset_c = 0.0,
 }
 
 // A heat-up of the same gyro: a cold soak, one ramp up, a hold (a run that never cools, so its
-// model's cooling rates have a finite edge).
-Log MakeHeatUp(Eigen::Index n, std::uint64_t seed) {
+// model's cooling rates have a finite edge); with `cool` the mirror, a cool-down from 40 degC (its
+// heating rates have one).
+Log MakeOneWay(Eigen::Index n, std::uint64_t seed, bool cool) {
   Log log{Eigen::VectorXd(n), Eigen::MatrixXd(n, 2)};
   Rng rng(seed, 0);
-  double lagged = 0.0;
+  double lagged = cool ? 40.0 : 0.0;
   for (Eigen::Index t = 0; t < n; ++t) {
     const double x = static_cast<double>(t) / static_cast<double>(n);
-    log.temperature(t, 0) = 40.0 * std::clamp((x - 0.1) / 0.6, 0.0, 1.0);
+    const double ramp = 40.0 * std::clamp((x - 0.1) / 0.6, 0.0, 1.0);
+    log.temperature(t, 0) = cool ? 40.0 - ramp : ramp;
     const double previous = lagged;
     lagged += (log.temperature(t, 0) - lagged) / 40.0;
     log.rate[t] = 0.01 * (lagged - 20.0) + 4.0 * (lagged - previous) + 0.02 * rng.Normal();
@@ -205,10 +208,13 @@ class FirmwareExport : public ::testing::Test {
     hyst.thermal.max_states = 1;  // no pair of nearly collinear states, whose float rounding
                                   // the other models already exercise
     hysteresis_ = new LoadedModel(Fit(MakeLog(3000, 3, 0.0, 0.3), hyst));
-    heat_up_ = new LoadedModel(Fit(MakeHeatUp(3000, 3), Compensate(Method::kThermal)));
+    heat_up_ = new LoadedModel(Fit(MakeOneWay(3000, 3, false), Compensate(Method::kThermal)));
+    cool_down_ = new LoadedModel(Fit(MakeOneWay(3000, 3, true), Compensate(Method::kThermal)));
   }
   static void TearDownTestSuite() {
-    for (LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_}) delete m;
+    for (LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_, cool_down_}) {
+      delete m;
+    }
   }
   static LoadedModel* thermal_;
   static LoadedModel* two_;
@@ -216,6 +222,7 @@ class FirmwareExport : public ::testing::Test {
   static LoadedModel* referenced_;
   static LoadedModel* hysteresis_;  // with a hysteresis term
   static LoadedModel* heat_up_;     // a state whose cooling rates have a finite edge
+  static LoadedModel* cool_down_;   // one whose heating rates have
 };
 LoadedModel* FirmwareExport::thermal_ = nullptr;
 LoadedModel* FirmwareExport::two_ = nullptr;
@@ -223,13 +230,21 @@ LoadedModel* FirmwareExport::ms_ = nullptr;
 LoadedModel* FirmwareExport::referenced_ = nullptr;
 LoadedModel* FirmwareExport::hysteresis_ = nullptr;
 LoadedModel* FirmwareExport::heat_up_ = nullptr;
+LoadedModel* FirmwareExport::cool_down_ = nullptr;
 
 // Whether a model has a state whose rate has a finite edge (its calibration never showed a
-// direction), so that exporting it exercises the rate beyond that edge.
+// direction) and a nonzero coefficient, so that exporting it exercises the rate beyond that edge
+// (the test log swings at up to 4 K/min both ways, the one-way runs ramp at 0.8 K/min).
 bool HasBoundedRate(const LoadedModel& m) {
   for (const auto& sub : m.model.sub_models) {
-    for (const auto& s : sub.thermal->states) {
-      if (std::isfinite(s.rate_min) || std::isfinite(s.rate_max)) return true;
+    const drift::ThermalRegression& t = *sub.thermal;
+    Eigen::Index rate = std::accumulate(t.static_power.begin(), t.static_power.end(), 0) +
+                        t.max_power + 1;  // the first state's rate column
+    for (const auto& s : t.states) {
+      if ((std::isfinite(s.rate_min) || std::isfinite(s.rate_max)) && t.coefficients[rate] != 0.0) {
+        return true;
+      }
+      rate += t.max_power + 1;
     }
   }
   return false;
@@ -243,7 +258,9 @@ TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
   ASSERT_TRUE(hysteresis_->model.sub_models[0].thermal->has_hysteresis())
       << hysteresis_->model.Summary();
   ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
-  for (const LoadedModel* m : {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_}) {
+  ASSERT_TRUE(HasBoundedRate(*cool_down_)) << cool_down_->model.Summary();
+  for (const LoadedModel* m :
+       {thermal_, two_, ms_, referenced_, hysteresis_, heat_up_, cool_down_}) {
     const json j = json::parse(RenderCoefficientsJson({*m}, kJson));
     EXPECT_EQ(j["format"], "gyrodrift-coefficients");
     EXPECT_EQ(j["format_version"], 4);
@@ -318,8 +335,9 @@ TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   const LoadedModel stateless = Fit(MakeLog(3000, 3), flat, 2, "rate_z_dph");
   ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
   ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
-  const std::vector<LoadedModel> axes{*thermal_,    *two_,     *ms_,     *referenced_,
-                                      *hysteresis_, *heat_up_, stateless};
+  ASSERT_TRUE(HasBoundedRate(*cool_down_)) << cool_down_->model.Summary();
+  const std::vector<LoadedModel> axes{*thermal_,  *two_,       *ms_,     *referenced_, *hysteresis_,
+                                      *heat_up_, *cool_down_, stateless};
   const Log test = MakeLog(2000, 4, 8.0);
   const std::string dir = test::TempDir("firmware_header");
   for (const bool single : {false, true}) {
