@@ -52,12 +52,12 @@ void HysteresisColumns(const Eigen::Ref<const Eigen::VectorXd>& level,
 
 // Columns of one state: its standardised level to the powers 1..max_power (the powers >= 2
 // continued along their tangent beyond [s.level_min, s.level_max]), its rate (K/s; with
-// `hold_rate`, beyond [s.rate_min, s.rate_max] at s.rate_beyond times its slope), then H_w of its
-// level for each of widths_k. With `learn_range` the ranges are first set to the state's own (the
-// calibration run). `level` receives the state's level (degC).
+// `within_support`, beyond [s.rate_min, s.rate_max] at s.rate_beyond times its slope), then H_w
+// of its level for each of widths_k. With `learn_range` the ranges are first set to the state's
+// own (the calibration run). `level` receives the state's level (degC).
 void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, int order,
                   int max_power, double dt_s, double centre, double scale, bool learn_range,
-                  bool hold_rate, const std::vector<Eigen::Index>& record_starts,
+                  bool within_support, const std::vector<Eigen::Index>& record_starts,
                   const std::vector<double>& widths_k, Eigen::Ref<Eigen::MatrixXd> out,
                   Eigen::VectorXd& state) {
   Eigen::VectorXd previous;
@@ -71,7 +71,7 @@ void StateColumns(const Eigen::Ref<const Eigen::VectorXd>& t, ThermalState& s, i
     s.rate_min = rate.minCoeff();
     s.rate_max = rate.maxCoeff();
   }
-  if (hold_rate) {
+  if (within_support) {
     for (Eigen::Index i = 0; i < rate.size(); ++i) {
       const double edge = std::clamp(rate[i], s.rate_min, s.rate_max);
       rate[i] = edge + s.rate_beyond * (rate[i] - edge);

@@ -105,7 +105,7 @@ Eigen::MatrixXd CandidateDesign(const Eigen::Ref<const Eigen::MatrixXd>& tempera
     const auto c = static_cast<size_t>(candidates[j].channel);
     StateColumns(temperatures_c.col(candidates[j].channel), candidates[j], model.order,
                  model.max_power, 1.0 / rate_hz, model.centre_c[c], model.scale_k[c],
-                 /*learn_range=*/true, /*hold_rate=*/false, record_starts, widths_k,
+                 /*learn_range=*/true, /*within_support=*/false, record_starts, widths_k,
                  x.middleCols(layout.StateColumn(static_cast<int>(j), 0),
                               layout.state_columns + layout.widths),
                  level);

@@ -200,7 +200,6 @@ Eigen::VectorXd FoldScores::TimeResidual(const std::vector<int>& cols) const {
 
 namespace {
 
-
 // The ladder's candidates scored, keeping the best subset of each level.
 class Ladder {
  public:
