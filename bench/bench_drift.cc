@@ -2,7 +2,7 @@
 // (navigation preset, builtin programme "chamber", seed 1; 28,800 samples; BEEMDAN defaults:
 // 100 realisations, ensemble-band bound, and every stage noise-assisted for comparison; 1 and 2
 // threads), in both modes, and the causal evaluation of
-// that record (fit on the first 70 %, then one BEEMDAN of the trailing 512-sample window per test
+// that record (fit on the first 70 %, then one BEEMDAN of the trailing 2048-sample window per test
 // sample, 8,640 windows). Targets: fit < 1 s on 2 cores (issue 24), causal evaluation < 2 min.
 // Wall time is the figure (UseRealTime); `process_cpu_s` is the CPU time of every thread of the
 // process per iteration (Google Benchmark's CPU column counts the main thread only).

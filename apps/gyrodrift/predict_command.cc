@@ -83,7 +83,7 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
   cmd->footer(
       "Example:\n"
       "  gyrodrift fit train.csv --target rate_dph --mode predict --lags 4 -o model.json\n"
-      "  gyrodrift predict model.json test.csv --protocol causal --window 512 -o pred.csv\n"
+      "  gyrodrift predict model.json test.csv --protocol causal --window 4096 -o pred.csv\n"
       "writes pred.csv with columns sample (1-based row of test.csv), time_s (if test.csv has\n"
       "it) and prediction, one row per predicted sample: rows before the model has its p lags\n"
       "of history (for ms-elm/emd-elm under the causal protocol, 16 samples to decompose), and\n"

@@ -244,7 +244,7 @@ class DriftModel:
         sub-models (docs/drift.md 1.5)."""
         return self._core.coefficients(reference_temperature=reference_temperature)
 
-    def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=512,
+    def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=2048,
                 threads=0, progress=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
         horizon-step-ahead predictions of y[first:], first being the model's history.
@@ -360,7 +360,7 @@ def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisatio
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
-             split=0.7, repeats=1, horizon=1, window=512, progress=None, **settings):
+             split=0.7, repeats=1, horizon=1, window=2048, progress=None, **settings):
     """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
     paper and causal protocols (predict mode), against ``truth`` when given (else the output).

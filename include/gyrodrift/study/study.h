@@ -65,7 +65,7 @@ struct StudyOptions {
   // [20, 100000]. Default 20, the least the level estimator accepts.
   int realisations = 20;
   // Trailing window of the causal protocol, samples; CausalOptions' range [16, 1000000].
-  // Default 128 (the library's is 512): the cost of each of the test block's windows.
+  // Default 128 (the library's is 2048): the cost of each of the test block's windows.
   int causal_window = 128;
   // The methods compared: each a method of compensate mode (predict mode runs those it
   // supports), none twice (each saves one model file). Default: all, in drift::AllMethods order.
