@@ -36,32 +36,6 @@ decomposition::DecompositionOptions DecompositionFor(const DriftModel& model) {
   return dopt;
 }
 
-// The trained indices say where noise ends on the training record; a window's slow end differs:
-// at W = 2048, about one window in 300 of the chamber record puts the drift in its mode 9 and
-// almost nothing in its residue, and the noise group's mean would predict it (docs/drift.md 4.3).
-Eigen::MatrixXd WindowSeries(const DriftModel& model, const decomposition::Decomposition& d) {
-  Eigen::MatrixXd series = GroupSeries(model, d);
-  const auto& energy = d.report.mode_log2_energy;
-  const auto& upper = d.report.noise_band_log2_upper;
-  // Entry j tested mode j + 2; the bound ends at the first mode above its band (NaN: no band).
-  if (energy.empty() || !(energy.back() > upper.back())) return series;
-  const int first_signal = static_cast<int>(energy.size()) + 1;
-  const auto& subs = model.sub_models;
-  const auto noise = std::find_if(subs.begin(), subs.end(),
-                                  [](const SubModel& s) { return s.name == "noise"; });
-  const auto rest = std::find_if(subs.begin(), subs.end(),
-                                 [](const SubModel& s) { return s.has_residue; });
-  if (noise == subs.end() || rest == subs.end() || noise == rest) return series;
-  const Eigen::Index from = noise - subs.begin(), to = rest - subs.begin();
-  for (int k : noise->imfs) {
-    if (k >= first_signal && k <= d.num_imfs()) {
-      series.col(from) -= d.imfs.col(k - 1);
-      series.col(to) += d.imfs.col(k - 1);
-    }
-  }
-  return series;
-}
-
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                                         const Eigen::Ref<const Eigen::VectorXd>& y,
                                         Eigen::Index origin, Eigen::Index count,
@@ -98,7 +72,7 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
     const Eigen::Index end = origin + r;  // the window ends just before the origin
     const Eigen::Index start = std::max<Eigen::Index>(0, end - causal.window);
     const Eigen::Index length = end - start;
-    const Eigen::MatrixXd series = WindowSeries(
+    const Eigen::MatrixXd series = GroupSeries(
         model, decomposition::Decompose(y.segment(start, length), dopt,
                                         length == causal.window ? full_window : one_thread));
     for (size_t g = 0; g < groups; ++g) {

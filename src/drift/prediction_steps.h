@@ -21,11 +21,6 @@ Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 // The decomposition a fitted model applies to new data: its options with its seed.
 decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
 
-// A causal window's sub-series: GroupSeries of its decomposition d, except that the mode at which
-// d's BEEMDAN bound ended the noise assistance (its energy above the white-noise band) and every
-// later mode leave MS-ELM's noise group (predicted by its mean) for the group holding the residue.
-Eigen::MatrixXd WindowSeries(const DriftModel& model, const decomposition::Decomposition& d);
-
 // Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
 // trailing window y[o-W .. o-1] alone: lags[g](r, k) = s_g[o - 1 - k] of that window's groups
 // (count x lags per sub-model g). Windows run in parallel on execution.threads, which reports

@@ -1,17 +1,13 @@
 // The causal protocol (causal_protocol.cc): nothing after a prediction's origin reaches it,
 // windows sharing the white-noise EMDs predict as windows decomposed alone, the ensemble and
-// progress options, the note on sub-models a window cannot feed, the grouping of a window whose
-// bound found a signal mode among the trained noise modes, and the option ranges.
+// progress options, the note on sub-models a window cannot feed, and the option ranges.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 #include <string>
 #include <vector>
 
 #include "gyrodrift/common/error.h"
-#include "drift/prediction_steps.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "unit/drift/drift_fixtures.h"
 
@@ -191,48 +187,6 @@ TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
                         : message.find("ensemble_size = ") != std::string::npos)
         << ensemble << ": " << message;
   }
-}
-
-// A hand-made MS-ELM grouping noise{1-3} drift{4, r} and a 4-IMF window decomposition whose
-// bound tested modes 2 and 3 (energies against the band's upper limits).
-struct WindowCase {
-  DriftModel model;
-  decomposition::Decomposition d;
-};
-
-WindowCase MakeWindowCase(std::vector<double> energy, std::vector<double> upper) {
-  WindowCase c;
-  c.model.sub_models = {{.name = "noise", .imfs = {1, 2, 3}},
-                        {.name = "drift", .imfs = {4}, .has_residue = true}};
-  c.d.imfs = Eigen::MatrixXd(3, 4);
-  c.d.imfs << 1, 10, 100, 1000,  //
-      2, 20, 200, 2000,          //
-      3, 30, 300, 3000;
-  c.d.residue = Eigen::Vector3d(10000, 20000, 30000);
-  c.d.report.mode_log2_energy = std::move(energy);
-  c.d.report.noise_band_log2_upper = std::move(upper);
-  return c;
-}
-
-TEST(DriftModel, AWindowModeOutsideTheNoiseBandLeavesTheNoiseGroup) {
-  // Mode 3 above its band: the bound ended there, so modes 3 and later are the window's signal.
-  const auto [model, d] = MakeWindowCase({1.0, 5.0}, {2.0, 3.0});
-  const Eigen::MatrixXd series = internal::WindowSeries(model, d);
-  EXPECT_EQ(series.col(0), Eigen::Vector3d(11, 22, 33));
-  EXPECT_EQ(series.col(1), Eigen::Vector3d(11100, 22200, 33300));
-  // Every tested mode inside its band, or the last without one (NaN: too few realisations
-  // reached it), or a model without a noise group: the trained grouping as it is.
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (const auto& [energy, upper] :
-       std::vector<std::pair<std::vector<double>, std::vector<double>>>{
-           {{1.0, 2.5}, {2.0, 3.0}}, {{1.0, 5.0}, {2.0, nan}}, {{}, {}}}) {
-    const auto [m, w] = MakeWindowCase(energy, upper);
-    EXPECT_EQ(internal::WindowSeries(m, w), GroupSeries(m, w));
-  }
-  auto [emd_elm, w] = MakeWindowCase({1.0, 5.0}, {2.0, 3.0});
-  emd_elm.sub_models[0].name = "imf1";
-  EXPECT_EQ(internal::WindowSeries(emd_elm, w), GroupSeries(emd_elm, w));
-  EXPECT_EQ(GroupSeries(emd_elm, w).col(0), Eigen::Vector3d(111, 222, 333));
 }
 
 }  // namespace
