@@ -225,14 +225,15 @@ Protocol ProtocolFromString(std::string_view name);  // "paper", "causal"
 
 struct CausalOptions {
   // W, samples of the trailing window, in [16, 1e6]. Default 2048 [choice, measured]: a window's
-  // residue estimates the drift at its end; on 1 Hz FOG records the error falls from W = 512 to
-  // a flat minimum at 2048-4096 samples, and 2048 is the cheapest there (docs/drift.md 4.3).
+  // residue estimates the drift at its end; on 1 Hz FOG records its mean error falls from W = 512
+  // to a flat minimum at 2048-4096 samples, and 2048 is the cheapest there (docs/drift.md 4.3).
   int window = 2048;
   // Realisations of each window's decomposition (noise-assisted methods), in [0, 100000]; 0 = the
   // model's own decomposition.ensemble_size. Default 20 [choice]: one decomposition per test
-  // sample is the whole cost of the causal protocol (W = 2048: about 42 ms CPU with 20
-  // realisations, W = 512: 8 ms; 8,640 test samples of an 8-h record), and docs/drift.md shows
-  // what 20 instead of 100 costs in accuracy.
+  // sample is the whole cost of the causal protocol (a window decomposed alone with 20
+  // realisations: about 42 ms CPU at W = 2048, 8 ms at 512; full windows share their white-noise
+  // EMDs: the causal evaluation of an 8-h record, its fit and 8,640 windows, took 204 s CPU at
+  // 2048), and docs/drift.md shows what 20 instead of 100 costs in accuracy.
   int ensemble_size = 20;
 
   void Validate() const;  // throws OptionError for a window or ensemble size out of range
