@@ -263,8 +263,8 @@ void ThermalRegression::Validate() const {
         !std::isfinite(s.level_max) || !(s.rate_min <= s.rate_max) || std::isnan(s.rate_min) ||
         std::isnan(s.rate_max) || !(s.rate_beyond >= 0.0 && s.rate_beyond <= 1.0)) {
       throw DataError(
-          "thermal model: a state names a channel, time constant, level or rate range, or a "
-          "rate_beyond outside [0, 1]");
+          "thermal model: a state's channel, time constant, level or rate range is out of "
+          "range, or its rate_beyond is outside [0, 1]");
     }
   }
   if (hysteresis_state < -1 || hysteresis_state >= static_cast<int>(states.size()) ||

@@ -49,12 +49,12 @@ SearchResult Choose(const LevelBests& best) {
 TEST(ThermalSearch, ALevelThatDoesNotBeatTheConstantPassesTheChoiceOn) {
   LevelBests best;
   best[CalibrationReport::kConstant] = Level(0, {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0});
-  best[CalibrationReport::kOneState] = Level(3, {0.9, 0.9, 0.9, 8.0, 0.9, 0.9, 0.9, 0.9});
-  best[CalibrationReport::kTwoStates] = Level(4, {0.95, 0.94, 0.96, 0.95, 0.93, 0.96, 0.95, 0.94});
+  best[CalibrationReport::kOneState] = Level(CalibrationReport::kOneState, {0.9, 0.9, 0.9, 8.0, 0.9, 0.9, 0.9, 0.9});
+  best[CalibrationReport::kTwoStates] = Level(CalibrationReport::kTwoStates, {0.95, 0.94, 0.96, 0.95, 0.93, 0.96, 0.95, 0.94});
   // Static powers and the lagged level clearly worse than the best, hysteresis not scored; one
   // state's mean is the best's + 0.84 with a standard error of 0.89 (one fold): within reach.
-  best[CalibrationReport::kStatic] = Level(1, {0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99});
-  best[CalibrationReport::kLag] = Level(2, {0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98});
+  best[CalibrationReport::kStatic] = Level(CalibrationReport::kStatic, {0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99});
+  best[CalibrationReport::kLag] = Level(CalibrationReport::kLag, {0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98});
   const SearchResult r = Choose(best);
   EXPECT_EQ(r.best_level, 4);
   EXPECT_EQ(r.chosen.level, 4);

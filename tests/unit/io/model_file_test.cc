@@ -312,7 +312,7 @@ TEST(ModelFile, TheShareOfAnUnshownRateComesBackAndOlderFilesHoldTheRate) {
   EXPECT_NE(drift::EstimateDrift(old.model, cooling), drift::EstimateDrift(model, cooling));
   j = json::parse(text);
   j["model"]["sub_models"][0]["thermal"]["states"][0]["rate_beyond"] = 2.0;
-  ExpectRefused(Reseal(j), "rate_beyond outside [0, 1]");
+  ExpectRefused(Reseal(j), "rate_beyond is outside [0, 1]");
 }
 
 TEST(ModelFile, EveryOptionAndAwkwardDoublesComeBackExactly) {
