@@ -207,7 +207,7 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
                   ->capture_default_str(),
               {"units"});
   BindSetting(cmd->add_option("--confidence", args->settings.confidence,
-                              "two-sided confidence of the bounds, in (0,1)")
+                              "two-sided confidence of the bounds, in (0, 1 - 1e-12]")
                   ->capture_default_str(),
               {"confidence"});
   BindSetting(

@@ -39,41 +39,6 @@ const CLI::Validator kSeed(
 
 std::string SidecarPath(const std::string& output_path) { return output_path + ".json"; }
 
-void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
-                                const std::vector<std::string>& outputs) {
-  namespace fs = std::filesystem;
-  for (const std::string& in : inputs) {
-    std::error_code ec;
-    if (in.empty() || !fs::exists(in, ec)) continue;
-    for (const std::string& out : outputs) {
-      if (out.empty() || !fs::exists(out, ec)) continue;
-      if (fs::equivalent(in, out, ec) && !ec) {
-        throw UsageError("output " + out + " is the input " + in +
-                         ": gyrodrift never overwrites its input (choose another output path)");
-      }
-    }
-  }
-}
-
-void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (folder.empty() || !fs::exists(folder, ec)) return;
-  const fs::path root = fs::canonical(folder, ec);
-  if (ec) return;
-  for (const std::string& in : inputs) {
-    if (in.empty() || !fs::exists(in, ec)) continue;
-    const fs::path file = fs::canonical(in, ec);
-    if (ec) continue;
-    for (fs::path p = file; !p.empty() && p != p.root_path(); p = p.parent_path()) {
-      if (fs::equivalent(p, root, ec) && !ec) {
-        throw UsageError("input " + in + " lies inside the output folder " + folder +
-                         ": gyrodrift never overwrites its input (choose another folder)");
-      }
-    }
-  }
-}
-
 nlohmann::json SidecarHeader(const std::string& command) {
   return {{"tool", "gyrodrift"}, {"version", kVersion}, {"command", command}};
 }

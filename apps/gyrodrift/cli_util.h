@@ -12,6 +12,7 @@
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/io/csv.h"
+#include "gyrodrift/io/files.h"
 #include "gyrodrift/io/gyro_log.h"
 
 namespace gyrodrift::cli {
@@ -26,15 +27,9 @@ extern const CLI::Validator kSeed;
 // The sidecar path of an output file: OUT.csv -> OUT.csv.json.
 std::string SidecarPath(const std::string& output_path);
 
-// The user's files are never overwritten: throws UsageError naming both paths when an output
-// (each output's sidecar included: pass both) is one of the inputs, however spelled (relative,
-// "./", a symbolic or a hard link: the same file by device and inode). Inputs that do not exist
-// or are empty strings are skipped. Called before any work.
-void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
-                                const std::vector<std::string>& outputs);
-
-// The same for an output folder: no input may lie inside it (or be it).
-void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder);
+// The guards of the user's log (io/files.h).
+using io::RequireInputsOutsideFolder;
+using io::RequireOutputsAreNotInputs;
 
 // Common metadata of every sidecar: tool name, version and subcommand.
 nlohmann::json SidecarHeader(const std::string& command);

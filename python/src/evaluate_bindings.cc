@@ -31,8 +31,15 @@ namespace gp = gyrodrift::python;
 // The method list as text: a string as given, a sequence joined by commas (tasks::ParseMethods).
 std::string MethodList(const py::object& methods) {
   if (py::isinstance<py::str>(methods)) return methods.cast<std::string>();
+  std::vector<std::string> names;
+  try {
+    names = methods.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {  // pybind's own message names no argument
+    throw OptionError("methods", py::str(py::repr(methods)).cast<std::string>(),
+                      "a method name or a sequence of them");
+  }
   std::string text;
-  for (const std::string& name : methods.cast<std::vector<std::string>>()) {
+  for (const std::string& name : names) {
     text += (text.empty() ? "" : ",") + name;
   }
   if (text.empty()) throw OptionError("methods", "(empty)", "at least one method");

@@ -1,19 +1,35 @@
 // Bindings of the logs people have and the runs they plan: read_ulog, ulog_columns (what
 // `gyrodrift convert` writes) and plan (what `gyrodrift plan` writes), as the CLI computes them.
 #include "bindings.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/drift/calibration_plan.h"
 #include "gyrodrift/io/ulog.h"
 
 namespace gyrodrift::python {
 namespace {
 
+// A log's text as str: a damaged log's names need not be UTF-8 (undecodable bytes become U+FFFD,
+// where the default conversion raised UnicodeDecodeError).
+py::str Text(const std::string& text) {
+  PyObject* decoded =
+      PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+  if (!decoded) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(decoded);
+}
+
+py::list Texts(const std::vector<std::string>& texts) {
+  py::list out;
+  for (const std::string& t : texts) out.append(Text(t));
+  return out;
+}
+
 // One series as a dict: its description, and its samples when decoded (values by field).
 py::dict SeriesDict(const io::UlogSeries& s) {
   py::dict d;
-  d["topic"] = s.topic;
+  d["topic"] = Text(s.topic);
   d["instance"] = s.instance;
-  d["fields"] = s.fields;
-  d["types"] = s.types;
+  d["fields"] = Texts(s.fields);
+  d["types"] = Texts(s.types);
   d["samples"] = s.samples;
   d["first_us"] = s.first_us;
   d["last_us"] = s.last_us;
@@ -24,7 +40,7 @@ py::dict SeriesDict(const io::UlogSeries& s) {
     py::dict values;
     for (const std::string& f : s.fields) {
       const std::vector<double> v = s.Column(f);
-      values[py::str(f)] = py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+      values[Text(f)] = py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
     }
     d["values"] = values;
   }
@@ -36,15 +52,18 @@ py::dict ReadUlog(const std::string& path, const std::vector<std::string>& decod
   py::dict d;
   d["version"] = log.version;
   d["start_us"] = log.start_us;
-  d["info"] = log.info;
-  d["parameters"] = log.parameters;
+  py::dict info, parameters;
+  for (const auto& [key, value] : log.info) info[Text(key)] = Text(value);
+  for (const auto& [key, value] : log.parameters) parameters[Text(key)] = value;
+  d["info"] = info;
+  d["parameters"] = parameters;
   d["dropouts"] = log.dropouts;
   d["appended"] = log.appended;
-  d["warnings"] = log.warnings;
+  d["warnings"] = Texts(log.warnings);
   py::list series;
   for (const io::UlogSeries& s : log.series) series.append(SeriesDict(s));
   d["series"] = series;
-  d["listing"] = io::DescribeUlog(log);
+  d["listing"] = Text(io::DescribeUlog(log));
   return d;
 }
 
@@ -55,11 +74,13 @@ py::dict UlogColumns(const std::string& path, const std::string& topic, int inst
                                       .axes = axes,
                                       .temperature = temperature_field,
                                       .units = allan::RateUnitFromString(units)};
+  // One series: "every instance" (a negative one to SeriesWithSamples) is not an answer here.
+  if (instance < 0) ThrowOption("instance", std::to_string(instance), "an integer >= 0");
   const io::Ulog log = io::ReadUlog(path, {topic});
   const io::UlogSeries& s = *io::SeriesWithSamples(log, path, topic, instance).front();
   py::dict d;
   for (const io::CsvColumn& c : io::UlogColumns(s, conversion)) d[py::str(c.name)] = ToArray(c.values);
-  d["warnings"] = log.warnings;
+  d["warnings"] = Texts(log.warnings);
   return d;
 }
 

@@ -52,6 +52,34 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.calibrate(tmp_path / "nonexistent.toml", tmp_path / "out")
     with pytest.raises(gd.UsageError, match="not fitted"):
         gd.DriftModel().summary
+    with pytest.raises(gd.FileError, match="is a directory"):
+        gd.DriftModel.load(tmp_path)
+    with pytest.raises(gd.DataError, match=r"sample 3 is 1e\+200: no instrument logs"):
+        gd.allan(np.array([0.1, 0.2, 1e200, 0.1, 0.3]), rate_hz=1.0)
+    with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
+        gd.evaluate(np.arange(100.0), methods=5)
+    with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):
+        gd.noise_terms([1, 2, 4, 8, 16], [1, .7, .5, .4, .3], [0] * 5)
+
+
+def test_calibrate_never_writes_over_its_own_logs(tmp_path):
+    # A verification log inside the output folder would be replaced by fleet.csv: refused, as the
+    # CLI refuses it, and the log is left as it was.
+    rng = np.random.default_rng(1)
+    t = np.arange(600.0)
+    temp = 20 + 10 * np.sin(t / 200)
+    log = tmp_path / "fleet.csv"
+    np.savetxt(log, np.c_[t, 0.01 * temp + rng.normal(0, 0.01, t.size), temp], delimiter=",",
+               header="time_s,gyro,temp", comments="")
+    before = log.read_bytes()
+    manifest = tmp_path / "m.toml"
+    manifest.write_text('[[axis]]\ntarget = "gyro"\ntemperature = "temp"\n'
+                        '[[unit]]\nserial = "SN1"\ncalibration = "fleet.csv"\n'
+                        'verification = ["fleet.csv"]\n')
+    with pytest.raises(gd.UsageError, match="lies inside the output folder"):
+        gd.calibrate(manifest, tmp_path)
+    assert log.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fleet.csv", "m.toml"]
 
 
 def test_allan_white_noise_has_the_expected_slope():

@@ -28,6 +28,23 @@ def test_read_ulog_lists_three_gyro_instances_with_temperature():
     assert len(log["parameters"]) == 980 and log["warnings"] == []
 
 
+def test_a_damaged_logs_text_and_bad_arguments_raise_gyrodrift_errors(tmp_path):
+    # A value that is not UTF-8 (the 'P' of sys_name = PX4 made 0xff): replaced, not a
+    # UnicodeDecodeError.
+    data = bytearray(LOG.read_bytes())
+    at = data.find(b"sys_namePX4") + len(b"sys_name")
+    data[at] = 0xFF
+    damaged = tmp_path / "damaged.ulg"
+    damaged.write_bytes(bytes(data))
+    assert gd.read_ulog(str(damaged))["info"]["sys_name"] == "\ufffdX4"
+    with pytest.raises(gd.FileError, match="is a directory"):
+        gd.read_ulog(str(tmp_path))
+    with pytest.raises(gd.UsageError, match=r"instance = -1: must be an integer >= 0"):
+        gd.ulog_columns(str(LOG), instance=-1)
+    with pytest.raises(gd.UsageError, match="named twice"):
+        gd.ulog_columns(str(LOG), instance=0, axes=("x", "x"))
+
+
 def test_ulog_columns_are_what_convert_writes(cli, tmp_path):
     cli("convert", LOG, "--instance", "1", "--units", "dps", "-o", tmp_path / "g.csv")
     written = read_csv(tmp_path / "g.csv")

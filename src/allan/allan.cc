@@ -204,8 +204,10 @@ std::string NoiseTypeName(int alpha) {
 
 void AllanOptions::Validate() const {
   RequirePositive("rate_hz", rate_hz);
-  if (!(confidence > 0.0 && confidence < 1.0))
-    ThrowOption("confidence", FormatValue(confidence), "in (0, 1)");
+  // Beyond 1 - 1e-12 the chi-square tails' quantiles lose their digits (at the last double
+  // below 1 the lower bound was NaN).
+  if (!(confidence > 0.0 && confidence <= 1.0 - 1e-12))
+    ThrowOption("confidence", FormatValue(confidence), "in (0, 1 - 1e-12]");
   if (forced_alpha && (*forced_alpha < -4 || *forced_alpha > 2))
     ThrowOption("forced_alpha", std::to_string(*forced_alpha), "an integer in -4..2");
   if (forced_alpha && *forced_alpha + 2 * DifferenceOrder(deviation) <= 1)

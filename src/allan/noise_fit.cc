@@ -286,6 +286,18 @@ NoiseTerms IdentifyNoiseImpl(const Eigen::VectorXd& tau_s, const Eigen::VectorXd
 
 NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& adev_dph,
                          const Eigen::VectorXd& edf, const NoiseFitOptions& options) {
+  // A curve from elsewhere: its taus and EDFs are checked (points without a positive deviation
+  // are passed over, as on an Allan result's longest taus).
+  for (Eigen::Index i = 0; i < std::min(tau_s.size(), edf.size()); ++i) {
+    if (!(tau_s[i] > 0.0) || !std::isfinite(tau_s[i])) {
+      throw DataError("tau_s point " + std::to_string(i + 1) + " is " + FormatValue(tau_s[i]) +
+                      ": every tau must be a finite number > 0");
+    }
+    if (!(edf[i] > 0.0) || !std::isfinite(edf[i])) {
+      throw DataError("edf point " + std::to_string(i + 1) + " is " + FormatValue(edf[i]) +
+                      ": every EDF must be a finite number > 0");
+    }
+  }
   return IdentifyNoiseImpl(tau_s, adev_dph, edf, Eigen::VectorXd(), options.sample_period_s,
                            options);
 }

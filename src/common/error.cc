@@ -56,11 +56,21 @@ void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::Ve
                     std::to_string(min_samples) + " are needed");
   }
   for (Eigen::Index i = 0; i < x.size(); ++i) {
-    if (!std::isfinite(x[i])) {
-      throw DataError(std::string(what) + " sample " + std::to_string(i + 1) + " is " +
-                      FormatValue(x[i]) + ": every sample must be finite");
-    }
+    // NaN fails the comparison too, so only a bad sample pays for the call.
+    if (!(std::fabs(x[i]) <= kLargestSampleMagnitude)) RequireUsableSample(what, i + 1, x[i]);
   }
+}
+
+void RequireUsableSample(std::string_view what, Eigen::Index number, double value, bool logged) {
+  if (std::isfinite(value) && std::fabs(value) <= kLargestSampleMagnitude) return;
+  const std::string sample = std::string(what) + " sample " + std::to_string(number) +
+                             (logged ? " (logged)" : "") + " is " + FormatValue(value);
+  if (!std::isfinite(value)) {
+    throw DataError(sample + ": every " + (logged ? "logged " : "") + "sample must be finite");
+  }
+  throw DataError(sample + ": no instrument logs a magnitude above " +
+                  FormatValue(kLargestSampleMagnitude) +
+                  " (the models' sums of squares would overflow)");
 }
 
 void RequireVaryingSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,

@@ -53,7 +53,8 @@ LearnerKind KindOf(Method method) {
 }
 
 void RequireTemperatureFor(const Eigen::Ref<const Eigen::MatrixXd>& temperature_c, Eigen::Index n) {
-  if (temperature_c.rows() != n || temperature_c.cols() < 1) {
+  if (temperature_c.cols() < 1) throw DataError("temperature has no column: give at least one");
+  if (temperature_c.rows() != n) {
     throw DataError("temperature has " + std::to_string(temperature_c.rows()) +
                     " samples, the target " + std::to_string(n) + ": they must match");
   }

@@ -290,6 +290,16 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                     " leaves too little data (at least 32 training and 16 test samples)");
   }
   CheckHorizon(base, options.horizon, split);
+  // Named as the training block: the fits see only it, and the whole record may vary.
+  const std::string block = "'s training block (samples 1.." + std::to_string(split) + ")";
+  RequireVaryingSignal("target" + block, y.head(split), "there is nothing to fit the methods on");
+  if (base.uses_temperature()) {
+    for (Eigen::Index c = 0; c < temperature_c.cols(); ++c) {
+      RequireVaryingSignal("temperature" + block, temperature_c.col(c).head(split),
+                           "a drift model on temperature needs a training block whose "
+                           "temperature changes");
+    }
+  }
   if (temperature_c.rows() == n && temperature_c.cols() > 0) {
     const auto t = temperature_c.col(0);
     result.training_temperature_min_c = t.head(split).minCoeff();

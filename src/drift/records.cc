@@ -71,10 +71,7 @@ void RequireFiniteLogged(std::string_view what, const Eigen::Ref<const Eigen::Ve
                     std::to_string(min_samples) + " are needed");
   }
   for (Eigen::Index r = 0; r < x.size(); ++r) {
-    if (logged[static_cast<size_t>(r)] && !std::isfinite(x[r])) {
-      throw DataError(std::string(what) + " sample " + std::to_string(r + 1) + " (logged) is " +
-                      FormatValue(x[r]) + ": every logged sample must be finite");
-    }
+    if (logged[static_cast<size_t>(r)]) RequireUsableSample(what, r + 1, x[r], /*logged=*/true);
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/parallel.h"
+#include "gyrodrift/common/random.h"
 #include "gyrodrift/common/statistics.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -308,16 +309,27 @@ json RowsJson(const std::vector<FleetRow>& rows) {
   return j;
 }
 
-// A finished unit's rows from its summary.json when the fingerprint matches; false otherwise
-// (missing, damaged, another fingerprint or another column set: the unit is redone).
-bool ReadFinished(const std::string& path, const std::string& fingerprint,
+std::string FileHash(std::string_view contents) {
+  return fmt::format("fnv1a64:{:016x}", Fnv1a64(contents));
+}
+
+// A finished unit's rows from its summary.json when the fingerprint matches and every file the
+// summary lists is in the folder with the hash it was written with; false otherwise (missing,
+// damaged, another fingerprint or another column set, a file deleted or edited since: the unit
+// is redone).
+bool ReadFinished(const std::string& folder, const std::string& fingerprint,
                   std::vector<FleetRow>* rows) {
+  const std::string path = (fs::path(folder) / kSummaryFile).string();
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return false;
   try {
     const json j = json::parse(io::ReadTextFile(path));
     if (j.at("fingerprint").get<std::string>() != fingerprint) return false;
     if (j.at("columns").get<std::vector<std::string>>() != FleetColumns()) return false;
+    for (const auto& [name, hash] : j.at("files").items()) {
+      const std::string file = (fs::path(folder) / name).string();
+      if (!fs::is_regular_file(file, ec) || FileHash(io::ReadTextFile(file)) != hash) return false;
+    }
     for (const json& cells : j.at("rows")) {
       FleetRow row{cells.get<std::vector<std::string>>()};
       if (row.cells.size() != FleetColumns().size()) return false;
@@ -328,6 +340,17 @@ bool ReadFinished(const std::string& path, const std::string& fingerprint,
     rows->clear();
     return false;
   }
+}
+
+// The manifest and the logs of `unit` (of every unit when null) must lie outside the output
+// folder: a unit's files, or fleet.csv, would otherwise overwrite a log.
+void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::string& folder) {
+  std::vector<std::string> inputs = {m.path};
+  for (const UnitSpec& u : m.units) {
+    if (unit && &u != unit) continue;
+    for (const std::string& log : u.Logs()) inputs.push_back(log);
+  }
+  io::RequireInputsOutsideFolder(inputs, folder);
 }
 
 }  // namespace
@@ -363,14 +386,19 @@ UnitOutputs CalibrateUnit(const Manifest& manifest, const UnitSpec& unit,
 }
 
 std::string FleetResult::Summary() const {
+  // No unit calibrated in this run (all skipped or failed): no time per unit to give.
+  const std::string per_unit =
+      calibrated > 0 ? fmt::format(" ({:.2f} s per calibrated unit, median)", unit_seconds_median)
+                     : "";
   return fmt::format(
       "{} units: {} calibrated, {} skipped (done before), {} failed their limits, {} could not be "
-      "calibrated; {:.1f} s ({:.2f} s per calibrated unit, median)",
-      units, calibrated, skipped, failed_limits, errors, seconds, unit_seconds_median);
+      "calibrated; {:.1f} s{}",
+      units, calibrated, skipped, failed_limits, errors, seconds, per_unit);
 }
 
 UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& output_dir,
                 bool force, const html::DygraphsAssets& assets) {
+  RequireInputsOutside(m, &unit, output_dir);
   const std::string folder = (fs::path(output_dir) / unit.serial).string();
   const std::string summary = (fs::path(folder) / kSummaryFile).string();
   UnitRun run;
@@ -385,7 +413,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     run.what = "error";
     return run;
   }
-  if (!force && ReadFinished(summary, fingerprint, &run.rows)) {
+  if (!force && ReadFinished(folder, fingerprint, &run.rows)) {
     run.what = "skipped";
     return run;
   }
@@ -395,16 +423,19 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     run.what = "error";
     return run;
   }
-  json s = {{"fingerprint", fingerprint},
-            {"serial", unit.serial},
-            {"columns", FleetColumns()},
-            {"rows", RowsJson(run.rows)}};
+  json hashes = json::object();
   std::vector<std::pair<std::string, std::string>> files;
   std::error_code ec;
   fs::create_directories(folder, ec);
   for (auto& [name, text] : outputs.files) {
+    hashes[name] = FileHash(text);
     files.push_back({(fs::path(folder) / name).string(), std::move(text)});
   }
+  const json s = {{"fingerprint", fingerprint},
+                  {"serial", unit.serial},
+                  {"columns", FleetColumns()},
+                  {"rows", RowsJson(run.rows)},
+                  {"files", hashes}};
   files.push_back({summary, s.dump(1) + "\n"});
   try {
     io::WriteFilesAtomically(files);
@@ -458,14 +489,15 @@ FleetResult FinishFleet(const Manifest& m, const std::string& output_dir,
     csv += "\n";
   }
   fleet.seconds = seconds;
-  io::WriteFilesAtomically({{(fs::path(output_dir) / "fleet.csv").string(), csv},
-                            {(fs::path(output_dir) / "fleet.html").string(),
-                             RenderFleetReport(m, fleet, assets)}});
+  io::WriteFilesAtomically(
+      {{(fs::path(output_dir) / kFleetTableFile).string(), csv},
+       {(fs::path(output_dir) / kFleetReportFile).string(), RenderFleetReport(m, fleet, assets)}});
   return fleet;
 }
 
 FleetResult RunFleet(const Manifest& m, const FleetOptions& o, const FleetContext& context) {
   ValidateThreads(context.threads);
+  RequireInputsOutside(m, nullptr, o.output_dir);
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   fs::create_directories(o.output_dir, ec);

@@ -1,14 +1,15 @@
 #include "gyrodrift/fleet/manifest.h"
 
 #include <fmt/core.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
-#include <toml++/toml.h>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/fit_settings.h"
@@ -333,12 +334,25 @@ void ReadUnits(const toml::table& root, const Context& c, const std::string& pat
     UnitSpec u;
     u.line = unit.line();
     u.serial = unit.String("serial");
-    // The serial names the unit's output folder: no path separators, no "." or "..".
+    // The serial names the unit's output folder: no path separators, no "." or "..", not the
+    // name of a fleet-level file (case aside: some file systems ignore it).
+    std::string lower = u.serial;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    if (u.serial.find_first_of(std::string("\0\n\r\t", 4)) != std::string::npos) {
+      // Not printed: a NUL would cut the message short.
+      c.Fail(u.line,
+             "serial holds a control character (NUL, tab or line break): it names a folder");
+    }
     if (u.serial == "." || u.serial == ".." ||
-        u.serial.find_first_of("/\\:*?\"<>|") != std::string::npos ||
-        u.serial.find_first_of(std::string("\0\n\r\t", 4)) != std::string::npos) {
+        u.serial.find_first_of("/\\:*?\"<>|") != std::string::npos) {
       c.Fail(u.line, fmt::format("serial '{}' must be usable as a folder name (no / \\ : * ? \" "
                                  "< > |)", u.serial));
+    }
+    if (lower == kFleetTableFile || lower == kFleetReportFile) {
+      c.Fail(u.line, fmt::format("serial '{}' is the name of a file the fleet writes beside the "
+                                 "units' folders: choose another",
+                                 u.serial));
     }
     for (const UnitSpec& earlier : m.units) {
       if (earlier.serial == u.serial) {

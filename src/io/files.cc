@@ -16,7 +16,48 @@
 
 namespace gyrodrift::io {
 
+void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
+                                const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  for (const std::string& in : inputs) {
+    std::error_code ec;
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    for (const std::string& out : outputs) {
+      if (out.empty() || !fs::exists(out, ec)) continue;
+      if (fs::equivalent(in, out, ec) && !ec) {
+        throw UsageError("output " + out + " is the input " + in +
+                         ": gyrodrift never overwrites its input (choose another output path)");
+      }
+    }
+  }
+}
+
+void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (folder.empty() || !fs::exists(folder, ec)) return;
+  const fs::path root = fs::canonical(folder, ec);
+  if (ec) return;
+  for (const std::string& in : inputs) {
+    if (in.empty() || !fs::exists(in, ec)) continue;
+    const fs::path file = fs::canonical(in, ec);
+    if (ec) continue;
+    for (fs::path p = file; !p.empty() && p != p.root_path(); p = p.parent_path()) {
+      if (fs::equivalent(p, root, ec) && !ec) {
+        throw UsageError("input " + in + " lies inside the output folder " + folder +
+                         ": gyrodrift never overwrites its input (choose another folder)");
+      }
+    }
+  }
+}
+
+void RequireNotDirectory(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a file");
+}
+
 std::string ReadTextFile(const std::string& path) {
+  RequireNotDirectory(path);  // a directory opens as a stream, then fails to read
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw IoError(path + ": cannot open for reading (" + std::strerror(errno) + ")");

@@ -10,6 +10,7 @@
 
 #include "../common/format.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
 #include "gyrodrift/io/ulog.h"
 
 namespace gyrodrift::io {
@@ -476,6 +477,7 @@ Ulog ParseUlog(std::span<const std::uint8_t> bytes, const std::vector<std::strin
 }
 
 Ulog ReadUlog(const std::string& path, const std::vector<std::string>& decode) {
+  RequireNotDirectory(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError("cannot open " + path + " for reading");
   const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)),
@@ -533,6 +535,13 @@ std::vector<CsvColumn> UlogColumns(const UlogSeries& series, const UlogConversio
     const std::vector<double> v = series.Column(field);
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())));
   };
+  for (size_t a = 0; a < conversion.axes.size(); ++a) {
+    for (size_t b = 0; b < a; ++b) {
+      if (conversion.axes[a] == conversion.axes[b]) {
+        throw UsageError("axes: '" + conversion.axes[a] + "' is named twice (one column per axis)");
+      }
+    }
+  }
   std::vector<CsvColumn> out;
   Eigen::VectorXd time(static_cast<Eigen::Index>(series.samples));
   for (std::size_t i = 0; i < series.samples; ++i) {

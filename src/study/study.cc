@@ -330,6 +330,10 @@ void AllanStep(StudyResult& s) {
 
 // Refuses a log the study cannot analyse, before any work.
 void CheckLog(const StudyOptions& options, const StudyLog& log) {
+  if (!log.target_name.empty() && log.target_name == log.temperature_name) {
+    throw UsageError("temperature column '" + log.temperature_name +
+                     "' is the target column: they must differ");
+  }
   ValidateAsSettings({{"features.rate_hz", "rate_hz"}},
                      [&] { internal::StudyDriftOptions(options, log.rate_hz, false).Validate(); });
   if (log.output.size() < kMinLogSamples) {

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "gyrodrift/allan/allan.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::tasks {
@@ -43,13 +44,23 @@ std::string FitResult::ModelFile() const { return io::RenderModelFile(axes); }
 
 void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogOptions& log) {
   const bool flags = SpeltAsFlags(log);
-  for (const std::string& name : run.temperatures) {
+  // The names as given (arrays from Python come without a spec: their names stand for it).
+  std::string spec = run.temperature_spec;
+  if (spec.empty()) {
+    for (const std::string& name : run.temperatures) spec += (spec.empty() ? "" : ",") + name;
+  }
+  for (size_t i = 0; i < run.temperatures.size(); ++i) {
+    const std::string& name = run.temperatures[i];
     for (const std::string& target : run.targets) {
       if (name != target) continue;
-      throw UsageError(flags ? "--temperature = " + run.temperature_spec +
-                                   ": must differ from --target"
-                             : "temperature = " + run.temperature_spec +
-                                   ": must differ from the target");
+      throw UsageError(flags ? "--temperature = " + spec + ": must differ from --target"
+                             : "temperature = " + spec + ": must differ from the target");
+    }
+    // As ReadColumns refuses a spec that names a column twice (arrays from Python come here).
+    for (size_t j = 0; j < i; ++j) {
+      if (run.temperatures[j] != name) continue;
+      ThrowOption(flags ? "--temperature" : "temperature", "'" + spec + "'",
+                  "a list without repeats");
     }
   }
   const std::string method(drift::ToString(o.method));

@@ -35,6 +35,8 @@ class BadInput : public ::testing::Test {
     Write("cell_nan.csv", ReplaceRow(good, 100, "99,nan,20,0"));
     Write("cell_inf.csv", ReplaceRow(good, 100, "99,inf,20,0"));
     Write("cell_huge.csv", ReplaceRow(good, 100, "99,1e999,20,0"));
+    Write("cell_big.csv", ReplaceRow(good, 100, "99,1e200,20,0"));  // parses, but overflows
+    Write("temperature_big.csv", ReplaceRow(good, 100, "99,0.1,1e300,0"));
     Write("cell_text.csv", ReplaceRow(good, 100, "99,abc,20,0"));
     Write("cell_empty.csv", ReplaceRow(good, 100, "99,,20,0"));
     Write("ragged.csv", ReplaceRow(good, 100, "99,0.1,20"));
@@ -106,7 +108,8 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"decompose %D%/noname.csv -c 1 -o %O%", 3, "has no name"},
       {"decompose %D%/garbage.csv -c 1 -o %O%", 3, "garbage.csv"},
       {"decompose %D%/hugeline.csv -c rate_dph -o %O%", 3, "data row 1"},
-      {"decompose %D%/backwards.csv -c rate_dph -o %O%", 3, "time_s goes backwards at data row 300"},
+      {"decompose %D%/backwards.csv -c rate_dph -o %O%", 3,
+       "time_s goes backwards at data row 300"},
       {"decompose %D%/constant.csv -c rate_dph -o %O%", 3, "constant"},
       {"decompose %D%/missing.csv -c rate_dph -o %O%", 2, "no such file"},
       {"decompose %D%/good.csv -c nope -o %O%", 2, "'nope' not found"},
@@ -126,6 +129,18 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"allan %D%/constant.csv -c rate_dph --rate-hz 1 -o %O%", 3, "constant"},
       {"allan %D%/cell_nan.csv -c rate_dph --rate-hz 1 -o %O%", 3, "data row 100"},
       {"allan %D%/backwards.csv -c rate_dph --rate-hz 1 -o %O%", 3, "goes backwards"},
+      // Finite but beyond any instrument: the squares would overflow into inf and NaN results.
+      {"decompose %D%/cell_big.csv -c rate_dph -m eemd -I 5 -o %O%", 3,
+       "sample 100 is 1e+200: no instrument logs a magnitude above 1e+100"},
+      {"allan %D%/cell_big.csv -c rate_dph --rate-hz 1 -o %O%", 3, "sample 100 is 1e+200"},
+      {"fit %D%/cell_big.csv -t rate_dph -T temperature_c --mode compensate -m poly -o %O%", 3,
+       "sample 100 is 1e+200"},
+      {"fit %D%/temperature_big.csv -t rate_dph -T temperature_c --mode compensate -o %O%", 3,
+       "sample 100 is 1e+300"},
+      {"evaluate %D%/cell_big.csv -t rate_dph -T temperature_c --mode compensate --methods poly "
+       "-o %O%",
+       3, "sample 100 is 1e+200"},
+      {"allan %D%/good.csv -c rate_dph --confidence 0.9999999999999999 -o %O%", 2, "--confidence"},
       {"fit %D%/good.csv -t rate_dph --mode compensate -o %O%", 2, "needs a temperature channel"},
       {"fit %D%/good.csv -t rate_dph -T temperature_c --mode foo -o %O%", 2, "--mode = 'foo'"},
       {"fit %D%/good.csv -t rate_dph -T rate_dph --mode compensate -o %O%", 2, "must differ"},
@@ -143,8 +158,7 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"fit %D%/good.csv -t rate_dph -T temperature_c --mode predict -m thermal -o %O%", 2,
        "thermal"},
       {"fit %D%/onerow.csv -t rate_dph -T temperature_c --mode compensate -o %O%", 3, "at least"},
-      {"fit %D%/constant.csv -t rate_dph -T temperature_c --mode compensate -o %O%", 3,
-       "constant"},
+      {"fit %D%/constant.csv -t rate_dph -T temperature_c --mode compensate -o %O%", 3, "constant"},
       {"fit %D%/backwards.csv -t rate_dph -T temperature_c --mode compensate -o %O%", 3,
        "goes backwards"},
       // Model files.
@@ -156,6 +170,9 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"compensate %D%/missing.json %D%/good.csv -o %O%", 2, "no such file"},
       {"compensate %D%/comp.json %D%/good.csv --truth nope -o %O%", 2, "'nope' not found"},
       {"compensate %D%/comp.json %D%/cell_nan.csv -o %O%", 3, "data row 100"},
+      {"compensate %D%/comp.json %D%/temperature_big.csv -o %O%", 3,
+       "sample 100 is 1e+300: no instrument logs a magnitude above 1e+100"},
+      {"predict %D%/pred.json %D%/cell_big.csv -o %O%", 3, "sample 100 is 1e+200"},
       {"compensate %D%/comp.json %D%/dup.csv -o %O%", 3, "twice"},
       {"predict %D%/comp.json %D%/good.csv -o %O%", 2, "compensate-mode model"},
       {"predict %D%/edited.json %D%/good.csv -o %O%", 3, "checksum mismatch"},

@@ -281,10 +281,13 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
       {"bad TOML", "method = \n", "bad.toml:1: not valid TOML"},
       {"unknown key", "methd = \"thermal\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: unknown key 'methd'"},
-      {"missing file", std::string(kAxes) + unit + "\n[[unit]]\nserial = \"SN9\"\ncalibration = "
-       "\"logs/none.csv\"\nverification = \"logs/SN1_ver.csv\"\n",
+      {"missing file",
+       std::string(kAxes) + unit +
+           "\n[[unit]]\nserial = \"SN9\"\ncalibration = "
+           "\"logs/none.csv\"\nverification = \"logs/SN1_ver.csv\"\n",
        "bad.toml:17: unit 'SN9': log"},
-      {"duplicate serial", std::string(kAxes) + unit + unit, "bad.toml:17: serial 'SN1' repeats the unit of line 12"},
+      {"duplicate serial", std::string(kAxes) + unit + unit,
+       "bad.toml:17: serial 'SN1' repeats the unit of line 12"},
       {"unknown column", "[[axis]]\ntarget = \"gyro_q\"\ntemperature = \"temp_x\"\n" + unit,
        "bad.toml:5: unit 'SN1':"},
       {"bad method", "method = \"wavelet\"\n" + std::string(kAxes) + unit, "bad.toml:1: method"},
@@ -292,24 +295,40 @@ TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {
       {"bad limit", "[limits]\nresidual_drift_rms = -1\n" + std::string(kAxes) + unit,
        "bad.toml:2: 'residual_drift_rms' = -1"},
       {"several calibration logs, not thermal",
-       "method = \"ms-elm\"\n" + std::string(kAxes) + "\n[[unit]]\nserial = \"SN1\"\n"
-       "calibration = [\"logs/SN1_cal.csv\", \"logs/SN2_cal.csv\"]\nverification = "
-       "\"logs/SN1_ver.csv\"\n",
+       "method = \"ms-elm\"\n" + std::string(kAxes) +
+           "\n[[unit]]\nserial = \"SN1\"\n"
+           "calibration = [\"logs/SN1_cal.csv\", \"logs/SN2_cal.csv\"]\nverification = "
+           "\"logs/SN1_ver.csv\"\n",
        "bad.toml:15: several calibration logs need method = 'thermal', not 'ms-elm'"},
       {"split, not thermal", "method = \"ms-elm\"\ngaps = \"split\"\n" + std::string(kAxes) + unit,
        "bad.toml:2: gaps = 'split' needs method = 'thermal'"},
-      {"carry, decomposition", "method = \"ms-elm\"\ngaps = \"carry\"\n" + std::string(kAxes) + unit,
+      {"carry, decomposition",
+       "method = \"ms-elm\"\ngaps = \"carry\"\n" + std::string(kAxes) + unit,
        "bad.toml:2: gaps = 'carry' needs a method that fits on the logged rows only"},
       {"bad delimiter", "delimiter = \"pipe\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: delimiter = 'pipe': must be one of auto, comma, tab, semicolon"},
       {"bad hysteresis", "hysteresis = \"sometimes\"\n" + std::string(kAxes) + unit,
        "bad.toml:1: hysteresis = 'sometimes': must be one of auto, on, off"},
-      {"hysteresis, not identified", "method = \"poly\"\nhysteresis = \"on\"\n" +
-       std::string(kAxes) + unit, "bad.toml:2: hysteresis = 'on': must be auto unless"},
+      {"hysteresis, not identified",
+       "method = \"poly\"\nhysteresis = \"on\"\n" + std::string(kAxes) + unit,
+       "bad.toml:2: hysteresis = 'on': must be auto unless"},
       {"reference out of range", "reference_temperature_c = 500\n" + std::string(kAxes) + unit,
        "bad.toml:1: reference_temperature_c = 500: must be in [-100, 200]"},
-      {"serial with a slash", std::string(kAxes) + "\n[[unit]]\nserial = \"a/b\"\ncalibration = "
-       "\"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n", "must be usable as a folder"},
+      {"serial with a slash",
+       std::string(kAxes) + "\n[[unit]]\nserial = \"a/b\"\ncalibration = "
+                            "\"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n",
+       "must be usable as a folder"},
+      // A unit folder named as a fleet-level file would take its place (case aside).
+      {"serial of a fleet file",
+       std::string(kAxes) +
+           "\n[[unit]]\nserial = \"Fleet.csv\"\n"
+           "calibration = \"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n",
+       "serial 'Fleet.csv' is the name of a file the fleet writes"},
+      {"serial with a NUL",
+       std::string(kAxes) +
+           "\n[[unit]]\nserial = \"a\\u0000b\"\n"
+           "calibration = \"logs/SN1_cal.csv\"\nverification = \"logs/SN1_ver.csv\"\n",
+       "serial holds a control character"},
   };
   for (const Case& c : cases) {
     io::WriteFileAtomically(Dir() + "/bad.toml", c.text);

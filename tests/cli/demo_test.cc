@@ -177,6 +177,8 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo -o " + not_a_folder, 4, "not a folder"},
       {"demo -o " + not_a_folder + "/sub", 4, "not a folder"},
       {"demo --input " + csv + " --target nope --temperature temp -o " + dir + "/o", 2, "nope"},
+      {"demo --input " + csv + " --target rate --temperature rate -o " + dir + "/o", 2,
+       "temperature column 'rate' is the target column: they must differ"},
       {"demo --input " + csv + " --target rate --temperature temp -o " + dir + "/o", 3,
        "at least 64"},
   };

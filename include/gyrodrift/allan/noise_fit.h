@@ -83,7 +83,8 @@ struct NoiseTerms {
 // than a factor sqrt(2) in tau are thinned to the first.
 // Cost: 31 small fits and one correlation matrix (about 4e4 x T^2) for T points: 11 ms for 19.
 NoiseTerms IdentifyNoise(const AllanResult& result, const NoiseFitOptions& options = {});
-// Same from a bare curve: tau (s), Allan deviation in deg/h and EDF per point.
+// Same from a bare curve: tau (s), Allan deviation in deg/h and EDF per point (DataError for a tau
+// or an EDF that is not a finite number > 0; points without a positive deviation are passed over).
 NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& adev_dph,
                          const Eigen::VectorXd& edf, const NoiseFitOptions& options = {});
 

@@ -52,8 +52,19 @@ void ValidateAsSettings(std::initializer_list<std::pair<std::string_view, std::s
   }
 }
 
-// Throws DataError naming `what` unless every sample is finite and there are at least
-// `min_samples` of them.
+// The largest sample magnitude a signal may hold: no instrument logs more, and the sums of
+// squares and the powers the models take of larger values overflow (1e200 gave inf and NaN
+// results with exit 0 before this bound).
+inline constexpr double kLargestSampleMagnitude = 1e100;
+
+// Throws DataError naming `what` and its 1-based sample `number` ("sample 7 (logged)" for a
+// logged row of a log with made-up rows) unless value is finite and at most
+// kLargestSampleMagnitude in magnitude.
+void RequireUsableSample(std::string_view what, Eigen::Index number, double value,
+                         bool logged = false);
+
+// Throws DataError naming `what` unless there are at least `min_samples` samples, each usable
+// (RequireUsableSample).
 void RequireFiniteSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
                          Eigen::Index min_samples);
 

@@ -48,8 +48,9 @@ Eigen::MatrixXd LoggedRows(const Eigen::Ref<const Eigen::MatrixXd>& m,
 // Rows logged: n when the mask is empty.
 Eigen::Index CountLogged(const std::vector<bool>& logged, Eigen::Index n);
 // RequireFiniteSignal (check.h) over the logged rows of x: at least min_samples of them, each
-// finite; one that is not is named by its row of the record ("<what> sample <row> (logged) is
-// nan"), a made-up row may hold anything. With an empty mask, RequireFiniteSignal itself.
+// usable (RequireUsableSample); one that is not is named by its row of the record ("<what> sample
+// <row> (logged) is nan"), a made-up row may hold anything. With an empty mask, RequireFiniteSignal
+// itself.
 void RequireFiniteLogged(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
                          const std::vector<bool>& logged, Eigen::Index min_samples);
 

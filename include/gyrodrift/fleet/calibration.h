@@ -16,10 +16,12 @@
 // inside, so results do not depend on the thread count). Each unit's files are written together,
 // atomically, into OUT/<serial>/ with summary.json last in the set; a rerun skips a unit whose
 // summary.json holds the same fingerprint (manifest settings and the logs' bytes: UnitFingerprint)
-// unless `force`. A unit that fails (unreadable log, a fit that cannot run) is reported with its
-// one-line error and the others go on. OUT/fleet.csv (one row per unit, axis and verification log)
-// and OUT/fleet.html (distributions across the fleet, outliers flagged, units whose calibration
-// could not identify their model marked, links to each unit's page) are written at the end.
+// and whose files are as written (summary.json keeps their hashes) unless `force`. The manifest
+// and the logs must lie outside OUT (UsageError). A unit that fails (unreadable log, a fit that
+// cannot run) is reported with its one-line error and the others go on. OUT/fleet.csv (one row per
+// unit, axis and verification log) and OUT/fleet.html (distributions across the fleet, outliers
+// flagged, units whose calibration could not identify their model marked, links to each unit's
+// page) are written at the end.
 #pragma once
 
 #include <Eigen/Core>

@@ -73,6 +73,11 @@ struct AxisSpec {
   int line = 0;                          // in the manifest
 };
 
+// The files a fleet run writes into its output folder beside the units' folders (named by their
+// serials): no serial may be one of them.
+inline constexpr const char* kFleetTableFile = "fleet.csv";
+inline constexpr const char* kFleetReportFile = "fleet.html";
+
 struct UnitSpec {
   std::vector<std::string> Logs() const;  // calibration, then verification
   std::string serial;

@@ -18,6 +18,20 @@
 
 namespace gyrodrift::io {
 
+// The user's files are never overwritten: throws UsageError naming both paths when an output
+// (each output's sidecar included: pass both) is one of the inputs, however spelled (relative,
+// "./", a symbolic or a hard link: the same file by device and inode). Inputs that do not exist
+// or are empty strings are skipped. Called before any work.
+void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
+                                const std::vector<std::string>& outputs);
+
+// The same for an output folder: no input may lie inside it (or be it).
+void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder);
+
+// Throws IoError naming the path when it is a directory (which opens as a stream, then fails to
+// read).
+void RequireNotDirectory(const std::string& path);
+
 // Throws IoError naming the path when the file cannot be read.
 std::string ReadTextFile(const std::string& path);
 

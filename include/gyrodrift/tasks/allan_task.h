@@ -32,7 +32,7 @@ struct AllanSettings {
   std::string taus = "octave";
   std::vector<double> tau_list_s = {};  // taus in s (the Python package's sequence form)
   std::string units = "dph";            // allan::RateUnit name: dph | dps | rads
-  double confidence = 0.683;            // two-sided confidence of the bounds, in (0, 1)
+  double confidence = 0.683;            // two-sided confidence of the bounds, in (0, 1 - 1e-12]
   int threads = 0;                      // worker threads, in [0, 1024]; 0 = every core
   double fit_tau_min_s = 0.0;           // noise fit: smallest tau, s
   double fit_tau_max_s = std::numeric_limits<double>::infinity();  // noise fit: largest tau, s

@@ -154,6 +154,21 @@ TEST(RequireFiniteSignal, NamesTheCountOrTheFirstBadSampleOneBased) {
             "rate_dph has 5 samples: at least 10 are needed");
 }
 
+TEST(RequireFiniteSignal, RefusesMagnitudesNoInstrumentLogs) {
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(4, -kLargestSampleMagnitude);
+  x[1] = kLargestSampleMagnitude;
+  EXPECT_NO_THROW(RequireFiniteSignal("rate_dph", x, 4));  // the bound itself is usable
+  x[3] = -1e200;                                           // finite, but its square overflows
+  EXPECT_EQ(DataMessage([&] { RequireFiniteSignal("rate_dph", x, 1); }),
+            "rate_dph sample 4 is -1e+200: no instrument logs a magnitude above 1e+100 (the "
+            "models' sums of squares would overflow)");
+  EXPECT_EQ(DataMessage([] { RequireUsableSample("target", 7, kNan, /*logged=*/true); }),
+            "target sample 7 (logged) is nan: every logged sample must be finite");
+  EXPECT_EQ(DataMessage([] { RequireUsableSample("target", 7, 2e100, /*logged=*/true); }),
+            "target sample 7 (logged) is 2e+100: no instrument logs a magnitude above 1e+100 (the "
+            "models' sums of squares would overflow)");
+}
+
 TEST(RequireVaryingSignal, RefusesOnlyAConstantSignal) {
   EXPECT_NO_THROW(RequireVaryingSignal("t", Eigen::VectorXd(), "nothing to fit"));
   Eigen::VectorXd x = Eigen::VectorXd::Constant(4, 20.5);

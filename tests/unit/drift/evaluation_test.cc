@@ -97,6 +97,31 @@ TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
   EXPECT_EQ(ShareOutsideRange(log.temperature, std::nan(""), std::nan("")), 0.0);
 }
 
+// A training block that is constant where the whole record is not: the refusal names the block
+// the fits see, not the record (which varies).
+TEST(Evaluation, AConstantTrainingBlockIsNamedAsTheBlock) {
+  Log log = MakeLog(1000, 9);
+  EvaluationOptions eo;
+  eo.methods = {Method::kPoly};
+  const auto message = [&] {
+    try {
+      Evaluate(log.rate, log.temperature, log.drift, Fast(Mode::kCompensate, Method::kPoly), eo);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  log.rate.head(700).setConstant(1.5);
+  EXPECT_EQ(message(),
+            "target's training block (samples 1..700) is constant (every sample is 1.5): there is "
+            "nothing to fit the methods on");
+  log = MakeLog(1000, 9);
+  log.temperature.head(700).setConstant(20.0);
+  EXPECT_EQ(message(),
+            "temperature's training block (samples 1..700) is constant (every sample is 20): a "
+            "drift model on temperature needs a training block whose temperature changes");
+}
+
 // The slow variation: the RMS of whole blocks' means (a last partial block left out).
 TEST(Evaluation, SlowVariationIsTheRmsOfBlockMeans) {
   const Eigen::VectorXd x = (Eigen::VectorXd(5) << 1, 1, 3, 3, 5).finished();

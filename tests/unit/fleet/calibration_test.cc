@@ -463,6 +463,16 @@ TEST_F(FleetCalibration, AFinishedUnitIsSkippedAndADamagedOneRedone) {
   // Forced: redone, to the same model.
   EXPECT_EQ(RunUnit(limited, limited.units[0], out, true, test::FakeDygraphs()).what, "calibrated");
   EXPECT_EQ(io::ReadTextFile(out + "/SN3/model.json"), model);
+  // A file deleted or edited since it was written: redone, never skipped over.
+  fs::remove(out + "/SN3/model.json");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what,
+            "calibrated");
+  EXPECT_EQ(io::ReadTextFile(out + "/SN3/model.json"), model);
+  io::WriteFileAtomically(out + "/SN3/report.html", "garbage");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what,
+            "calibrated");
+  EXPECT_NE(io::ReadTextFile(out + "/SN3/report.html"), "garbage");
+  EXPECT_EQ(RunUnit(limited, limited.units[0], out, false, test::FakeDygraphs()).what, "skipped");
 }
 
 // Rows by hand for FinishFleet: unit i on axis "gyro" with the given residual drift after.
@@ -516,6 +526,14 @@ TEST(FinishFleet, CountsFlagsOutliersAndWritesTheTable) {
                                  "limits, 1 could not be calibrated"),
             std::string::npos)
       << fleet.Summary();
+  // A rerun that calibrated nothing has no time per unit to give (it printed "nan s" before).
+  FleetResult rerun;
+  rerun.units = rerun.skipped = 3;
+  rerun.seconds = 0.5;
+  rerun.unit_seconds_median = std::nan("");
+  EXPECT_EQ(rerun.Summary(),
+            "3 units: 0 calibrated, 3 skipped (done before), 0 failed their limits, 0 could not be "
+            "calibrated; 0.5 s");
 
   // fleet.csv: a cell with a comma or a quote is quoted, its quotes doubled.
   const std::string csv = io::ReadTextFile(dir + "/fleet.csv");
@@ -617,6 +635,19 @@ TEST_F(FleetCalibration, RunFleetRefusesWhatIsNotAUnitsOwnProblem) {
   EXPECT_FALSE(fs::exists(out));  // refused before the folder is made
   io::WriteFileAtomically(out, "a file");
   EXPECT_THROW(RunFleet(m, {.output_dir = out + "/sub"}), IoError);
+  // An output folder that holds the manifest's logs: refused before anything is written, by the
+  // fleet and by a unit's run alone (the Python package's Dask tasks), whatever the front end.
+  const std::string holder = fs::path(m.units[0].calibration[0]).parent_path().string();
+  const auto listing = [&] {
+    std::vector<std::string> names;
+    for (const auto& e : fs::recursive_directory_iterator(holder)) names.push_back(e.path());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const std::vector<std::string> before = listing();
+  EXPECT_THROW(RunFleet(m, {.output_dir = holder}), UsageError);
+  EXPECT_THROW(RunUnit(m, m.units[0], holder, false, test::FakeDygraphs()), UsageError);
+  EXPECT_EQ(listing(), before);
 }
 
 TEST_F(FleetCalibration, AProgressThatThrowsStopsTheFleet) {

@@ -59,6 +59,11 @@ TEST(ReadTextFile, AMissingFileIsAnIoErrorNamingThePath) {
   EXPECT_EQ(message.rfind(path + ": cannot open for reading (", 0), 0u) << message;
 }
 
+TEST(ReadTextFile, ADirectoryIsAnIoErrorNamingThePath) {
+  const std::string dir = test::TempDir("files_directory");
+  EXPECT_EQ(IoMessage([&] { ReadTextFile(dir); }), dir + ": is a directory, not a file");
+}
+
 TEST(WriteFileAtomically, CreatesAndReplacesWithoutLeavingATemporary) {
   const std::string dir = test::TempDir("files_single");
   WriteFileAtomically(dir + "/out.csv", "first\n");

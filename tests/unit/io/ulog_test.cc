@@ -83,6 +83,21 @@ TEST(Ulog, ThreeGyroInstancesWithTemperatureAsAnIndependentReaderReadsThem) {
   EXPECT_THROW(g0.Column("no_such_field"), DataError);
 }
 
+TEST(Ulog, AnAxisNamedTwiceOrADirectoryIsRefused) {
+  const Ulog log = ReadUlog(kSmall, {"sensor_gyro"});
+  const UlogSeries& g0 = *log.Find("sensor_gyro", 0);
+  UlogConversion twice;
+  twice.axes = {"x", "y", "x"};
+  try {
+    UlogColumns(g0, twice);
+    ADD_FAILURE() << "an axis named twice was converted";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), "axes: 'x' is named twice (one column per axis)");
+  }
+  const std::string dir = test::TempDir("ulog_directory");
+  EXPECT_THROW(ReadUlog(dir), IoError);
+}
+
 TEST(Ulog, TaggedLogWithDefaultParameters) {
   const Ulog log = ReadUlog(kTagged, {"*"});
   EXPECT_EQ(log.start_us, 280000u);

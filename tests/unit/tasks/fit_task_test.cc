@@ -93,6 +93,15 @@ TEST(FitTask, TheRunsChecksNameTheSettingAsTheUserTypesIt) {
             "--temperature = rate_dph: must differ from --target");
   EXPECT_EQ(message([&] { RunFit(same, Compensate(), "dph", keys); }),
             "temperature = rate_dph: must differ from the target");
+  // A run made of arrays (Python's) names its columns without a spec: the names stand for it.
+  FitRun twice = AssembleFitRun({ReadTaskLog(a, kFlags, 0.0)}, "rate_dph", "temperature_c", keys);
+  twice.temperature_spec.clear();
+  twice.temperatures = {"temperature_c", "temperature_c"};
+  EXPECT_EQ(message([&] { RunFit(twice, Compensate(), "dph", keys); }),
+            "temperature = 'temperature_c,temperature_c': must be a list without repeats");
+  twice.temperatures = {"rate_dph"};
+  EXPECT_EQ(message([&] { RunFit(twice, Compensate(), "dph", keys); }),
+            "temperature = rate_dph: must differ from the target");
   const std::vector<TaskLog> two = {ReadTaskLog(a, kFlags, 0.0), ReadTaskLog(b, kFlags, 0.0)};
   const FitRun records = AssembleFitRun(two, "rate_dph", "temperature_c", kFlags);
   EXPECT_NE(message([&] { RunFit(records, Compensate("poly"), "dph", kFlags); })
