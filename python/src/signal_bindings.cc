@@ -37,6 +37,12 @@ py::tuple Decompose(const Array& x_in, const tasks::DecomposeSettings& settings,
   if (noise_realisations) {
     tasks::RequireNoiseTaken(settings, "noise_realisations");
     supplied = ToMatrix(*noise_realisations, "noise_realisations");
+    // Empty means "draw them" to the library: an empty array given is a mistake, not that.
+    if (supplied.size() == 0) {
+      throw UsageError(
+          "noise_realisations: an (N, I) array with I >= 1 realisations is needed, got " +
+          std::to_string(supplied.rows()) + " x " + std::to_string(supplied.cols()));
+    }
   }
   LongCall call(progress);
   dec::Decomposition d;

@@ -56,6 +56,8 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.DriftModel.load(tmp_path)
     with pytest.raises(gd.DataError, match=r"sample 3 is 1e\+200: no instrument logs"):
         gd.allan(np.array([0.1, 0.2, 1e200, 0.1, 0.3]), rate_hz=1.0)
+    with pytest.raises(gd.UsageError, match=r"noise_realisations: an \(N, I\) array"):
+        gd.decompose(np.arange(100.0), method="eemd", noise_realisations=np.zeros((100, 0)))
     with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
         gd.evaluate(np.arange(100.0), methods=5)
     with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):

@@ -1,5 +1,7 @@
 #include "gyrodrift/io/csv.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -17,6 +19,23 @@
 
 namespace gyrodrift::io {
 namespace {
+
+// A cell as a message may quote it: control bytes as \xNN (a NUL would end the message), at most
+// 40 bytes of it.
+std::string Printable(std::string_view cell) {
+  constexpr size_t kLongest = 40;
+  std::string out;
+  for (size_t i = 0; i < cell.size() && i < kLongest; ++i) {
+    const auto byte = static_cast<unsigned char>(cell[i]);
+    if (byte < 0x20 || byte == 0x7F) {
+      out += fmt::format("\\x{:02X}", byte);
+    } else {
+      out += cell[i];
+    }
+  }
+  if (cell.size() > kLongest) out += "... (" + std::to_string(cell.size()) + " bytes)";
+  return out;
+}
 
 std::string_view Trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -157,6 +176,13 @@ class CsvTable::Parser {
 
   CsvTable Finish() {
     if (!started_) Start();
+    // The whole file one line with CRs inside: lines that end in CR alone (classic Mac text).
+    const size_t cr = carry_.find('\r');
+    if (!have_header_ && cr != std::string::npos && cr + 1 < carry_.size()) {
+      throw DataError(table_.source_ +
+                      ": lines end in CR alone (classic Mac text): save it with LF or CRLF line "
+                      "endings");
+    }
     if (!carry_.empty()) Line(carry_);  // the last line has no newline
     if (!have_header_) throw DataError(table_.source_ + ": empty file (no header row)");
     if (table_.rows_ == 0) throw DataError(table_.source_ + ": header but no data rows");
@@ -168,7 +194,11 @@ class CsvTable::Parser {
   }
 
  private:
-  static std::string_view WithoutBom(std::string_view text) {
+  // The text after a UTF-8 byte-order mark; UTF-16 (told by its mark) is refused by name.
+  std::string_view WithoutBom(std::string_view text) const {
+    if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF") {
+      throw DataError(table_.source_ + ": UTF-16 text (its byte-order mark): save it as UTF-8");
+    }
     if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
     return text;
   }
@@ -414,9 +444,8 @@ const Eigen::VectorXd& CsvTable::ColumnRef(int index) const {
   }
   const auto& bad = first_bad_[c];
   if (bad.row >= 0) {
-    throw DataError(source_ + ": column '" + header_[c] + "' data row " +
-                    std::to_string(bad.row) + " is '" + bad.text +
-                    "': every value must be a finite number");
+    throw DataError(source_ + ": column '" + header_[c] + "' data row " + std::to_string(bad.row) +
+                    " is '" + Printable(bad.text) + "': every value must be a finite number");
   }
   return columns_[c];
 }

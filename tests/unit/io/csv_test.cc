@@ -78,6 +78,40 @@ TEST(CsvTable, NonNumericAndNonFiniteCellsNameTheRow) {
   EXPECT_TRUE(u.IsKept(1));
 }
 
+// Messages a user can act on: a quoted cell shows its control bytes (a NUL would end the message)
+// and at most 40 bytes; CR-only line endings and UTF-16 text are named as such.
+TEST(CsvTable, UnreadableTextIsNamedForWhatItIs) {
+  const auto quoted = [](const std::string& text) {
+    try {
+      CsvTable::Parse(text, "f.csv").Column("b");
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(quoted(std::string("a,b\n1,2\n2,3\0x\n", 14)),
+            "f.csv: column 'b' data row 2 is '3\\x00x': every value must be a finite number");
+  EXPECT_EQ(quoted("a,b\n1," + std::string(100, '9') + "x\n"),
+            "f.csv: column 'b' data row 1 is '" + std::string(40, '9') +
+                "... (101 bytes)': every value must be a finite number");
+  const auto refusal = [](const std::string& text) {
+    try {
+      CsvTable::Parse(text, "f.csv");
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(
+      refusal("a,b\r1,2\r2,3\r"),
+      "f.csv: lines end in CR alone (classic Mac text): save it with LF or CRLF line endings");
+  EXPECT_EQ(refusal(std::string("\xFF\xFE"
+                                "a\0,\0b\0\n\0",
+                                10)),
+            "f.csv: UTF-16 text (its byte-order mark): save it as UTF-8");
+  EXPECT_EQ(refusal("a,b\r\n1,2\r\n"), "");  // CRLF stays fine
+}
+
 TEST(CsvTable, DuplicateHeaderNamesAreErrors) {
   try {
     CsvTable::Parse("a,b,a\n1,2,3\n", "dup.csv");
