@@ -19,6 +19,7 @@ See docs/python.md.
 """
 
 import inspect
+import numbers
 import os
 
 from . import _gyrodrift
@@ -29,6 +30,27 @@ __all__ = [
     "decompose", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_ulog",
     "select_modes", "simulate", "temperature_warning", "ulog_columns",
 ]
+
+
+# pybind refuses an integer beyond its C type with a TypeError that names no argument and lists
+# the whole signature; _call names the argument instead (the ranges are the C types').
+_UNSIGNED_RANGES = {"seed": (64, "[0, 2^64)"), "device_ids": (32, "[0, 2^32)")}
+
+
+def _call(function, *args, **kwargs):
+    try:
+        return function(*args, **kwargs)
+    except TypeError as error:
+        if "incompatible function arguments" not in str(error):
+            raise
+        for name, value in kwargs.items():
+            bits, text = _UNSIGNED_RANGES.get(name, (None, "[-2^31, 2^31)"))
+            lo, hi = (0, 2 ** bits) if bits else (-2 ** 31, 2 ** 31)
+            values = value if isinstance(value, (list, tuple)) else [value]
+            for v in values:
+                if isinstance(v, numbers.Integral) and not isinstance(v, bool) and not lo <= v < hi:
+                    raise UsageError(f"{name} = {v}: must be an integer in {text}") from None
+        raise
 
 
 def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, seed=1, threads=0,
@@ -54,7 +76,8 @@ def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, s
     >>> imfs.shape[0]
     2000
     """
-    return _gyrodrift.decompose(
+    return _call(
+        _gyrodrift.decompose,
         x, method=method, stop=stop, ensemble=ensemble, noise=noise, seed=seed, threads=threads,
         max_imfs=max_imfs, max_sifts=max_sifts, s_number=s_number, fixed_sifts=fixed_sifts,
         sd=sd, noise_scaling=noise_scaling, bound=bound, band=band, noise_stages=noise_stages,
@@ -83,10 +106,10 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
     >>> round(float(r["tau_s"][0]), 1)
     1.0
     """
-    return _gyrodrift.allan(x, rate_hz=rate_hz, type=type, dev=dev, taus=taus, units=units,
-                            confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
-                            fit_tau_max=fit_tau_max,
-                            logged=[] if logged is None else [bool(v) for v in logged])
+    return _call(_gyrodrift.allan, x, rate_hz=rate_hz, type=type, dev=dev, taus=taus,
+                 units=units, confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
+                 fit_tau_max=fit_tau_max,
+                 logged=[] if logged is None else [bool(v) for v in logged])
 
 
 def noise_terms(tau_s, adev_dph, edf, *, fit_tau_min=0.0, fit_tau_max=float("inf"),
@@ -100,9 +123,9 @@ def noise_terms(tau_s, adev_dph, edf, *, fit_tau_min=0.0, fit_tau_max=float("inf
     >>> gd.noise_terms(r["tau_s"], r["dev"], r["edf"])["N"]["identified"]
     True
     """
-    return _gyrodrift.noise_terms(tau_s, adev_dph, edf, fit_tau_min=fit_tau_min,
-                                  fit_tau_max=fit_tau_max, min_share=min_share,
-                                  significance=significance, sample_period_s=sample_period_s)
+    return _call(_gyrodrift.noise_terms, tau_s, adev_dph, edf, fit_tau_min=fit_tau_min,
+                 fit_tau_max=fit_tau_max, min_share=min_share, significance=significance,
+                 sample_period_s=sample_period_s)
 
 
 def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1.0, seed=1,
@@ -122,9 +145,9 @@ def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1
     >>> len(sim["rate_dph"]), sorted(sim["truth"])[0]
     (600, 'bias_dph')
     """
-    return _gyrodrift.simulate(duration=duration, profile=profile, preset=preset, rate_hz=rate_hz,
-                               seed=seed, winding=winding, asymmetry=asymmetry,
-                               input_rate_dph=input_rate_dph, noise=noise)
+    return _call(_gyrodrift.simulate, duration=duration, profile=profile, preset=preset,
+                 rate_hz=rate_hz, seed=seed, winding=winding, asymmetry=asymmetry,
+                 input_rate_dph=input_rate_dph, noise=noise)
 
 
 def read_ulog(path, *, decode=("sensor_gyro",)):
@@ -143,8 +166,8 @@ def ulog_columns(path, *, topic="sensor_gyro", instance=0, axes=("x", "y", "z"),
                  temperature_field="temperature", units="dph"):
     """The columns ``gyrodrift convert`` writes for one series: ``time_s``, ``<axis>_<units>``
     (the rad/s fields converted) and ``temperature_c``, as arrays, plus ``warnings``."""
-    return _gyrodrift.ulog_columns(path, topic=topic, instance=instance, axes=list(axes),
-                                   temperature_field=temperature_field, units=units)
+    return _call(_gyrodrift.ulog_columns, path, topic=topic, instance=instance, axes=list(axes),
+                 temperature_field=temperature_field, units=units)
 
 
 def plan(*, hours=8.0, min_c=-20.0, max_c=60.0, rate=0.0, dwell_min=80.0):
@@ -314,8 +337,8 @@ def export(models, *, format="c", single_precision=False, prefix="gyro_comp", de
     >>> params = gd.export("imu0.json", format="px4", device_ids=[2490378])  # doctest: +SKIP
     """
     paths = [str(models)] if isinstance(models, (str, os.PathLike)) else [str(m) for m in models]
-    return _gyrodrift.export(paths, format=format, single_precision=single_precision,
-                             prefix=prefix, device_ids=list(device_ids))
+    return _call(_gyrodrift.export, paths, format=format, single_precision=single_precision,
+                 prefix=prefix, device_ids=list(device_ids))
 
 
 def temperature_warning(temperature, name="temperature"):
@@ -354,9 +377,9 @@ def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisatio
     >>> [g["kind"] for g in s["groups"]][0]
     'noise'
     """
-    return _gyrodrift.select_modes(x, imfs, residue, criterion=criterion, distance=distance,
-                                   realisations=realisations, confidence=confidence, seed=seed,
-                                   band=band, threads=threads)
+    return _call(_gyrodrift.select_modes, x, imfs, residue, criterion=criterion,
+                 distance=distance, realisations=realisations, confidence=confidence, seed=seed,
+                 band=band, threads=threads)
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
@@ -382,7 +405,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     >>> [row["method"] for row in r["rows"]], r["first_test_sample"]
     (['none', 'constant', 'poly'], 5040)
     """
-    return _gyrodrift.evaluate(
+    return _call(
+        _gyrodrift.evaluate,
         y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,
         repeats=repeats, horizon=horizon, window=window, progress=progress, **settings)
 
@@ -420,4 +444,5 @@ def calibrate(manifest_path, output_dir, *, force=False, threads=0):
     (units, calibrated, skipped, errors, failed_limits), ``all_pass`` and ``summary``. Units
     that fail their limits are rows, not exceptions. ``gyrodrift.fleet`` runs the same on Dask.
     """
-    return _gyrodrift.calibrate(str(manifest_path), str(output_dir), force=force, threads=threads)
+    return _call(_gyrodrift.calibrate, str(manifest_path), str(output_dir), force=force,
+                 threads=threads)

@@ -58,6 +58,16 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.allan(np.array([0.1, 0.2, 1e200, 0.1, 0.3]), rate_hz=1.0)
     with pytest.raises(gd.UsageError, match=r"noise_realisations: an \(N, I\) array"):
         gd.decompose(np.arange(100.0), method="eemd", noise_realisations=np.zeros((100, 0)))
+    # Integers beyond the C types: one line naming the argument (pybind listed the signature).
+    with pytest.raises(gd.UsageError, match=r"^ensemble = 1099511627776: must be an integer in "
+                                            r"\[-2\^31, 2\^31\)$"):
+        gd.decompose(np.arange(100.0), method="eemd", ensemble=2**40)
+    with pytest.raises(gd.UsageError, match=r"^seed = -1: must be an integer in \[0, 2\^64\)$"):
+        gd.simulate(duration=600, seed=-1)
+    with pytest.raises(gd.UsageError, match=r"^device_ids = -1: must be an integer in \[0, 2\^32\)"):
+        gd.export([], format="px4", device_ids=[-1])
+    with pytest.raises(TypeError):  # a wrong type stays pybind's TypeError
+        gd.decompose(np.arange(100.0), ensemble="many")
     with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
         gd.evaluate(np.arange(100.0), methods=5)
     with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):
