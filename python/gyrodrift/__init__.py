@@ -33,8 +33,16 @@ __all__ = [
 
 
 # pybind refuses an integer beyond its C type with a TypeError that names no argument and lists
-# the whole signature; _call names the argument instead (the ranges are the C types').
-_UNSIGNED_RANGES = {"seed": (64, "[0, 2^64)"), "device_ids": (32, "[0, 2^32)")}
+# the whole signature; _call names the argument instead. Only the integer parameters are looked
+# at (a float parameter takes any integer), each with its C type's range.
+_INT = (-2 ** 31, 2 ** 31, "[-2^31, 2^31)")
+_INTEGER_RANGES = {
+    **{name: _INT for name in ("ensemble", "threads", "max_imfs", "max_sifts", "s_number",
+                               "fixed_sifts", "noise_stages", "realisations", "instance",
+                               "repeats", "horizon", "window")},
+    "seed": (0, 2 ** 64, "[0, 2^64)"),
+    "device_ids": (0, 2 ** 32, "[0, 2^32)"),
+}
 
 
 def _call(function, *args, **kwargs):
@@ -44,8 +52,9 @@ def _call(function, *args, **kwargs):
         if "incompatible function arguments" not in str(error):
             raise
         for name, value in kwargs.items():
-            bits, text = _UNSIGNED_RANGES.get(name, (None, "[-2^31, 2^31)"))
-            lo, hi = (0, 2 ** bits) if bits else (-2 ** 31, 2 ** 31)
+            if name not in _INTEGER_RANGES:
+                continue
+            lo, hi, text = _INTEGER_RANGES[name]
             values = value if isinstance(value, (list, tuple)) else [value]
             for v in values:
                 if isinstance(v, numbers.Integral) and not isinstance(v, bool) and not lo <= v < hi:

@@ -68,6 +68,8 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.export([], format="px4", device_ids=[-1])
     with pytest.raises(TypeError):  # a wrong type stays pybind's TypeError
         gd.decompose(np.arange(100.0), ensemble="many")
+    with pytest.raises(TypeError):  # a float parameter's large integer is not blamed for it
+        gd.allan(np.arange(100.0), rate_hz=1, fit_tau_max=10**10, units=5)
     with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
         gd.evaluate(np.arange(100.0), methods=5)
     with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):

@@ -21,11 +21,16 @@ namespace gyrodrift::io {
 namespace {
 
 // A cell as a message may quote it: control bytes as \xNN (a NUL would end the message), at most
-// 40 bytes of it.
+// 40 bytes of it, cut before a UTF-8 continuation byte (half a character is not UTF-8, which the
+// Python package's strings must be).
 std::string Printable(std::string_view cell) {
   constexpr size_t kLongest = 40;
+  size_t end = std::min(cell.size(), kLongest);
+  while (end > 0 && end < cell.size() && (static_cast<unsigned char>(cell[end]) & 0xC0) == 0x80) {
+    --end;
+  }
   std::string out;
-  for (size_t i = 0; i < cell.size() && i < kLongest; ++i) {
+  for (size_t i = 0; i < end; ++i) {
     const auto byte = static_cast<unsigned char>(cell[i]);
     if (byte < 0x20 || byte == 0x7F) {
       out += fmt::format("\\x{:02X}", byte);
@@ -33,7 +38,7 @@ std::string Printable(std::string_view cell) {
       out += cell[i];
     }
   }
-  if (cell.size() > kLongest) out += "... (" + std::to_string(cell.size()) + " bytes)";
+  if (end < cell.size()) out += "... (" + std::to_string(cell.size()) + " bytes)";
   return out;
 }
 

@@ -94,6 +94,10 @@ TEST(CsvTable, UnreadableTextIsNamedForWhatItIs) {
   EXPECT_EQ(quoted("a,b\n1," + std::string(100, '9') + "x\n"),
             "f.csv: column 'b' data row 1 is '" + std::string(40, '9') +
                 "... (101 bytes)': every value must be a finite number");
+  // A character across byte 40 is left out whole ("\xC3\xA0" is a UTF-8 a-grave at bytes 39-40).
+  EXPECT_EQ(quoted("a,b\n1," + std::string(39, 'x') + "\xC3\xA0" + "yz\n"),
+            "f.csv: column 'b' data row 1 is '" + std::string(39, 'x') +
+                "... (43 bytes)': every value must be a finite number");
   const auto refusal = [](const std::string& text) {
     try {
       CsvTable::Parse(text, "f.csv");
