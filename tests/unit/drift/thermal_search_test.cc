@@ -24,13 +24,14 @@ struct EightFolds {
   }
 };
 
-Subset Level(int level, std::initializer_list<double> per_fold) {
-  Subset s;
+// best[level] = the level's best subset with these fold scores (its level named once).
+void Put(LevelBests& best, int level, std::initializer_list<double> per_fold) {
+  Subset& s = best[static_cast<size_t>(level)];
+  s = Subset{};
   s.level = level;
   s.fold_scores = Eigen::Map<const Eigen::VectorXd>(per_fold.begin(),
                                                     static_cast<Eigen::Index>(per_fold.size()));
   s.score = s.fold_scores.mean();
-  return s;
 }
 
 SearchResult Choose(const LevelBests& best) {
@@ -48,16 +49,16 @@ SearchResult Choose(const LevelBests& best) {
 // the constant, which cost that unit 13 points of the mission's drift).
 TEST(ThermalSearch, ALevelThatDoesNotBeatTheConstantPassesTheChoiceOn) {
   LevelBests best;
-  best[CalibrationReport::kConstant] = Level(0, {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0});
-  best[CalibrationReport::kOneState] = Level(CalibrationReport::kOneState, {0.9, 0.9, 0.9, 8.0, 0.9, 0.9, 0.9, 0.9});
-  best[CalibrationReport::kTwoStates] = Level(CalibrationReport::kTwoStates, {0.95, 0.94, 0.96, 0.95, 0.93, 0.96, 0.95, 0.94});
+  Put(best, CalibrationReport::kConstant, {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0});
+  Put(best, CalibrationReport::kOneState, {0.9, 0.9, 0.9, 8.0, 0.9, 0.9, 0.9, 0.9});
+  Put(best, CalibrationReport::kTwoStates, {0.95, 0.94, 0.96, 0.95, 0.93, 0.96, 0.95, 0.94});
   // Static powers and the lagged level clearly worse than the best, hysteresis not scored; one
   // state's mean is the best's + 0.84 with a standard error of 0.89 (one fold): within reach.
-  best[CalibrationReport::kStatic] = Level(CalibrationReport::kStatic, {0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99});
-  best[CalibrationReport::kLag] = Level(CalibrationReport::kLag, {0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98});
+  Put(best, CalibrationReport::kStatic, {0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99, 0.99});
+  Put(best, CalibrationReport::kLag, {0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98, 0.98});
   const SearchResult r = Choose(best);
-  EXPECT_EQ(r.best_level, 4);
-  EXPECT_EQ(r.chosen.level, 4);
+  EXPECT_EQ(r.best_level, CalibrationReport::kTwoStates);
+  EXPECT_EQ(r.chosen.level, CalibrationReport::kTwoStates);
   EXPECT_FALSE(r.fell_back_to_constant);
 }
 
@@ -65,16 +66,16 @@ TEST(ThermalSearch, ALevelThatDoesNotBeatTheConstantPassesTheChoiceOn) {
 // constant stands; when no level beats the constant, the constant stands and says so.
 TEST(ThermalSearch, TheSimplestLevelNearTheBestThatBeatsTheConstantStands) {
   LevelBests best;
-  best[CalibrationReport::kConstant] = Level(0, {1.0, 1.1, 0.9, 1.0, 1.05, 0.95, 1.0, 1.0});
-  best[1] = Level(1, {0.80, 0.90, 0.71, 0.80, 0.86, 0.75, 0.80, 0.79});
-  best[2] = Level(2, {0.75, 0.92, 0.70, 0.82, 0.83, 0.77, 0.78, 0.80});
+  Put(best, CalibrationReport::kConstant, {1.0, 1.1, 0.9, 1.0, 1.05, 0.95, 1.0, 1.0});
+  Put(best, CalibrationReport::kStatic, {0.80, 0.90, 0.71, 0.80, 0.86, 0.75, 0.80, 0.79});
+  Put(best, CalibrationReport::kLag, {0.75, 0.92, 0.70, 0.82, 0.83, 0.77, 0.78, 0.80});
   SearchResult r = Choose(best);
-  EXPECT_EQ(r.best_level, 2);
-  EXPECT_EQ(r.chosen.level, 1);
+  EXPECT_EQ(r.best_level, CalibrationReport::kLag);
+  EXPECT_EQ(r.chosen.level, CalibrationReport::kStatic);
   // The best level's gain over the constant within the folds' noise: the constant, which says
   // that a richer level scored best.
-  best[1] = Level(1, {0.9, 1.2, 0.8, 1.1, 1.0, 0.95, 1.05, 0.98});
-  best[2] = Level(2, {1.1, 0.9, 0.85, 0.95, 1.0, 0.9, 1.1, 0.95});
+  Put(best, CalibrationReport::kStatic, {0.9, 1.2, 0.8, 1.1, 1.0, 0.95, 1.05, 0.98});
+  Put(best, CalibrationReport::kLag, {1.1, 0.9, 0.85, 0.95, 1.0, 0.9, 1.1, 0.95});
   r = Choose(best);
   EXPECT_EQ(r.chosen.level, CalibrationReport::kConstant);
   EXPECT_TRUE(r.fell_back_to_constant);
