@@ -68,26 +68,6 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
   return s;
 }
 
-// A log split at its gaps (--gaps split) analysed on one grid: the records joined with one missing
-// sample between them (allan::ComputeWithGaps), so no cluster pair spans a break.
-Eigen::VectorXd JoinRecords(const Eigen::VectorXd& column, const std::vector<Eigen::Index>& starts,
-                            std::vector<bool>* logged) {
-  Eigen::VectorXd joined(column.size() + static_cast<Eigen::Index>(starts.size()));
-  logged->assign(static_cast<size_t>(joined.size()), true);
-  Eigen::Index from = 0, to = 0;
-  for (size_t r = 0; r <= starts.size(); ++r) {
-    const Eigen::Index end = r < starts.size() ? starts[r] : column.size();
-    joined.segment(to, end - from) = column.segment(from, end - from);
-    to += end - from;
-    if (r < starts.size()) {
-      joined[to] = 0.0;  // never read: a break between records
-      (*logged)[static_cast<size_t>(to++)] = false;
-    }
-    from = end;
-  }
-  return joined;
-}
-
 void Run(const AllanArgs& a) {
   RequireOutputsAreNotInputs({a.input}, {a.output, SidecarPath(a.output)});
   // Every option error before any file is read; without --rate-hz the rate, and what depends on
@@ -102,7 +82,7 @@ void Run(const AllanArgs& a) {
   // builds the phase in the column's storage: at 1e8 samples it is 800 MB (docs/errors.md,
   // Memory). The note on the time axis is worked out while the table is there, printed at the
   // end.
-  std::string notes, time_note;
+  std::string notes, time_note, name;
   std::vector<bool> logged;
   Eigen::VectorXd data = [&] {
     std::vector<Eigen::Index> starts;
@@ -116,14 +96,13 @@ void Run(const AllanArgs& a) {
       }
       settings.Validate();
     }
+    name = "column '" + ColumnName(table, a.column) + "'";
     Eigen::VectorXd column = table.TakeColumn(a.column);
-    RequireVaryingSignal("column '" + ColumnName(table, a.column) + "'", column,
-                         "its Allan deviation is zero at every tau (a logging fault?)");
     if (a.log.gaps == "carry" || starts.empty()) return column;
-    return JoinRecords(column, starts, &logged);
+    return tasks::JoinRecords(column, starts, &logged);
   }();
   if (a.log.gaps == "interpolate") logged.clear();  // the made-up rows are analysed as data
-  const tasks::AllanRun r = tasks::RunAllan(std::move(data), logged, settings);
+  const tasks::AllanRun r = tasks::RunAllan(std::move(data), logged, settings, name);
 
   std::vector<io::CsvColumn> columns(5);
   const char* names[] = {"tau_s", "dev", "dev_lo", "dev_hi", "n_terms"};

@@ -34,7 +34,7 @@ using io::RequireOutputsAreNotInputs;
 // Common metadata of every sidecar: tool name, version and subcommand.
 nlohmann::json SidecarHeader(const std::string& command);
 
-// True when stdout or stderr is a terminal and progress may be shown.
+// True when stderr (where progress goes) is a terminal and progress may be shown.
 bool IsTerminal();
 
 // --duration text: "30s", "10min", "8h", "1.5h", "3600" (seconds), "1e4s". Anything else, or a

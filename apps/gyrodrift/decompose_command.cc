@@ -31,20 +31,6 @@ struct DecomposeArgs {
   bool quiet = false;
 };
 
-// Beyond this many samples a decomposition does not fit in the memory of a workstation: the
-// IMFs alone are 8 bytes x samples x (about log2(samples) modes), and sifting keeps a dozen
-// working vectors of the signal's length per thread (measured peaks in docs/errors.md).
-constexpr Eigen::Index kMaxDecomposeSamples = 20'000'000;
-
-void RequireDecomposableSize(const std::string& name, Eigen::Index samples) {
-  if (samples > kMaxDecomposeSamples) {
-    throw DataError(fmt::format(
-        "{} has {} samples: decompose takes at most {} (memory grows with samples x modes; "
-        "decimate or split the log)",
-        name, samples, kMaxDecomposeSamples));
-  }
-}
-
 void Run(const DecomposeArgs& a) {
   RequireOutputsAreNotInputs({a.input, a.noise_file}, {a.output, SidecarPath(a.output)});
   const tasks::DecomposeSettings& settings = a.settings;
@@ -53,14 +39,11 @@ void Run(const DecomposeArgs& a) {
 
   // Only the column (and time_s) is read, and the table is dropped once the column is out.
   a.log.RequireOneRecord("decompose", "a decomposition runs across the gaps");
-  std::string notes;
+  std::string notes, name;
   const Eigen::VectorXd x = [&] {
     io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
-    Eigen::VectorXd column = table.TakeColumn(a.column);
-    const std::string name = "column '" + ColumnName(table, a.column) + "'";
-    RequireVaryingSignal(name, column, "it has no oscillation to decompose");
-    RequireDecomposableSize(name, column.size());
-    return column;
+    name = "column '" + ColumnName(table, a.column) + "'";
+    return table.TakeColumn(a.column);
   }();
   Eigen::MatrixXd noise;  // --noise-file: one realisation per column
   const std::string noise_name = "--noise-file = " + a.noise_file;
@@ -77,7 +60,8 @@ void Run(const DecomposeArgs& a) {
     progress.BeginStage(0, std::string(dec::ToString(method)));
     d = tasks::RunDecompose(
         x, settings, noise,
-        [&progress](double fraction, std::string_view) { progress.Update(fraction); }, noise_name);
+        [&progress](double fraction, std::string_view) { progress.Update(fraction); }, noise_name,
+        name);
   }
 
   // Streamed from the decomposition itself: the text of 1e7 samples is gigabytes.

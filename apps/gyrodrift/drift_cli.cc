@@ -10,7 +10,6 @@
 #include "cli_util.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
-#include "gyrodrift/drift/temperature_check.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -144,26 +143,9 @@ drift::FitSettings Settings(const DriftArgs& a, const std::string& method) {
   return s;
 }
 
-double ResolveRateHz(const DriftArgs& a, const io::CsvTable& table, std::string* how) {
+double GivenRateHz(const DriftArgs& a) {
   const bool given = a.rate_option != nullptr && a.rate_option->count() > 0;
-  return ResolveSampleRate(table, given ? a.settings.rate_hz : 0.0, how);
-}
-
-std::string InputWarnings(const std::string& path, const std::string& rate_how,
-                          const io::CsvTable& table,
-                          const std::vector<std::string>& temperature_columns) {
-  std::string out;
-  if (rate_how == "default") {
-    out += fmt::format(
-        "warning: {} has no time_s column: its sample rate is taken as 1 Hz (give --rate-hz if "
-        "it is not)\n",
-        path);
-  }
-  for (const std::string& column : temperature_columns) {
-    const std::string w = drift::TemperatureWarning(table.Column(column), column);
-    if (!w.empty()) out += "warning: " + path + ": " + w + "\n";
-  }
-  return out;
+  return given ? a.settings.rate_hz : 0.0;
 }
 
 }  // namespace gyrodrift::cli

@@ -1,6 +1,6 @@
 // Option plumbing shared by the drift-model subcommands (fit, predict, compensate, evaluate): the
-// model options fit and evaluate take, the sample-rate rule, the column checks a saved model
-// needs, and the terminal progress line.
+// model options fit and evaluate take, the given sample rate, and the column checks a saved model
+// needs.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -36,28 +36,19 @@ struct DriftArgs {
 };
 
 // Adds the input(s) (several with `split_records`: fit's calibration logs),
-// --target, --temperature, --reference-temperature, --nonlinear, --hysteresis, --mode,
-// --decomposition, --lags, --hidden, --rate-hz, --thermal-features, --time-constants,
-// --ensemble, --realisations, --seed, --threads, --gaps, --delimiter and --quiet to cmd, each
-// flag bound to its drift::FitSettings setting.
+// --target, --temperature, --reference-temperature, --nonlinear, --hysteresis,
+// --standard-errors, --mode, --decomposition, --lags, --hidden, --rate-hz, --thermal-features,
+// --time-constants, --ensemble, --realisations, --seed, --threads, the log options
+// (AddLogOptions) and --quiet to cmd, each flag bound to its drift::FitSettings setting.
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
 // The settings of the arguments with `method` ("auto" or a method name), before any file is
-// read (drift::MakeDriftOptions maps them; the sample rate is settled later by ResolveRateHz).
+// read (drift::MakeDriftOptions maps them; the sample rate is settled later by
+// tasks::ReadTaskLog, given GivenRateHz).
 drift::FitSettings Settings(const DriftArgs& args, const std::string& method);
 
-// --rate-hz if given; else 1 / (median step of a `time_s` column) if the file has one; else 1.
-// `how` receives "given", "time_s" or "default". Throws DataError on a time_s column whose
-// median step is not positive.
-double ResolveRateHz(const DriftArgs& args, const io::CsvTable& table, std::string* how);
-
-// The warnings to print before the work on a log `path`: its sample rate assumed (`rate_how` as
-// ResolveRateHz returns it, "default"; "" = the command takes no rate) and each of its
-// `temperature_columns` that does not look like degC (drift::TemperatureWarning). Each line
-// "warning: ...\n"; "" when there is nothing to say.
-std::string InputWarnings(const std::string& path, const std::string& rate_how,
-                          const io::CsvTable& table,
-                          const std::vector<std::string>& temperature_columns);
+// --rate-hz if given, else 0 (tasks::ReadTaskLog then reads the rate from time_s, or takes 1 Hz).
+double GivenRateHz(const DriftArgs& args);
 
 using tasks::RequireModelColumns;
 

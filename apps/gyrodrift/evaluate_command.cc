@@ -18,6 +18,7 @@
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/tasks/evaluate_task.h"
+#include "gyrodrift/tasks/task_log.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -67,15 +68,17 @@ void Run(const EvaluateArgs& a) {
   }
   a.log.RequireOneRecord("evaluate", "it splits one record chronologically and scores every "
                          "method on it; fit --gaps " + a.log.gaps + " and compensate take records");
-  std::string gap_note;
-  const io::CsvTable table = ReadLog(a.inputs.front(), a.log, &gap_note);
-  tasks::EvaluateInput in{.input = a.inputs.front()};
-  settings.fit.rate_hz = ResolveRateHz(a, table, &in.rate_hz_from);
+  const tasks::TaskLog log = tasks::ReadTaskLog(a.inputs.front(), a.log.Options(), GivenRateHz(a));
+  const io::CsvTable& table = log.table;
+  tasks::EvaluateInput in{.input = a.inputs.front(), .rate_hz_from = log.rate_how};
+  settings.fit.rate_hz = log.rate_hz;
   Record record = ReadRecord(a, table, &in);
   // Before the work: an assumed sample rate, a temperature that does not look like degC.
   if (!a.quiet) {
-    fmt::print("{}", InputWarnings(a.inputs.front(), in.rate_hz_from, table,
-                                   record.temperature_names));
+    for (const std::string& w : tasks::LogWarnings(log, log.rate_how, record.temperature_names,
+                                                   /*flags=*/true)) {
+      fmt::print("warning: {}\n", w);
+    }
     std::fflush(stdout);
   }
   if (!a.truth.empty()) {
@@ -96,8 +99,10 @@ void Run(const EvaluateArgs& a) {
   }
   nlohmann::json sidecar = SidecarHeader("evaluate");
   sidecar.update(tasks::EvaluateRecord(run, in));
-  std::string notes = gap_note + NonUniformTimeNote(table);
-  if (!notes.empty() && notes.back() != '\n') notes += "\n";
+  std::string notes;
+  for (const std::string* note : {&log.gap_note, &log.time_note}) {
+    if (!note->empty()) notes += *note + (note->back() == '\n' ? "" : "\n");
+  }
   notes += tasks::EvaluateNotes(run.result);
   io::WriteFilesAtomically({{a.output, tasks::EvaluateTableCsv(run.result)},
                             {SidecarPath(a.output), sidecar.dump(2) + "\n"}});

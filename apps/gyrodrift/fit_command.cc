@@ -104,7 +104,7 @@ void PrintModel(const io::LoadedModel& axis, const drift::DriftOptions& o) {
 
 struct FitArgs : DriftArgs {
   std::string method = "auto";
-  std::string units = "dph";  // of the target column(s), recorded in the model file
+  std::string units = io::ModelFileInfo{}.rate_unit;  // of the target(s), kept in the model file
   std::string output;
 };
 
@@ -113,10 +113,9 @@ struct FitArgs : DriftArgs {
 // warnings to print before the work go to *notes and *warnings.
 tasks::FitRun ReadRun(const FitArgs& a, std::string* notes, std::string* warnings) {
   const io::LogOptions log = a.log.Options();
-  const bool rate_given = a.rate_option != nullptr && a.rate_option->count() > 0;
   std::vector<tasks::TaskLog> logs;
   for (const std::string& input : a.inputs) {
-    tasks::TaskLog l = tasks::ReadTaskLog(input, log, rate_given ? a.settings.rate_hz : 0.0);
+    tasks::TaskLog l = tasks::ReadTaskLog(input, log, GivenRateHz(a));
     if (!l.gap_note.empty()) *notes += l.gap_note + "\n";
     if (!l.time_note.empty()) *notes += (a.inputs.size() > 1 ? input + ": " : "") + l.time_note + "\n";
     // Each log's columns are checked where they are read, before its warnings.

@@ -146,11 +146,7 @@ void Run(const SimulateArgs& a) {
   if (!a.duration.empty()) o.duration_s = ParseDuration(a.duration);
   RequireInRange("--rate-hz", a.rate_hz, 1e-3, 1e4);
   const sim::TemperatureProgramme programme = LoadProgramme(a.profile);
-  if (a.duration.empty()) {
-    o.duration_s = programme.kind() == sim::TemperatureProgramme::Kind::kSine
-                       ? 8 * 3600.0
-                       : programme.NominalDuration();
-  }
+  if (a.duration.empty()) o.duration_s = programme.DefaultSimulationDuration();
   const sim::SimulationResult r = sim::Simulate(programme, params, o);
 
   const std::vector<io::CsvColumn> columns = {

@@ -94,7 +94,7 @@ def decompose(x, *, method="beemdan", stop="rilling", ensemble=100, noise=0.2, s
 
 
 def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", confidence=0.683,
-          threads=0, fit_tau_min=0.0, fit_tau_max=float("inf"), logged=None):
+          threads=0, fit_tau_min=0.0, fit_tau_max=float("inf"), logged=None, record_starts=()):
     """Allan-family deviation with confidence intervals and the IEEE 952 noise terms.
 
     As ``gyrodrift allan`` (both call the library's one allan operation, tasks::RunAllan).
@@ -103,7 +103,9 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
     ``logged``: one bool per sample of a record with gaps on its time grid, False where the
     sample is missing (its value, NaN or a filled one, is not used): as ``gyrodrift allan
     --gaps carry``, the overlapping estimators (oadev, ohdev) skip the cluster pairs that hold a
-    missing sample.
+    missing sample. ``record_starts``: the first sample of every record after the first, for
+    records given one after the other (as ``gyrodrift allan --gaps split``): they are analysed on
+    one grid with a missing sample between them, so no cluster pair spans a break.
 
     Returns a dict: ``tau_s``, ``m``, ``dev``, ``dev_lo``, ``dev_hi``, ``n_terms``, ``edf``,
     ``alpha``, ``alpha_identified`` (arrays, one entry per tau), ``dev_unit``, ``summary`` and
@@ -118,7 +120,8 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
     return _call(_gyrodrift.allan, x, rate_hz=rate_hz, type=type, dev=dev, taus=taus,
                  units=units, confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
                  fit_tau_max=fit_tau_max,
-                 logged=[] if logged is None else [bool(v) for v in logged])
+                 logged=[] if logged is None else [bool(v) for v in logged],
+                 record_starts=list(record_starts))
 
 
 def noise_terms(tau_s, adev_dph, edf, *, fit_tau_min=0.0, fit_tau_max=float("inf"),
@@ -209,8 +212,8 @@ class DriftModel:
         self._core = _core if _core is not None else _gyrodrift.DriftModel()
 
     def fit(self, y, temperature=None, *, mode="compensate", target="rate_dph",
-            temperature_columns=None, source="python", record_starts=(), logged=None,
-            progress=None, **settings):
+            temperature_columns=None, source="python", units="dph", record_starts=(),
+            logged=None, progress=None, **settings):
         """Fits the model on output ``y`` and ``temperature`` (N, or (N, C) for C channels, degC).
 
         ``settings``: the fit settings as keywords, named and defaulted as the library's
@@ -224,7 +227,9 @@ class DriftModel:
         term is in ``sub_models[g]["thermal"]["hysteresis"]``). The settings map onto the library's
         options as the CLI's flags do; a refusal names the keyword, and a keyword that names no
         setting raises TypeError. ``target`` and ``temperature_columns`` are the column
-        names written into the model file (the CLI's compensate reads those columns).
+        names written into the model file (the CLI's compensate reads those columns), ``units``
+        the unit of ``y`` ("dph", "dps" or "rads"), as ``gyrodrift fit --units``:
+        kept in the model file, it labels every estimate and scales the PX4 export.
         Several calibration runs (or one log split at its gaps, as ``--gaps split``) are given
         one after the other with ``record_starts`` the first sample of each run after the first:
         the thermal model's lag states restart there (``fit A.csv B.csv``; method thermal in
@@ -236,7 +241,7 @@ class DriftModel:
         ``decompose`` (Ctrl-C stops the fit at its next report). Returns self.
         """
         self._core.fit(y, temperature, mode=mode, target=target,
-                       temperature_columns=temperature_columns, source=source,
+                       temperature_columns=temperature_columns, source=source, units=units,
                        record_starts=list(record_starts),
                        logged=[] if logged is None else [bool(v) for v in logged],
                        progress=progress, **settings)
@@ -253,16 +258,24 @@ class DriftModel:
         ``gyrodrift compensate``."""
         return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
-    def compensation_summary(self, temperature, y, *, record_starts=(), drift_window_s=600.0):
+    def compensation_summary(self, temperature, y, *, record_starts=(), drift_window_s=600.0,
+                             logged=None, truth=None):
         """Compensate mode: what compensating ``y`` does to it, the figures ``gyrodrift
         compensate`` prints and keeps in its sidecar. Returns a dict: ``before`` and ``after``
         (each ``mean``, ``rms`` about zero, ``std`` about the mean and ``slow_variation``, the RMS
         about their mean of ``drift_window_s`` block means, NaN on a log shorter than two blocks),
-        ``samples``, ``slow_variation_block_s``, ``slow_variation_blocks`` and ``table`` (the
-        printed lines). The blocks are timed at the model's sample rate (docs/drift.md 1.5);
-        ``drift_window_s`` as ``compensate --drift-window-s`` and the manifest key."""
-        return self._core.compensation_summary(temperature, y, record_starts=list(record_starts),
-                                               drift_window_s=drift_window_s)
+        ``samples``, ``slow_variation_block_s``, ``slow_variation_blocks``, ``table`` (the
+        printed lines), ``outside_share`` (the share of the rows beyond the calibration's
+        temperatures) and ``drift_sd_mean`` (identified models, else NaN). The blocks are timed
+        at the model's sample rate (docs/drift.md 1.5); ``drift_window_s`` as ``compensate
+        --drift-window-s`` and the manifest key. ``logged``: one bool per sample,
+        False on rows made up across a gap (``--gaps carry``): the figures use the logged rows
+        only. ``truth``: the true drift (the simulator's ``drift_dph``), as ``compensate
+        --truth``: adds ``truth_rms``, ``residual_rms`` (of truth - estimate) and
+        ``truth_removed`` = 1 - residual_rms / truth_rms."""
+        return self._core.compensation_summary(
+            temperature, y, record_starts=list(record_starts), drift_window_s=drift_window_s,
+            logged=[] if logged is None else [bool(v) for v in logged], truth=truth)
 
     def coefficients(self, *, reference_temperature=None):
         """The thermal sub-models' coefficients in physical units, as ``gyrodrift fit`` prints

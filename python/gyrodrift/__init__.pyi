@@ -33,7 +33,7 @@ def allan(
     taus: Literal["all", "octave", "decade"] | Sequence[float] = ...,
     units: Literal["dph", "dps", "rads"] = ..., confidence: float = ..., threads: int = ...,
     fit_tau_min: float = ..., fit_tau_max: float = ...,
-    logged: Sequence[bool] | None = ...,
+    logged: Sequence[bool] | None = ..., record_starts: Sequence[int] = ...,
 ) -> dict[str, Any]: ...
 
 def noise_terms(
@@ -69,6 +69,7 @@ class DriftModel:
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *,
         mode: Literal["compensate", "predict"] = ..., target: str = ...,
         temperature_columns: Sequence[str] | None = ..., source: str = ...,
+        units: Literal["dph", "dps", "rads"] = ...,
         record_starts: Sequence[int] = ...,
         logged: Sequence[bool] | None = ...,
         progress: Callable[[float], object] | None = ...,
@@ -87,6 +88,8 @@ class DriftModel:
         *,
         record_starts: Sequence[int] = ...,
         drift_window_s: float = ...,
+        logged: Sequence[bool] | None = ...,
+        truth: ArrayLike | None = ...,
     ) -> dict[str, Any]: ...
     def coefficients(
         self, *, reference_temperature: float | None = ...

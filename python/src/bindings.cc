@@ -174,16 +174,4 @@ drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings 
   return base;
 }
 
-std::vector<std::string> SplitColumns(const std::string& names) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (true) {
-    const size_t comma = names.find(',', start);
-    out.push_back(
-        names.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) return out;
-    start = comma + 1;
-  }
-}
-
 }  // namespace gyrodrift::python

@@ -57,8 +57,6 @@ drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings 
 // call takes as a keyword (mode: a keyword of its own; has_temperature: set from temperature):
 // gd.fit_defaults().
 nlohmann::json FitKeywordDefaults();
-// The comma-separated names of a model file's temperature_column.
-std::vector<std::string> SplitColumns(const std::string& names);
 
 // Ctrl-C during a long call. Python runs its SIGINT handler's work on the main thread only, between
 // bytecodes, which a call inside the library never reaches. So while any long call runs, SIGINT
@@ -197,7 +195,7 @@ inline Execution ExecutionOf(int threads, LongCall& call) {
 
 // The functions of each binding file, called by PYBIND11_MODULE (module.cc).
 void BindSignal(py::module_& m);      // decompose, allan, noise_terms, simulate, select_modes
-void BindDriftModel(py::module_& m);  // DriftModel, temperature_warning
+void BindDriftModel(py::module_& m);  // DriftModel, temperature_warning, fit_defaults
 void BindExport(py::module_& m);      // export (model files for firmware and PX4)
 void BindEvaluate(py::module_& m);    // evaluate
 void BindFleet(py::module_& m);       // calibrate and the fleet's helpers

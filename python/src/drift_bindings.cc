@@ -1,5 +1,5 @@
 // DriftModel: fit, estimate, compensate, predict, save and load (as the CLI's fit, compensate,
-// predict and export read a model file).
+// predict and export read a model file), temperature_warning and fit_defaults; export.
 #include "bindings.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
@@ -23,6 +23,7 @@
 #include "gyrodrift/tasks/decompose_task.h"
 #include "gyrodrift/tasks/fit_task.h"
 #include "gyrodrift/tasks/predict_task.h"
+#include "gyrodrift/tasks/task_log.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -42,8 +43,9 @@ class PyDriftModel {
   void Fit(const Array& y_in, const std::optional<Array>& temperature_in,
            const drift::FitSettings& settings, const std::string& target,
            const std::optional<std::vector<std::string>>& temperature_columns,
-           const std::string& source, const std::vector<Eigen::Index>& record_starts,
-           const std::vector<bool>& logged, const py::object& progress) {
+           const std::string& source, const std::string& units,
+           const std::vector<Eigen::Index>& record_starts, const std::vector<bool>& logged,
+           const py::object& progress) {
     LongCall call(progress);
     settings.Validate();  // option errors before the arrays are looked at
     const Execution execution = ExecutionOf(settings.threads, call);
@@ -87,7 +89,7 @@ class PyDriftModel {
     run.rows.Append(rows, record_starts, logged);
     tasks::FitResult fit;
     call.Run([&] {
-      fit = tasks::RunFit(run, settings, io::ModelFileInfo{}.rate_unit, {},
+      fit = tasks::RunFit(run, settings, units, {},
                           [&execution](int, double fraction, std::string_view step) {
                             if (execution.progress) execution.progress(fraction, step);
                           });
@@ -109,11 +111,14 @@ class PyDriftModel {
     }
   }
 
-  // tasks::CompensateAxis of y (or of zeros: the estimate alone), as `gyrodrift compensate`.
+  // tasks::CompensateAxis of y (or of zeros: the estimate alone), as `gyrodrift compensate`;
+  // the figures over the `logged` rows (empty: every row) against `truth` (None: no truth).
   tasks::AxisCompensation Compensation(const char* what, const Array& temperature_in,
                                        const Array* y_in,
                                        const std::vector<Eigen::Index>& record_starts,
-                                       const tasks::CompensateSettings& settings = {}) const {
+                                       const tasks::CompensateSettings& settings = {},
+                                       const std::vector<bool>& logged = {},
+                                       const std::optional<Array>& truth_in = std::nullopt) const {
     RequireMode(drift::Mode::kCompensate, what);
     const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
     const Eigen::VectorXd y = y_in ? ToVector(*y_in, "y") : Eigen::VectorXd::Zero(t.rows());
@@ -121,8 +126,13 @@ class PyDriftModel {
       throw DataError(std::string(what) + ": y has " + std::to_string(y.size()) +
                       " samples, temperature " + std::to_string(t.rows()));
     }
+    const Eigen::VectorXd truth = truth_in ? ToVector(*truth_in, "truth") : Eigen::VectorXd();
+    if (truth_in && truth.size() != t.rows()) {
+      throw DataError(std::string(what) + ": truth has " + std::to_string(truth.size()) +
+                      " samples, temperature " + std::to_string(t.rows()));
+    }
     py::gil_scoped_release release;
-    return tasks::CompensateAxis(Loaded(), y, t, record_starts, {}, Eigen::VectorXd(), settings);
+    return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, settings);
   }
 
   py::tuple Estimate(const Array& temperature_in,
@@ -141,11 +151,12 @@ class PyDriftModel {
   // model (at the model's sample rate).
   py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
                                const std::vector<Eigen::Index>& record_starts,
-                               double drift_window_s) const {
-    const drift::CompensationSummary s =
+                               double drift_window_s, const std::vector<bool>& logged,
+                               const std::optional<Array>& truth) const {
+    const tasks::AxisCompensation c =
         Compensation("compensation_summary", temperature_in, &y_in, record_starts,
-                     {.drift_window_s = drift_window_s})
-            .summary;
+                     {.drift_window_s = drift_window_s}, logged, truth);
+    const drift::CompensationSummary& s = c.summary;
     auto figures = [](const drift::SignalSummary& f) {
       py::dict d;
       d["mean"] = f.mean;
@@ -161,6 +172,15 @@ class PyDriftModel {
     d["slow_variation_block_s"] = s.block_s;
     d["slow_variation_blocks"] = s.blocks;
     d["table"] = s.Table(Loaded().info.target_column, Loaded().info.rate_unit);
+    // As the sidecar of `gyrodrift compensate`: the share of the rows outside the calibration's
+    // temperatures, the mean drift_sd (identified models) and, with a truth, its share removed.
+    d["outside_share"] = c.outside_share;
+    d["drift_sd_mean"] = c.drift_sd_mean;
+    if (c.has_truth) {
+      d["truth_rms"] = c.truth_rms;
+      d["residual_rms"] = c.residual_rms;
+      d["truth_removed"] = c.truth_removed;
+    }
     return d;
   }
 
@@ -168,7 +188,7 @@ class PyDriftModel {
   // the model's reference temperature, else the calibration's means (as `gyrodrift fit` prints).
   py::list Coefficients(std::optional<double> reference_temperature) const {
     const io::LoadedModel& l = Loaded();
-    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    const std::vector<std::string> channels = tasks::SplitColumns(l.info.temperature_column);
     const std::optional<double> reference =
         reference_temperature ? reference_temperature : l.model.options.reference_c;
     py::list out;
@@ -237,7 +257,7 @@ class PyDriftModel {
 
   py::list SubModels() const {
     const io::LoadedModel& l = Loaded();
-    const std::vector<std::string> channels = SplitColumns(l.info.temperature_column);
+    const std::vector<std::string> channels = tasks::SplitColumns(l.info.temperature_column);
     py::list out;
     for (const drift::SubModel& sub : l.model.sub_models) {
       py::dict d;
@@ -301,12 +321,13 @@ void FitKeywords(gp::PyDriftModel& d, const gp::Array& y,
                  const std::optional<gp::Array>& temperature, const std::string& mode,
                  const std::string& target,
                  const std::optional<std::vector<std::string>>& temperature_columns,
-                 const std::string& source, const std::vector<Eigen::Index>& record_starts,
-                 const std::vector<bool>& logged, const py::object& progress,
-                 const py::kwargs& settings) {
+                 const std::string& source, const std::string& units,
+                 const std::vector<Eigen::Index>& record_starts, const std::vector<bool>& logged,
+                 const py::object& progress, const py::kwargs& settings) {
   const gyrodrift::drift::FitSettings s = gp::FitSettingsOf(
       settings, {.mode = mode, .has_temperature = temperature.has_value()}, "fit", {});
-  d.Fit(y, temperature, s, target, temperature_columns, source, record_starts, logged, progress);
+  d.Fit(y, temperature, s, target, temperature_columns, source, units, record_starts, logged,
+        progress);
 }
 
 }  // namespace
@@ -320,21 +341,22 @@ void BindDriftModel(py::module_& m) {
       .def("fit", &FitKeywords, arg("y"), arg("temperature") = py::none(), py::kw_only(),
            arg("mode") = "compensate", arg("target") = "rate_dph",
            arg("temperature_columns") = py::none(), arg("source") = "python",
-           arg("record_starts") = std::vector<Eigen::Index>{},
-           arg("logged") = std::vector<bool>{}, arg("progress") = py::none())
+           arg("units") = gyrodrift::io::ModelFileInfo{}.rate_unit,
+           arg("record_starts") = std::vector<Eigen::Index>{}, arg("logged") = std::vector<bool>{},
+           arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
            arg("record_starts") = std::vector<Eigen::Index>{})
       .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
            arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{},
-           arg("drift_window_s") = gyrodrift::tasks::CompensateSettings{}.drift_window_s)
+           arg("drift_window_s") = gyrodrift::tasks::CompensateSettings{}.drift_window_s,
+           arg("logged") = std::vector<bool>{}, arg("truth") = py::none())
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
-           arg("window") = pd.window, arg("threads") = pd.threads,
-           arg("progress") = py::none())
+           arg("window") = pd.window, arg("threads") = pd.threads, arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
@@ -356,7 +378,8 @@ void BindDriftModel(py::module_& m) {
       .def_property_readonly("temperature_columns",
                              [](const gp::PyDriftModel& d) {
                                const std::string& t = d.Loaded().info.temperature_column;
-                               return t.empty() ? std::vector<std::string>{} : gp::SplitColumns(t);
+                               return t.empty() ? std::vector<std::string>{}
+                                                : gyrodrift::tasks::SplitColumns(t);
                              })
       .def_property_readonly("temperature_range_c", [](const gp::PyDriftModel& d) {
         return py::make_tuple(d.Loaded().model.temperature_min_c,

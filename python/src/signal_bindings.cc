@@ -54,10 +54,18 @@ py::tuple Decompose(const Array& x_in, const tasks::DecomposeSettings& settings,
 
 // ---- allan ----------------------------------------------------------------------------------
 
-py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings,
-               const std::vector<bool>& logged) {
+py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings, std::vector<bool> logged,
+               const std::vector<Eigen::Index>& record_starts) {
   settings.Validate();
   Eigen::VectorXd data = ToVector(x_in, "x");
+  if (!record_starts.empty()) {
+    if (!logged.empty()) {
+      throw UsageError(
+          "logged and record_starts: give one (a record with gaps on its time grid, "
+          "or records to join)");
+    }
+    data = tasks::JoinRecords(data, record_starts, &logged);
+  }
   tasks::AllanRun run;
   {
     py::gil_scoped_release release;
@@ -149,11 +157,7 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   o.seed = seed;
   o.input_rate_dph = input_rate_dph;
   o.include_noise = noise;
-  // As `gyrodrift simulate`: without a duration, the programme's own length (8 h for a sine).
-  o.duration_s = duration ? *duration
-                 : programme->kind() == sim::TemperatureProgramme::Kind::kSine
-                     ? 8 * 3600.0
-                     : programme->NominalDuration();
+  o.duration_s = duration ? *duration : programme->DefaultSimulationDuration();
   sim::SimulationResult r;
   {
     py::gil_scoped_release release;
@@ -307,7 +311,7 @@ void BindSignal(py::module_& m) {
       [](const gp::Array& x, double rate_hz, const std::string& type, const std::string& dev,
          const std::variant<std::string, std::vector<double>>& taus, const std::string& units,
          double confidence, int threads, double fit_tau_min, double fit_tau_max,
-         const std::vector<bool>& logged) {
+         const std::vector<bool>& logged, const std::vector<Eigen::Index>& record_starts) {
         gyrodrift::tasks::AllanSettings s{.rate_hz = rate_hz,
                                           .type = type,
                                           .dev = dev,
@@ -323,13 +327,14 @@ void BindSignal(py::module_& m) {
           if (s.tau_list_s.empty())
             throw gyrodrift::OptionError("taus", "[]", "a non-empty sequence");
         }
-        return gp::Allan(x, s, logged);
+        return gp::Allan(x, s, logged, record_starts);
       },
       arg("x"), py::kw_only(), arg("rate_hz"), arg("type") = allan_defaults.type,
       arg("dev") = allan_defaults.dev, arg("taus") = allan_defaults.taus,
       arg("units") = allan_defaults.units, arg("confidence") = allan_defaults.confidence,
       arg("threads") = allan_defaults.threads, arg("fit_tau_min") = allan_defaults.fit_tau_min_s,
-      arg("fit_tau_max") = allan_defaults.fit_tau_max_s, arg("logged") = std::vector<bool>{});
+      arg("fit_tau_max") = allan_defaults.fit_tau_max_s, arg("logged") = std::vector<bool>{},
+      arg("record_starts") = std::vector<Eigen::Index>{});
   BindNoiseTermsSimulateSelect(m);
 }
 

@@ -72,6 +72,11 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.allan(np.arange(100.0), rate_hz=1, fit_tau_max=10**10, units=5)
     with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
         gd.evaluate(np.arange(100.0), methods=5)
+    # A constant signal is refused by the library, for Python as for the CLI.
+    with pytest.raises(gd.DataError, match=r"^x is constant \(every sample is 2\): it has no osc"):
+        gd.decompose(np.full(100, 2.0))
+    with pytest.raises(gd.DataError, match=r"^x is constant \(every sample is 2\): its Allan"):
+        gd.allan(np.full(100, 2.0), rate_hz=1.0)
     with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):
         gd.noise_terms([1, 2, 4, 8, 16], [1, .7, .5, .4, .3], [0] * 5)
 

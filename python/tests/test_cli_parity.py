@@ -125,6 +125,17 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
         for figure in ("mean", "rms", "std", "slow_variation"):
             assert summary[when][figure] == side[when][figure], (when, figure)
     assert summary["slow_variation_blocks"] == side["slow_variation_blocks"] == 12
+    assert summary["outside_share"] == side["outside_training_temperature_share"]
+    assert summary["drift_sd_mean"] == side["drift_sd_mean"]
+    assert "truth_removed" not in summary
+    # Against the true drift, as compensate --truth.
+    cli("compensate", tmp_path / "cli_model.json", sim_csv, "--truth", "drift_dph", "-q", "-o",
+        tmp_path / "truth.csv")
+    side = read_json(tmp_path / "truth.csv.json")["truth"]
+    summary = loaded.compensation_summary(temperature, y, truth=log["drift_dph"])
+    assert summary["truth_rms"] == side["rms"]
+    assert summary["residual_rms"] == side["residual_rms"]
+    assert 100.0 * summary["truth_removed"] == side["removed_percent"]
     printed = cli("compensate", tmp_path / "cli_model.json", sim_csv, "-o",
                   tmp_path / "comp2.csv").stdout
     assert summary["table"] in printed
@@ -159,6 +170,35 @@ def test_fit_settings_map_as_the_cli_flags(cli, sim_csv, tmp_path):
                             method="poly", hysteresis="off")
     with pytest.raises(ValueError, match=r"^lags = 8: must be left unset in mode 'compensate'"):
         gd.DriftModel().fit(log["rate_dph"], log["temperature_c"], mode="compensate", lags=8)
+
+
+def test_fit_units_as_the_cli_flag(cli, sim_csv, tmp_path):
+    # The target's unit (fit --units, units=) is kept in the model file, labels the estimates and
+    # scales the PX4 export: a deg/s gyro fitted in Python exports as the CLI's does.
+    sim = read_csv(sim_csv)
+    axes = {"x": sim["rate_dph"], "y": -0.5 * sim["rate_dph"], "z": 2.0 * sim["rate_dph"]}
+    write_csv(tmp_path / "xyz.csv", {"time_s": sim["time_s"],
+                                     **{f"{a}_dps": v / 3600.0 for a, v in axes.items()},
+                                     "temperature_c": sim["temperature_c"]})
+    cli("fit", tmp_path / "xyz.csv", "-t", "x_dps,y_dps,z_dps", "-T", "temperature_c",
+        "--mode", "compensate", "--units", "dps", "-q", "-o", tmp_path / "cli.json")
+    log = read_csv(tmp_path / "xyz.csv")
+    fit = dict(mode="compensate", temperature_columns=["temperature_c"],
+               source=str(tmp_path / "xyz.csv"))
+    models = [gd.DriftModel().fit(log[f"{a}_dps"], log["temperature_c"], target=f"{a}_dps",
+                                  units="dps", **fit) for a in axes]
+    gd.DriftModel.save_axes(tmp_path / "py.json", models)
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert models[0].coefficients()[0]["terms"][0]["unit"].startswith("dps")
+    # The same numbers recorded as deg/h would export 3600 times too small a correction.
+    dph = [gd.DriftModel().fit(log[f"{a}_dps"], log["temperature_c"], target=f"{a}_dps", **fit)
+           for a in axes]
+    gd.DriftModel.save_axes(tmp_path / "dph.json", dph)
+    px4 = [gd.export(tmp_path / name, format="px4", device_ids=[1])
+           for name in ("py.json", "cli.json", "dph.json")]
+    assert px4[0] == px4[1] != px4[2]
+    with pytest.raises(gd.UsageError, match=r"^units = 'knots': must be"):
+        gd.DriftModel().fit(log["x_dps"], log["temperature_c"], units="knots", **fit)
 
 
 def test_two_axis_model_file_matches_cli(cli, tmp_path):

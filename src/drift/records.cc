@@ -71,7 +71,10 @@ void RequireFiniteLogged(std::string_view what, const Eigen::Ref<const Eigen::Ve
                     std::to_string(min_samples) + " are needed");
   }
   for (Eigen::Index r = 0; r < x.size(); ++r) {
-    if (logged[static_cast<size_t>(r)]) RequireUsableSample(what, r + 1, x[r], /*logged=*/true);
+    // As RequireFiniteSignal: only a bad sample pays for the call.
+    if (logged[static_cast<size_t>(r)] && !(std::fabs(x[r]) <= kLargestSampleMagnitude)) {
+      RequireUsableSample(what, r + 1, x[r], /*logged=*/true);
+    }
   }
 }
 

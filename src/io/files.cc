@@ -120,11 +120,13 @@ void RemoveAll(const std::vector<std::string>& paths) {
   }
 }
 
-// Refuses what would fail half-way through the renames: a target named twice, or a directory.
+// Refuses what would fail half-way through the renames: an empty name, a target named twice, or
+// a directory.
 void CheckTargets(const std::vector<StreamedFile>& files) {
   namespace fs = std::filesystem;
   std::set<fs::path> targets;
   for (const auto& [path, write] : files) {
+    if (path.empty()) throw IoError("the name of a file to write is empty");
     std::error_code ec;
     const fs::path key = fs::weakly_canonical(fs::path(path), ec);
     if (!targets.insert(ec ? fs::path(path) : key).second) {

@@ -117,6 +117,10 @@ double TemperatureProgramme::NominalDuration() const {
   return kind_ == Kind::kSine ? period_s_ : time_s_.back();
 }
 
+double TemperatureProgramme::DefaultSimulationDuration() const {
+  return kind_ == Kind::kSine ? 8 * 3600.0 : NominalDuration();
+}
+
 double TemperatureProgramme::MaxRateKPerS() const {
   if (kind_ == Kind::kSine) return 2.0 * std::numbers::pi * amplitude_c_ / period_s_;
   double r = 0.0;

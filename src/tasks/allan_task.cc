@@ -130,9 +130,39 @@ void AllanSettings::Validate() const {
   FitOptions();
 }
 
+Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
+                            const std::vector<Eigen::Index>& record_starts,
+                            std::vector<bool>* logged) {
+  Eigen::Index previous = 0;
+  for (size_t r = 0; r < record_starts.size(); ++r) {
+    if (record_starts[r] <= previous || record_starts[r] >= data.size()) {
+      throw DataError(
+          fmt::format("record_starts[{}] = {}: record starts must increase within 1..{}", r,
+                      record_starts[r], data.size() - 1));
+    }
+    previous = record_starts[r];
+  }
+  Eigen::VectorXd joined(data.size() + static_cast<Eigen::Index>(record_starts.size()));
+  logged->assign(static_cast<size_t>(joined.size()), true);
+  Eigen::Index from = 0, to = 0;
+  for (size_t r = 0; r <= record_starts.size(); ++r) {
+    const Eigen::Index end = r < record_starts.size() ? record_starts[r] : data.size();
+    joined.segment(to, end - from) = data.segment(from, end - from);
+    to += end - from;
+    if (r < record_starts.size()) {
+      joined[to] = 0.0;  // never read: a break between records
+      (*logged)[static_cast<size_t>(to++)] = false;
+    }
+    from = end;
+  }
+  return joined;
+}
+
 AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
-                  const AllanSettings& settings) {
+                  const AllanSettings& settings, std::string_view signal_name) {
   const al::AllanOptions o = settings.Options();
+  RequireVaryingSignal(signal_name, data,
+                       "its Allan deviation is zero at every tau (a logging fault?)");
   const Execution execution = settings.MakeExecution();
   const al::NoiseFitOptions fit_options = settings.FitOptions();
   const bool allan_curve = AllanCurve(o.deviation);

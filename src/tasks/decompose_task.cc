@@ -1,7 +1,10 @@
 #include "gyrodrift/tasks/decompose_task.h"
 
+#include <fmt/core.h>
+
 #include <utility>
 
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::tasks {
@@ -52,8 +55,15 @@ void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise
 dec::Decomposition RunDecompose(const Eigen::VectorXd& x, const DecomposeSettings& settings,
                                 const Eigen::MatrixXd& noise,
                                 std::function<void(double, std::string_view)> progress,
-                                std::string_view noise_name) {
+                                std::string_view noise_name, std::string_view signal_name) {
   dec::DecompositionOptions o = settings.Options();
+  RequireVaryingSignal(signal_name, x, "it has no oscillation to decompose");
+  if (x.size() > kMaxDecomposeSamples) {
+    throw DataError(fmt::format(
+        "{} has {} samples: decompose takes at most {} (memory grows with samples x modes; "
+        "decimate or split the log)",
+        signal_name, x.size(), kMaxDecomposeSamples));
+  }
   const dec::DecompositionContext context = settings.Context(std::move(progress));
   if (noise.size() == 0) return dec::Decompose(x, o, context);
   RequireNoiseTaken(settings, noise_name);

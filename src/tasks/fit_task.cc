@@ -115,6 +115,7 @@ void RequireUlogUnit(const FitRun& run, const std::string& rate_unit, const io::
 FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
                  const std::string& rate_unit, const io::LogOptions& log,
                  const FitProgress& progress) {
+  (void)allan::RateUnitFromString(rate_unit);  // dph | dps | rads, refused as "units"
   drift::FitSettings s = settings;
   if (run.rate_hz > 0.0) s.rate_hz = run.rate_hz;
   FitResult r;

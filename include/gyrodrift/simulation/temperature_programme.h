@@ -49,6 +49,9 @@ class TemperatureProgramme {
   double TemperatureAt(double t_s) const;
   // Length of the defined part (last breakpoint time, or one period for a sine), s.
   double NominalDuration() const;
+  // The length to simulate when none is asked (`gyrodrift simulate`, Python's simulate): the
+  // defined part, or 8 h for a sine (one period is too short to see a drift), s.
+  double DefaultSimulationDuration() const;
   Kind kind() const { return kind_; }
   const std::string& name() const { return name_; }
   // Breakpoints of a piecewise-linear programme (empty for a sine).

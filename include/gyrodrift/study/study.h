@@ -1,7 +1,6 @@
 // The thermal-drift study: one pipeline from a gyro record to comparison tables, fitted
-// compensation models and the data of every figure, shared by `gyrodrift demo`, the coming
-// `calibrate` command and the Python package. files.h renders and writes its files and its HTML
-// report.
+// compensation models and the data of every figure, behind `gyrodrift demo`. study_files.h
+// renders and writes its files and its HTML report.
 //
 // What it computes (docs/demo.md gives the choices and the measured results)
 //   0. Data: two simulated runs of a navigation-grade FOG (simulation::Preset::kNavigation, 1 Hz)

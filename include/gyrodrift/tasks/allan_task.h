@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
@@ -59,9 +60,18 @@ struct AllanRun {
 // per sample, false where the sample is missing (allan::ComputeWithGaps). The samples are taken
 // by value: handed over (std::move), their last use builds the phase in their storage (no second
 // copy of the record, allan::Compute). Throws what AllanSettings::Validate and allan::Compute
-// throw; a fit with too few points is reported in fit_error, not thrown.
+// throw, and a DataError naming `signal_name` for constant data (its deviation is zero at every
+// tau); a fit with too few points is reported in fit_error, not thrown.
 AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
-                  const AllanSettings& settings);
+                  const AllanSettings& settings, std::string_view signal_name = "x");
+
+// Records (a log split at its gaps: `record_starts`, the first sample of every record after the
+// first, increasing, inside 1..size-1) analysed on one grid: joined with one missing sample between
+// them, *logged marking it (allan::ComputeWithGaps), so no cluster pair spans a break. Throws
+// DataError for starts out of order or out of range.
+Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
+                            const std::vector<Eigen::Index>& record_starts,
+                            std::vector<bool>* logged);
 
 // The records the sidecar writes (docs/allan.md): the noise terms (the keys of `noise_terms`
 // without source_dev and method), and the whole analysis: options (the settings with the tau grid

@@ -59,12 +59,18 @@ struct DecomposeSettings {
 // what supplied it ("noise_realisations", or a flag such as "--noise-file = n.csv").
 void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise_name);
 
+// Beyond this many samples a decomposition does not fit in the memory of a workstation: the
+// IMFs alone are 8 bytes x samples x (about log2(samples) modes), and sifting keeps a dozen
+// working vectors of the signal's length per thread (measured peaks in docs/errors.md).
+inline constexpr Eigen::Index kMaxDecomposeSamples = 20'000'000;
+
 // The decomposition of x; with `noise` not empty (one white-noise realisation per column; see
-// RequireNoiseTaken) the supplied noise is used instead of drawing.
+// RequireNoiseTaken) the supplied noise is used instead of drawing. A constant x (nothing to
+// decompose) or one longer than kMaxDecomposeSamples is a DataError naming `signal_name`.
 decomposition::Decomposition RunDecompose(
     const Eigen::VectorXd& x, const DecomposeSettings& settings, const Eigen::MatrixXd& noise = {},
     std::function<void(double, std::string_view)> progress = {},
-    std::string_view noise_name = "noise_realisations");
+    std::string_view noise_name = "noise_realisations", std::string_view signal_name = "x");
 
 // The sidecar's records: the options the run used (ensemble_size the noise's columns when
 // supplied; threads as asked) and the decomposition's report.

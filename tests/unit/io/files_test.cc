@@ -118,6 +118,9 @@ TEST(WriteFilesAtomically, RefusalsNameThePath) {
               WriteFilesAtomically({{dir + "/x.csv", "1"}, {dir + "/sub/../x.csv", "2"}});
             }),
             dir + "/sub/../x.csv: named twice among the files of one output set");
+  // An empty name (`-o ''`) is named as such, before any temporary is written.
+  EXPECT_EQ(IoMessage([&] { WriteFileAtomically("", "z"); }),
+            "the name of a file to write is empty");
   EXPECT_EQ(Entries(dir), std::set<std::string>{"sub"});
   EXPECT_TRUE(Entries(dir + "/sub").empty());
 }

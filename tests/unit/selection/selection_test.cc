@@ -175,7 +175,9 @@ TEST(SelectModes, DistanceOfNarrowModesIsTheExactL2OnTheRefinedGrid) {
     const double d_refined = refined.pdf_distance[static_cast<size_t>(k - 1)];
     const double d_plain = plain.pdf_distance[static_cast<size_t>(k - 1)];
     EXPECT_NEAR(d_refined, exact.back(), 1e-3 * exact.back()) << k;
-    if (k == 2 || k == 3) EXPECT_GT(d_plain, 1.5 * exact.back()) << k;  // the plain grid's error
+    if (k == 2 || k == 3) {
+      EXPECT_GT(d_plain, 1.5 * exact.back()) << k;  // the plain grid's error
+    }
   }
   const int exact_k_star =
       1 + static_cast<int>(std::max_element(exact.begin(), exact.end()) - exact.begin());

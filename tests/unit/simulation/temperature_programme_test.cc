@@ -47,6 +47,9 @@ TEST(TemperatureProgramme, SineHasItsAmplitudeAndSlope) {
   EXPECT_NEAR(s.TemperatureAt(1800.0), 40.0, 1e-12);
   EXPECT_NEAR(s.TemperatureAt(5400.0), 0.0, 1e-12);
   EXPECT_NEAR(s.MaxRateKPerS(), 2 * M_PI * 20 / 7200, 1e-15);
+  // One period is its defined part; a simulation without a duration runs 8 h of it.
+  EXPECT_DOUBLE_EQ(s.NominalDuration(), 7200.0);
+  EXPECT_DOUBLE_EQ(s.DefaultSimulationDuration(), 8 * 3600.0);
 }
 
 TEST(TemperatureProgramme, SamplesAreInterpolatedAndHeld) {
@@ -59,6 +62,7 @@ TEST(TemperatureProgramme, SamplesAreInterpolatedAndHeld) {
   EXPECT_DOUBLE_EQ(p.TemperatureAt(30), 0.0);
   EXPECT_DOUBLE_EQ(p.TemperatureAt(100), -10.0);
   EXPECT_DOUBLE_EQ(p.NominalDuration(), 40.0);
+  EXPECT_DOUBLE_EQ(p.DefaultSimulationDuration(), 40.0);
   EXPECT_NE(p.Summary().find("file.csv"), std::string::npos);
 }
 
