@@ -17,6 +17,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/tasks/allan_task.h"
+#include "gyrodrift/tasks/task_log.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -137,7 +138,8 @@ void Run(const AllanArgs& a) {
   if (!time_note.empty()) notes += time_note + "\n";
   fmt::print("{}", notes);
   if (!rate_given) {
-    fmt::print("sample rate: {} Hz ({})\n", settings.rate_hz, RateSourceText(rate_how));
+    fmt::print("sample rate: {} Hz ({})\n", settings.rate_hz,
+               tasks::RateSourceText(rate_how, /*flags=*/true));
   }
   fmt::print("wrote {} and {}\n", a.output, SidecarPath(a.output));
 }

@@ -45,12 +45,6 @@ nlohmann::json SidecarHeader(const std::string& command) {
 
 bool IsTerminal() { return ::isatty(STDERR_FILENO) != 0; }
 
-std::string RateSourceText(const std::string& how) {
-  return how == "given"    ? "given by --rate-hz"
-         : how == "time_s" ? "from the median step of time_s"
-                           : "assumed: no --rate-hz and no time_s column";
-}
-
 namespace {
 
 // Every binding of BindSetting: a name and the flag that sets it.

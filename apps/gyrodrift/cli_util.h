@@ -45,9 +45,6 @@ double ParseDuration(const std::string& text);
 using io::NonUniformTimeNote;
 using io::ReadLog;
 using io::ResolveSampleRate;
-// Where ResolveSampleRate's rate came from, as the commands print it: `how` "given", "time_s" or
-// "default".
-std::string RateSourceText(const std::string& how);
 
 // How a command reads its log: --gaps (io::GapPolicy) and --delimiter (io::Delimiter).
 struct LogArgs {

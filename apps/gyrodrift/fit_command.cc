@@ -16,6 +16,7 @@
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/tasks/fit_task.h"
+#include "gyrodrift/tasks/task_log.h"
 #include "progress.h"
 
 namespace gyrodrift::cli {
@@ -169,7 +170,7 @@ void Run(const FitArgs& a) {
     PrintModel(axis, fit.options);
   }
   fmt::print("sample rate: {} Hz ({})\n{}wrote {}\n", fit.options.features.rate_hz,
-             RateSourceText(run.rate_how), notes, a.output);
+             tasks::RateSourceText(run.rate_how, /*flags=*/true), notes, a.output);
 }
 
 const RegisterCommand kRegister("fit", 50, [](CLI::App& app) {

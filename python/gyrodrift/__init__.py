@@ -27,7 +27,7 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_ulog",
+    "decompose", "demo", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_ulog",
     "select_modes", "simulate", "temperature_warning", "ulog_columns",
 ]
 
@@ -468,3 +468,33 @@ def calibrate(manifest_path, output_dir, *, force=False, threads=0):
     """
     return _call(_gyrodrift.calibrate, str(manifest_path), str(output_dir), force=force,
                  threads=threads)
+
+
+def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, rate_hz=None,
+         units="dph", duration=28800.0, ensemble=20, realisations=20, window=128, methods="all",
+         seed=1, threads=0, gaps="error", progress=None):
+    """The whole study of ``gyrodrift demo`` (docs/demo.md): simulate a navigation-grade FOG (or
+    study ``input``, a log of your own: its ``target`` and ``temperature`` columns, ``rate_hz``
+    or its time_s column, ``units`` of its output, ``gaps``), decompose and group it, compare
+    MS-ELM and every baseline in predict and compensate mode, the Allan deviation before and
+    after; writes the same folder as the CLI to ``output`` (data, models, tables, demo.json and
+    report.html, one atomic set). ``duration`` (s, at least 7200), ``ensemble``,
+    ``realisations``, ``window`` and ``methods`` size the study as the CLI's flags of those names.
+    ``progress``: a callable given the fraction of the run done (Ctrl-C stops it).
+
+    Returns a dict: ``output``, ``files`` (the names written), ``report`` (its path),
+    ``simulated``, ``compensated_by``, ``best_by``, ``tables`` (``predict``, ``compensate``,
+    ``noise_terms``, ``settings``, ``timing``: the text the CLI prints) and ``seconds``.
+
+    >>> import tempfile, gyrodrift as gd
+    >>> r = gd.demo(tempfile.mkdtemp() + "/study", duration=7200, methods="thermal,poly",
+    ...             ensemble=4, window=32)
+    >>> r["files"][-2:], r["compensated_by"]
+    (['report.html', 'demo.json'], 'thermal (train A test B)')
+    """
+    return _call(_gyrodrift.demo, str(output), input="" if input is None else str(input),
+                 target="" if target is None else str(target),
+                 temperature="" if temperature is None else str(temperature), rate_hz=rate_hz,
+                 units=units, duration=duration, ensemble=ensemble, realisations=realisations,
+                 window=window, methods=methods, seed=seed, threads=threads, gaps=gaps,
+                 progress=progress)

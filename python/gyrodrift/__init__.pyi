@@ -155,3 +155,12 @@ def calibrate(
     manifest_path: str | PathLike[str], output_dir: str | PathLike[str], *, force: bool = ...,
     threads: int = ...,
 ) -> dict[str, Any]: ...
+
+def demo(
+    output: str | PathLike[str] = ..., *, input: str | PathLike[str] | None = ...,
+    target: str | None = ..., temperature: str | None = ..., rate_hz: float | None = ...,
+    units: Literal["dph", "dps", "rads"] = ..., duration: float = ..., ensemble: int = ...,
+    realisations: int = ..., window: int = ..., methods: str = ..., seed: int = ...,
+    threads: int = ..., gaps: Literal["error", "interpolate"] = ...,
+    progress: Callable[[float], object] | None = ...,
+) -> dict[str, Any]: ...

@@ -200,5 +200,6 @@ void BindExport(py::module_& m);      // export (model files for firmware and PX
 void BindEvaluate(py::module_& m);    // evaluate
 void BindFleet(py::module_& m);       // calibrate and the fleet's helpers
 void BindLogs(py::module_& m);        // read_ulog, ulog_columns, plan
+void BindDemo(py::module_& m);        // demo (the whole study, its folder)
 
 }  // namespace gyrodrift::python

@@ -50,4 +50,5 @@ PYBIND11_MODULE(_gyrodrift, m) {
   gp::BindEvaluate(m);
   gp::BindFleet(m);
   gp::BindLogs(m);
+  gp::BindDemo(m);
 }

@@ -278,3 +278,33 @@ def test_export_matches_cli(cli, sim_csv, tmp_path, fmt, extra):
     if fmt == "px4":
         with pytest.raises(gd.UsageError, match="device_ids"):
             gd.export(model, format="px4")
+
+
+def test_demo_matches_cli(cli, tmp_path):
+    # The same study and folder as `gyrodrift demo` (study::RunDemo), but for the wall times.
+    cli("demo", "-o", tmp_path / "cli", "-q", "--duration", "2h", "--methods", "thermal,poly",
+        "--ensemble", "4", "--window", "32")
+    fractions = []
+    r = gd.demo(tmp_path / "py", duration=7200, methods="thermal,poly", ensemble=4, window=32,
+                progress=fractions.append)
+    assert r["simulated"] and r["report"] == str(tmp_path / "py" / "report.html")
+    assert fractions and fractions == sorted(fractions) and 0 <= fractions[0] <= fractions[-1] <= 1
+    for name in r["files"]:
+        ours, theirs = tmp_path / "py" / name, tmp_path / "cli" / name
+        if name.endswith("_table.csv"):  # every column but the seconds
+            a, b = (list(csv.reader(open(p, newline=""))) for p in (ours, theirs))
+            assert a[0] == b[0] and len(a) == len(b)
+            kept = [i for i, column in enumerate(a[0]) if not column.endswith("_s")]
+            assert [[row[i] for i in kept] for row in a] == [[row[i] for i in kept] for row in b]
+        elif name == "demo.json":
+            a, b = read_json(ours)["options"], read_json(theirs)["options"]
+            assert a.pop("output") == str(tmp_path / "py") and b.pop("output") == str(tmp_path / "cli")
+            assert a == b
+        elif name != "report.html":
+            assert ours.read_bytes() == theirs.read_bytes(), name
+    assert "thermal" in r["tables"]["compensate"]
+    with pytest.raises(gd.UsageError, match=r"^target, temperature, rate_hz, units, gaps and "
+                                            r"delimiter need input"):
+        gd.demo(tmp_path / "x", target="rate_dph")
+    with pytest.raises(gd.UsageError, match=r"^input needs target"):
+        gd.demo(tmp_path / "x", input=tmp_path / "py" / "run_a.csv")

@@ -32,6 +32,7 @@ PAIRS = [
     ("select_modes", gyrodrift.select_modes, _gyrodrift.select_modes),
     ("evaluate", gyrodrift.evaluate, _gyrodrift.evaluate),
     ("calibrate", gyrodrift.calibrate, _gyrodrift.calibrate),
+    ("demo", gyrodrift.demo, _gyrodrift.demo),
     ("DriftModel.fit", gyrodrift.DriftModel.fit, _gyrodrift.DriftModel.fit),
     ("DriftModel.predict", gyrodrift.DriftModel.predict, _gyrodrift.DriftModel.predict),
     ("DriftModel.compensation_summary", gyrodrift.DriftModel.compensation_summary,

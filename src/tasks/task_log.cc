@@ -26,6 +26,13 @@ TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log, double r
 
 bool SpeltAsFlags(const io::LogOptions& log) { return log.gaps_name.rfind("--", 0) == 0; }
 
+std::string RateSourceText(const std::string& how, bool flags) {
+  const std::string rate = flags ? "--rate-hz" : "rate_hz";
+  return how == "given"    ? "given by " + rate
+         : how == "time_s" ? "from the median step of time_s"
+                           : "assumed: no " + rate + " and no time_s column";
+}
+
 std::vector<std::string> SplitColumns(const std::string& names) {
   std::vector<std::string> out;
   size_t start = 0;

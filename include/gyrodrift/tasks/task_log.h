@@ -37,6 +37,10 @@ TaskLog ReadTaskLog(const std::string& path, const io::LogOptions& log);
 // True when the caller's user spells settings as flags (log.gaps_name "--gaps").
 bool SpeltAsFlags(const io::LogOptions& log);
 
+// Where io::ResolveSampleRate's rate came from (`how` "given", "time_s" or "default"), as the
+// user reads it beside the rate: "given by --rate-hz" (`flags`) or "given by rate_hz", ...
+std::string RateSourceText(const std::string& how, bool flags);
+
 // The columns of `spec` ("a" or "a,b", names or 1-based indices): their names, the names joined by
 // commas, and the N x C matrix. Throws UsageError naming `option` (--target, target) for an
 // unknown, empty or repeated column.
