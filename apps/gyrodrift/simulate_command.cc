@@ -14,6 +14,7 @@
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
 #include "gyrodrift/simulation/fog_simulator.h"
+#include "gyrodrift/tasks/simulate_task.h"
 
 namespace gyrodrift::cli {
 namespace {
@@ -34,27 +35,6 @@ struct SimulateArgs {
   std::string output;
   bool quiet = false;
 };
-
-// A built-in name, or a CSV file with columns time_s and temperature_c.
-sim::TemperatureProgramme LoadProgramme(const std::string& profile) {
-  for (const auto& name : sim::BuiltinProgrammeNames()) {
-    if (profile == name) return sim::BuiltinProgramme(name);
-  }
-  std::string path = profile;
-  if (!kInputFile(path).empty()) {
-    throw UsageError("--profile = " + profile +
-                     ": must be chamber, chamber-b, sine or an existing CSV file");
-  }
-  const io::CsvTable table = io::CsvTable::Read(profile);
-  for (const char* column : {"time_s", "temperature_c"}) {
-    if (!table.HasColumn(column)) {
-      throw DataError(profile + ": no column '" + column +
-                      "' (a profile CSV needs time_s and temperature_c)");
-    }
-  }
-  return sim::TemperatureProgramme::FromSamples(table.Column("time_s"),
-                                                table.Column("temperature_c"), profile);
-}
 
 nlohmann::json ProgrammeJson(const sim::TemperatureProgramme& p) {
   nlohmann::json j = {{"name", p.name()}, {"summary", p.Summary()}};
@@ -145,7 +125,7 @@ void Run(const SimulateArgs& a) {
   // Check what can be checked before the profile file is read.
   if (!a.duration.empty()) o.duration_s = ParseDuration(a.duration);
   RequireInRange("--rate-hz", a.rate_hz, 1e-3, 1e4);
-  const sim::TemperatureProgramme programme = LoadProgramme(a.profile);
+  const sim::TemperatureProgramme programme = tasks::LoadProgramme(a.profile, "--profile");
   if (a.duration.empty()) o.duration_s = programme.DefaultSimulationDuration();
   const sim::SimulationResult r = sim::Simulate(programme, params, o);
 

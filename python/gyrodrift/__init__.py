@@ -45,6 +45,16 @@ _INTEGER_RANGES = {
 }
 
 
+def _flags(logged):
+    """`logged` as the list of bools the library takes ([] for None); a string is refused (its
+    letters would each read as True)."""
+    if logged is None:
+        return []
+    if isinstance(logged, (str, bytes)):
+        raise UsageError(f"logged = {logged!r}: must be a sequence of bools, one per sample")
+    return [bool(v) for v in logged]
+
+
 def _call(function, *args, **kwargs):
     try:
         return function(*args, **kwargs)
@@ -120,7 +130,7 @@ def allan(x, *, rate_hz, type="rate", dev="oadev", taus="octave", units="dph", c
     return _call(_gyrodrift.allan, x, rate_hz=rate_hz, type=type, dev=dev, taus=taus,
                  units=units, confidence=confidence, threads=threads, fit_tau_min=fit_tau_min,
                  fit_tau_max=fit_tau_max,
-                 logged=[] if logged is None else [bool(v) for v in logged],
+                 logged=_flags(logged),
                  record_starts=list(record_starts))
 
 
@@ -145,7 +155,8 @@ def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1
     """Simulates a fibre optic gyro's thermal drift in a temperature chamber.
 
     As ``gyrodrift simulate``: ``duration`` in seconds (None: the programme's own length),
-    ``profile`` a built-in programme name ("chamber", "chamber-b", "sine") or a pair of arrays
+    ``profile`` a built-in programme name ("chamber", "chamber-b", "sine"), a CSV file with
+    columns time_s and temperature_c (as ``--profile FILE``) or a pair of arrays
     ``(time_s, temperature_c)``; ``noise=False`` is ``--no-noise``.
 
     Returns a dict with what a user would log, ``time_s``, ``rate_dph`` and ``temperature_c``,
@@ -157,6 +168,8 @@ def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1
     >>> len(sim["rate_dph"]), sorted(sim["truth"])[0]
     (600, 'bias_dph')
     """
+    if isinstance(profile, os.PathLike):
+        profile = os.fspath(profile)
     return _call(_gyrodrift.simulate, duration=duration, profile=profile, preset=preset,
                  rate_hz=rate_hz, seed=seed, winding=winding, asymmetry=asymmetry,
                  input_rate_dph=input_rate_dph, noise=noise)
@@ -171,14 +184,19 @@ def read_ulog(path, *, decode=("sensor_gyro",)):
     ``types``, ``samples``, ``first_us``, ``last_us``); the series of the topics named in
     ``decode`` (``"*"``: every topic) also hold ``timestamp_us`` and ``values`` (field -> array).
     """
-    return _gyrodrift.read_ulog(path, decode=list(decode))
+    if isinstance(decode, (str, os.PathLike)):  # one topic, not its letters
+        decode = [decode]
+    return _gyrodrift.read_ulog(os.fspath(path), decode=[str(t) for t in decode])
 
 
 def ulog_columns(path, *, topic="sensor_gyro", instance=0, axes=("x", "y", "z"),
                  temperature_field="temperature", units="dph"):
     """The columns ``gyrodrift convert`` writes for one series: ``time_s``, ``<axis>_<units>``
     (the rad/s fields converted) and ``temperature_c``, as arrays, plus ``warnings``."""
-    return _call(_gyrodrift.ulog_columns, path, topic=topic, instance=instance, axes=list(axes),
+    if isinstance(axes, str):
+        axes = [axes]
+    return _call(_gyrodrift.ulog_columns, os.fspath(path), topic=topic, instance=instance,
+                 axes=list(axes),
                  temperature_field=temperature_field, units=units)
 
 
@@ -243,7 +261,7 @@ class DriftModel:
         self._core.fit(y, temperature, mode=mode, target=target,
                        temperature_columns=temperature_columns, source=source, units=units,
                        record_starts=list(record_starts),
-                       logged=[] if logged is None else [bool(v) for v in logged],
+                       logged=_flags(logged),
                        progress=progress, **settings)
         return self
 
@@ -275,7 +293,7 @@ class DriftModel:
         ``truth_removed`` = 1 - residual_rms / truth_rms."""
         return self._core.compensation_summary(
             temperature, y, record_starts=list(record_starts), drift_window_s=drift_window_s,
-            logged=[] if logged is None else [bool(v) for v in logged], truth=truth)
+            logged=_flags(logged), truth=truth)
 
     def coefficients(self, *, reference_temperature=None):
         """The thermal sub-models' coefficients in physical units, as ``gyrodrift fit`` prints
@@ -321,6 +339,8 @@ class DriftModel:
     def save_axes(path, models):
         """Writes several fitted models (one per axis, each with its own ``target``) into one
         model file, as ``gyrodrift fit --target gyro_x,gyro_y,...`` does."""
+        if not all(isinstance(m, DriftModel) for m in models):
+            raise UsageError("models: must be a sequence of DriftModel")
         _gyrodrift.DriftModel.save_axes(str(path), [m._core for m in models])
 
     @classmethod

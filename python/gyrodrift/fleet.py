@@ -39,10 +39,15 @@ def calibrate(manifest_path, output_dir, *, client=None, scheduler=None, workers
     LocalCluster of ``workers`` processes (default: every core)."""
     from dask.distributed import Client, LocalCluster
 
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or not 1 <= workers <= 1024):
+        raise _gyrodrift.UsageError(f"workers = {workers!r}: must be an integer in [1, 1024]")
     manifest_path = os.path.abspath(manifest_path)
     output_dir = os.path.abspath(output_dir)
     start = time.monotonic()
-    serials = _gyrodrift._manifest_serials(manifest_path)  # checks the manifest and its logs
+    # The manifest, its logs and their columns, and that no log lies in the output folder: before
+    # any cluster starts.
+    serials = _gyrodrift._manifest_serials(manifest_path, output_dir)
     try:
         os.makedirs(output_dir, exist_ok=True)
     except OSError as e:
@@ -84,20 +89,21 @@ def main(argv=None):
                         help="redo units already calibrated with the same settings")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     a = parser.parse_args(argv)
-    if a.workers is not None and not 1 <= a.workers <= 1024:
-        print(f"error: --workers = {a.workers}: must be in [1, 1024]", file=sys.stderr)
-        return 2
     try:
         r = calibrate(a.manifest, a.output, scheduler=a.scheduler, workers=a.workers,
                       force=a.force)
     except _gyrodrift.UsageError as e:
-        print(f"error: {e}", file=sys.stderr)
+        text = str(e)  # the keyword as the flag that set it
+        print(f"error: {'--' + text if text.startswith('workers = ') else text}", file=sys.stderr)
         return 2
     except _gyrodrift.DataError as e:
         print(f"error: {e}", file=sys.stderr)
         return 3
     except _gyrodrift.FileError as e:
         print(f"error: {e}", file=sys.stderr)
+        return 4
+    except OSError as e:  # a scheduler that cannot be reached
+        print(f"error: {a.scheduler or 'the cluster'}: {e}", file=sys.stderr)
         return 4
     if not a.quiet:
         for row in r["rows"]:

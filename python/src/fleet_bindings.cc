@@ -135,12 +135,14 @@ void BindFleet(py::module_& m) {
         arg("seconds"));
   m.def(
       "_manifest_serials",
-      [](const std::string& path) {
+      [](const std::string& path, const std::string& output_dir) {
+        const fleet::Manifest m = gp::LoadManifest(path);
+        if (!output_dir.empty()) fleet::RequireInputsOutside(m, nullptr, output_dir);
         std::vector<std::string> serials;
-        for (const auto& u : gp::LoadManifest(path).units) serials.push_back(u.serial);
+        for (const auto& u : m.units) serials.push_back(u.serial);
         return serials;
       },
-      arg("path"));
+      arg("path"), arg("output_dir") = "");
 }
 
 }  // namespace gyrodrift::python

@@ -18,6 +18,7 @@
 #include "gyrodrift/simulation/temperature_programme.h"
 #include "gyrodrift/tasks/allan_task.h"
 #include "gyrodrift/tasks/decompose_task.h"
+#include "gyrodrift/tasks/simulate_task.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -138,14 +139,14 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   // A built-in programme by name, or (time_s, temperature_c) samples of a chamber programme.
   std::optional<sim::TemperatureProgramme> programme;
   if (py::isinstance<py::str>(profile)) {
-    programme = sim::BuiltinProgramme(profile.cast<std::string>());
+    programme = tasks::LoadProgramme(profile.cast<std::string>(), "profile");
   } else {
     std::pair<Array, Array> pair;
     try {
       pair = profile.cast<std::pair<Array, Array>>();
     } catch (const py::cast_error&) {
       throw UsageError(
-          "profile: must be chamber, chamber-b, sine or a pair of arrays "
+          "profile: must be chamber, chamber-b, sine, a CSV file or a pair of arrays "
           "(time_s, temperature_c)");
     }
     programme = sim::TemperatureProgramme::FromSamples(

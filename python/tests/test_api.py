@@ -1,6 +1,7 @@
 """The Python API on its own: shapes, errors as Python exceptions with the library's messages,
 array conversion, predict mode, model files of several axes, and the GIL released in long calls."""
 
+import re
 import threading
 import time
 
@@ -72,11 +73,25 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.allan(np.arange(100.0), rate_hz=1, fit_tau_max=10**10, units=5)
     with pytest.raises(gd.UsageError, match=r"methods = 5: must be a method name"):
         gd.evaluate(np.arange(100.0), methods=5)
+    # Column names a model file could not be read back with.
+    s = gd.simulate(duration=3600, seed=5)
+    for names, says in (({"temperature_columns": [""]}, "temperature = '': must be a column name "
+                         "without a comma"),
+                        ({"temperature_columns": ["a,b"]}, "temperature = 'a,b': must be a column"),
+                        ({"target": ""}, "target = '': must be a column name")):
+        with pytest.raises(gd.UsageError, match="^" + re.escape(says)):
+            gd.DriftModel().fit(s["rate_dph"], s["temperature_c"], **names)
+    with pytest.raises(gd.UsageError, match=r"^logged = '0101': must be a sequence of bools"):
+        gd.allan(np.arange(4.0), rate_hz=1.0, logged="0101")
+    with pytest.raises(gd.UsageError, match=r"^models: must be a sequence of DriftModel"):
+        gd.DriftModel.save_axes(tmp_path / "m.json", ["x"])
     # A constant signal is refused by the library, for Python as for the CLI.
     with pytest.raises(gd.DataError, match=r"^x is constant \(every sample is 2\): it has no osc"):
         gd.decompose(np.full(100, 2.0))
     with pytest.raises(gd.DataError, match=r"^x is constant \(every sample is 2\): its Allan"):
         gd.allan(np.full(100, 2.0), rate_hz=1.0)
+    with pytest.raises(gd.DataError, match=r"adev_dph point 2 is nan: every deviation must be"):
+        gd.noise_terms([1, 2, 4, 8], [1, np.nan, .5, .4], [10] * 4)
     with pytest.raises(gd.DataError, match=r"edf point 1 is 0: every EDF must be"):
         gd.noise_terms([1, 2, 4, 8, 16], [1, .7, .5, .4, .3], [0] * 5)
 

@@ -122,7 +122,15 @@ def test_command_line_entry_point(fleet):
     assert p.returncode == 4 and "missing.toml" in p.stderr, p.stderr
     p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", str(fleet / "fleet.toml"),
                         "-o", str(fleet / "x"), "--workers", "0"], capture_output=True, text=True)
-    assert p.returncode == 2 and "--workers" in p.stderr
+    assert p.returncode == 2 and "--workers = 0: must be" in p.stderr, p.stderr
+    # The function refuses the same before a cluster starts (-1 started one with no worker, and
+    # the units waited for ever), and a log inside the output folder.
+    for workers in (-1, 0, "2", True):
+        with pytest.raises(gd.UsageError, match="^workers = "):
+            gyrodrift.fleet.calibrate(fleet / "fleet.toml", fleet / "x", workers=workers)
+    p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", str(fleet / "fleet.toml"),
+                        "-o", str(fleet)], capture_output=True, text=True, env=os.environ)
+    assert p.returncode == 2 and len(p.stderr.splitlines()) == 1, p.stderr
 
 
 class KillWorkerInUnit(WorkerPlugin):

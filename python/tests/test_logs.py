@@ -26,6 +26,12 @@ def test_read_ulog_lists_three_gyro_instances_with_temperature():
     assert gyros[0]["timestamp_us"][0] == 21312030
     assert gyros[0]["values"]["x"][0] == -0.04130320996046066
     assert len(log["parameters"]) == 980 and log["warnings"] == []
+    # A path object and one topic as a string (not its letters) read the same.
+    one = gd.read_ulog(LOG, decode="sensor_gyro")
+    assert [s["values"]["x"][0] for s in one["series"] if s["topic"] == "sensor_gyro"][0] == \
+        gyros[0]["values"]["x"][0]
+    # --list names every series on a line of its own, however many fields it has.
+    assert len(log["listing"].splitlines()) == 2 + len(log["series"]) + 3
 
 
 def test_a_damaged_logs_text_and_bad_arguments_raise_gyrodrift_errors(tmp_path):
@@ -61,5 +67,13 @@ def test_plan_is_what_the_cli_writes(cli, tmp_path):
     np.testing.assert_array_equal(p["temperature_c"], written["temperature_c"])
     sim = gd.simulate(profile=(p["time_s"], p["temperature_c"]), duration=3600, seed=1)
     assert len(sim["rate_dph"]) == 3600
+    # The plan's file as simulate --profile FILE reads it, in Python as in the CLI.
+    cli("simulate", "--profile", tmp_path / "p.csv", "--duration", "1h", "--seed", "1", "-q",
+        "-o", tmp_path / "s.csv")
+    from_file = gd.simulate(profile=tmp_path / "p.csv", duration=3600, seed=1)
+    assert np.array_equal(from_file["rate_dph"], read_csv(tmp_path / "s.csv")["rate_dph"])
+    assert np.array_equal(from_file["rate_dph"], sim["rate_dph"])
+    with pytest.raises(gd.UsageError, match=r"^profile = nope.csv: must be chamber, chamber-b, "):
+        gd.simulate(profile="nope.csv")
     with pytest.raises(gd.UsageError, match="give --hours"):
         gd.plan(hours=4, min_c=-40, max_c=80)

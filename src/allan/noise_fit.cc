@@ -286,8 +286,15 @@ NoiseTerms IdentifyNoiseImpl(const Eigen::VectorXd& tau_s, const Eigen::VectorXd
 
 NoiseTerms IdentifyNoise(const Eigen::VectorXd& tau_s, const Eigen::VectorXd& adev_dph,
                          const Eigen::VectorXd& edf, const NoiseFitOptions& options) {
-  // A curve from elsewhere: its taus and EDFs are checked (points without a positive deviation
-  // are passed over, as on an Allan result's longest taus).
+  // A curve from elsewhere: its taus and EDFs are checked, and its deviations are finite (points
+  // without a positive deviation are passed over, as on an Allan result's longest taus).
+  for (Eigen::Index i = 0; i < adev_dph.size(); ++i) {
+    if (!std::isfinite(adev_dph[i])) {
+      throw DataError("adev_dph point " + std::to_string(i + 1) + " is " +
+                      FormatValue(adev_dph[i]) +
+                      ": every deviation must be finite (0 where it was not measured)");
+    }
+  }
   for (Eigen::Index i = 0; i < std::min(tau_s.size(), edf.size()); ++i) {
     if (!(tau_s[i] > 0.0) || !std::isfinite(tau_s[i])) {
       throw DataError("tau_s point " + std::to_string(i + 1) + " is " + FormatValue(tau_s[i]) +

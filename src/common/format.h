@@ -6,7 +6,7 @@
 
 namespace gyrodrift::internal {
 
-// The text of `format` with its arguments, cut at 511 characters.
+// The text of `format` with its arguments, whole however long.
 std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
 }  // namespace gyrodrift::internal

@@ -342,8 +342,8 @@ bool ReadFinished(const std::string& folder, const std::string& fingerprint,
   }
 }
 
-// The manifest and the logs of `unit` (of every unit when null) must lie outside the output
-// folder: a unit's files, or fleet.csv, would otherwise overwrite a log.
+}  // namespace
+
 void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::string& folder) {
   std::vector<std::string> inputs = {m.path};
   for (const UnitSpec& u : m.units) {
@@ -352,8 +352,6 @@ void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::st
   }
   io::RequireInputsOutsideFolder(inputs, folder);
 }
-
-}  // namespace
 
 bool AxisResult::pass() const {
   for (const VerificationResult& v : verification) {

@@ -150,6 +150,9 @@ AxisCompensation CompensateAxis(const io::LoadedModel& loaded, const Eigen::Vect
                                 const std::vector<bool>& logged, const Eigen::VectorXd& truth_all,
                                 const CompensateSettings& settings) {
   settings.Validate();
+  // Arrays from Python come unchecked (a log's cells are checked when it is read).
+  drift::RequireFiniteLogged("y", y_all, logged, 1);
+  if (truth_all.size() > 0) drift::RequireFiniteLogged("truth", truth_all, logged, 1);
   const drift::DriftModel& model = loaded.model;
   AxisCompensation c;
   const Eigen::MatrixXd estimate_sd =

@@ -44,6 +44,18 @@ std::string FitResult::ModelFile() const { return io::RenderModelFile(axes); }
 
 void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogOptions& log) {
   const bool flags = SpeltAsFlags(log);
+  // The names a model file records and compensate looks up (arrays from Python come with the
+  // names given for them): none empty, and no temperature's with a comma, which separates them
+  // in the file (a semicolon-separated log may name its target with one).
+  for (const std::string& name : run.targets) {
+    if (name.empty()) ThrowOption(flags ? "--target" : "target", "''", "a column name");
+  }
+  for (const std::string& name : run.temperatures) {
+    if (!name.empty() && name.find(',') == std::string::npos) continue;
+    ThrowOption(flags ? "--temperature" : "temperature", "'" + name + "'",
+                "a column name without a comma (a model file separates its temperature columns "
+                "by commas)");
+  }
   // The names as given (arrays from Python come without a spec: their names stand for it).
   std::string spec = run.temperature_spec;
   if (spec.empty()) {

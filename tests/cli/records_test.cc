@@ -167,6 +167,14 @@ TEST_F(RecordsCli, TheDelimiterCanBeNamed) {
   r = test::RunCli(fit + "--delimiter pipe -o " + Path("pipe.json"));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--delimiter"), std::string::npos) << r.err;
+  // The same column as a temperature cannot be recorded (a model file separates its temperature
+  // columns by commas): refused at the fit, not when the model is loaded.
+  r = test::RunCli("fit " + Path("semi.csv") + " -t temperature_c -T 2 --mode compensate " +
+                   "--delimiter semicolon -o " + Path("semi_t.json"));
+  test::ExpectCleanFailure(r, 2,
+                           "--temperature = 'rate (deg/h, x)': must be a column name without a "
+                           "comma",
+                           Dir() + "/semi_t.json", "a temperature named with a comma");
 }
 
 }  // namespace

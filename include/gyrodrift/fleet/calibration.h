@@ -146,6 +146,12 @@ struct UnitRun {
 UnitRun RunUnit(const Manifest& manifest, const UnitSpec& unit, const std::string& output_dir,
                 bool force, const html::DygraphsAssets& assets);
 
+// UsageError unless the manifest and the logs of `unit` (of every unit when null) lie outside
+// `output_dir`: a unit's files, or fleet.csv, would otherwise overwrite a log. RunFleet and RunUnit
+// check it; a scheduler of units checks it once before it starts any.
+void RequireInputsOutside(const Manifest& manifest, const UnitSpec* unit,
+                          const std::string& output_dir);
+
 // The end of RunFleet: the totals of every unit's run (manifest order, one per unit; UsageError
 // otherwise), outliers flagged, and output_dir/fleet.csv and fleet.html written. `seconds` is the
 // fleet's wall time as the caller measured it.

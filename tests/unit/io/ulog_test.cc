@@ -116,6 +116,23 @@ TEST(Ulog, TaggedLogWithDefaultParameters) {
   EXPECT_NE(listing.find("temperature"), std::string::npos) << listing;
 }
 
+TEST(Ulog, TheListingHasALineForEverySeriesHoweverManyFields) {
+  // The small log's battery_status has 500+ characters of field names: its line was cut, lost
+  // its newline and ran into the next series' line.
+  const Ulog log = ReadUlog(kSmall, {"*"});
+  const std::string listing = DescribeUlog(log);
+  size_t devices = 0;
+  for (const UlogSeries& s : log.series)
+    devices += s.decoded && s.samples > 0 && s.Field("device_id") >= 0;
+  EXPECT_EQ(static_cast<size_t>(std::count(listing.begin(), listing.end(), '\n')),
+            2 + log.series.size() + devices);
+  for (const UlogSeries& s : log.series) {
+    std::string fields;
+    for (const std::string& f : s.fields) fields += (fields.empty() ? "" : ",") + f;
+    EXPECT_NE(listing.find(fields + "\n"), std::string::npos) << s.topic;
+  }
+}
+
 TEST(Ulog, ACutFileKeepsWhatCameBeforeTheCutAndSaysWhere) {
   std::vector<std::uint8_t> bytes = Bytes(kSmall);
   const std::size_t cut = bytes.size() - 1000;
