@@ -20,7 +20,7 @@
 // Units: the simulated output is in deg/h, a log's in StudyOptions::units; temperatures in degC
 // (a log's in whatever unit it has); times in s (hours on the time axes of the result).
 // Cost: dominated by the causal protocol, one BEEMDAN of `causal_window` samples per test sample
-// for each decomposing method (ms-elm, emd-elm): the defaults take about 25 s on 2 cores.
+// for each decomposing method (ms-elm, emd-elm): the defaults take about 30 s on 2 cores.
 // Nothing here reads files or prints: RunStudy reports through its StudyContext, which also holds
 // the worker threads; StudyOptions are plain values (comparable with ==) that decide the result.
 #pragma once
@@ -49,7 +49,7 @@ namespace gyrodrift::study {
 std::uint64_t RunBSeed(std::uint64_t seed);
 
 // The size of the study. The defaults are smaller than the library's (docs/demo.md, "Settings
-// and cost"): they keep the simulated study near 25 s on 2 cores. Ranges the library owns are
+// and cost"): they keep the simulated study near 30 s on 2 cores. Ranges the library owns are
 // checked by the library's own Validate (named as it names them); the rest here.
 struct StudyOptions {
   // Length of each simulated run, s; at least 7200 (run A must show the model a ramp and a dwell
