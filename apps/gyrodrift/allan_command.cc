@@ -198,10 +198,10 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
   BindSetting(
       cmd->add_option("--fit-tau-min", args->settings.fit_tau_min_s, "noise fit: smallest tau in s")
           ->capture_default_str(),
-      {"tau_min_s"});
+      {"fit_tau_min"});
   BindSetting(
       cmd->add_option("--fit-tau-max", args->settings.fit_tau_max_s, "noise fit: largest tau in s"),
-      {"tau_max_s"});
+      {"fit_tau_max"});
   AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });

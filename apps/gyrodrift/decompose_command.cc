@@ -43,7 +43,9 @@ void Run(const DecomposeArgs& a) {
   const Eigen::VectorXd x = [&] {
     io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {a.column});
     name = "column '" + ColumnName(table, a.column) + "'";
-    return table.TakeColumn(a.column);
+    Eigen::VectorXd column = table.TakeColumn(a.column);
+    tasks::RequireDecomposable(column, name);  // before a noise file is read
+    return column;
   }();
   Eigen::MatrixXd noise;  // --noise-file: one realisation per column
   const std::string noise_name = "--noise-file = " + a.noise_file;
@@ -114,21 +116,21 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   BindSetting(
       cmd->add_option("--stop", args->settings.stop, "sifting stop rule: rilling|snumber|fixed|sd")
           ->capture_default_str(),
-      {"stop_rule", "sifting.stop_rule"});
+      {"stop"});
   BindSetting(cmd->add_option("--max-sifts", args->settings.max_sifts,
                               "sift cap per IMF (0 = rule default: 2000 rilling/sd, 50 snumber)")
                   ->capture_default_str(),
-              {"sifting.max_sifts"});
+              {"max_sifts"});
   BindSetting(cmd->add_option("--s-number", args->settings.s_number, "S of the S-number rule")
                   ->capture_default_str(),
-              {"sifting.s_number"});
+              {"s_number"});
   BindSetting(
       cmd->add_option("--fixed-sifts", args->settings.fixed_sifts, "sifts per IMF for --stop fixed")
           ->capture_default_str(),
-      {"sifting.fixed_sifts"});
+      {"fixed_sifts"});
   BindSetting(cmd->add_option("--sd", args->settings.sd, "Cauchy SD threshold for --stop sd")
                   ->capture_default_str(),
-              {"sifting.sd_threshold"});
+              {"sd"});
   BindSetting(cmd->add_option("--max-imfs", args->settings.max_imfs,
                               "IMF cap (0 = until the residue is monotone)")
                   ->capture_default_str(),
@@ -136,11 +138,11 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
   BindSetting(cmd->add_option("--ensemble,-I", args->settings.ensemble,
                               "ensemble size (noise-assisted methods)")
                   ->capture_default_str(),
-              {"ensemble_size"});
+              {"ensemble"});
   BindSetting(cmd->add_option("--noise", args->settings.noise,
                               "noise strength eps (relative to the signal's std)")
                   ->capture_default_str(),
-              {"noise_strength"});
+              {"noise"});
   cmd->add_option("--seed", args->settings.seed, "seed; realisation i uses stream (seed, i)")
       ->check(kSeed)
       ->capture_default_str();
@@ -157,11 +159,11 @@ const RegisterCommand kRegister("decompose", 20, [](CLI::App& app) {
                       "BEEMDAN noise bound: ensemble (band of the ensemble's white-noise modes) | "
                       "energy (Flandrin et al.'s band) | stages | full (= ICEEMDAN)")
           ->capture_default_str(),
-      {"beemdan_bound"});
+      {"bound"});
   BindSetting(
       cmd->add_option("--band", args->settings.band, "BEEMDAN band confidence: 0.95 or 0.99")
           ->capture_default_str(),
-      {"band_confidence"});
+      {"band"});
   BindSetting(cmd->add_option("--noise-stages", args->settings.noise_stages,
                               "BEEMDAN stages with --bound stages")
                   ->capture_default_str(),

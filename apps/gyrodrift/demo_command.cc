@@ -28,7 +28,7 @@ namespace {
 
 struct DemoArgs {
   study::DemoSettings settings;  // the defaults are the library's
-  std::string duration = "8h";   // as typed; settings.duration_s is parsed from it
+  std::string duration;          // as typed; empty: settings.duration_s, the library's default
   double rate_hz = 1.0;
   CLI::Option* rate_option = nullptr;  // "--rate-hz given"
   LogArgs log;                         // --gaps, --delimiter
@@ -41,7 +41,7 @@ study::DemoSettings Settings(const DemoArgs& a) {
   study::DemoSettings s = a.settings;
   s.log = a.log.Options();
   if (a.rate_option->count() > 0) s.rate_hz = a.rate_hz;
-  s.duration_s = ParseDuration(a.duration);
+  if (!a.duration.empty()) s.duration_s = ParseDuration(a.duration);
   try {
     (void)s.Options();
   } catch (const OptionError& e) {
@@ -127,7 +127,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   BindSetting(
       cmd->add_option("--duration", args->duration,
                       "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
-          ->capture_default_str()
+          ->default_str(FormatValue(study::DemoSettings{}.duration_s / 3600.0) + "h")
           ->group("Advanced"),
       {"duration_s"});
   BindSetting(

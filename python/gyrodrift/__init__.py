@@ -507,8 +507,9 @@ def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, 
     ``noise_terms``, ``settings``, ``timing``: the text the CLI prints) and ``seconds``.
 
     >>> import tempfile, gyrodrift as gd
-    >>> r = gd.demo(tempfile.mkdtemp() + "/study", duration=7200, methods="thermal,poly",
-    ...             ensemble=4, window=32)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     r = gd.demo(folder + "/study", duration=7200, methods="thermal,poly", ensemble=4,
+    ...                 window=32)
     >>> r["files"][-2:], r["compensated_by"]
     (['report.html', 'demo.json'], 'thermal (train A test B)')
     """

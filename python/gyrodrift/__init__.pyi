@@ -44,16 +44,18 @@ def noise_terms(
 
 def simulate(
     *, duration: float | None = ...,
-    profile: str | tuple[ArrayLike, ArrayLike] = ...,
+    profile: str | PathLike[str] | tuple[ArrayLike, ArrayLike] = ...,
     preset: Literal["navigation", "tactical"] = ..., rate_hz: float = ..., seed: int = ...,
     winding: str = ..., asymmetry: float | None = ..., input_rate_dph: float = ...,
     noise: bool = ...,
 ) -> dict[str, Any]: ...
 
-def read_ulog(path: str, *, decode: Sequence[str] = ...) -> dict[str, Any]: ...
+def read_ulog(
+    path: str | PathLike[str], *, decode: str | Sequence[str] = ...
+) -> dict[str, Any]: ...
 
 def ulog_columns(
-    path: str, *, topic: str = ..., instance: int = ..., axes: Sequence[str] = ...,
+    path: str | PathLike[str], *, topic: str = ..., instance: int = ..., axes: Sequence[str] = ...,
     temperature_field: str = ..., units: Literal["dph", "dps", "rads"] = ...,
 ) -> dict[str, Any]: ...
 

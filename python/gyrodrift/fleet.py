@@ -19,6 +19,7 @@ unit leaves no partial file; the retry's write removes the dead process's tempor
 """
 
 import argparse
+import numbers
 import os
 import sys
 import time
@@ -39,7 +40,8 @@ def calibrate(manifest_path, output_dir, *, client=None, scheduler=None, workers
     LocalCluster of ``workers`` processes (default: every core)."""
     from dask.distributed import Client, LocalCluster
 
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+    if workers is not None and (isinstance(workers, bool)
+                                or not isinstance(workers, numbers.Integral)
                                 or not 1 <= workers <= 1024):
         raise _gyrodrift.UsageError(f"workers = {workers!r}: must be an integer in [1, 1024]")
     manifest_path = os.path.abspath(manifest_path)

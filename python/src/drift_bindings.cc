@@ -48,6 +48,7 @@ class PyDriftModel {
            const py::object& progress) {
     LongCall call(progress);
     settings.Validate();  // option errors before the arrays are looked at
+    (void)allan::RateUnitFromString(units);
     const Execution execution = ExecutionOf(settings.threads, call);
 
     const Eigen::VectorXd y = ToVector(y_in, "y");

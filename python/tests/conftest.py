@@ -20,8 +20,8 @@ def cli():
     if not os.access(path, os.X_OK):
         pytest.fail(f"no gyrodrift CLI at {path} (set GYRODRIFT_CLI)")
 
-    def run(*args, check=True):
-        r = subprocess.run([path, *map(str, args)], capture_output=True, text=True)
+    def run(*args, check=True, cwd=None):
+        r = subprocess.run([path, *map(str, args)], capture_output=True, text=True, cwd=cwd)
         if check and r.returncode != 0:
             raise AssertionError(f"gyrodrift {' '.join(map(str, args))}: exit {r.returncode}\n"
                                  f"{r.stdout}{r.stderr}")

@@ -303,8 +303,8 @@ def test_demo_matches_cli(cli, tmp_path):
         elif name != "report.html":
             assert ours.read_bytes() == theirs.read_bytes(), name
     assert "thermal" in r["tables"]["compensate"]
-    with pytest.raises(gd.UsageError, match=r"^target, temperature, rate_hz, units, gaps and "
-                                            r"delimiter need input"):
+    with pytest.raises(gd.UsageError, match=r"^target, temperature, rate_hz, units and gaps need "
+                                            r"input"):
         gd.demo(tmp_path / "x", target="rate_dph")
     with pytest.raises(gd.UsageError, match=r"^input needs target"):
         gd.demo(tmp_path / "x", input=tmp_path / "py" / "run_a.csv")

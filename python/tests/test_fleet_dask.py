@@ -108,11 +108,13 @@ def test_dask_fleet_matches_calibrate(cli, fleet):
     assert p.returncode == 0, p.stderr
     assert "2 units: 0 calibrated, 2 skipped" in p.stdout, p.stdout
     assert without_unit_seconds(dask_csv) == without_unit_seconds(cli_csv)
-    # Each front end skips what the other calibrated, however the manifest is named (here from
-    # its own folder, relatively): a unit's fingerprint names its logs by their absolute paths.
-    p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", "fleet.toml", "-o", "cli",
-                        "--workers", "1"], cwd=fleet, capture_output=True, text=True,
-                       env=os.environ)
+    # Each front end skips what the other calibrated, however the manifest is named: calibrate
+    # from the manifest's folder (a relative name), then the Dask runner (an absolute one) on
+    # its output. The fingerprint names each log by its path from the manifest's folder.
+    cli("calibrate", "fleet.toml", "-o", "relative", "-q", cwd=fleet)
+    p = subprocess.run([sys.executable, "-m", "gyrodrift.fleet", str(fleet / "fleet.toml"),
+                        "-o", str(fleet / "relative"), "--workers", "1"], capture_output=True,
+                       text=True, env=os.environ)
     assert p.returncode == 0, p.stderr
     assert "2 units: 0 calibrated, 2 skipped" in p.stdout, p.stdout
 

@@ -19,7 +19,6 @@
 #include "gyrodrift/drift/records.h"
 #include "gyrodrift/drift/thermal_model.h"
 #include "gyrodrift/elm/elm.h"
-#include "gyrodrift/io/gyro_log.h"
 #include "thermal_columns.h"
 #include "thermal_folds.h"
 #include "thermal_report.h"
@@ -41,12 +40,12 @@ constexpr int kLeastSkillBlocks = 4;
 // Candidates of the nonlinear correction (hidden units ascending: they share one hidden layer).
 constexpr std::array<int, 4> kCorrectionUnits{5, 10, 20, 40};
 constexpr std::array<double, 4> kCorrectionRidge{1e-2, 1.0, 1e2, 1e4};
-// A log with most rows made up (more than io::kMostlyMadeUpShare, where interpolate warns; a
-// duty-cycled log: 5 s of every 300 s leaves 480 samples of 8 h) has every coefficient but the
-// intercept shrunk by a ridge worth kSparsePriorSamples logged samples at the regressor's mean
-// square, in the fold fits and the final fit [choice, docs/drift.md 4.8: on duty-cycled family
-// units no unit worse than raw].
-constexpr double kSparseLoggedShare = 1.0 - io::kMostlyMadeUpShare;
+// A log of which less than this share of rows was logged (most rows made up, as io's
+// kMostlyMadeUpShare words it; a duty-cycled log: 5 s of every 300 s leaves 480 samples of 8 h)
+// has every coefficient but the intercept shrunk by a ridge worth kSparsePriorSamples logged
+// samples at the regressor's mean square, in the fold fits and the final fit [choice,
+// docs/drift.md 4.8: on duty-cycled family units no unit worse than raw].
+constexpr double kSparseLoggedShare = 0.5;
 constexpr double kSparsePriorSamples = 16.0;
 // Beyond the rates of a direction the run never showed (a heat-up's cooling), a state's rate moves
 // at this share of its slope: midway between no response (held) and the shown direction's (the

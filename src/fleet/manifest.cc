@@ -474,13 +474,16 @@ nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
   }
   // NaN (a limit not set) as null.
   auto limit = [](double v) { return std::isnan(v) ? nlohmann::json() : nlohmann::json(v); };
-  // Each log by its absolute path: the same however the manifest was named and from whichever
-  // folder or front end the run started (a rerun from elsewhere redid every unit).
+  // Each log by its path from the manifest's folder: the same however the manifest was named and
+  // from whichever folder or front end the run started (a rerun from elsewhere redid every unit),
+  // and when the whole tree moves.
   nlohmann::json logs = nlohmann::json::array();
   for (const std::string& log : u.Logs()) {
     std::error_code ec;
-    const fs::path absolute = fs::weakly_canonical(fs::absolute(log, ec), ec);
-    logs.push_back({{"path", ec ? log : absolute.string()},
+    const fs::path folder = fs::absolute(m.path, ec).parent_path();
+    const fs::path absolute = fs::absolute(log, ec).lexically_normal();
+    const fs::path relative = absolute.lexically_relative(folder);
+    logs.push_back({{"path", ec ? log : (relative.empty() ? absolute : relative).string()},
                     {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
   return {{"settings", tasks::SettingsToJson(m.fit, m.log)},

@@ -37,11 +37,13 @@ void RequireInputSettings(const DemoSettings& s) {
   if (s.input.empty()) {
     if (!s.target.empty() || !s.temperature.empty() || s.rate_hz ||
         s.units != DemoSettings{}.units || log_given) {
+      // Flags: the log options every command takes (AddLogOptions); keys: Python's demo's one.
+      const std::string log_settings =
+          tasks::SpeltAsFlags(s.log) ? "--gaps and --delimiter" : "and gaps";
       throw UsageError(fmt::format(
-          "{}, {}, {}, {}, {} and {} need {} (the simulated output is in "
-          "deg/h at 1 Hz)",
+          "{}, {}, {}, {}{} {} need {} (the simulated output is in deg/h at 1 Hz)",
           Spell(s, "target"), Spell(s, "temperature"), Spell(s, "rate_hz"), Spell(s, "units"),
-          Spell(s, "gaps"), Spell(s, "delimiter"), Spell(s, "input")));
+          tasks::SpeltAsFlags(s.log) ? "," : "", log_settings, Spell(s, "input")));
     }
     return;
   }

@@ -9,6 +9,7 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/records.h"
 
 namespace gyrodrift::tasks {
 namespace {
@@ -96,25 +97,29 @@ al::AllanOptions AllanSettings::Options() const {
   // Beyond this range the averages under- or overflow (1e308 Hz gave all-zero deviations).
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e9);
   al::AllanOptions o;
-  o.rate_hz = rate_hz;
-  o.data_type = al::DataTypeFromString(type);
-  o.deviation = al::DeviationFromString(dev);
-  o.units = al::RateUnitFromString(units);
-  o.confidence = confidence;
-  if (tau_list_s.empty()) {
-    ParseTaus(taus, &o);
-  } else {
-    o.grid = al::TauGrid::kList;
-    o.tau_list_s = tau_list_s;
-  }
-  RequireWholeSamples(o.tau_list_s, rate_hz);
-  o.Validate();
+  // A refusal names the setting the user gave (type, taus), not the library's field.
+  ValidateAsSettings({{"data_type", "type"}, {"deviation", "dev"}, {"tau_list_s", "taus"}}, [&] {
+    o.rate_hz = rate_hz;
+    o.data_type = al::DataTypeFromString(type);
+    o.deviation = al::DeviationFromString(dev);
+    o.units = al::RateUnitFromString(units);
+    o.confidence = confidence;
+    if (tau_list_s.empty()) {
+      ParseTaus(taus, &o);
+    } else {
+      o.grid = al::TauGrid::kList;
+      o.tau_list_s = tau_list_s;
+    }
+    RequireWholeSamples(o.tau_list_s, rate_hz);
+    o.Validate();
+  });
   return o;
 }
 
 al::NoiseFitOptions AllanSettings::FitOptions() const {
   const al::NoiseFitOptions o{.tau_min_s = fit_tau_min_s, .tau_max_s = fit_tau_max_s};
-  o.Validate();
+  ValidateAsSettings({{"tau_min_s", "fit_tau_min"}, {"tau_max_s", "fit_tau_max"}},
+                     [&] { o.Validate(); });
   return o;
 }
 
@@ -161,8 +166,13 @@ Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
 AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                   const AllanSettings& settings, std::string_view signal_name) {
   const al::AllanOptions o = settings.Options();
-  RequireVaryingSignal(signal_name, data,
-                       "its Allan deviation is zero at every tau (a logging fault?)");
+  // Constant where it was logged (the breaks and made-up rows hold anything).
+  const char* why = "its Allan deviation is zero at every tau (a logging fault?)";
+  if (logged.empty()) {
+    RequireVaryingSignal(signal_name, data, why);
+  } else {
+    RequireVaryingSignal(signal_name, drift::LoggedRows(data, logged), why);
+  }
   const Execution execution = settings.MakeExecution();
   const al::NoiseFitOptions fit_options = settings.FitOptions();
   const bool allan_curve = AllanCurve(o.deviation);
@@ -173,7 +183,8 @@ AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                     : al::Compute(data, options, execution);
   };
   AllanRun run;
-  run.curve = compute(o, allan_curve);
+  ValidateAsSettings({{"deviation", "dev"}, {"data_type", "type"}},
+                     [&] { run.curve = compute(o, allan_curve); });
   run.dev_unit = al::ToString(o.units) + (o.deviation == al::Deviation::kTdev ? "*s" : "");
   run.fit_source = al::ToString(o.deviation);
   try {

@@ -13,21 +13,35 @@ namespace dec = gyrodrift::decomposition;
 
 dec::DecompositionOptions DecomposeSettings::Options() const {
   dec::DecompositionOptions o;
-  o.method = dec::MethodFromString(method);
-  o.sifting.stop_rule = dec::StopRuleFromString(stop);
-  o.sifting.max_sifts = max_sifts;
-  o.sifting.s_number = s_number;
-  o.sifting.fixed_sifts = fixed_sifts;
-  o.sifting.sd_threshold = sd;
-  o.max_imfs = max_imfs;
-  o.ensemble_size = ensemble;
-  o.noise_strength = noise;
-  o.seed = seed;
-  o.noise_scaling = dec::NoiseScalingFromString(noise_scaling);
-  o.beemdan_bound = dec::BeemdanBoundFromString(bound);
-  o.band_confidence = band;
-  o.noise_stages = noise_stages;
-  o.Validate();
+  // A refusal names the setting the user gave (ensemble, as Python's keyword and the CLI's flag
+  // spell it), not the library's field (ensemble_size).
+  ValidateAsSettings({{"stop_rule", "stop"},
+                      {"sifting.stop_rule", "stop"},
+                      {"sifting.max_sifts", "max_sifts"},
+                      {"sifting.s_number", "s_number"},
+                      {"sifting.fixed_sifts", "fixed_sifts"},
+                      {"sifting.sd_threshold", "sd"},
+                      {"ensemble_size", "ensemble"},
+                      {"noise_strength", "noise"},
+                      {"beemdan_bound", "bound"},
+                      {"band_confidence", "band"}},
+                     [&] {
+                       o.method = dec::MethodFromString(method);
+                       o.sifting.stop_rule = dec::StopRuleFromString(stop);
+                       o.sifting.max_sifts = max_sifts;
+                       o.sifting.s_number = s_number;
+                       o.sifting.fixed_sifts = fixed_sifts;
+                       o.sifting.sd_threshold = sd;
+                       o.max_imfs = max_imfs;
+                       o.ensemble_size = ensemble;
+                       o.noise_strength = noise;
+                       o.seed = seed;
+                       o.noise_scaling = dec::NoiseScalingFromString(noise_scaling);
+                       o.beemdan_bound = dec::BeemdanBoundFromString(bound);
+                       o.band_confidence = band;
+                       o.noise_stages = noise_stages;
+                       o.Validate();
+                     });
   return o;
 }
 
@@ -52,11 +66,7 @@ void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise
   }
 }
 
-dec::Decomposition RunDecompose(const Eigen::VectorXd& x, const DecomposeSettings& settings,
-                                const Eigen::MatrixXd& noise,
-                                std::function<void(double, std::string_view)> progress,
-                                std::string_view noise_name, std::string_view signal_name) {
-  dec::DecompositionOptions o = settings.Options();
+void RequireDecomposable(const Eigen::VectorXd& x, std::string_view signal_name) {
   RequireVaryingSignal(signal_name, x, "it has no oscillation to decompose");
   if (x.size() > kMaxDecomposeSamples) {
     throw DataError(fmt::format(
@@ -64,6 +74,14 @@ dec::Decomposition RunDecompose(const Eigen::VectorXd& x, const DecomposeSetting
         "decimate or split the log)",
         signal_name, x.size(), kMaxDecomposeSamples));
   }
+}
+
+dec::Decomposition RunDecompose(const Eigen::VectorXd& x, const DecomposeSettings& settings,
+                                const Eigen::MatrixXd& noise,
+                                std::function<void(double, std::string_view)> progress,
+                                std::string_view noise_name, std::string_view signal_name) {
+  dec::DecompositionOptions o = settings.Options();
+  RequireDecomposable(x, signal_name);
   const dec::DecompositionContext context = settings.Context(std::move(progress));
   if (noise.size() == 0) return dec::Decompose(x, o, context);
   RequireNoiseTaken(settings, noise_name);

@@ -51,8 +51,10 @@ void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogO
     if (name.empty()) ThrowOption(flags ? "--target" : "target", "''", "a column name");
   }
   for (const std::string& name : run.temperatures) {
-    if (!name.empty() && name.find(',') == std::string::npos) continue;
-    ThrowOption(flags ? "--temperature" : "temperature", "'" + name + "'",
+    const char* setting = flags ? "--temperature" : "temperature";
+    if (name.empty()) ThrowOption(setting, "''", "a column name");
+    if (name.find(',') == std::string::npos) continue;
+    ThrowOption(setting, "'" + name + "'",
                 "a column name without a comma (a model file separates its temperature columns "
                 "by commas)");
   }

@@ -161,6 +161,22 @@ TEST_F(GapsCli, EveryCommandTakesTheFourModesAndSpellsTheFlagAsTyped) {
   EXPECT_NE(r.err.find("--gaps"), std::string::npos) << r.err;
 }
 
+TEST_F(GapsCli, AllanRefusesAColumnConstantWhereLoggedWhateverTheGaps) {
+  // The break between joined records (split) or a made-up row (carry) is no variation: a stuck
+  // sensor's log with a hole is refused as the same log without it is.
+  std::string text = "time_s,rate_dph\n";
+  for (int t = 0; t < 2000; ++t) {
+    if (t < 1000 || t >= 1500) text += std::to_string(t) + ",2.5\n";
+  }
+  io::WriteFileAtomically(Dir() + "/stuck.csv", text);
+  for (const char* gaps : {"split", "carry", "interpolate"}) {
+    const auto r = test::RunCli("allan " + Path("stuck.csv") + " -c rate_dph --gaps " + gaps +
+                                " -o " + Path("stuck_adev.csv"));
+    test::ExpectCleanFailure(r, 3, "column 'rate_dph' is constant (every sample is 2.5)",
+                             Dir() + "/stuck_adev.csv", std::string("stuck, --gaps ") + gaps);
+  }
+}
+
 TEST_F(GapsCli, AllanSkipsTheClusterPairsThatHoldAMadeUpSample) {
   const std::string allan = "allan " + Path("holed.csv") + " -c rate_dph --rate-hz 1 ";
   // split (records joined with a break) and carry (the hole filled and masked) are the same

@@ -106,10 +106,11 @@ struct StudyContext {
   // Worker threads of every step (decompositions, causal windows, fits, Allan deviations), in
   // [0, 1024]; 0 (default) = every core. Recorded in the settings table.
   int threads = 0;
-  // Progress: the stage (in [0, kStudyStages)), the fraction of it done in [0, 1] and what is
-  // being done. Called with fraction 0 when a stage begins; never concurrently, from the calling
-  // thread or a worker. The fraction weighs each evaluation trial by its expected cost, not by its
-  // count. May be empty (default); throw from it to cancel the study.
+  // Progress: the stage (in [0, kStudyStages); RunDemo adds kStudyStages, writing the files),
+  // the fraction of it done in [0, 1] and what is being done. Called with fraction 0 when a stage
+  // begins; never concurrently, from the calling thread or a worker. The fraction weighs each
+  // evaluation trial by its expected cost, not by its count. May be empty (default); throw from it
+  // to cancel the study.
   std::function<void(int stage, double fraction, const std::string& what)> progress = {};
   // A finished stage's results as the text `gyrodrift demo` prints: "1. simulated run A: ...",
   // the tables of stages 2-4 (Table::Text), each ending in a newline. May be empty (default).

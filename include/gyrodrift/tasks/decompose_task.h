@@ -64,9 +64,12 @@ void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise
 // working vectors of the signal's length per thread (measured peaks in docs/errors.md).
 inline constexpr Eigen::Index kMaxDecomposeSamples = 20'000'000;
 
-// The decomposition of x; with `noise` not empty (one white-noise realisation per column; see
-// RequireNoiseTaken) the supplied noise is used instead of drawing. A constant x (nothing to
-// decompose) or one longer than kMaxDecomposeSamples is a DataError naming `signal_name`.
+// DataError naming `signal_name` for a constant x (nothing to decompose) or one longer than
+// kMaxDecomposeSamples. RunDecompose checks it; a front end may check it as soon as it has x.
+void RequireDecomposable(const Eigen::VectorXd& x, std::string_view signal_name);
+
+// The decomposition of x (RequireDecomposable); with `noise` not empty (one white-noise
+// realisation per column; see RequireNoiseTaken) the supplied noise is used instead of drawing.
 decomposition::Decomposition RunDecompose(
     const Eigen::VectorXd& x, const DecomposeSettings& settings, const Eigen::MatrixXd& noise = {},
     std::function<void(double, std::string_view)> progress = {},
