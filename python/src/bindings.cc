@@ -1,6 +1,7 @@
 // The shared helpers of the bindings (bindings.h).
 #include "bindings.h"
 
+#include "gyrodrift/drift/temperature_check.h"
 #include "gyrodrift/tasks/settings_json.h"
 
 namespace gyrodrift::python {
@@ -172,6 +173,24 @@ drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings 
   }
   tasks::FitSettingsFromJson(given, &base);
   return base;
+}
+
+void WarnOfTemperatures(const Eigen::MatrixXd& temperature, const std::vector<std::string>& names) {
+  for (Eigen::Index c = 0; c < temperature.cols(); ++c) {
+    const std::string w =
+        drift::TemperatureWarning(temperature.col(c), names.at(static_cast<size_t>(c)));
+    if (!w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) {
+      throw py::error_already_set();
+    }
+  }
+}
+
+std::vector<std::string> TemperatureNames(Eigen::Index columns) {
+  if (columns == 1) return {"temperature_c"};
+  std::vector<std::string> names;
+  for (Eigen::Index c = 0; c < columns; ++c)
+    names.push_back("temperature_c" + std::to_string(c + 1));
+  return names;
 }
 
 }  // namespace gyrodrift::python

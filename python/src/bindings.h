@@ -53,6 +53,12 @@ py::object ToPython(const nlohmann::json& j);
 // reader's OptionError (UsageError) naming it.
 drift::FitSettings FitSettingsOf(const py::kwargs& keywords, drift::FitSettings base,
                                  const char* function, const std::vector<std::string>& own);
+// Before the work, as the CLI's fit, evaluate and compensate: a UserWarning for each column of
+// `temperature` that does not look like degC (drift::TemperatureWarning), named by `names`.
+void WarnOfTemperatures(const Eigen::MatrixXd& temperature, const std::vector<std::string>& names);
+// The names of arrays' temperature columns: temperature_c, or temperature_c1, temperature_c2, ...
+std::vector<std::string> TemperatureNames(Eigen::Index columns);
+
 // The settings keywords and their defaults, drift::FitSettings{} as JSON without the fields no
 // call takes as a keyword (mode: a keyword of its own; has_temperature: set from temperature):
 // gd.fit_defaults().

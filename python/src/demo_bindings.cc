@@ -71,7 +71,8 @@ void BindDemo(py::module_& m) {
                               .window = window,
                               .methods = methods,
                               .seed = seed,
-                              .threads = threads};
+                              .threads = threads,
+                              .log = {}};
         s.log.gaps = io::GapPolicyFromString(gaps);
         return Demo(s, progress);
       },

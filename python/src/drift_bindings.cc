@@ -54,27 +54,13 @@ class PyDriftModel {
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::MatrixXd temperature;
     if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
-    std::vector<std::string> names;
-    if (temperature_columns) {
-      names = *temperature_columns;
-    } else if (temperature.cols() == 1) {
-      names = {"temperature_c"};
-    } else {
-      for (Eigen::Index c = 0; c < temperature.cols(); ++c)
-        names.push_back("temperature_c" + std::to_string(c + 1));
-    }
+    const std::vector<std::string> names =
+        temperature_columns ? *temperature_columns : TemperatureNames(temperature.cols());
     if (temperature_in && static_cast<Eigen::Index>(names.size()) != temperature.cols()) {
       throw UsageError("temperature_columns: " + std::to_string(names.size()) + " names for " +
                        std::to_string(temperature.cols()) + " temperature columns");
     }
-    // Before the work, as `gyrodrift fit`: a temperature that does not look like degC.
-    for (Eigen::Index c = 0; c < temperature.cols(); ++c) {
-      const std::string w =
-          drift::TemperatureWarning(temperature.col(c), names[static_cast<size_t>(c)]);
-      if (!w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) {
-        throw py::error_already_set();
-      }
-    }
+    WarnOfTemperatures(temperature, names);
     // One target: the run of the arrays, as tasks::AssembleFitRun makes it of logs.
     tasks::FitRun run{.targets = {target}, .temperatures = {}, .rows = {}, .source = source};
     if (temperature_in) run.temperatures = names;
@@ -102,6 +88,11 @@ class PyDriftModel {
   const io::LoadedModel& Loaded() const {
     if (!fitted_) throw UsageError("DriftModel: not fitted (call fit() or DriftModel.load())");
     return loaded_;
+  }
+
+  // The model's temperature columns, as its file names them.
+  std::vector<std::string> Channels() const {
+    return tasks::SplitColumns(Loaded().info.temperature_column);
   }
 
   void RequireMode(drift::Mode mode, const char* what) const {
@@ -132,6 +123,7 @@ class PyDriftModel {
       throw DataError(std::string(what) + ": truth has " + std::to_string(truth.size()) +
                       " samples, temperature " + std::to_string(t.rows()));
     }
+    if (t.cols() == static_cast<Eigen::Index>(Channels().size())) WarnOfTemperatures(t, Channels());
     py::gil_scoped_release release;
     return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, settings);
   }

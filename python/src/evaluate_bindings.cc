@@ -56,6 +56,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
   const Eigen::VectorXd y = ToVector(y_in, "y");
   Eigen::MatrixXd temperature;
   if (temperature_in) temperature = ToMatrix(*temperature_in, "temperature");
+  WarnOfTemperatures(temperature, TemperatureNames(temperature.cols()));
   Eigen::VectorXd truth;
   if (truth_in) truth = ToVector(*truth_in, "truth");
   drift::EvaluationResult result;

@@ -85,9 +85,15 @@ py::dict UlogColumns(const std::string& path, const std::string& topic, int inst
 }
 
 py::dict Plan(double hours, double min_c, double max_c, double rate, double dwell_min) {
-  const drift::CalibrationPlan plan = drift::PlanCalibration(
-      {.hours = hours, .min_c = min_c, .max_c = max_c, .rate_k_per_min = rate,
-       .shortest_dwell_min = dwell_min});
+  drift::CalibrationPlan plan;
+  // A refusal names the keyword (rate, dwell_min), as the CLI's names its flag.
+  ValidateAsSettings({{"rate_k_per_min", "rate"}, {"shortest_dwell_min", "dwell_min"}}, [&] {
+    plan = drift::PlanCalibration({.hours = hours,
+                                   .min_c = min_c,
+                                   .max_c = max_c,
+                                   .rate_k_per_min = rate,
+                                   .shortest_dwell_min = dwell_min});
+  });
   py::dict d;
   const auto n = static_cast<Eigen::Index>(plan.time_s.size());
   d["time_s"] = ToArray(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(plan.time_s.data(), n)));

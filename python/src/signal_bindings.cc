@@ -2,6 +2,7 @@
 #include "bindings.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -135,7 +136,8 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   sim::FogParameters params = sim::PresetParameters(sim::PresetFromString(preset));
   if (!winding.empty()) params.coil.winding = sim::WindingPatternFromString(winding);
   if (asymmetry) params.coil.winding_asymmetry = *asymmetry;
-  params.Validate();
+  // A refusal names the keyword (asymmetry), as the CLI's names its flag.
+  ValidateAsSettings({{"coil.winding_asymmetry", "asymmetry"}}, [&] { params.Validate(); });
   // A built-in programme by name, or (time_s, temperature_c) samples of a chamber programme.
   std::optional<sim::TemperatureProgramme> programme;
   if (py::isinstance<py::str>(profile)) {
@@ -159,6 +161,7 @@ py::dict Simulate(std::optional<double> duration, const py::object& profile,
   o.input_rate_dph = input_rate_dph;
   o.include_noise = noise;
   o.duration_s = duration ? *duration : programme->DefaultSimulationDuration();
+  ValidateAsSettings({{"duration_s", "duration"}}, [&] { o.Validate(); });
   sim::SimulationResult r;
   {
     py::gil_scoped_release release;

@@ -84,6 +84,15 @@ def test_errors_are_python_exceptions_with_the_library_messages(tmp_path):
         gd.allan(np.arange(4.0), rate_hz=1.0, logged="0101")
     with pytest.raises(gd.UsageError, match=r"^models: must be a sequence of DriftModel"):
         gd.DriftModel.save_axes(tmp_path / "m.json", ["x"])
+    # Refusals name the keyword given, not the library's field.
+    with pytest.raises(gd.UsageError, match=r"^asymmetry = 0.6: must be"):
+        gd.simulate(duration=600, asymmetry=0.6)
+    with pytest.raises(gd.UsageError, match=r"^duration = 0: must be"):
+        gd.simulate(duration=0)
+    with pytest.raises(gd.UsageError, match=r"^rate = -1: must be"):
+        gd.plan(rate=-1)
+    with pytest.raises(gd.UsageError, match=r"^dwell_min = 0: must be"):
+        gd.plan(dwell_min=0)
     # A constant signal is refused by the library, for Python as for the CLI.
     with pytest.raises(gd.DataError, match=r"^x is constant \(every sample is 2\): it has no osc"):
         gd.decompose(np.full(100, 2.0))
@@ -193,7 +202,13 @@ def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():
     counts = np.round(sim["temperature_c"] * 512.0)  # a die-temperature register, not degC
     with pytest.warns(UserWarning, match=r"^temperature column 'temp_raw' runs from .* outside "
                                          r"-80\.\.200 degC; whole numbers only: raw ADC counts\?"):
-        gd.DriftModel().fit(sim["rate_dph"], counts, mode="compensate",
-                            temperature_columns=["temp_raw"])
+        model = gd.DriftModel().fit(sim["rate_dph"], counts, mode="compensate",
+                                    temperature_columns=["temp_raw"])
+    # And before evaluate and compensate, as the CLI's commands warn.
+    kelvin = sim["temperature_c"] + 273.15
+    with pytest.warns(UserWarning, match=r"^temperature column 'temp_raw' runs from"):
+        model.compensate(counts, sim["rate_dph"])
+    with pytest.warns(UserWarning, match=r"^temperature column 'temperature_c' runs from .* kelvin\?"):
+        gd.evaluate(sim["rate_dph"], kelvin, mode="compensate", methods="constant")
     assert gd.temperature_warning(sim["temperature_c"]) == ""
     assert "whole numbers only" in gd.temperature_warning(counts, "temp_raw")
