@@ -28,7 +28,6 @@ extern const CLI::Validator kSeed;
 std::string SidecarPath(const std::string& output_path);
 
 // The guards of the user's log (io/files.h).
-using io::RequireInputsOutsideFolder;
 using io::RequireOutputsAreNotInputs;
 
 // Common metadata of every sidecar: tool name, version and subcommand.

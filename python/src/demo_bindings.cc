@@ -11,7 +11,6 @@ namespace gyrodrift::python {
 namespace {
 
 py::dict Demo(const study::DemoSettings& settings, const py::object& progress) {
-  (void)settings.Options();  // option errors before the work
   LongCall call(progress);
   // The study reports (stage, fraction of it); the callable gets the fraction of the whole run,
   // each stage weighed by its measured cost.

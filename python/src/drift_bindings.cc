@@ -123,7 +123,8 @@ class PyDriftModel {
       throw DataError(std::string(what) + ": truth has " + std::to_string(truth.size()) +
                       " samples, temperature " + std::to_string(t.rows()));
     }
-    if (t.cols() == static_cast<Eigen::Index>(Channels().size())) WarnOfTemperatures(t, Channels());
+    const std::vector<std::string> channels = Channels();
+    if (t.cols() == static_cast<Eigen::Index>(channels.size())) WarnOfTemperatures(t, channels);
     py::gil_scoped_release release;
     return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, settings);
   }

@@ -60,14 +60,7 @@ py::dict Allan(const Array& x_in, const tasks::AllanSettings& settings, std::vec
                const std::vector<Eigen::Index>& record_starts) {
   settings.Validate();
   Eigen::VectorXd data = ToVector(x_in, "x");
-  if (!record_starts.empty()) {
-    if (!logged.empty()) {
-      throw UsageError(
-          "logged and record_starts: give one (a record with gaps on its time grid, "
-          "or records to join)");
-    }
-    data = tasks::JoinRecords(data, record_starts, &logged);
-  }
+  if (!record_starts.empty()) data = tasks::JoinRecords(data, record_starts, &logged);
   tasks::AllanRun run;
   {
     py::gil_scoped_release release;

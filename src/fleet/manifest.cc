@@ -479,11 +479,12 @@ nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
   // and when the whole tree moves.
   nlohmann::json logs = nlohmann::json::array();
   for (const std::string& log : u.Logs()) {
-    std::error_code ec;
-    const fs::path folder = fs::absolute(m.path, ec).parent_path();
-    const fs::path absolute = fs::absolute(log, ec).lexically_normal();
+    std::error_code folder_error, log_error;
+    const fs::path folder = fs::absolute(m.path, folder_error).parent_path();
+    const fs::path absolute = fs::absolute(log, log_error).lexically_normal();
     const fs::path relative = absolute.lexically_relative(folder);
-    logs.push_back({{"path", ec ? log : (relative.empty() ? absolute : relative).string()},
+    const bool named = !folder_error && !log_error;  // else the path as the manifest gave it
+    logs.push_back({{"path", named ? (relative.empty() ? absolute : relative).string() : log},
                     {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
   return {{"settings", tasks::SettingsToJson(m.fit, m.log)},

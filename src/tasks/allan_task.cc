@@ -9,7 +9,6 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
-#include "gyrodrift/drift/records.h"
 
 namespace gyrodrift::tasks {
 namespace {
@@ -138,6 +137,11 @@ void AllanSettings::Validate() const {
 Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
                             const std::vector<Eigen::Index>& record_starts,
                             std::vector<bool>* logged) {
+  if (!logged->empty()) {
+    throw UsageError(
+        "logged and record_starts: give one (a record with gaps on its time grid, "
+        "or records to join)");
+  }
   Eigen::Index previous = 0;
   for (size_t r = 0; r < record_starts.size(); ++r) {
     if (record_starts[r] <= previous || record_starts[r] >= data.size()) {
@@ -166,12 +170,20 @@ Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
 AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                   const AllanSettings& settings, std::string_view signal_name) {
   const al::AllanOptions o = settings.Options();
-  // Constant where it was logged (the breaks and made-up rows hold anything).
+  // Constant where it was logged (the breaks and made-up rows hold anything), found without a
+  // copy of the record: RequireVaryingSignal of the first logged sample alone names its value.
   const char* why = "its Allan deviation is zero at every tau (a logging fault?)";
   if (logged.empty()) {
     RequireVaryingSignal(signal_name, data, why);
   } else {
-    RequireVaryingSignal(signal_name, drift::LoggedRows(data, logged), why);
+    Eigen::Index first = -1;
+    bool varies = false;
+    for (Eigen::Index i = 0; i < data.size() && !varies; ++i) {
+      if (!logged[static_cast<size_t>(i)]) continue;
+      if (first < 0) first = i;
+      varies = data[i] != data[first];
+    }
+    if (first >= 0 && !varies) RequireVaryingSignal(signal_name, data.segment(first, 1), why);
   }
   const Execution execution = settings.MakeExecution();
   const al::NoiseFitOptions fit_options = settings.FitOptions();

@@ -67,8 +67,9 @@ AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
 
 // Records (a log split at its gaps: `record_starts`, the first sample of every record after the
 // first, increasing, inside 1..size-1) analysed on one grid: joined with one missing sample between
-// them, *logged marking it (allan::ComputeWithGaps), so no cluster pair spans a break. Throws
-// DataError for starts out of order or out of range.
+// them, *logged (empty going in: records, or a mask, not both) marking it (allan::ComputeWithGaps),
+// so no cluster pair spans a break. Throws DataError for starts out of order or out of range,
+// UsageError for a mask given.
 Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
                             const std::vector<Eigen::Index>& record_starts,
                             std::vector<bool>* logged);
