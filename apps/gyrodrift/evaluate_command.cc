@@ -75,8 +75,8 @@ void Run(const EvaluateArgs& a) {
   Record record = ReadRecord(a, table, &in);
   // Before the work: an assumed sample rate, a temperature that does not look like degC.
   if (!a.quiet) {
-    for (const std::string& w : tasks::LogWarnings(log, log.rate_how, record.temperature_names,
-                                                   /*flags=*/true)) {
+    for (const std::string& w :
+         tasks::LogWarnings(log, log.rate_how, record.temperature_names, tasks::Audience::kFlags)) {
       fmt::print("warning: {}\n", w);
     }
     std::fflush(stdout);

@@ -124,7 +124,8 @@ tasks::FitRun ReadRun(const FitArgs& a, std::string* notes, std::string* warning
     const std::vector<std::string> temperatures =
         a.temperature.empty() ? std::vector<std::string>{}
                               : tasks::ReadColumns(l.table, a.temperature, "--temperature").names;
-    for (const std::string& w : tasks::LogWarnings(l, l.rate_how, temperatures, true)) {
+    for (const std::string& w :
+         tasks::LogWarnings(l, l.rate_how, temperatures, tasks::Audience::kFlags)) {
       *warnings += "warning: " + w + "\n";
     }
     logs.push_back(std::move(l));

@@ -27,8 +27,8 @@ from ._gyrodrift import DataError, FileError, UsageError, __version__
 
 __all__ = [
     "DataError", "DriftModel", "FileError", "UsageError", "__version__", "allan", "calibrate",
-    "decompose", "demo", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_ulog",
-    "select_modes", "simulate", "temperature_warning", "ulog_columns",
+    "decompose", "demo", "evaluate", "export", "fit_defaults", "noise_terms", "plan", "read_log",
+    "read_ulog", "select_modes", "simulate", "temperature_warning", "ulog_columns",
 ]
 
 
@@ -39,7 +39,8 @@ _INT = (-2 ** 31, 2 ** 31, "[-2^31, 2^31)")
 _INTEGER_RANGES = {
     **{name: _INT for name in ("ensemble", "threads", "max_imfs", "max_sifts", "s_number",
                                "fixed_sifts", "noise_stages", "realisations", "instance",
-                               "repeats", "horizon", "window")},
+                               "repeats", "horizon", "window", "skip_rows",
+                               "ulog_instance")},
     "seed": (0, 2 ** 64, "[0, 2^64)"),
     "device_ids": (0, 2 ** 32, "[0, 2^32)"),
 }
@@ -173,6 +174,38 @@ def simulate(*, duration=None, profile="chamber", preset="navigation", rate_hz=1
     return _call(_gyrodrift.simulate, duration=duration, profile=profile, preset=preset,
                  rate_hz=rate_hz, seed=seed, winding=winding, asymmetry=asymmetry,
                  input_rate_dph=input_rate_dph, noise=noise)
+
+
+def read_log(path, *, gaps="error", rate_hz=None, delimiter="auto", names=(), skip_rows=0,
+             bad_lines="error", ulog_topic="sensor_gyro", ulog_instance=0, ulog_units="dph"):
+    """Reads a gyro log as the CLI's ``fit``, ``compensate``, ``evaluate`` and ``allan`` read it:
+    a CSV (or a PX4 ULog, known by its first bytes), its gaps in ``time_s`` refused or handled
+    under ``gaps`` (``error``, ``interpolate``, ``split``, ``carry``: docs/cli.md), its sample
+    rate given or taken from ``time_s``. The keywords are the CLI's flags; ``names`` are the
+    columns of a file without a header row (``--no-header --columns``).
+
+    Returns a dict: ``columns`` (name -> float64 array, the file's order, gaps filled under
+    ``interpolate`` and ``carry``), ``rate_hz`` and ``rate_source``, ``logged`` (bools, False on
+    the rows made up across a gap; None when every row was logged), ``record_starts`` (under
+    ``split``, the first row of every later record), ``notes`` (the CLI's notes on gaps and time
+    steps) and ``path``. A rate assumed for want of ``time_s`` is a ``UserWarning``, as the CLI
+    warns. Hand ``logged`` (carry) or ``record_starts`` (split) on to ``DriftModel.fit``,
+    ``compensation_summary`` and ``allan``: the numbers are then the CLI's.
+
+    >>> import os, tempfile, gyrodrift as gd
+    >>> path = os.path.join(tempfile.mkdtemp(), "bursts.csv")
+    >>> with open(path, "w") as f:
+    ...     _ = f.write("time_s,rate_dph\\n1,0.5\\n2,0.4\\n5,0.7\\n6,0.6\\n")
+    >>> log = gd.read_log(path, gaps="carry")
+    >>> log["columns"]["time_s"], log["logged"]
+    (array([1., 2., 3., 4., 5., 6.]), array([ True,  True, False, False,  True,  True]))
+    """
+    if isinstance(names, str):  # one name, not its letters
+        names = [names]
+    return _call(_gyrodrift.read_log, os.fspath(path), gaps=gaps, rate_hz=rate_hz,
+                 delimiter=delimiter, names=[str(n) for n in names], skip_rows=skip_rows,
+                 bad_lines=bad_lines, ulog_topic=ulog_topic, ulog_instance=ulog_instance,
+                 ulog_units=ulog_units)
 
 
 def read_ulog(path, *, decode=("sensor_gyro",)):

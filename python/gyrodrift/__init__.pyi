@@ -50,6 +50,14 @@ def simulate(
     noise: bool = ...,
 ) -> dict[str, Any]: ...
 
+def read_log(
+    path: str | PathLike[str], *, gaps: Literal["error", "interpolate", "split", "carry"] = ...,
+    rate_hz: float | None = ..., delimiter: Literal["auto", "comma", "tab", "semicolon"] = ...,
+    names: str | Sequence[str] = ..., skip_rows: int = ...,
+    bad_lines: Literal["error", "skip"] = ..., ulog_topic: str = ..., ulog_instance: int = ...,
+    ulog_units: Literal["dph", "dps", "rads"] = ...,
+) -> dict[str, Any]: ...
+
 def read_ulog(
     path: str | PathLike[str], *, decode: str | Sequence[str] = ...
 ) -> dict[str, Any]: ...

@@ -1,9 +1,11 @@
-// Bindings of the logs people have and the runs they plan: read_ulog, ulog_columns (what
-// `gyrodrift convert` writes) and plan (what `gyrodrift plan` writes), as the CLI computes them.
+// Bindings of the logs people have and the runs they plan: read_log (a gyro log as every command
+// reads it), read_ulog, ulog_columns (what `gyrodrift convert` writes) and plan (what
+// `gyrodrift plan` writes), as the CLI computes them.
 #include "bindings.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/drift/calibration_plan.h"
 #include "gyrodrift/io/ulog.h"
+#include "gyrodrift/tasks/task_log.h"
 
 namespace gyrodrift::python {
 namespace {
@@ -44,6 +46,68 @@ py::dict SeriesDict(const io::UlogSeries& s) {
     }
     d["values"] = values;
   }
+  return d;
+}
+
+// A gyro log as the CLI's fit, compensate, evaluate and allan read it (tasks::ReadTaskLog):
+// every column, the gaps filled or split under `gaps`, the rate settled; what the CLI prints as a
+// warning before the work is a UserWarning here.
+py::dict ReadLog(const std::string& path, const std::string& gaps, std::optional<double> rate_hz,
+                 const std::string& delimiter, const std::vector<std::string>& names, int skip_rows,
+                 const std::string& bad_lines, const std::string& ulog_topic, int ulog_instance,
+                 const std::string& ulog_units) {
+  // The range io::ResolveSampleRate accepts from a time_s column.
+  if (rate_hz) RequireInRange("rate_hz", *rate_hz, 1e-9, 1e6);
+  io::LogOptions options;
+  options.gaps = io::GapPolicyFromString(gaps);
+  options.delimiter = io::DelimiterFromString(delimiter);
+  options.names = names;
+  options.skip_rows = skip_rows;
+  options.bad_lines = io::BadLinesFromString(bad_lines);
+  options.ulog.topic = ulog_topic;
+  options.ulog.units = allan::RateUnitFromString(ulog_units);
+  options.ulog_instance = ulog_instance;
+  tasks::TaskLog log;
+  {
+    py::gil_scoped_release release;  // a long log takes a while; nothing here touches Python
+    log = tasks::ReadTaskLog(path, options, rate_hz.value_or(0.0));
+  }
+  for (const std::string& w :
+       tasks::LogWarnings(log, log.rate_how, {}, tasks::Audience::kKeywords)) {
+    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+  }
+  py::dict columns;
+  for (const std::string& name : log.table.header()) {
+    columns[Text(name)] = ToArray(log.table.Column(name));
+  }
+  py::dict d;
+  d["path"] = path;
+  d["columns"] = columns;
+  d["rate_hz"] = log.rate_hz;
+  d["rate_source"] = tasks::RateSourceText(log.rate_how, /*flags=*/false);
+  if (log.logged.empty()) {
+    d["logged"] = py::none();
+  } else {
+    py::array_t<bool> logged(static_cast<py::ssize_t>(log.logged.size()));
+    auto flags = logged.mutable_unchecked<1>();
+    for (size_t i = 0; i < log.logged.size(); ++i)
+      flags(static_cast<py::ssize_t>(i)) = log.logged[i];
+    d["logged"] = logged;
+  }
+  py::list starts;
+  for (const Eigen::Index s : log.record_starts) starts.append(s);
+  d["record_starts"] = starts;
+  py::list notes;
+  for (const std::string* note : {&log.gap_note, &log.time_note}) {
+    // A note may hold several lines (skipped rows are listed on lines of their own).
+    size_t start = 0;
+    while (start < note->size()) {
+      const size_t end = std::min(note->find('\n', start), note->size());
+      if (end > start) notes.append(Text(note->substr(start, end - start)));
+      start = end + 1;
+    }
+  }
+  d["notes"] = notes;
   return d;
 }
 
@@ -120,6 +184,13 @@ py::dict Plan(double hours, double min_c, double max_c, double rate, double dwel
 
 void BindLogs(py::module_& m) {
   using py::arg;
+  const io::LogOptions ld;
+  m.def("read_log", &ReadLog, arg("path"), py::kw_only(),
+        arg("gaps") = std::string(io::ToString(ld.gaps)), arg("rate_hz") = py::none(),
+        arg("delimiter") = std::string(io::ToString(ld.delimiter)), arg("names") = ld.names,
+        arg("skip_rows") = ld.skip_rows, arg("bad_lines") = std::string(io::ToString(ld.bad_lines)),
+        arg("ulog_topic") = ld.ulog.topic, arg("ulog_instance") = ld.ulog_instance,
+        arg("ulog_units") = std::string(allan::ToString(ld.ulog.units)));
   m.def("read_ulog", &ReadUlog, arg("path"), py::kw_only(),
         arg("decode") = std::vector<std::string>{"sensor_gyro"});
   const io::UlogConversion cd;

@@ -28,6 +28,7 @@ PAIRS = [
     ("noise_terms", gyrodrift.noise_terms, _gyrodrift.noise_terms),
     ("simulate", gyrodrift.simulate, _gyrodrift.simulate),
     ("plan", gyrodrift.plan, _gyrodrift.plan),
+    ("read_log", gyrodrift.read_log, _gyrodrift.read_log),
     ("export", gyrodrift.export, _gyrodrift.export),
     ("select_modes", gyrodrift.select_modes, _gyrodrift.select_modes),
     ("evaluate", gyrodrift.evaluate, _gyrodrift.evaluate),

@@ -1,7 +1,8 @@
-"""A duty-cycled log in Python as on the CLI: ``fit(..., logged=...)`` on the filled log writes
-the model file ``gyrodrift fit --gaps carry`` writes, ``compensation_summary(..., logged=...)``
-gives ``gyrodrift compensate --gaps carry``'s figures, and ``allan(..., logged=...)`` gives
-``gyrodrift allan --gaps carry``'s deviations."""
+"""A log with gaps in Python as on the CLI: ``read_log`` reads it as the commands do, and
+``fit(..., logged=...)`` on the filled log writes the model file ``gyrodrift fit --gaps carry``
+writes, ``compensation_summary(..., logged=...)`` gives ``gyrodrift compensate --gaps carry``'s
+figures, ``allan(..., logged=...)`` gives ``gyrodrift allan --gaps carry``'s deviations, and
+``record_starts`` does what ``--gaps split`` does."""
 
 import json
 
@@ -20,15 +21,14 @@ def test_carry_matches_cli(cli, tmp_path, method):
               {k: sim[k][keep] for k in ("time_s", "rate_dph", "temperature_c")})
     cli("fit", tmp_path / "bursts.csv", "-t", "rate_dph", "-T", "temperature_c", "--mode",
         "compensate", "-m", method, "--gaps", "carry", "-q", "-o", tmp_path / "cli.json")
-    # The filled log as the CLI reads it, with the made-up rows marked.
-    cli("compensate", tmp_path / "cli.json", tmp_path / "bursts.csv", "--gaps", "interpolate", "-q",
-        "-o", tmp_path / "filled.csv")
-    filled = read_csv(tmp_path / "filled.csv")
-    logged = filled["interpolated"] == 0
+    log = gd.read_log(tmp_path / "bursts.csv", gaps="carry")
+    logged = log["logged"]
     assert logged.sum() == keep.sum()
+    filled = log["columns"]
     y = np.where(logged, filled["rate_dph"], np.nan)  # the made-up rows are never read
     m = gd.DriftModel().fit(y, filled["temperature_c"], mode="compensate", method=method,
-                            logged=logged, source=str(tmp_path / "bursts.csv"))
+                            logged=logged, rate_hz=log["rate_hz"],
+                            source=str(tmp_path / "bursts.csv"))
     m.save(tmp_path / "py.json")
     assert (tmp_path / "py.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
     if method == "thermal":  # 10 % of the rows logged: the sparse-log ridge (docs/drift.md 4.8)
@@ -79,3 +79,64 @@ def test_records_joined_match_cli_split(cli, tmp_path):
         gd.allan(x, rate_hz=1.0, record_starts=[second], logged=np.ones(x.size, bool))
     with pytest.raises(gd.DataError, match=r"^record_starts\[0\] = 0: record starts must"):
         gd.allan(x, rate_hz=1.0, record_starts=[0])
+
+
+def test_read_log_fills_and_splits_as_the_cli(cli, tmp_path):
+    sim = gd.simulate(duration=3 * 3600, seed=8)
+    keep = (sim["time_s"] % 600.0) < 120.0  # 2 min of every 10
+    write_csv(tmp_path / "bursts.csv",
+              {k: sim[k][keep] for k in ("time_s", "rate_dph", "temperature_c")})
+    # The filled rows: those compensate --gaps interpolate writes, the made-up ones marked.
+    cli("fit", tmp_path / "bursts.csv", "-t", "rate_dph", "-T", "temperature_c", "--mode",
+        "compensate", "-m", "poly", "--gaps", "carry", "-q", "-o", tmp_path / "carry.json")
+    cli("compensate", tmp_path / "carry.json", tmp_path / "bursts.csv", "--gaps", "interpolate",
+        "-q", "-o", tmp_path / "filled.csv")
+    filled = read_csv(tmp_path / "filled.csv")
+    for gaps in ("interpolate", "carry"):
+        log = gd.read_log(tmp_path / "bursts.csv", gaps=gaps)
+        assert list(log["columns"]) == ["time_s", "rate_dph", "temperature_c"]
+        for name, values in log["columns"].items():
+            assert np.array_equal(values, filled[name]), (gaps, name)
+        assert np.array_equal(log["logged"], filled["interpolated"] == 0)
+        assert log["record_starts"] == []
+        assert log["rate_hz"] == 1.0 and log["rate_source"] == "from the median step of time_s"
+        assert "gaps" in log["notes"][0]
+
+    # Split: the records' starts, which fit and allan take as --gaps split does.
+    log = gd.read_log(tmp_path / "bursts.csv", gaps="split")
+    assert log["logged"] is None and len(log["record_starts"]) == 18
+    assert np.array_equal(log["columns"]["rate_dph"], sim["rate_dph"][keep])
+    cli("fit", tmp_path / "bursts.csv", "-t", "rate_dph", "-T", "temperature_c", "--mode",
+        "compensate", "-m", "thermal", "--gaps", "split", "-q", "-o", tmp_path / "split.json")
+    m = gd.DriftModel().fit(log["columns"]["rate_dph"], log["columns"]["temperature_c"],
+                            mode="compensate", method="thermal", rate_hz=log["rate_hz"],
+                            record_starts=log["record_starts"],
+                            source=str(tmp_path / "bursts.csv"))
+    m.save(tmp_path / "py.json")
+    assert (tmp_path / "py.json").read_bytes() == (tmp_path / "split.json").read_bytes()
+
+    # What the CLI refuses, read_log refuses with its message.
+    with pytest.raises(gd.DataError, match="time_s jumps by 481 s before data row 120"):
+        gd.read_log(tmp_path / "bursts.csv")
+    with pytest.raises(gd.UsageError, match="^gaps = 'fill': must be one of"):
+        gd.read_log(tmp_path / "bursts.csv", gaps="fill")
+    with pytest.raises(gd.UsageError, match="^rate_hz = 0: must be in"):
+        gd.read_log(tmp_path / "bursts.csv", rate_hz=0)
+    with pytest.raises(gd.UsageError, match="^skip_rows = -1"):
+        gd.read_log(tmp_path / "bursts.csv", skip_rows=-1)
+    with pytest.raises(gd.UsageError, match="^skip_rows = 4294967296: must be an integer"):
+        gd.read_log(tmp_path / "bursts.csv", skip_rows=2 ** 32)
+    with pytest.raises(gd.FileError):
+        gd.read_log(tmp_path / "missing.csv")
+
+
+def test_read_log_of_a_capture_without_time_warns_of_the_rate(tmp_path):
+    # A serial capture: a banner, no header row, no time column.
+    (tmp_path / "capture.txt").write_text("BMI270 ready\n25.5,1.0\n25.5,2.0\n25.6,4.0\n")
+    with pytest.warns(UserWarning, match=r"has no time_s column: .* \(give rate_hz= if"):
+        log = gd.read_log(tmp_path / "capture.txt", names=["temp_c", "gx"], skip_rows=1)
+    assert np.array_equal(log["columns"]["gx"], [1.0, 2.0, 4.0])
+    assert log["rate_source"] == "assumed: no rate_hz and no time_s column"
+    log = gd.read_log(tmp_path / "capture.txt", names="temp_c,gx".split(","), skip_rows=1,
+                      rate_hz=100.0)
+    assert log["rate_hz"] == 100.0 and log["rate_source"] == "given by rate_hz"

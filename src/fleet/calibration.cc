@@ -165,7 +165,7 @@ std::vector<std::string> TemperatureColumns(const Manifest& m) {
 // What the user must know about a log's inputs: an assumed sample rate, temperature columns of
 // the axes that do not look like degC, each naming the log's file.
 std::vector<std::string> Warnings(const Manifest& m, const tasks::TaskLog& log) {
-  return tasks::LogWarnings(log, log.rate_how, TemperatureColumns(m), false);
+  return tasks::LogWarnings(log, log.rate_how, TemperatureColumns(m), tasks::Audience::kManifest);
 }
 
 std::string Joined(const std::vector<std::string>& names) {

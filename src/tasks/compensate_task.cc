@@ -225,7 +225,8 @@ std::vector<std::string> CompensateWarnings(const std::vector<io::LoadedModel>& 
       }
     }
   }
-  return LogWarnings(log, "", temperature_columns, SpeltAsFlags(o));
+  return LogWarnings(log, "", temperature_columns,
+                     SpeltAsFlags(o) ? Audience::kFlags : Audience::kManifest);
 }
 
 CompensateResult RunCompensate(const std::vector<io::LoadedModel>& axes, const TaskLog& log,

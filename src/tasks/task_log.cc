@@ -69,16 +69,20 @@ SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
 
 std::vector<std::string> LogWarnings(const TaskLog& log, const std::string& rate_how,
                                      const std::vector<std::string>& temperature_columns,
-                                     bool flags) {
+                                     Audience audience) {
   std::vector<std::string> out;
-  // Flags name the file as typed; a manifest's table names its file only.
+  // A manifest's table names its file only; flags and keywords name the path as given.
+  const bool manifest = audience == Audience::kManifest;
   const std::string name =
-      flags ? log.path : std::filesystem::path(log.path).filename().string();
+      manifest ? std::filesystem::path(log.path).filename().string() : log.path;
   if (rate_how == "default") {
-    out.push_back(flags ? name + " has no time_s column: its sample rate is taken as 1 Hz (give "
-                                 "--rate-hz if it is not)"
-                        : name + ": no time_s column: its sample rate is taken as 1 Hz (set "
-                                 "rate_hz in the manifest if it is not)");
+    out.push_back(manifest
+                      ? name +
+                            ": no time_s column: its sample rate is taken as 1 Hz (set "
+                            "rate_hz in the manifest if it is not)"
+                      : fmt::format("{} has no time_s column: its sample rate is taken as 1 "
+                                    "Hz (give {} if it is not)",
+                                    name, audience == Audience::kFlags ? "--rate-hz" : "rate_hz="));
   }
   for (const std::string& column : temperature_columns) {
     const std::string w = drift::TemperatureWarning(log.table.Column(column), column);

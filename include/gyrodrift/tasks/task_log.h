@@ -55,13 +55,18 @@ SelectedColumns ReadColumns(const io::CsvTable& table, const std::string& spec,
 // The comma-separated names of a model file's temperature_column ("" gives one empty name).
 std::vector<std::string> SplitColumns(const std::string& names);
 
+// Who reads a message about a log, and so how it names the file and a setting: the CLI's user
+// (the path as typed, --rate-hz), a manifest's (the file's name, rate_hz in the manifest) or
+// Python's (the path as given, the keyword rate_hz=).
+enum class Audience { kFlags, kManifest, kKeywords };
+
 // What the user must know about a log before the work: its sample rate assumed (rate_how
 // "default"; "" = the task takes no rate) and each `temperature_columns` that does not look like
-// degC (drift::TemperatureWarning). One line each, without "warning: ": spelt for flags
-// "PATH has no time_s column: ... (give --rate-hz if it is not)", for keys
+// degC (drift::TemperatureWarning). One line each, without "warning: ": for flags
+// "PATH has no time_s column: ... (give --rate-hz if it is not)", for a manifest
 // "FILE: no time_s column: ... (set rate_hz in the manifest if it is not)".
 std::vector<std::string> LogWarnings(const TaskLog& log, const std::string& rate_how,
                                      const std::vector<std::string>& temperature_columns,
-                                     bool flags);
+                                     Audience audience);
 
 }  // namespace gyrodrift::tasks
