@@ -82,7 +82,7 @@ const RegisterCommand kRegister("calibrate", 75, [](CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "output folder (created if missing)")->required();
   cmd->add_flag("--force", args->force, "redo units already calibrated with the same settings");
   BindSetting(
-      cmd->add_option("--threads", args->threads, "units calibrated at once (0: every core)")
+      cmd->add_option("--threads,-j", args->threads, "units calibrated at once (0: every core)")
           ->capture_default_str(),
       {"threads"});
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");

@@ -136,10 +136,11 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log) {
       ->capture_default_str();
   cmd->add_flag("--no-header", log->no_header,
                 "the file has no header row: --columns names its columns (a serial capture)");
-  cmd->add_option("--columns", log->columns,
-                  "with --no-header: the names of the file's columns, in order, comma-separated "
-                  "(e.g. temp_c,ax,ay,az,gx,gy,gz)")
-      ->delimiter(',');
+  BindSetting(cmd->add_option("--columns", log->columns,
+                              "with --no-header: the names of the file's columns, in order, "
+                              "comma-separated (e.g. temp_c,ax,ay,az,gx,gy,gz)")
+                  ->delimiter(','),
+              {"names"});
   cmd->add_option("--skip-rows", log->skip_rows,
                   "lines skipped at the start of the file, before the header or the first row "
                   "(a terminal program's banner); lines starting with # are skipped anyway")

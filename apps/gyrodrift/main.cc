@@ -1,5 +1,6 @@
 // gyrodrift: the command line tool. Subcommands live in *_command.cc and register themselves.
 #include <fmt/core.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include "command.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/version.h"
+#include "gyrodrift/io/files.h"
 
 namespace gyrodrift::cli {
 std::vector<Command>& Commands() {
@@ -17,7 +19,34 @@ std::vector<Command>& Commands() {
 }
 }  // namespace gyrodrift::cli
 
+namespace {
+
+// Ctrl-C, a kill or a closed terminal during a write: the temporaries go, then the signal ends the
+// process as it would have (its exit status says so).
+extern "C" void EndOnSignal(int signal_number) {
+  gyrodrift::io::RemoveTemporariesOnSignal();
+  ::signal(signal_number, SIG_DFL);
+  ::raise(signal_number);
+}
+
+void RemoveTemporariesWhenEnded() {
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction current {};
+    // A signal the caller ignores (nohup's SIGHUP) stays ignored.
+    if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) {
+      continue;
+    }
+    struct sigaction action {};
+    action.sa_handler = EndOnSignal;
+    ::sigemptyset(&action.sa_mask);
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  RemoveTemporariesWhenEnded();
   CLI::App app{
       "gyrodrift: model and compensate the thermal drift of gyroscopes (MS-ELM, Chen & Cui 2016).",
       "gyrodrift"};

@@ -1,6 +1,7 @@
 // gyrodrift simulate: a thermal-chamber FOG log with the drift truth kept apart.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <memory>
@@ -111,8 +112,13 @@ nlohmann::json ParametersJson(const sim::FogParameters& p) {
 }
 
 void Run(const SimulateArgs& a) {
-  // A --profile FILE is an input (the builtin names are not files unless one exists by that name).
-  RequireOutputsAreNotInputs({a.profile}, {a.output, SidecarPath(a.output)});
+  // A --profile FILE is an input; a builtin name is not, even where a file has that name (the
+  // name wins: tasks::LoadProgramme).
+  const std::vector<std::string> builtin = sim::BuiltinProgrammeNames();
+  const bool named = std::find(builtin.begin(), builtin.end(), a.profile) != builtin.end();
+  RequireOutputsAreNotInputs(
+      named ? std::vector<std::string>{} : std::vector<std::string>{a.profile},
+      {a.output, SidecarPath(a.output)});
   sim::FogParameters params = sim::PresetParameters(sim::PresetFromString(a.preset));
   if (!a.winding.empty()) params.coil.winding = sim::WindingPatternFromString(a.winding);
   if (a.asymmetry_option->count() > 0) params.coil.winding_asymmetry = a.asymmetry;

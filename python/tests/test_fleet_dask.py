@@ -148,7 +148,7 @@ class KillWorkerInUnit(WorkerPlugin):
     is inside the `_unit` call (polled every 10 ms on the worker's event loop, which is also what
     would report the task's end, so the task cannot be reported done between the check and the
     kill). Just before, it leaves in the unit's folder the half-written temporaries a kill in the
-    unit's write phase leaves (`<file>.tmp.<pid>`), for the retry to clean up.
+    unit's write phase leaves (`<file>.gyrodrift-tmp.<pid>`), for the retry to clean up.
 
     Files in `log_dir`: `start.<pid>.<key>` for every unit a worker starts (the retry shows as a
     second start of the same key by another process), `claim` (one kill in all: the first worker
@@ -188,7 +188,7 @@ class KillWorkerInUnit(WorkerPlugin):
         os.makedirs(folder, exist_ok=True)  # RunUnit creates it just before its writes
         left = []
         for name in ("model.json", "allan.csv", "summary.json"):
-            left.append(os.path.join(folder, f"{name}.tmp.{os.getpid()}"))
+            left.append(os.path.join(folder, f"{name}.gyrodrift-tmp.{os.getpid()}"))
             with open(left[-1], "w") as f:
                 f.write('{"half": ')
         with open(os.path.join(self.log_dir, "killed"), "w") as f:
@@ -197,7 +197,7 @@ class KillWorkerInUnit(WorkerPlugin):
 
 
 def leftovers(folder):
-    return sorted(str(p) for p in folder.rglob("*") if re.search(r"\.(tmp|bak)\.\d+$", p.name))
+    return sorted(str(p) for p in folder.rglob("*") if re.search(r"\.gyrodrift-(tmp|bak)\.\d+$", p.name))
 
 
 def test_killed_worker_is_retried(fleet, tmp_path):

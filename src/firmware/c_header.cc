@@ -16,16 +16,15 @@ namespace {
 
 using namespace internal;
 
-// Text safe inside a /* */ comment: printable ASCII, no "*/", no trigraph.
+// Text safe inside a /* */ comment: printable ASCII, no "*/", no "/*" (-Wcomment), no trigraph.
 std::string CommentText(std::string_view text) {
   std::string out;
   for (char ch : text) {
     const auto u = static_cast<unsigned char>(ch);
     out += (u >= 0x20 && u < 0x7f) ? ch : '_';
-    if (out.size() >= 2 && out.compare(out.size() - 2, 2, "*/") == 0)
-      out.insert(out.size() - 1, " ");
-    if (out.size() >= 2 && out.compare(out.size() - 2, 2, "??") == 0)
-      out.insert(out.size() - 1, " ");
+    if (out.size() < 2) continue;
+    const std::string_view last = std::string_view(out).substr(out.size() - 2);
+    if (last == "*/" || last == "/*" || last == "??") out.insert(out.size() - 1, " ");
   }
   return out;
 }
@@ -116,6 +115,9 @@ class CWriter {
         " *   {p}_state s;\n"
         " *   {p}_init(&s, t);        once, with the first sample's temperature(s)\n"
         " *   {p}_step(&s, t, drift); at every sample, the first one included\n"
+        " * A temperature that is not finite (a sensor's NaN) is not taken: step holds that\n"
+        " * channel at its last temperature and returns how many it held; init returns how\n"
+        " * many it could not take (then call it again before step).\n"
         " *   compensated[a] = measured[a] - drift[a]   (units of the axis' target column)\n"
         " * t: {P}_N_CHANNELS temperatures in degC; drift: {P}_N_AXES estimates.\n"
         " * drift[a] is what 'gyrodrift compensate' writes as drift_est, the same model:\n"
@@ -142,6 +144,8 @@ class CWriter {
     out_ += fmt::format("#define {}_N_LAGS {}\n", P_, plan_.lag_stages);
     if (plan_.plays > 0) out_ += fmt::format("#define {}_N_PLAYS {}\n", P_, plan_.plays);
     out_ += fmt::format("#define {}_RATE_HZ {}\n", P_, Literal(plan_.rate_hz));
+    // x - x is 0 for a finite x, NaN for an infinity or a NaN: no libm, no == on reals.
+    out_ += fmt::format("#define {}_FINITE(x) ((x) - (x) < {})\n", P_, Literal(1.0));
     for (size_t a = 0; a < plan_.axes.size(); ++a) {
       out_ += fmt::format("#define {}_AXIS_{}_NAME {}\n", P_, a, CString(plan_.axes[a].name));
     }
@@ -201,9 +205,12 @@ class CWriter {
   void Init() {
     out_ += fmt::format(
         "\n/* Every lag in equilibrium at the first sample's temperatures. */\n"
-        "static inline void {p}_init({p}_state *s, const {r} temperature_c[{P}_N_CHANNELS]) {{\n"
-        "  int i;\n"
-        "  for (i = 0; i < {P}_N_CHANNELS; ++i) s->temperature_c[i] = temperature_c[i];\n",
+        "static inline int {p}_init({p}_state *s, const {r} temperature_c[{P}_N_CHANNELS]) {{\n"
+        "  int i, missing = 0;\n"
+        "  for (i = 0; i < {P}_N_CHANNELS; ++i) {{\n"
+        "    s->temperature_c[i] = temperature_c[i];\n"
+        "    if (!{P}_FINITE(temperature_c[i])) ++missing;\n"
+        "  }}\n",
         fmt::arg("p", p_), fmt::arg("r", real_), fmt::arg("P", P_));
     if (plan_.lag_stages > 0) {
       out_ += fmt::format("  for (i = 0; i < {}_N_LAGS; ++i) s->lag[i] = {};\n", P_, Literal(0.0));
@@ -217,17 +224,19 @@ class CWriter {
                             chain.channel, Literal(st.centre_c));
       }
     }
-    out_ += "}\n";
+    out_ += "  return missing;\n}\n";
   }
 
   void Step() {
     out_ += fmt::format(
         "\n/* One sample: the lags advance to temperature_c (degC), then drift[a] is axis a's\n"
         " * estimate (units of its target column). */\n"
-        "static inline void {p}_step({p}_state *s, const {r} temperature_c[{P}_N_CHANNELS],\n"
-        "{indent}{r} drift[{P}_N_AXES]) {{\n",
+        "static inline int {p}_step({p}_state *s, const {r} temperature_c[{P}_N_CHANNELS],\n"
+        "{indent}{r} drift[{P}_N_AXES]) {{\n"
+        "  {r} t[{P}_N_CHANNELS];\n"
+        "  int i, held = 0;\n",
         fmt::arg("p", p_), fmt::arg("r", real_), fmt::arg("P", P_),
-        fmt::arg("indent", std::string(p_.size() + 25, ' ')));
+        fmt::arg("indent", std::string(p_.size() + 24, ' ')));
     bool any_z = false, any_estimate = false, any_held = false;
     for (const Axis& a : plan_.axes) {
       for (const Sub& s : a.subs) {
@@ -241,6 +250,17 @@ class CWriter {
     if (plan_.plays > 0) out_ += fmt::format("  {} v;\n", real_);
     if (any_z) out_ += fmt::format("  {} z;\n", real_);
     if (any_estimate) out_ += fmt::format("  {} e;\n", real_);
+    out_ += fmt::format(
+        "  /* One NaN taken into the lags would make every later estimate NaN. */\n"
+        "  for (i = 0; i < {P}_N_CHANNELS; ++i) {{\n"
+        "    if ({P}_FINITE(temperature_c[i])) {{\n"
+        "      t[i] = temperature_c[i];\n"
+        "    }} else {{\n"
+        "      t[i] = s->temperature_c[i];\n"
+        "      ++held;\n"
+        "    }}\n"
+        "  }}\n",
+        fmt::arg("P", P_));
     // Lags: stage k of a chain sees its input move by d; its deviation u = input - output becomes
     // (u + d)(1 - g) and its output moves by g (u + d), the next stage's d.
     for (size_t c = 0; c < plan_.chains.size(); ++c) {
@@ -248,7 +268,7 @@ class CWriter {
       out_ += fmt::format("  /* lags of {}, tau {:.4g} s, gain 1 - exp(-{} s / tau) */\n",
                           CommentText(plan_.channels[static_cast<size_t>(chain.channel)]),
                           chain.tau_s, 1.0 / plan_.rate_hz);
-      out_ += fmt::format("  d = temperature_c[{0}] - s->temperature_c[{0}];\n", chain.channel);
+      out_ += fmt::format("  d = t[{0}] - s->temperature_c[{0}];\n", chain.channel);
       for (int k = 0; k < chain.stages; ++k) {
         const int i = chain.first + k;
         out_ += fmt::format("  w = s->lag[{0}] + d;\n  d = {1} * w;\n  s->lag[{0}] = w - d;\n", i,
@@ -270,11 +290,8 @@ class CWriter {
         SubModel(a, sub, !std::isnan(axis.reference_c));
       }
     }
-    out_ += fmt::format(
-        "  {{\n    int i;\n    for (i = 0; i < {}_N_CHANNELS; ++i) s->temperature_c[i] = "
-        "temperature_c[i];\n  }}\n",
-        P_);
-    out_ += "}\n";
+    out_ += fmt::format("  for (i = 0; i < {}_N_CHANNELS; ++i) s->temperature_c[i] = t[i];\n", P_);
+    out_ += "  return held;\n}\n";
   }
 
   // The level of a state less its centre, K: the input less the deviations of the stages up to
@@ -285,8 +302,7 @@ class CWriter {
     for (int k = 0; k < st.order; ++k) {
       deviations += fmt::format("{}s->lag[{}]", k ? " + " : "", chain.first + k);
     }
-    return fmt::format("(temperature_c[{}] - {}) - ({})", chain.channel, Literal(st.centre_c),
-                       deviations);
+    return fmt::format("(t[{}] - {}) - ({})", chain.channel, Literal(st.centre_c), deviations);
   }
 
   // e += each power of z (the first plain, the others along their tangent beyond [lo, hi]).
@@ -305,7 +321,7 @@ class CWriter {
     out_ += fmt::format("  /* sub-model {} */\n  e = {};\n", CommentText(sub.name),
                         Literal(sub.intercept));
     for (const Static& st : sub.statics) {
-      out_ += fmt::format("  /* {} */\n  z = (temperature_c[{}] - {}) / {};\n",
+      out_ += fmt::format("  /* {} */\n  z = (t[{}] - {}) / {};\n",
                           CommentText(plan_.channels[static_cast<size_t>(st.channel)]), st.channel,
                           Literal(st.centre_c), Literal(st.scale_k));
       Powers(st.powers, st.level_min, st.level_max);

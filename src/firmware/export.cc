@@ -9,6 +9,7 @@
 #include "common/enum_names.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
 #include "plan.h"
 
 namespace gyrodrift::firmware {
@@ -53,8 +54,14 @@ void ExportOptions::Validate() const {
                   "sensor by it: `gyrodrift convert LOG.ulg --list` shows sensor_gyro's "
                   "device_id)");
     }
-    for (std::uint32_t id : device_ids) {
+    for (size_t i = 0; i < device_ids.size(); ++i) {
+      const std::uint32_t id = device_ids[i];
       if (id == 0) ThrowOption("device_ids", "0", "a sensor's DEVID, not 0");
+      if (std::find(device_ids.begin(), device_ids.begin() + static_cast<std::ptrdiff_t>(i), id) !=
+          device_ids.begin() + static_cast<std::ptrdiff_t>(i)) {
+        ThrowOption("device_ids", std::to_string(id) + " twice",
+                    "one DEVID per gyro instance, each once");
+      }
     }
   } else if (!device_ids.empty()) {
     ThrowOption("device_ids", std::to_string(device_ids.size()) + " given",
@@ -78,6 +85,8 @@ std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptio
 ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options) {
   options.Validate();  // before any file is read, so a bad option is the error the user sees
+  io::RequireDistinctFiles(model_paths, "model files",
+                           "each gyro axis has its own model (give each file once)");
   ExportResult out;
   for (const std::string& path : model_paths) {
     for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));

@@ -169,7 +169,10 @@ void RequireExportable(const std::vector<LoadedModel>& axes) {
             "sigmoid units need exp at every sample: refit linear to export",
             axis, sub.name));
       }
-      if (rate_hz != 0.0 && sub.thermal->rate_hz != rate_hz) {
+      // One logger's rate read from two logs' time stamps differs in its last digits; each lag
+      // chain takes its gain from its own model's rate (PlanState), so only a real difference
+      // is refused.
+      if (rate_hz != 0.0 && std::abs(sub.thermal->rate_hz / rate_hz - 1.0) > 1e-6) {
         throw UsageError(fmt::format(
             "{} was fitted at {} Hz, an earlier axis at {} Hz: one step function serves every "
             "axis, so their models need one sample rate",

@@ -202,6 +202,11 @@ AxisResult ModelFigures(const AxisSpec& axis, const io::LoadedModel& model) {
 }
 
 FittedUnit FitUnit(const Manifest& m, const UnitSpec& unit) {
+  // A verification that is a calibration log would judge the model on what it was fitted on.
+  std::vector<std::string> logs = unit.calibration;
+  logs.insert(logs.end(), unit.verification.begin(), unit.verification.end());
+  io::RequireDistinctFiles(logs, unit.serial + ": logs",
+                           "each log is calibration or verification, once");
   std::vector<tasks::TaskLog> cal;
   std::vector<std::string> warnings;
   for (const std::string& path : unit.calibration) {
@@ -246,6 +251,7 @@ std::string VerifyLog(const Manifest& m, const UnitSpec& spec, size_t k,
         path, ver.table.rows() - drift::CountLogged(ver.logged, ver.table.rows()),
         ver.table.rows()));
   }
+  tasks::RequireModelRate(models, "the unit's model", path, ver.rate_hz, ver.rate_how, false);
   const std::vector<std::string> warnings = Warnings(m, ver);
   for (AxisResult& a : unit.axes) a.warnings.insert(a.warnings.end(), warnings.begin(), warnings.end());
   std::vector<io::CsvColumn> columns;

@@ -3,6 +3,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -16,9 +18,36 @@
 
 namespace gyrodrift::io {
 
+namespace {
+
+// Refuses a target that exists and is not a regular file or a link to one: a device (/dev/null),
+// a pipe or a socket would be replaced by the rename that places the file, and a link that leads
+// nowhere would be replaced rather than followed.
+void RequireFileTarget(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (ec || !fs::exists(link)) return;
+  const fs::file_status target = fs::status(path, ec);
+  if (fs::is_symlink(link) && (ec || !fs::exists(target))) {
+    throw IoError(path + ": is a symbolic link to nothing: name the file to write");
+  }
+  if (fs::is_directory(target)) throw IoError(path + ": is a directory, cannot write a file there");
+  if (!fs::is_regular_file(target)) {
+    throw IoError(path +
+                  ": is not a regular file (a device, a pipe or a socket): gyrodrift writes a "
+                  "whole file and renames it into place; name a file");
+  }
+}
+
+}  // namespace
+
 void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
                                 const std::vector<std::string>& outputs) {
   namespace fs = std::filesystem;
+  for (const std::string& out : outputs) {
+    if (!out.empty()) RequireFileTarget(out);
+  }
   for (const std::string& in : inputs) {
     std::error_code ec;
     if (in.empty() || !fs::exists(in, ec)) continue;
@@ -27,6 +56,19 @@ void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
       if (fs::equivalent(in, out, ec) && !ec) {
         throw UsageError("output " + out + " is the input " + in +
                          ": gyrodrift never overwrites its input (choose another output path)");
+      }
+    }
+  }
+}
+
+void RequireDistinctFiles(const std::vector<std::string>& paths, const std::string& what,
+                          const std::string& why) {
+  namespace fs = std::filesystem;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      std::error_code ec;
+      if (fs::equivalent(paths[j], paths[i], ec) && !ec) {
+        throw UsageError(what + " " + paths[j] + " and " + paths[i] + " are one file: " + why);
       }
     }
   }
@@ -70,9 +112,14 @@ std::string ReadTextFile(const std::string& path) {
 
 namespace {
 
-// "<name>.tmp.<pid>" or "<name>.bak.<pid>" -> pid; 0 for anything else.
+// The marks of our temporaries and backups: "<target><mark><pid>". Distinct enough that no
+// user's file (a dated "x.csv.bak.20261127") is taken for one of ours and removed.
+constexpr const char* kTemporaryMark = ".gyrodrift-tmp.";
+constexpr const char* kBackupMark = ".gyrodrift-bak.";
+
+// "<name><mark><pid>" -> pid; 0 for anything else.
 pid_t TemporaryOwner(const std::string& entry, const std::string& name) {
-  for (const char* kind : {".tmp.", ".bak."}) {
+  for (const char* kind : {kTemporaryMark, kBackupMark}) {
     const std::string prefix = name + kind;
     if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) continue;
     const std::string digits = entry.substr(prefix.size());
@@ -113,6 +160,46 @@ void RemoveStaleTemporaries(const std::vector<std::string>& targets) {
   }
 }
 
+// The temporaries being written, for RemoveTemporariesOnSignal: fixed slots, so that a signal
+// handler reads them without allocating or locking. A slot is 0 free, 1 being filled, 2 in use.
+constexpr size_t kRegistrySlots = 64;
+constexpr size_t kRegistryPathBytes = 4096;
+std::array<std::atomic<int>, kRegistrySlots> registry_state{};
+char registry_paths[kRegistrySlots][kRegistryPathBytes];
+
+// Registers `path` (a temporary just opened); the slot, or -1 when none is free or the path too
+// long (that temporary is then left by a signal, as by SIGKILL).
+int RegisterTemporary(const std::string& path) {
+  if (path.size() >= kRegistryPathBytes) return -1;
+  for (size_t i = 0; i < kRegistrySlots; ++i) {
+    int expected = 0;
+    if (!registry_state[i].compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(registry_paths[i], path.c_str(), path.size() + 1);
+    registry_state[i].store(2);
+    return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void ReleaseTemporary(int slot) {
+  if (slot >= 0) registry_state[static_cast<size_t>(slot)].store(0);
+}
+
+// Releases the slots of a set's temporaries when it goes out of scope (placed or failed).
+class RegisteredTemporaries {
+ public:
+  RegisteredTemporaries() = default;
+  RegisteredTemporaries(const RegisteredTemporaries&) = delete;
+  RegisteredTemporaries& operator=(const RegisteredTemporaries&) = delete;
+  ~RegisteredTemporaries() {
+    for (int slot : slots_) ReleaseTemporary(slot);
+  }
+  void Add(const std::string& path) { slots_.push_back(RegisterTemporary(path)); }
+
+ private:
+  std::vector<int> slots_;
+};
+
 // Removes each of `paths` that is not empty, ignoring failures (cleaning up after one).
 void RemoveAll(const std::vector<std::string>& paths) {
   for (const auto& p : paths) {
@@ -120,8 +207,8 @@ void RemoveAll(const std::vector<std::string>& paths) {
   }
 }
 
-// Refuses what would fail half-way through the renames: an empty name, a target named twice, or
-// a directory.
+// Refuses what would fail half-way through the renames, or replace what is not a file: an
+// empty name, a target named twice, a directory, a device, a pipe, a dangling link.
 void CheckTargets(const std::vector<StreamedFile>& files) {
   namespace fs = std::filesystem;
   std::set<fs::path> targets;
@@ -132,19 +219,32 @@ void CheckTargets(const std::vector<StreamedFile>& files) {
     if (!targets.insert(ec ? fs::path(path) : key).second) {
       throw IoError(path + ": named twice among the files of one output set");
     }
-    if (fs::is_directory(fs::path(path), ec)) {
-      throw IoError(path + ": is a directory, cannot write a file there");
-    }
+    RequireFileTarget(path);
   }
 }
 
-// Each file written by its writer to its temporary "<path>.tmp<suffix>", in order; on a failure
-// the temporaries written so far are removed before the error is thrown.
+// A link's file is written where it lies, so the link stays a link (the rename would replace it).
+std::vector<StreamedFile> FollowLinks(const std::vector<StreamedFile>& files) {
+  namespace fs = std::filesystem;
+  std::vector<StreamedFile> out = files;
+  for (StreamedFile& f : out) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(f.path, ec))) continue;
+    const fs::path target = fs::canonical(f.path, ec);
+    if (!ec) f.path = target.string();
+  }
+  return out;
+}
+
+// Each file written by its writer to its temporary "<path><kTemporaryMark><suffix>", in order; on a
+// failure the temporaries written so far are removed before the error is thrown.
 std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files,
-                                          const std::string& suffix) {
+                                          const std::string& suffix,
+                                          RegisteredTemporaries& registered) {
   std::vector<std::string> temps;
   for (const auto& [path, write] : files) {
-    const std::string temp = path + ".tmp" + suffix;
+    const std::string temp = path + kTemporaryMark + suffix;
+    registered.Add(temp);  // before it exists: a signal from here on removes it
     std::FILE* f = std::fopen(temp.c_str(), "wb");
     if (!f) {
       const std::string reason = std::strerror(errno);
@@ -168,8 +268,8 @@ std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files
   return temps;
 }
 
-// For a set, each existing target hard-linked (or copied) to "<path>.bak<suffix>", so that a
-// failed later rename can rename every earlier backup back over its new file; "" where there is
+// For a set, each existing target hard-linked (or copied) to "<path><kBackupMark><suffix>", so that
+// a failed later rename can rename every earlier backup back over its new file; "" where there is
 // no target. On a failure the backups and `temps` are removed before the error is thrown.
 std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
                                      const std::string& suffix,
@@ -180,7 +280,7 @@ std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
     const std::string& target = files[i].path;
     std::error_code ec;
     if (!fs::exists(fs::symlink_status(target, ec))) continue;
-    const std::string backup = target + ".bak" + suffix;
+    const std::string backup = target + kBackupMark + suffix;
     if (::link(target.c_str(), backup.c_str()) != 0) {
       fs::copy_file(target, backup, fs::copy_options::overwrite_existing, ec);
       if (ec) {
@@ -231,15 +331,23 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
   WriteStreamedFilesAtomically(streamed);
 }
 
-void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files) {
-  CheckTargets(files);
-  const std::string suffix = "." + std::to_string(::getpid());
+void RemoveTemporariesOnSignal() {
+  for (size_t i = 0; i < kRegistrySlots; ++i) {
+    if (registry_state[i].load() == 2) ::unlink(registry_paths[i]);
+  }
+}
+
+void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& given) {
+  CheckTargets(given);
+  const std::vector<StreamedFile> files = FollowLinks(given);
+  const std::string suffix = std::to_string(::getpid());
   {
     std::vector<std::string> targets;
     for (const auto& file : files) targets.push_back(file.path);
     RemoveStaleTemporaries(targets);
   }
-  const std::vector<std::string> temps = WriteTemporaries(files, suffix);
+  RegisteredTemporaries registered;
+  const std::vector<std::string> temps = WriteTemporaries(files, suffix, registered);
   // Each target is replaced by one atomic rename, so a reader sees the old file or the new one,
   // never none; a set keeps backups so that it is placed whole or not at all.
   const std::vector<std::string> backups =

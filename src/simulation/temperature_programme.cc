@@ -66,6 +66,11 @@ TemperatureProgramme TemperatureProgramme::FromSamples(const Eigen::VectorXd& ti
                       ": times must strictly increase");
     }
   }
+  // The run starts at 0 s: a profile that ends there would give a run of no length.
+  if (time_s.size() > 0 && !(time_s[time_s.size() - 1] > 0.0)) {
+    throw DataError(name + " time_s ends at " + FormatValue(time_s[time_s.size() - 1]) +
+                    " s: a profile's times are seconds from the start of the run, which is 0");
+  }
   for (Eigen::Index i = 0; i < temperature_c.size(); ++i) {
     if (temperature_c[i] < kMinC || temperature_c[i] > kMaxC) {
       throw DataError(name + " temperature_c row " + std::to_string(i + 1) + " is " +

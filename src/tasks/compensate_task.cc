@@ -114,6 +114,9 @@ void CheckLog(const std::vector<io::LoadedModel>& axes, const TaskLog& log,
       }
     }
   }
+  std::string how;
+  const double log_hz = io::ResolveSampleRate(log.table, settings.rate_hz, &how);
+  RequireModelRate(axes, model_path, log.path, log_hz, how, SpeltAsFlags(o));
   if (!log.logged.empty() && o.gaps != io::GapPolicy::kCarry &&
       log.table.HasColumn("interpolated")) {
     throw DataError(log.path + " already has a column 'interpolated': " +
@@ -198,6 +201,23 @@ void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& tabl
     for (const std::string& c : SplitColumns(loaded.info.temperature_column)) {
       require(c, "--temperature");
     }
+  }
+}
+
+void RequireModelRate(const std::vector<io::LoadedModel>& axes, const std::string& model_path,
+                      const std::string& log_path, double log_hz, const std::string& how,
+                      bool flags) {
+  if (how == "default") return;
+  for (const io::LoadedModel& axis : axes) {
+    const double model_hz = axis.model.options.features.rate_hz;
+    const double ratio = log_hz / model_hz;
+    if (std::abs(ratio - 1.0) <= 0.01) continue;
+    throw DataError(fmt::format(
+        "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its thermal lags and "
+        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz, or fit "
+        "the model on a log at {:g} Hz)",
+        log_path, log_hz, RateSourceText(how, flags), model_path, model_hz,
+        ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow", model_hz, log_hz));
   }
 }
 

@@ -70,6 +70,11 @@ std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mod
     if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
       ThrowOption(name, "'" + text + "'", "a list without repeats");
     }
+    // Refused here, before any work, rather than when the method's turn comes.
+    if (!drift::SupportsMode(m, mode)) {
+      ThrowOption(name, "'" + text + "'",
+                  fmt::format("methods of {} mode ({} is not one)", drift::ToString(mode), item));
+    }
     methods.push_back(m);
     if (comma == std::string::npos) break;
     start = comma + 1;

@@ -7,12 +7,18 @@
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/io/files.h"
 
 namespace gyrodrift::tasks {
 
 FitRun AssembleFitRun(const std::vector<TaskLog>& logs, const std::string& target,
                       const std::string& temperature, const io::LogOptions& log,
                       const std::string& target_option, const std::string& temperature_option) {
+  std::vector<std::string> paths;
+  for (const TaskLog& l : logs) paths.push_back(l.path);
+  // A log given twice would be fitted twice and leak into its own held-out folds.
+  io::RequireDistinctFiles(paths, "calibration logs",
+                           "each log is one record of the calibration (give it once)");
   FitRun run;
   run.logs = logs.size();
   run.temperature_spec = temperature;

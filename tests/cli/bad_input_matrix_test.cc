@@ -47,6 +47,8 @@ class BadInput : public ::testing::Test {
     Write("garbage.csv", garbage);
     Write("hugeline.csv", "time_s,rate_dph\n1," + std::string(1 << 20, '9') + "\n");
     Write("backwards.csv", ReplaceRow(good, 300, "250,0.1,20,0"));
+    Write("before_start.csv", "time_s,temperature_c\n-3600,20\n0,40\n");
+    Write("headerless.csv", "1,2,3\n2,3,5\n3,5,4\n4,1,2\n");
     Write("constant.csv", [] {
       std::string s = "time_s,rate_dph,temperature_c\n";
       for (int i = 0; i < 600; ++i) s += std::to_string(i) + ",0.5,20\n";
@@ -206,6 +208,15 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
       {"demo --duration 1h -o %O%", 2, "--duration = 1h"},
       {"demo --ensemble 0 -o %O%", 2, "--ensemble = 0"},
       {"demo --input %D%/good.csv --target rate_dph -o %O%", 2, "--temperature"},
+      {"demo --methods ms-elm,exp-smoothing -o %O%", 2,
+       "--methods = 'ms-elm,exp-smoothing': must be methods of compensate mode (exp-smoothing is "
+       "not one)"},
+      {"simulate --profile %D%/before_start.csv -o %O%", 3,
+       "before_start.csv time_s ends at 0 s: a profile's times are seconds from the start"},
+      {"decompose %D%/headerless.csv --no-header --columns a,a,b -c b -o %O%", 2,
+       "--columns = 'a'"},
+      {"fit %D%/good.csv -t rate_dph -T temperature_c --mode compensate -o /dev/null", 4,
+       "/dev/null: is not a regular file"},
       {"frobnicate", 2, "frobnicate"},
   };
   const std::string out = *dir_ + "/out.csv";
@@ -216,6 +227,7 @@ TEST_F(BadInput, EveryCaseFailsCleanlyAndLeavesTheInputsAlone) {
     test::ExpectCleanFailure(test::RunCli(args), c.exit_code, c.message, out, args);
   }
   EXPECT_GE(cases.size(), 60u);
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));  // not replaced by a file
   for (const auto& [path, text] : *inputs_) {
     EXPECT_EQ(io::ReadTextFile(path), text) << path << " changed";
   }

@@ -299,6 +299,15 @@ TEST(ExportCliPx4, TwoGyrosFromOneFitEachToOneParameterFile) {
   test::ExpectCleanFailure(test::RunCli("export " + q + d + "/gyro0.json' --format px4 "
                                         "--device-id 1,2 -o " + q + out2 + "'"),
                            2, "PX4 calibrates 1 to 3 gyros of 3 axes each", out2, "one gyro");
+  // A typo that names one model twice, or one sensor twice, would run one gyro's model on another.
+  test::ExpectCleanFailure(
+      test::RunCli("export " + models + " --format px4 --device-id 7,7 -o " + q + out2 + "'"), 2,
+      "--device-id = 7 twice: must be one DEVID per gyro instance", out2, "one device id twice");
+  test::ExpectCleanFailure(
+      test::RunCli("export " + q + d + "/gyro0.json' " + q + d + "/./gyro0.json' -o " + q + d +
+                   "/twice.h'"),
+      2, "model files " + d + "/gyro0.json and " + d + "/./gyro0.json are one file", d + "/twice.h",
+      "one model file twice");
   std::filesystem::remove_all(d);
 }
 

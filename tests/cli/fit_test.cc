@@ -3,8 +3,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <optional>
+#include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/io/csv.h"
@@ -346,6 +347,10 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"nan target", "fit %DIR%/nan.csv -t rate_dph --mode predict", 3, "data row 3"},
       {"too short", "fit %DIR%/short.csv -t rate_dph --mode predict -m elm", 3, "at least 32"},
       {"time runs backwards", "fit %DIR%/backwards.csv -t rate_dph --mode predict", 3, "time_s"},
+      {"one log twice",
+       "fit %IN% %DIR%/../" + std::filesystem::path(dir_).filename().string() + "/" +
+           std::filesystem::path(input_).filename().string() + " " + ok,
+       2, "are one file: each log is one record of the calibration (give it once)"},
   };
   const std::string out = dir_ + "/bad.json";
   for (const auto& c : cases) {
@@ -353,6 +358,10 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
         test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
+  // A device would be replaced by the rename that places the file: refused before the work.
+  const auto device = Fit(ok, "/dev/null");
+  EXPECT_EQ(device.exit_code, 4) << device.err;
+  EXPECT_NE(device.err.find("/dev/null: is not a regular file"), std::string::npos) << device.err;
   const auto r = Fit(ok, dir_ + "/no/such/dir/m.json");
   EXPECT_EQ(r.exit_code, 4) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;

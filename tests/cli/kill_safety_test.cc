@@ -1,8 +1,9 @@
 // A command killed by SIGKILL (the OOM killer, a closed laptop lid, `kill -9`) leaves every
 // output path holding the complete previous file or the complete new one (or nothing, where
 // there was none), never a partial file. A SIGKILL cannot be caught, so temporaries of the
-// killed run (<target>.tmp.<pid>, <target>.bak.<pid>) may be left beside the outputs; they never
-// carry an output's name, and the next run of the command removes them (io::WriteFilesAtomically).
+// killed run (<target>.gyrodrift-tmp.<pid>, <target>.gyrodrift-bak.<pid>) may be left beside the
+// outputs; they never carry an output's name, and the next run of the command removes them
+// (io::WriteFilesAtomically).
 //
 // Each command runs once to completion (the reference: its duration and its complete outputs),
 // then is started again over a "previous version" of every output and killed at fixed times, at
@@ -95,7 +96,7 @@ std::map<std::string, std::string> Snapshot(const std::string& root) {
 }
 
 bool IsTemporaryName(const std::string& name) {
-  static const std::regex pattern(R"(.*\.(tmp|bak)\.[0-9]+$)");
+  static const std::regex pattern(R"(.*\.gyrodrift-(tmp|bak)\.[0-9]+$)");
   return std::regex_match(name, pattern);
 }
 
@@ -248,6 +249,43 @@ TEST_F(KillSafety, Decompose) {
        {log, "-c", "rate_dph", "--method", "emd", "-q", "-o", dir_ + "/out/imfs.csv"},
        dir_ + "/out",
        {}});
+}
+
+// Ctrl-C, SIGTERM and SIGHUP are caught: the temporaries of the write under way go, the previous
+// outputs stay, and the process ends by the signal.
+TEST_F(KillSafety, InterruptedWriteLeavesNoTemporary) {
+  const std::string log = dir_ + "/log.csv";
+  io::WriteFileAtomically(log, test::ThermalLogCsv(Sanitized() ? 20000 : 60000, 1));
+  const std::vector<std::string> args = {
+      "decompose", log, "-c", "rate_dph", "--method", "emd", "-q", "-o", dir_ + "/out/imfs.csv"};
+  int caught_writing = 0;
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    fs::create_directories(dir_ + "/out");
+    for (const char* name : {"imfs.csv", "imfs.csv.json"}) {
+      std::ofstream(dir_ + "/out/" + name, std::ios::trunc) << "previous\n";
+    }
+    const pid_t pid = Spawn(args);
+    ASSERT_GT(pid, 0);
+    int code = -1;
+    bool done = false;
+    const auto t0 = Clock::now();
+    while (!(done = Exited(pid, &code)) && !AnyTemporary(dir_ + "/out") &&
+           std::chrono::duration<double>(Clock::now() - t0).count() < 60.0) {
+    }
+    if (!done) {
+      ++caught_writing;
+      ::kill(pid, signal_number);
+      code = Wait(pid);
+      EXPECT_EQ(code, 128 + signal_number) << "signal " << signal_number;
+    }
+    EXPECT_FALSE(AnyTemporary(dir_ + "/out")) << "signal " << signal_number;
+    for (const auto& [relative, contents] : Snapshot(dir_ + "/out")) {
+      if (code != 0) {
+        EXPECT_EQ(contents, "previous\n") << relative;
+      }
+    }
+  }
+  EXPECT_GE(caught_writing, 2) << "too few runs were still writing when signalled";
 }
 
 TEST_F(KillSafety, Fit) {

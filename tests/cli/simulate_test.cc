@@ -170,6 +170,17 @@ TEST_F(SimulateCli, UnwritableOutputIsAnIoErrorWithNothingLeft) {
   EXPECT_FALSE(test::FileExists(out));
 }
 
+// A builtin profile's name is not a file, whatever lies in the folder under that name.
+TEST_F(SimulateCli, AnOutputNamedAsAProfileIsNotTakenForTheInput) {
+  for (int run = 0; run < 2; ++run) {
+    // From the output's folder, where "chamber" is the file the first run wrote.
+    const auto r = test::RunShell("cd '" + dir_ + "' && '" + GYRODRIFT_CLI +
+                                  "' simulate --duration 60 --profile chamber -q -o chamber");
+    EXPECT_EQ(r.exit_code, 0) << "run " << run << ": " << r.err;
+  }
+  EXPECT_TRUE(test::FileExists(Path("chamber")));
+}
+
 TEST_F(SimulateCli, HelpShowsAWorkedExample) {
   const auto r = test::RunCli("simulate --help");
   EXPECT_EQ(r.exit_code, 0);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
@@ -68,8 +69,10 @@ TEST(UlogInputCli, CalibrateReadsAUlogAsFitDoes) {
   for (const char* axis : {"x_dph", "y_dph", "z_dph"}) {
     manifest += std::string("[[axis]]\ntarget = \"") + axis + "\"\ntemperature = \"temperature_c\"\n";
   }
-  manifest += "[[unit]]\nserial = \"IMU\"\ncalibration = \"" + ulg + "\"\nverification = \"" +
-              ulg + "\"\n";
+  // The verification a copy: one file cannot be both (FitUnit refuses it).
+  std::filesystem::copy_file(ulg, d + "/ver.ulg");
+  manifest += "[[unit]]\nserial = \"IMU\"\ncalibration = \"" + ulg + "\"\nverification = \"" + d +
+              "/ver.ulg\"\n";
   io::WriteFileAtomically(d + "/fleet.toml", manifest);
   const test::CommandResult cal =
       test::RunCli("calibrate '" + d + "/fleet.toml' -o '" + d + "/out' -q");

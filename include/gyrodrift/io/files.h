@@ -4,10 +4,11 @@
 // is written to a temporary beside its target first, and only when all are written are they
 // renamed into place, so a failure leaves no partial output.
 //
-// Temporaries are named <target>.tmp.<pid> (and, while a set is renamed, backups
-// <target>.bak.<pid>), beside their targets. A process killed by SIGKILL (or a power cut) cannot
-// remove them; they never carry a target's name, and the next write of the same target removes
-// those whose process no longer runs.
+// Temporaries are named <target>.gyrodrift-tmp.<pid> (and, while a set is renamed, backups
+// <target>.gyrodrift-bak.<pid>), beside their targets. A process killed by SIGKILL (or a power
+// cut) cannot remove them; they never carry a target's name, and the next write of the same
+// target removes those whose process no longer runs (nothing else: a user's "x.csv.bak.1" stays).
+// A program that catches SIGINT / SIGTERM calls RemoveTemporariesOnSignal from its handler.
 #pragma once
 
 #include <cstdio>
@@ -21,9 +22,17 @@ namespace gyrodrift::io {
 // The user's files are never overwritten: throws UsageError naming both paths when an output
 // (each output's sidecar included: pass both) is one of the inputs, however spelled (relative,
 // "./", a symbolic or a hard link: the same file by device and inode). Inputs that do not exist
-// or are empty strings are skipped. Called before any work.
+// or are empty strings are skipped. Also throws IoError for an output that exists and is not a
+// regular file or a link to one (a directory, /dev/null, a pipe, a dangling link), which the
+// write would refuse after the work. Called before any work.
 void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
                                 const std::vector<std::string>& outputs);
+
+// Throws UsageError naming both when two of `paths` are one file however spelled (by device and
+// inode: "./a.csv", a link): "`what` a.csv and ./a.csv are one file" and `why`. Paths that do not
+// exist are skipped (reading them fails on its own).
+void RequireDistinctFiles(const std::vector<std::string>& paths, const std::string& what,
+                          const std::string& why);
 
 // The same for an output folder: no input may lie inside it (or be it).
 void RequireInputsOutsideFolder(const std::vector<std::string>& inputs, const std::string& folder);
@@ -36,11 +45,12 @@ void RequireNotDirectory(const std::string& path);
 std::string ReadTextFile(const std::string& path);
 
 // Writes each (path, contents) atomically as a set: every file is written to a temporary beside
-// its target, then renamed into place (one atomic replace per file: readers never find it
-// missing); for a set, existing targets are first hard-linked (or copied) to backups that are
-// renamed back if a later rename fails. Throws IoError naming the path that failed (also for a
-// path named twice or a directory target); then no target is created or changed (the message
-// says so if a restore itself failed).
+// its target (a symbolic link's file, where it lies: the link stays), then renamed into place
+// (one atomic replace per file: readers never find it missing); for a set, existing targets are
+// first hard-linked (or copied) to backups that are renamed back if a later rename fails. Throws
+// IoError naming the path that failed (also for a path named twice, or a target that is not a
+// regular file: RequireOutputsAreNotInputs); then no target is created or changed (the message says
+// so if a restore itself failed).
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
@@ -53,5 +63,9 @@ struct StreamedFile {
 };
 // As above, with the same guarantees.
 void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files);
+
+// Removes the temporaries of the writes under way (async-signal-safe: no allocation, no lock):
+// for a signal handler that then ends the process.
+void RemoveTemporariesOnSignal();
 
 }  // namespace gyrodrift::io

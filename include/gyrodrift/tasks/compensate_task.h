@@ -67,6 +67,14 @@ struct CompensateResult {
   std::string text;                    // the console report, the log's gap note first
 };
 
+// DataError naming the log and the model when the log's sample rate (`log_hz`, from
+// io::ResolveSampleRate with `how`; "default", a rate nobody stated, is not checked) differs from a
+// model's by more than 1 %: the model's thermal lags and temperature rates would run that many
+// times too fast or slow, silently. `flags`: the rate's source spelt as flags (--rate-hz).
+void RequireModelRate(const std::vector<io::LoadedModel>& axes, const std::string& model_path,
+                      const std::string& log_path, double log_hz, const std::string& how,
+                      bool flags);
+
 // UsageError naming `model_path` unless every axis is a compensate-mode model.
 void RequireCompensateMode(const std::vector<io::LoadedModel>& axes,
                            const std::string& model_path);

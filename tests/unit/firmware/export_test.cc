@@ -361,6 +361,33 @@ TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   }
 }
 
+// A temperature that is not finite (a sensor's NaN) is held at the channel's last one: the
+// estimates are the library's on the series with that sample repeated, not NaN ever after.
+TEST_F(FirmwareExport, HeaderHoldsATemperatureThatIsNotFinite) {
+  ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
+  const std::vector<LoadedModel> axes{*two_, *hysteresis_};
+  const Log test = MakeLog(1200, 6, 8.0);
+  Eigen::MatrixXd glitched = test.temperature, held = test.temperature;
+  glitched(400, 0) = std::numeric_limits<double>::quiet_NaN();
+  glitched(401, 0) = std::numeric_limits<double>::quiet_NaN();
+  glitched(900, 1) = std::numeric_limits<double>::infinity();
+  held(400, 0) = held(401, 0) = held(399, 0);
+  held(900, 1) = held(899, 1);
+  const std::string dir = test::TempDir("firmware_nan");
+  WriteFileAtomically(dir + "/held.h", RenderFirmwareC(axes, {.prefix = "held"}));
+  const Eigen::MatrixXd got = test::RunFirmwareHeader(dir + "/held.h", "held", glitched, dir);
+  ASSERT_EQ(got.cols(), 2);
+  for (Eigen::Index a = 0; a < 2; ++a) {
+    const LoadedModel& axis = axes[static_cast<size_t>(a)];
+    EXPECT_TRUE(got.col(a).allFinite()) << "axis " << a;
+    EXPECT_LT(MaxRelativeError(got.col(a),
+                               drift::EstimateDrift(
+                                   axis.model, held.leftCols(axis.model.temperature_channels()))),
+              1e-9)
+        << "axis " << a;
+  }
+}
+
 TEST_F(FirmwareExport, RenderingIsDeterministicAndHasTheDocumentedShape) {
   const ExportOptions c{.prefix = "imu_x"};
   const std::string text = RenderFirmwareC({*ms_}, c);
@@ -372,8 +399,8 @@ TEST_F(FirmwareExport, RenderingIsDeterministicAndHasTheDocumentedShape) {
   for (const char* needle :
        {"#ifndef IMU_X_H", "#define IMU_X_N_AXES 1", "#define IMU_X_N_CHANNELS 1",
         "#define IMU_X_AXIS_0_NAME \"rate_dph\"", "#define IMU_X_CHANNEL_0_NAME \"case_c\"",
-        "typedef double imu_x_real;", "} imu_x_state;", "static inline void imu_x_init(",
-        "static inline void imu_x_step(", "no libm", "Sample rate: 1 Hz"}) {
+        "typedef double imu_x_real;", "} imu_x_state;", "static inline int imu_x_init(",
+        "static inline int imu_x_step(", "no libm", "Sample rate: 1 Hz"}) {
     EXPECT_NE(text.find(needle), std::string::npos) << needle;
   }
   // Nothing to link and no other header: the gains are literals. (Comments mention exp.)
@@ -401,10 +428,10 @@ TEST_F(FirmwareExport, RenderingIsDeterministicAndHasTheDocumentedShape) {
 
 TEST_F(FirmwareExport, NamesAreQuotedSafely) {
   LoadedModel odd = *thermal_;
-  odd.info.target_column = "rate \"x\"?\?/ */ \xc2\xb0";
+  odd.info.target_column = "rate \"x\"?\?/ */ /* \xc2\xb0";
   odd.info.temperature_column = "T*/\\";
   const std::string text = RenderFirmwareC({odd}, {});
-  EXPECT_NE(text.find("#define GYRO_COMP_AXIS_0_NAME \"rate \\\"x\\\"\\?\\?/ */ \\302\\260\""),
+  EXPECT_NE(text.find("#define GYRO_COMP_AXIS_0_NAME \"rate \\\"x\\\"\\?\\?/ */ /* \\302\\260\""),
             std::string::npos)
       << text.substr(0, 2000);
   EXPECT_NE(text.find("#define GYRO_COMP_CHANNEL_0_NAME \"T*/\\\\\""), std::string::npos);
@@ -412,8 +439,9 @@ TEST_F(FirmwareExport, NamesAreQuotedSafely) {
   size_t comment_ends = 0, opens = 0;
   for (size_t at = 0; (at = text.find("*/", at)) != std::string::npos; ++at) ++comment_ends;
   for (size_t at = 0; (at = text.find("/*", at)) != std::string::npos; ++at) ++opens;
-  // (the names' "*/" inside the string literals of the two #defines count once each)
-  EXPECT_EQ(comment_ends, opens + 2);
+  // (the names' "*/" inside the string literals of the two #defines count once each, the
+  // target's "/*" once)
+  EXPECT_EQ(comment_ends, opens - 1 + 2);
 }
 
 TEST_F(FirmwareExport, RefusesWhatCannotRunInFirmware) {

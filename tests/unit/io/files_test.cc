@@ -7,6 +7,7 @@
 #include "gyrodrift/io/files.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -208,6 +209,53 @@ TEST(WriteStreamedFilesAtomically, RelativePathsWriteIntoTheWorkingFolder) {
   EXPECT_EQ(Entries(dir), std::set<std::string>{"plain.txt"});
 }
 
+// The rename that places a file would replace whatever sits at its name: a link is followed (its
+// file replaced, the link kept); a pipe, a device or a link to nothing is refused before any
+// work, by the output check as by the write.
+TEST(Files, TargetsThatAreNotRegularFilesAreFollowedOrRefused) {
+  namespace fs = std::filesystem;
+  const std::string dir = test::TempDir("atomic_special");
+  fs::create_directories(dir + "/runs");
+  WriteFileAtomically(dir + "/runs/r1.csv", "old");
+  fs::create_symlink("runs/r1.csv", dir + "/latest.csv");
+  WriteFileAtomically(dir + "/latest.csv", "new");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir + "/latest.csv")));
+  EXPECT_EQ(ReadTextFile(dir + "/runs/r1.csv"), "new");
+  EXPECT_EQ(Entries(dir), (std::set<std::string>{"latest.csv", "runs"}));
+
+  ASSERT_EQ(::mkfifo((dir + "/pipe.csv").c_str(), 0644), 0);
+  fs::create_symlink("runs/none.csv", dir + "/dangling.csv");
+  for (const auto& [name, message] : std::vector<std::pair<std::string, std::string>>{
+           {"/pipe.csv", "is not a regular file (a device, a pipe or a socket)"},
+           {"/dangling.csv", "is a symbolic link to nothing"}}) {
+    try {
+      RequireOutputsAreNotInputs({}, {dir + name});
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(dir + name + ": " + message), std::string::npos)
+          << e.what();
+    }
+    EXPECT_THROW(WriteFileAtomically(dir + name, "x"), IoError) << name;
+  }
+  EXPECT_TRUE(fs::is_fifo(dir + "/pipe.csv"));
+  EXPECT_THROW(RequireOutputsAreNotInputs({}, {"/dev/null"}), IoError);
+}
+
+TEST(Files, OneFileNamedTwiceIsRefused) {
+  const std::string dir = test::TempDir("distinct_files");
+  WriteFileAtomically(dir + "/a.csv", "a");
+  WriteFileAtomically(dir + "/b.csv", "a");
+  EXPECT_NO_THROW(RequireDistinctFiles({dir + "/a.csv", dir + "/b.csv", dir + "/none.csv"}, "logs",
+                                       "give it once"));
+  try {
+    RequireDistinctFiles({dir + "/a.csv", dir + "/./a.csv"}, "logs", "give it once");
+    ADD_FAILURE() << "one file named twice was accepted";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "logs " + dir + "/a.csv and " + dir + "/./a.csv are one file: give it once");
+  }
+}
+
 TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
   const std::string dir = test::TempDir("atomic_stale");
   // A pid that no longer runs: a child that has exited and been reaped.
@@ -217,11 +265,14 @@ TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
   ::waitpid(child, nullptr, 0);
   const std::string dead = std::to_string(child);
   const std::string alive = std::to_string(::getppid());
-  const std::vector<std::string> stale = {"x.csv.tmp." + dead, "x.csv.bak." + dead};
+  const std::vector<std::string> stale = {"x.csv.gyrodrift-tmp." + dead,
+                                          "x.csv.gyrodrift-bak." + dead};
   const std::vector<std::string> kept = {
-      "x.csv.tmp." + alive,  // a writer that still runs
-      "y.csv.tmp." + dead,   // another target's: that write cleans it
-      "x.csv.tmp.12ab",      // not our naming pattern
+      "x.csv.gyrodrift-tmp." + alive,  // a writer that still runs
+      "y.csv.gyrodrift-tmp." + dead,   // another target's: that write cleans it
+      "x.csv.gyrodrift-tmp.12ab",      // not our naming pattern
+      "x.csv.tmp." + dead,             // a user's file, whatever its digits
+      "x.csv.bak.20261127",            // a user's dated backup
       "x.csv.old"};
   for (const auto& name : stale) WriteFileAtomically(dir + "/" + name, "partial");
   for (const auto& name : kept) WriteFileAtomically(dir + "/" + name, "other");

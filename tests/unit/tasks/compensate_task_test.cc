@@ -112,5 +112,35 @@ TEST(CompensateTask, RefusalsComeBeforeAnyEstimate) {
   EXPECT_THROW(CompensateWarnings({other}, log, kFlags), DataError);
 }
 
+// A log at another rate than the model's would run its lags that many times too fast: refused
+// where time_s says so, run where nothing states the log's rate.
+TEST(CompensateTask, RefusesALogAtAnotherSampleRate) {
+  const std::string cal = WriteText("cal_rate.csv", test::ThermalLogCsv(1500, 5));
+  const std::vector<io::LoadedModel> axes = Fit(cal, "rate_dph");
+  const io::CsvTable ver = io::CsvTable::Parse(test::ThermalLogCsv(600, 6), "ver");
+  std::vector<io::CsvColumn> columns;
+  for (const std::string& name : ver.header()) {
+    Eigen::VectorXd v = ver.Column(name);
+    if (name == "time_s") v *= 0.1;  // 10 Hz
+    columns.push_back({name, v});
+  }
+  const std::string fast = WriteText("fast.csv", io::RenderCsv(columns));
+  try {
+    RunCompensate(axes, ReadTaskLog(fast, kFlags), kFlags, {}, "m.json");
+    FAIL() << "a 10 Hz log ran through a 1 Hz model";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "fast.csv is sampled at 10 Hz (from the median step of time_s), m.json was "
+                  "fitted at 1 Hz: its thermal lags and temperature rates would run 10 times too "
+                  "fast"),
+              std::string::npos)
+        << e.what();
+  }
+  columns.erase(columns.begin());  // no time_s: the rate is the model's
+  const std::string untimed = WriteText("untimed.csv", io::RenderCsv(columns));
+  EXPECT_EQ(RunCompensate(axes, ReadTaskLog(untimed, kFlags), kFlags, {}, "m.json").axes.size(),
+            1u);
+}
+
 }  // namespace
 }  // namespace gyrodrift::tasks
