@@ -24,7 +24,7 @@ struct CompensateArgs {
   std::string model;
   std::string input;
   std::string output;
-  tasks::CompensateSettings settings;  // --truth, --drift-window-s
+  tasks::CompensateSettings settings;  // --truth, --drift-window-s, --rate-hz
   LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
@@ -85,6 +85,10 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
                               "after, s (the fleet manifest's drift_window_s)")
                   ->capture_default_str(),
               {"drift_window_s"});
+  BindSetting(cmd->add_option("--rate-hz", args->settings.rate_hz,
+                              "the log's sample rate, Hz, where its time_s does not give it (as "
+                              "fit --rate-hz); it must be the model's (default: from time_s)"),
+              {"rate_hz"});
   cmd->add_option("--truth", args->settings.truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "
                   "share of its RMS the estimate removes");

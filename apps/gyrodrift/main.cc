@@ -1,10 +1,13 @@
 // gyrodrift: the command line tool. Subcommands live in *_command.cc and register themselves.
 #include <fmt/core.h>
+#include <pthread.h>
 #include <signal.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <thread>
 
 #include "cli_util.h"
 #include "command.h"
@@ -21,32 +24,40 @@ std::vector<Command>& Commands() {
 
 namespace {
 
-// Ctrl-C, a kill or a closed terminal during a write: the temporaries go, then the signal ends the
-// process as it would have (its exit status says so).
-extern "C" void EndOnSignal(int signal_number) {
-  gyrodrift::io::RemoveTemporariesOnSignal();
-  ::signal(signal_number, SIG_DFL);
-  ::raise(signal_number);
-}
-
-void RemoveTemporariesWhenEnded() {
+// Ctrl-C, a kill or a closed terminal: one thread of its own takes these signals (every other
+// thread blocks them, so no handler runs amid a write), removes the temporaries of the writes
+// under way once a set being placed is whole, then ends the process by the signal, as it would
+// have ended (the exit status says so). A signal the caller ignores (nohup's SIGHUP) stays ignored.
+void EndOnSignals() {
+  sigset_t set;
+  ::sigemptyset(&set);
   for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction current {};
-    // A signal the caller ignores (nohup's SIGHUP) stays ignored.
-    if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) {
+    if (::sigaction(signal_number, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) {
       continue;
     }
-    struct sigaction action {};
-    action.sa_handler = EndOnSignal;
-    ::sigemptyset(&action.sa_mask);
-    ::sigaction(signal_number, &action, nullptr);
+    ::sigaddset(&set, signal_number);
   }
+  // Before any other thread starts, so that every thread inherits the mask.
+  if (::pthread_sigmask(SIG_BLOCK, &set, nullptr) != 0) return;  // the defaults then stand
+  std::thread([set] {
+    int signal_number = 0;
+    if (::sigwait(&set, &signal_number) != 0) return;
+    gyrodrift::io::RemoveTemporariesForExit();
+    ::signal(signal_number, SIG_DFL);
+    sigset_t taken;
+    ::sigemptyset(&taken);
+    ::sigaddset(&taken, signal_number);
+    ::pthread_sigmask(SIG_UNBLOCK, &taken, nullptr);
+    ::raise(signal_number);
+    std::_Exit(128 + signal_number);  // not reached: the signal ended the process
+  }).detach();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  RemoveTemporariesWhenEnded();
+  EndOnSignals();
   CLI::App app{
       "gyrodrift: model and compensate the thermal drift of gyroscopes (MS-ELM, Chen & Cui 2016).",
       "gyrodrift"};

@@ -2,6 +2,7 @@
 #include "bindings.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -51,7 +52,8 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const std::optional<Array>& truth_in, const tasks::EvaluateSettings& settings,
                   const py::object& progress) {
   LongCall call(progress);
-  settings.Validate();
+  // A refusal names the keyword (window), as the CLI's names its flag.
+  ValidateAsSettings({{"causal.window", "window"}}, [&] { settings.Validate(); });
   (void)ExecutionOf(settings.fit.threads, call);
   const Eigen::VectorXd y = ToVector(y_in, "y");
   Eigen::MatrixXd temperature;

@@ -199,7 +199,10 @@ py::dict SelectModesPy(
   o.monte_carlo.confidence = confidence;
   o.monte_carlo.seed = seed;
   o.band_confidence = band;
-  o.Validate();
+  ValidateAsSettings({{"monte_carlo.realisations", "realisations"},
+                      {"monte_carlo.confidence", "confidence"},
+                      {"band_confidence", "band"}},
+                     [&] { o.Validate(); });
   const Execution execution{.threads = threads};
   execution.Validate();
   const Eigen::VectorXd x = ToVector(x_in, "x");

@@ -195,6 +195,13 @@ def test_select_modes_groups_a_decomposition_into_series_that_add_up():
     assert s["noise_level_seed"] == 3 and "noise{" in s["summary"]
     with pytest.raises(gd.UsageError, match="criterion"):
         gd.select_modes(x, imfs, residue, criterion="nope")
+    # Refusals name the keywords, as the CLI's name its flags.
+    with pytest.raises(gd.UsageError, match=r"^realisations = 1: must be"):
+        gd.select_modes(x, imfs, residue, realisations=1)
+    with pytest.raises(gd.UsageError, match=r"^confidence = 2: must be"):
+        gd.select_modes(x, imfs, residue, confidence=2)
+    with pytest.raises(gd.UsageError, match=r"^window = 1: must be"):
+        gd.evaluate(x, window=1)
 
 
 def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():

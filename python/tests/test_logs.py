@@ -75,5 +75,5 @@ def test_plan_is_what_the_cli_writes(cli, tmp_path):
     assert np.array_equal(from_file["rate_dph"], sim["rate_dph"])
     with pytest.raises(gd.UsageError, match=r"^profile = nope.csv: must be chamber, chamber-b, "):
         gd.simulate(profile="nope.csv")
-    with pytest.raises(gd.UsageError, match="give --hours"):
+    with pytest.raises(gd.UsageError, match="it needs 8.4 h or more"):
         gd.plan(hours=4, min_c=-40, max_c=80)

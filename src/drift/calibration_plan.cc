@@ -50,11 +50,12 @@ CalibrationPlan PlanCalibration(const PlanSettings& settings) {
         (3.0 * span / rate + kDwells * settings.shortest_dwell_min) / 60.0;
     throw UsageError(Format(
         "a plan of %.3g h cannot hold ramps over %.3g K at %.2g and %.2g K/min and %d dwells of "
-        "%.0f min: give --hours %.3g or more%s",
+        "%.0f min: it needs %.3g h or more%s",
         settings.hours, span, rate, rate / 2.0, kDwells, settings.shortest_dwell_min,
         std::ceil(hours_needed * 10.0) / 10.0,
-        rate < kFastestRate ? Format(" (or a faster --rate, up to %.0f K/min)", kFastestRate).c_str()
-                            : ""));
+        rate < kFastestRate
+            ? Format(" (or a faster ramp rate, up to %.0f K/min)", kFastestRate).c_str()
+            : ""));
   }
   const double d = 60.0 * dwell_min(r);
   CalibrationPlan plan;

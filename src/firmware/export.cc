@@ -59,8 +59,10 @@ void ExportOptions::Validate() const {
       if (id == 0) ThrowOption("device_ids", "0", "a sensor's DEVID, not 0");
       if (std::find(device_ids.begin(), device_ids.begin() + static_cast<std::ptrdiff_t>(i), id) !=
           device_ids.begin() + static_cast<std::ptrdiff_t>(i)) {
-        ThrowOption("device_ids", std::to_string(id) + " twice",
-                    "one DEVID per gyro instance, each once");
+        std::string ids;
+        for (std::uint32_t d : device_ids) ids += (ids.empty() ? "" : ",") + std::to_string(d);
+        ThrowOption("device_ids", ids,
+                    "one DEVID per gyro instance, each once (" + std::to_string(id) + " twice)");
       }
     }
   } else if (!device_ids.empty()) {
@@ -85,8 +87,7 @@ std::string RenderExport(const std::vector<LoadedModel>& axes, const ExportOptio
 ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options) {
   options.Validate();  // before any file is read, so a bad option is the error the user sees
-  io::RequireDistinctFiles(model_paths, "model files",
-                           "each gyro axis has its own model (give each file once)");
+  io::RequireDistinctFiles(model_paths, "model files", "give each file once");
   ExportResult out;
   for (const std::string& path : model_paths) {
     for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));

@@ -205,8 +205,7 @@ FittedUnit FitUnit(const Manifest& m, const UnitSpec& unit) {
   // A verification that is a calibration log would judge the model on what it was fitted on.
   std::vector<std::string> logs = unit.calibration;
   logs.insert(logs.end(), unit.verification.begin(), unit.verification.end());
-  io::RequireDistinctFiles(logs, unit.serial + ": logs",
-                           "each log is calibration or verification, once");
+  io::RequireDistinctFiles(logs, "logs", "each log is calibration or verification, once");
   std::vector<tasks::TaskLog> cal;
   std::vector<std::string> warnings;
   for (const std::string& path : unit.calibration) {

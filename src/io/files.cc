@@ -3,14 +3,13 @@
 #include <signal.h>
 #include <unistd.h>
 
-#include <array>
-#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -160,44 +159,38 @@ void RemoveStaleTemporaries(const std::vector<std::string>& targets) {
   }
 }
 
-// The temporaries being written, for RemoveTemporariesOnSignal: fixed slots, so that a signal
-// handler reads them without allocating or locking. A slot is 0 free, 1 being filled, 2 in use.
-constexpr size_t kRegistrySlots = 64;
-constexpr size_t kRegistryPathBytes = 4096;
-std::array<std::atomic<int>, kRegistrySlots> registry_state{};
-char registry_paths[kRegistrySlots][kRegistryPathBytes];
+// The temporaries being written, for RemoveTemporariesForExit. A set is placed (its backups
+// made, its renames, its backups removed) under the mutex, so an exit waits for it to be whole.
+struct TemporaryRegistry {
+  std::mutex mutex;
+  std::multiset<std::string> paths;  // guarded by mutex
+};
 
-// Registers `path` (a temporary just opened); the slot, or -1 when none is free or the path too
-// long (that temporary is then left by a signal, as by SIGKILL).
-int RegisterTemporary(const std::string& path) {
-  if (path.size() >= kRegistryPathBytes) return -1;
-  for (size_t i = 0; i < kRegistrySlots; ++i) {
-    int expected = 0;
-    if (!registry_state[i].compare_exchange_strong(expected, 1)) continue;
-    std::memcpy(registry_paths[i], path.c_str(), path.size() + 1);
-    registry_state[i].store(2);
-    return static_cast<int>(i);
-  }
-  return -1;
+TemporaryRegistry& Registry() {
+  static TemporaryRegistry* registry = new TemporaryRegistry;  // never destroyed: exits use it
+  return *registry;
 }
 
-void ReleaseTemporary(int slot) {
-  if (slot >= 0) registry_state[static_cast<size_t>(slot)].store(0);
-}
-
-// Releases the slots of a set's temporaries when it goes out of scope (placed or failed).
+// A set's temporaries, registered from before each exists until the set is placed or failed.
 class RegisteredTemporaries {
  public:
   RegisteredTemporaries() = default;
   RegisteredTemporaries(const RegisteredTemporaries&) = delete;
   RegisteredTemporaries& operator=(const RegisteredTemporaries&) = delete;
   ~RegisteredTemporaries() {
-    for (int slot : slots_) ReleaseTemporary(slot);
+    TemporaryRegistry& r = Registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    for (const std::string& path : paths_) r.paths.erase(r.paths.find(path));
   }
-  void Add(const std::string& path) { slots_.push_back(RegisterTemporary(path)); }
+  void Add(const std::string& path) {
+    TemporaryRegistry& r = Registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    r.paths.insert(path);
+    paths_.push_back(path);
+  }
 
  private:
-  std::vector<int> slots_;
+  std::vector<std::string> paths_;
 };
 
 // Removes each of `paths` that is not empty, ignoring failures (cleaning up after one).
@@ -223,28 +216,32 @@ void CheckTargets(const std::vector<StreamedFile>& files) {
   }
 }
 
-// A link's file is written where it lies, so the link stays a link (the rename would replace it).
-std::vector<StreamedFile> FollowLinks(const std::vector<StreamedFile>& files) {
+// Where each file is written: its path, or a link's file where it lies (so the link stays a
+// link: the rename would replace it). Messages keep naming the path as given.
+std::vector<std::string> Targets(const std::vector<StreamedFile>& files) {
   namespace fs = std::filesystem;
-  std::vector<StreamedFile> out = files;
-  for (StreamedFile& f : out) {
+  std::vector<std::string> targets;
+  for (const StreamedFile& f : files) {
     std::error_code ec;
+    targets.push_back(f.path);
     if (!fs::is_symlink(fs::symlink_status(f.path, ec))) continue;
-    const fs::path target = fs::canonical(f.path, ec);
-    if (!ec) f.path = target.string();
+    const fs::path file = fs::canonical(f.path, ec);
+    if (!ec) targets.back() = file.string();
   }
-  return out;
+  return targets;
 }
 
 // Each file written by its writer to its temporary "<path><kTemporaryMark><suffix>", in order; on a
 // failure the temporaries written so far are removed before the error is thrown.
 std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files,
+                                          const std::vector<std::string>& targets,
                                           const std::string& suffix,
                                           RegisteredTemporaries& registered) {
   std::vector<std::string> temps;
-  for (const auto& [path, write] : files) {
-    const std::string temp = path + kTemporaryMark + suffix;
-    registered.Add(temp);  // before it exists: a signal from here on removes it
+  for (size_t i = 0; i < files.size(); ++i) {
+    const auto& [path, write] = files[i];
+    const std::string temp = targets[i] + kTemporaryMark + suffix;
+    registered.Add(temp);  // before it exists: an exit from here on removes it
     std::FILE* f = std::fopen(temp.c_str(), "wb");
     if (!f) {
       const std::string reason = std::strerror(errno);
@@ -272,12 +269,13 @@ std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files
 // a failed later rename can rename every earlier backup back over its new file; "" where there is
 // no target. On a failure the backups and `temps` are removed before the error is thrown.
 std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
+                                     const std::vector<std::string>& targets,
                                      const std::string& suffix,
                                      const std::vector<std::string>& temps) {
   namespace fs = std::filesystem;
   std::vector<std::string> backups(files.size());
   for (size_t i = 0; i < files.size(); ++i) {
-    const std::string& target = files[i].path;
+    const std::string& target = targets[i];
     std::error_code ec;
     if (!fs::exists(fs::symlink_status(target, ec))) continue;
     const std::string backup = target + kBackupMark + suffix;
@@ -286,7 +284,8 @@ std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
       if (ec) {
         RemoveAll(backups);
         RemoveAll(temps);
-        throw IoError(target + ": cannot keep a copy of the existing file (" + ec.message() + ")");
+        throw IoError(files[i].path + ": cannot keep a copy of the existing file (" + ec.message() +
+                      ")");
       }
     }
     backups[i] = backup;
@@ -296,22 +295,21 @@ std::vector<std::string> KeepBackups(const std::vector<StreamedFile>& files,
 
 // Each temporary renamed over its target. When a rename fails, the targets placed before it are
 // restored from their backups (or removed where there was none) and the error thrown.
-void PlaceFiles(const std::vector<StreamedFile>& files, const std::vector<std::string>& temps,
-                const std::vector<std::string>& backups) {
+void PlaceFiles(const std::vector<StreamedFile>& files, const std::vector<std::string>& targets,
+                const std::vector<std::string>& temps, const std::vector<std::string>& backups) {
   for (size_t i = 0; i < files.size(); ++i) {
-    const std::string& target = files[i].path;
-    if (std::rename(temps[i].c_str(), target.c_str()) == 0) continue;
+    if (std::rename(temps[i].c_str(), targets[i].c_str()) == 0) continue;
     const std::string reason = std::strerror(errno);
     std::string restore_failed;
     for (size_t j = 0; j < i; ++j) {
-      const std::string& placed = files[j].path;
+      const std::string& placed = targets[j];
       const bool ok = backups[j].empty() ? std::remove(placed.c_str()) == 0
                                          : std::rename(backups[j].c_str(), placed.c_str()) == 0;
-      if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + placed;
+      if (!ok) restore_failed += (restore_failed.empty() ? "" : ", ") + files[j].path;
     }
     RemoveAll(backups);
     RemoveAll(temps);
-    throw IoError(target + ": cannot rename the temporary file into place (" + reason + ")" +
+    throw IoError(files[i].path + ": cannot rename the temporary file into place (" + reason + ")" +
                   (restore_failed.empty()
                        ? ""
                        : "; could not restore the earlier state of " + restore_failed));
@@ -331,28 +329,27 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
   WriteStreamedFilesAtomically(streamed);
 }
 
-void RemoveTemporariesOnSignal() {
-  for (size_t i = 0; i < kRegistrySlots; ++i) {
-    if (registry_state[i].load() == 2) ::unlink(registry_paths[i]);
-  }
+void RemoveTemporariesForExit() {
+  TemporaryRegistry& r = Registry();
+  r.mutex.lock();  // held to the end: no write starts or places a set after this
+  for (const std::string& path : r.paths) ::unlink(path.c_str());
 }
 
-void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& given) {
-  CheckTargets(given);
-  const std::vector<StreamedFile> files = FollowLinks(given);
+void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files) {
+  CheckTargets(files);
+  const std::vector<std::string> targets = Targets(files);
   const std::string suffix = std::to_string(::getpid());
-  {
-    std::vector<std::string> targets;
-    for (const auto& file : files) targets.push_back(file.path);
-    RemoveStaleTemporaries(targets);
-  }
+  RemoveStaleTemporaries(targets);
   RegisteredTemporaries registered;
-  const std::vector<std::string> temps = WriteTemporaries(files, suffix, registered);
+  const std::vector<std::string> temps = WriteTemporaries(files, targets, suffix, registered);
   // Each target is replaced by one atomic rename, so a reader sees the old file or the new one,
-  // never none; a set keeps backups so that it is placed whole or not at all.
-  const std::vector<std::string> backups =
-      files.size() > 1 ? KeepBackups(files, suffix, temps) : std::vector<std::string>(files.size());
-  PlaceFiles(files, temps, backups);
+  // never none; a set keeps backups so that it is placed whole or not at all. An exit
+  // (RemoveTemporariesForExit) waits until then, so the backups never outlive it.
+  const std::lock_guard<std::mutex> placing(Registry().mutex);
+  const std::vector<std::string> backups = files.size() > 1
+                                               ? KeepBackups(files, targets, suffix, temps)
+                                               : std::vector<std::string>(files.size());
+  PlaceFiles(files, targets, temps, backups);
   RemoveAll(backups);
 }
 

@@ -214,10 +214,11 @@ void RequireModelRate(const std::vector<io::LoadedModel>& axes, const std::strin
     if (std::abs(ratio - 1.0) <= 0.01) continue;
     throw DataError(fmt::format(
         "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its thermal lags and "
-        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz, or fit "
-        "the model on a log at {:g} Hz)",
+        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz, fit the "
+        "model on a log at {:g} Hz, or give {} if time_s is wrong)",
         log_path, log_hz, RateSourceText(how, flags), model_path, model_hz,
-        ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow", model_hz, log_hz));
+        ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow", model_hz, log_hz,
+        flags ? "--rate-hz" : "rate_hz"));
   }
 }
 

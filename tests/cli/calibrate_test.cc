@@ -268,6 +268,21 @@ TEST_F(CalibrateCli, AFailingUnitIsReportedAndTheOthersGoOn) {
   EXPECT_NE(r.out.find("1 calibrated"), std::string::npos) << r.out;
   EXPECT_TRUE(test::FileExists(Dir() + "/out_broken/SN1/summary.json"));
   EXPECT_FALSE(test::FileExists(Dir() + "/out_broken/SN2/summary.json"));
+
+  // A verification that is the calibration's own log (however spelt) would judge the model on
+  // what it was fitted on: that unit is not calibrated.
+  std::string own = io::ReadTextFile(Manifest("own.toml", "", 2));
+  own.replace(own.find("verification = [\"logs/SN2_ver.csv"), 33,
+              "verification = [\"./logs/SN2_ver.csv");
+  own.replace(own.find("logs/SN2_cal.csv"), 16, "logs/SN2_ver.csv");
+  io::WriteFileAtomically(Dir() + "/own.toml", own);
+  r = test::RunCli("calibrate '" + Dir() + "/own.toml' -o '" + Dir() + "/out_own'");
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_NE(r.out.find("error: unit SN2: logs "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("SN2_ver.csv are one file: each log is calibration or verification, once"),
+            std::string::npos)
+      << r.out;
+  EXPECT_FALSE(test::FileExists(Dir() + "/out_own/SN2/summary.json"));
 }
 
 TEST_F(CalibrateCli, BadManifestsAreNamedByLine) {

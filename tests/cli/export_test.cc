@@ -302,7 +302,8 @@ TEST(ExportCliPx4, TwoGyrosFromOneFitEachToOneParameterFile) {
   // A typo that names one model twice, or one sensor twice, would run one gyro's model on another.
   test::ExpectCleanFailure(
       test::RunCli("export " + models + " --format px4 --device-id 7,7 -o " + q + out2 + "'"), 2,
-      "--device-id = 7 twice: must be one DEVID per gyro instance", out2, "one device id twice");
+      "--device-id = 7,7: must be one DEVID per gyro instance, each once (7 twice)", out2,
+      "one device id twice");
   test::ExpectCleanFailure(
       test::RunCli("export " + q + d + "/gyro0.json' " + q + d + "/./gyro0.json' -o " + q + d +
                    "/twice.h'"),

@@ -32,9 +32,8 @@ TEST(PlanCli, APlanFollowedBySimulateAndFitGivesNoIdentificationWarning) {
 
 TEST(PlanCli, APlanThatCannotFitIsRefused) {
   const std::string out = test::TempDir("cli_plan_bad") + "/plan.csv";
-  test::ExpectCleanFailure(
-      test::RunCli("plan --hours 4 --min -40 --max 80 -o '" + out + "'"), 2,
-      "give --hours 8.4 or more", out, "too short");
+  test::ExpectCleanFailure(test::RunCli("plan --hours 4 --min -40 --max 80 -o '" + out + "'"), 2,
+                           "it needs 8.4 h or more", out, "too short");
   test::ExpectCleanFailure(test::RunCli("plan --min 20 --max 25 -o '" + out + "'"), 2,
                            "--max = 25: must be in [35, 200]",
                            out, "too narrow");

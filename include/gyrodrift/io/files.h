@@ -7,8 +7,10 @@
 // Temporaries are named <target>.gyrodrift-tmp.<pid> (and, while a set is renamed, backups
 // <target>.gyrodrift-bak.<pid>), beside their targets. A process killed by SIGKILL (or a power
 // cut) cannot remove them; they never carry a target's name, and the next write of the same
-// target removes those whose process no longer runs (nothing else: a user's "x.csv.bak.1" stays).
-// A program that catches SIGINT / SIGTERM calls RemoveTemporariesOnSignal from its handler.
+// target removes those whose process no longer runs (nothing else: a user's "x.csv.bak.1" stays;
+// so do the "<target>.tmp.<pid>" temporaries of earlier gyrodrift versions: remove those by
+// hand).
+// A program that ends on SIGINT / SIGTERM calls RemoveTemporariesForExit first.
 #pragma once
 
 #include <cstdio>
@@ -64,8 +66,9 @@ struct StreamedFile {
 // As above, with the same guarantees.
 void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files);
 
-// Removes the temporaries of the writes under way (async-signal-safe: no allocation, no lock):
-// for a signal handler that then ends the process.
-void RemoveTemporariesOnSignal();
+// Removes the temporaries of the writes under way, after a set being placed is whole, and keeps
+// any other write from starting or placing a set: for a thread that then ends the process (the
+// CLI's signal thread, apps/gyrodrift/main.cc). Not for a signal handler (it takes a mutex).
+void RemoveTemporariesForExit();
 
 }  // namespace gyrodrift::io

@@ -24,7 +24,9 @@ namespace gyrodrift::tasks {
 
 struct CompensateSettings {
   std::string truth = "";  // column of the true drift (the simulator's drift_dph); "" = none
-  // Sample rate of the figures' slow-variation blocks, Hz; 0 = the model's.
+  // The log's sample rate, Hz, where its time_s does not give it (0: from time_s, else the
+  // model's): RequireModelRate checks it against the model's; it times the figures'
+  // slow-variation blocks.
   double rate_hz = 0.0;
   // Length of those blocks, s (the fleet's drift_window_s).
   double drift_window_s = drift::kSlowVariationBlockS;

@@ -44,8 +44,7 @@ TEST(CalibrationPlan, TooShortIsRefusedWithWhatWouldFit) {
     PlanCalibration({.hours = 4.0, .min_c = -40.0, .max_c = 80.0});
     ADD_FAILURE() << "a 4-h plan over 120 K was accepted";
   } catch (const UsageError& e) {
-    EXPECT_NE(std::string(e.what()).find("give --hours 8.4 or more"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("it needs 8.4 h or more"), std::string::npos) << e.what();
   }
   EXPECT_THROW(PlanCalibration({.hours = 8.0, .min_c = 20.0, .max_c = 25.0}), OptionError);
   EXPECT_THROW(PlanCalibration({.rate_k_per_min = 5.0}), OptionError);

@@ -388,6 +388,39 @@ TEST_F(FirmwareExport, HeaderHoldsATemperatureThatIsNotFinite) {
   }
 }
 
+// init and step say how many temperatures they could not take.
+TEST_F(FirmwareExport, InitAndStepCountTheTemperaturesTheyCouldNotTake) {
+  ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
+  const std::string dir = test::TempDir("firmware_counts");
+  WriteFileAtomically(dir + "/two.h", RenderFirmwareC({*two_}, {.prefix = "two"}));
+  WriteFileAtomically(dir + "/counts.c", R"(#include <math.h>
+#include <stdio.h>
+#include "two.h"
+int main(void) {
+  two_state s;
+  two_real t[TWO_N_CHANNELS] = {(two_real)NAN, 21.0};
+  two_real drift[TWO_N_AXES];
+  int at_nan, at_good, held, none;
+  at_nan = two_init(&s, t);
+  t[0] = 20.0;
+  at_good = two_init(&s, t);
+  t[1] = (two_real)INFINITY;
+  held = two_step(&s, t, drift);
+  t[1] = 21.5;
+  none = two_step(&s, t, drift);
+  printf("%d %d %d %d %d\n", at_nan, at_good, held, none, drift[0] == drift[0]);
+  return 0;
+}
+)");
+  const test::CommandResult compiled =
+      test::RunShell(std::string("'") + test::kCCompiler + "' " + test::kCFlags + " '" + dir +
+                     "/counts.c' -o '" + dir + "/counts'");
+  ASSERT_EQ(compiled.exit_code, 0) << compiled.err;
+  const test::CommandResult run = test::RunShell("'" + dir + "/counts'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out, "1 0 1 0 1\n");
+}
+
 TEST_F(FirmwareExport, RenderingIsDeterministicAndHasTheDocumentedShape) {
   const ExportOptions c{.prefix = "imu_x"};
   const std::string text = RenderFirmwareC({*ms_}, c);

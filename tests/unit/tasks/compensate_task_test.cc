@@ -132,10 +132,15 @@ TEST(CompensateTask, RefusesALogAtAnotherSampleRate) {
     EXPECT_NE(std::string(e.what()).find(
                   "fast.csv is sampled at 10 Hz (from the median step of time_s), m.json was "
                   "fitted at 1 Hz: its thermal lags and temperature rates would run 10 times too "
-                  "fast"),
+                  "fast (resample the log to 1 Hz, fit the model on a log at 10 Hz, or give "
+                  "--rate-hz if time_s is wrong)"),
               std::string::npos)
         << e.what();
   }
+  // The rate stated (time_s is wrong, as fit --rate-hz says): compensated at it.
+  EXPECT_EQ(RunCompensate(axes, ReadTaskLog(fast, kFlags), kFlags, {.rate_hz = 1.0}, "m.json")
+                .axes.size(),
+            1u);
   columns.erase(columns.begin());  // no time_s: the rate is the model's
   const std::string untimed = WriteText("untimed.csv", io::RenderCsv(columns));
   EXPECT_EQ(RunCompensate(axes, ReadTaskLog(untimed, kFlags), kFlags, {}, "m.json").axes.size(),
