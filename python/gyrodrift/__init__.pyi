@@ -134,7 +134,8 @@ class DriftModel:
     def fitted(self) -> bool: ...
 
 def export(
-    models: str | PathLike[str] | Sequence[str | PathLike[str]], *,
+    models: str | PathLike[str] | DriftModel | Sequence[str | PathLike[str]] | Sequence[DriftModel],
+    *,
     format: Literal["c", "json-coefficients", "px4"] = ..., single_precision: bool = ...,
     prefix: str = ..., device_ids: Sequence[int] = ...,
 ) -> str: ...

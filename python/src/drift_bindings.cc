@@ -398,13 +398,27 @@ void BindExport(py::module_& m) {
   const fw::ExportOptions ed;
   m.def(
       "export",
-      [](const std::vector<std::string>& models, const std::string& format, bool single_precision,
+      [](const py::list& models, const std::string& format, bool single_precision,
          const std::string& prefix, const std::vector<std::uint32_t>& device_ids) {
-        return fw::ExportModelFiles(models, {.format = fw::ExportFormatFromString(format),
-                                             .single_precision = single_precision,
-                                             .prefix = prefix,
-                                             .device_ids = device_ids})
-            .text;
+        const fw::ExportOptions options{.format = fw::ExportFormatFromString(format),
+                                        .single_precision = single_precision,
+                                        .prefix = prefix,
+                                        .device_ids = device_ids};
+        // Model files, or models fitted or loaded here (one axis each), not both.
+        std::vector<std::string> paths;
+        std::vector<io::LoadedModel> axes;
+        for (const py::handle item : models) {
+          if (py::isinstance<PyDriftModel>(item)) {
+            axes.push_back(item.cast<const PyDriftModel&>().Loaded());
+          } else {
+            paths.push_back(item.cast<std::string>());
+          }
+        }
+        if (!paths.empty() && !axes.empty()) {
+          throw UsageError("models: give model files or DriftModel objects, not both");
+        }
+        return paths.empty() ? fw::ExportAxes(std::move(axes), options).text
+                             : fw::ExportModelFiles(paths, options).text;
       },
       arg("models"), py::kw_only(), arg("format") = std::string(fw::ToString(ed.format)),
       arg("single_precision") = ed.single_precision, arg("prefix") = ed.prefix,

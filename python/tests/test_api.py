@@ -219,3 +219,19 @@ def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():
         gd.evaluate(sim["rate_dph"], kelvin, mode="compensate", methods="constant")
     assert gd.temperature_warning(sim["temperature_c"]) == ""
     assert "whole numbers only" in gd.temperature_warning(counts, "temp_raw")
+
+
+def test_export_takes_fitted_models_as_their_files(tmp_path):
+    sim = gd.simulate(duration=2 * 3600, seed=11)
+    x = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"])
+    y = gd.DriftModel().fit(-0.5 * sim["rate_dph"], sim["temperature_c"], target="rate_y")
+    x.save(tmp_path / "x.json")
+    y.save(tmp_path / "y.json")
+    assert gd.export([x, y], prefix="imu") == gd.export(
+        [tmp_path / "x.json", tmp_path / "y.json"], prefix="imu")
+    assert gd.export(x, format="json-coefficients") == gd.export(
+        tmp_path / "x.json", format="json-coefficients")
+    with pytest.raises(gd.UsageError, match="give model files or DriftModel objects, not both"):
+        gd.export([x, tmp_path / "y.json"])
+    with pytest.raises(gd.UsageError, match="not fitted"):
+        gd.export(gd.DriftModel())

@@ -88,10 +88,17 @@ ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options) {
   options.Validate();  // before any file is read, so a bad option is the error the user sees
   io::RequireDistinctFiles(model_paths, "model files", "give each file once");
-  ExportResult out;
+  std::vector<LoadedModel> axes;
   for (const std::string& path : model_paths) {
-    for (LoadedModel& axis : io::ReadModelFileAxes(path)) out.axes.push_back(std::move(axis));
+    for (LoadedModel& axis : io::ReadModelFileAxes(path)) axes.push_back(std::move(axis));
   }
+  return ExportAxes(std::move(axes), options);
+}
+
+ExportResult ExportAxes(std::vector<LoadedModel> axes, const ExportOptions& options) {
+  options.Validate();
+  ExportResult out;
+  out.axes = std::move(axes);
   if (options.format == ExportFormat::kPx4Params) {
     Px4Params px4 = MakePx4Params(out.axes, options.device_ids);
     out.text = std::move(px4.text);

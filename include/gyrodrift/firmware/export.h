@@ -129,5 +129,7 @@ struct ExportResult {
 };
 ExportResult ExportModelFiles(const std::vector<std::string>& model_paths,
                               const ExportOptions& options);
+// The same of axes already loaded (Python's DriftModel objects), in order.
+ExportResult ExportAxes(std::vector<LoadedModel> axes, const ExportOptions& options);
 
 }  // namespace gyrodrift::firmware
