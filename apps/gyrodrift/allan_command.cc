@@ -92,6 +92,11 @@ void Run(const AllanArgs& a) {
     if (!rate_given) {
       settings.rate_hz = io::ResolveSampleRate(table, 0.0, &rate_how);
       if (rate_how != "time_s") {
+        // A time_s column of one row gives no step either: that log is too short, not untimed.
+        if (table.rows() < 2) {
+          throw DataError(a.input + " has " + std::to_string(table.rows()) +
+                          " data row: an Allan deviation needs at least 2 samples");
+        }
         throw UsageError("--rate-hz is required: " + a.input +
                          " has no time_s column to read the sample rate from");
       }

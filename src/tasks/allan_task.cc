@@ -170,6 +170,11 @@ Eigen::VectorXd JoinRecords(const Eigen::VectorXd& data,
 AllanRun RunAllan(Eigen::VectorXd data, const std::vector<bool>& logged,
                   const AllanSettings& settings, std::string_view signal_name) {
   const al::AllanOptions o = settings.Options();
+  // One sample has no difference to take (it would read as "constant" below).
+  if (data.size() < 2) {
+    throw DataError(fmt::format("{} has {} sample{}: an Allan deviation needs at least 2",
+                                signal_name, data.size(), data.size() == 1 ? "" : "s"));
+  }
   // Constant where it was logged (the breaks and made-up rows hold anything), found without a
   // copy of the record: RequireVaryingSignal of the first logged sample alone names its value.
   const char* why = "its Allan deviation is zero at every tau (a logging fault?)";
