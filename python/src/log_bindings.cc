@@ -77,8 +77,9 @@ py::dict ReadLog(const std::string& path, const std::string& gaps, std::optional
     if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
   }
   py::dict columns;
+  // ColumnRef: the table's own values, copied once into the array.
   for (const std::string& name : log.table.header()) {
-    columns[Text(name)] = ToArray(log.table.Column(name));
+    columns[Text(name)] = ToArray(log.table.ColumnRef(name));
   }
   py::dict d;
   d["path"] = path;
@@ -94,18 +95,10 @@ py::dict ReadLog(const std::string& path, const std::string& gaps, std::optional
       flags(static_cast<py::ssize_t>(i)) = log.logged[i];
     d["logged"] = logged;
   }
-  py::list starts;
-  for (const Eigen::Index s : log.record_starts) starts.append(s);
-  d["record_starts"] = starts;
-  py::list notes;
+  d["record_starts"] = log.record_starts;
+  py::list notes;  // as the CLI prints them (a gap note may hold a line per skipped row)
   for (const std::string* note : {&log.gap_note, &log.time_note}) {
-    // A note may hold several lines (skipped rows are listed on lines of their own).
-    size_t start = 0;
-    while (start < note->size()) {
-      const size_t end = std::min(note->find('\n', start), note->size());
-      if (end > start) notes.append(Text(note->substr(start, end - start)));
-      start = end + 1;
-    }
+    if (!note->empty()) notes.append(Text(*note));
   }
   d["notes"] = notes;
   return d;
