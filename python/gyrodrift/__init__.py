@@ -518,15 +518,17 @@ _show_settings(DriftModel.fit)
 _show_settings(evaluate, skip=("method",))
 
 
-def calibrate(manifest_path, output_dir, *, force=False, threads=0):
+def calibrate(manifest_path, output_dir, *, force=False, threads=0, progress=None):
     """Calibrates a fleet from a TOML manifest, as ``gyrodrift calibrate`` (docs/calibration.md).
 
     Returns a dict: ``rows`` (fleet.csv's rows, each a dict of its columns, as text), the counts
     (units, calibrated, skipped, errors, failed_limits), ``all_pass`` and ``summary``. Units
-    that fail their limits are rows, not exceptions. ``gyrodrift.fleet`` runs the same on Dask.
+    that fail their limits are rows, not exceptions. ``progress``: a callable given the share of
+    the units done. Ctrl-C stops the run once the units under way are written (those done stay;
+    a rerun skips them). ``gyrodrift.fleet`` runs the same on Dask.
     """
     return _call(_gyrodrift.calibrate, str(manifest_path), str(output_dir), force=force,
-                 threads=threads)
+                 threads=threads, progress=progress)
 
 
 def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, rate_hz=None,

@@ -164,7 +164,7 @@ def fit_defaults() -> dict[str, Any]: ...
 
 def calibrate(
     manifest_path: str | PathLike[str], output_dir: str | PathLike[str], *, force: bool = ...,
-    threads: int = ...,
+    threads: int = ..., progress: Callable[[float], object] | None = ...,
 ) -> dict[str, Any]: ...
 
 def demo(

@@ -61,20 +61,26 @@ fleet::Manifest LoadManifest(const std::string& path) {
   return m;
 }
 
+// Reports the units done to `progress` and stops at Ctrl-C once the units under way are written
+// (a unit is all there or not there; those done stay, and a rerun skips them).
 py::dict Calibrate(const std::string& manifest_path, const std::string& output_dir, bool force,
-                   int threads) {
+                   int threads, py::object progress) {
   ValidateThreads(threads);
+  LongCall call(std::move(progress));
+  const auto hook = call.Hook();
   fleet::FleetResult r;
-  {
-    py::gil_scoped_release release;
+  call.Run([&] {
     const fleet::Manifest m = LoadManifest(manifest_path);
     fleet::FleetOptions o;
     o.output_dir = output_dir;
     o.force = force;
     fleet::FleetContext context;
     context.threads = threads;
+    context.progress = [&hook](int done, int total, const std::string&, const std::string&) {
+      hook(static_cast<double>(done) / static_cast<double>(total), "");
+    };
     r = fleet::RunFleet(m, o, context);
-  }
+  });
   return FleetDict(r);
 }
 
@@ -128,7 +134,7 @@ py::dict FinishFleet(const std::string& manifest_path, const std::string& output
 void BindFleet(py::module_& m) {
   using py::arg;
   m.def("calibrate", &gp::Calibrate, arg("manifest_path"), arg("output_dir"), py::kw_only(),
-        arg("force") = false, arg("threads") = 0);
+        arg("force") = false, arg("threads") = 0, arg("progress") = py::none());
   m.def("_calibrate_unit", &gp::CalibrateUnit, arg("manifest_path"), arg("index"),
         arg("output_dir"), arg("force") = false);
   m.def("_finish_fleet", &gp::FinishFleet, arg("manifest_path"), arg("output_dir"), arg("units"),

@@ -118,10 +118,22 @@ def test_dask_fleet_matches_calibrate(cli, fleet):
     assert p.returncode == 0, p.stderr
     assert "2 units: 0 calibrated, 2 skipped" in p.stdout, p.stdout
 
-    # The in-process binding of RunFleet agrees too.
-    direct = gd.calibrate(fleet / "fleet.toml", fleet / "direct", threads=2)
+    # The in-process binding of RunFleet agrees too, and reports the share of the units done.
+    done = []
+    direct = gd.calibrate(fleet / "fleet.toml", fleet / "direct", threads=2, progress=done.append)
     assert [{k: v for k, v in row.items() if k != "unit_seconds"} for row in direct["rows"]] == \
            [{k: v for k, v in row.items() if k != "unit_seconds"} for row in r["rows"]]
+    assert done == [0.5, 1.0]
+
+    # Stopped after the first unit (as Ctrl-C stops it): that unit is written whole, the fleet's
+    # files are not, and the exception is the call's.
+    def stop(fraction):
+        raise RuntimeError("stop")
+    with pytest.raises(RuntimeError, match="stop"):
+        gd.calibrate(fleet / "fleet.toml", fleet / "stopped", threads=1, progress=stop)
+    assert [(fleet / "stopped" / sn / "summary.json").exists() for sn in ("SN1", "SN2")] == \
+           [True, False]
+    assert not (fleet / "stopped/fleet.csv").exists()
 
 
 def test_command_line_entry_point(fleet):

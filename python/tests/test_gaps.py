@@ -99,7 +99,7 @@ def test_read_log_fills_and_splits_as_the_cli(cli, tmp_path):
             assert np.array_equal(values, filled[name]), (gaps, name)
         assert np.array_equal(log["logged"], filled["interpolated"] == 0)
         assert log["record_starts"] == []
-        assert log["rate_hz"] == 1.0 and log["rate_source"] == "from the median step of time_s"
+        assert log["rate_hz"] == 1.0 and log["rate_source"] == "from the steps of time_s"
         assert "gaps" in log["notes"][0]
 
     # Split: the records' starts, which fit and allan take as --gaps split does.

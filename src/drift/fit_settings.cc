@@ -73,8 +73,23 @@ void FitSettings::Validate() const {
 }
 
 Method ResolveMethod(std::string_view method, Mode mode) {
-  if (method != "auto") return MethodFromString(method);
-  return mode == Mode::kCompensate ? Method::kThermal : Method::kMsElm;
+  if (method == "auto") return mode == Mode::kCompensate ? Method::kThermal : Method::kMsElm;
+  // The names this mode takes (a method of the other mode is refused where the mode is known,
+  // with its reason).
+  std::string allowed = "auto";
+  std::vector<Method> methods = AllMethods(mode);
+  for (Method m : ReferenceMethods()) {
+    if (SupportsMode(m, mode)) methods.push_back(m);
+  }
+  for (Method m : methods) {
+    if (ToString(m) == method) return m;
+    allowed += ", " + std::string(ToString(m));
+  }
+  for (Method m : AllMethods(mode == Mode::kCompensate ? Mode::kPredict : Mode::kCompensate)) {
+    if (ToString(m) == method) return m;
+  }
+  ThrowOption("method", "'" + std::string(method) + "'",
+              "one of " + allowed + " (in " + std::string(ToString(mode)) + " mode)");
 }
 
 DriftOptions MakeDriftOptions(const FitSettings& s) {

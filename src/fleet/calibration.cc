@@ -222,8 +222,9 @@ FittedUnit FitUnit(const Manifest& m, const UnitSpec& unit) {
   settings.threads = 1;
   FittedUnit fitted;
   for (const AxisSpec& axis : m.axes) {
-    const tasks::FitRun run = tasks::AssembleFitRun(cal, axis.target, Joined(axis.temperature),
-                                                    m.log, "target", "temperature");
+    tasks::FitRun run = tasks::AssembleFitRun(cal, axis.target, Joined(axis.temperature), m.log,
+                                              "target", "temperature");
+    if (!unit.calibration_as_written.empty()) run.source = Joined(unit.calibration_as_written);
     tasks::FitResult fit = tasks::RunFit(run, settings, std::string(allan::ToString(m.rate_unit)), m.log);
     AxisResult a = ModelFigures(axis, fit.axes.front());
     a.warnings.insert(a.warnings.end(), warnings.begin(), warnings.end());
@@ -347,6 +348,34 @@ bool ReadFinished(const std::string& folder, const std::string& fingerprint,
   }
 }
 
+// A unit that could not be calibrated loses what an earlier run wrote for it, which its error row
+// would contradict (a model.json from logs the manifest no longer names, a page saying PASS). The
+// summary goes first, so that a removal cut short leaves an unfinished unit, not a finished one
+// that is wrong; then the files it lists and the ones every unit has, nothing else of the folder,
+// and the folder when that leaves it empty.
+void RetractUnit(const std::string& folder) {
+  const fs::path summary = fs::path(folder) / kSummaryFile;
+  std::error_code ec;
+  if (!fs::is_regular_file(summary, ec)) return;
+  std::set<std::string> names = {"model.json", "allan.csv", "report.html"};
+  try {
+    const json j = json::parse(io::ReadTextFile(summary.string()));
+    for (const auto& [name, hash] : j.at("files").items()) names.insert(name);
+  } catch (const std::exception&) {
+    // A damaged summary: the files every unit has.
+  }
+  fs::remove(summary, ec);
+  for (const std::string& name : names) {
+    // Only names of the folder's own files (an edited summary could name others).
+    if (name.empty() || fs::path(name).filename() != fs::path(name) || name == "." ||
+        name == "..") {
+      continue;
+    }
+    fs::remove(fs::path(folder) / name, ec);
+  }
+  fs::remove(folder, ec);  // fails, leaving it, unless it is empty
+}
+
 }  // namespace
 
 void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::string& folder) {
@@ -414,6 +443,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     failed.error = e.what();
     run.rows = Rows(failed);
     run.what = "error";
+    RetractUnit(folder);
     return run;
   }
   if (!force && ReadFinished(folder, fingerprint, &run.rows)) {
@@ -424,6 +454,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
   run.rows = Rows(outputs.result);
   if (!outputs.result.error.empty()) {
     run.what = "error";
+    RetractUnit(folder);
     return run;
   }
   json hashes = json::object();
@@ -448,6 +479,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     outputs.result.error = e.what();
     run.rows = Rows(outputs.result);
     run.what = "error";
+    RetractUnit(folder);
   }
   return run;
 }

@@ -19,6 +19,10 @@ namespace fs = std::filesystem;
 
 std::string Fmt(double v) { return std::isnan(v) ? "" : io::FormatDouble(v); }
 
+// A noise term the Allan fit did not identify is empty, not its 0 (a set limit on B is then held
+// against B's bound: Failures).
+std::string Term(const allan::NoiseTerm& t) { return t.identified ? Fmt(t.value) : ""; }
+
 int ColumnIndex(const std::string& name) {
   const auto& c = FleetColumns();
   return static_cast<int>(std::find(c.begin(), c.end(), name) - c.begin());
@@ -119,19 +123,21 @@ std::vector<FleetRow> Rows(const UnitResult& unit) {
                                Fmt(v.drift_rms_after),
                                Fmt(drift_removed),
                                Fmt(v.truth_removed),
-                               Fmt(v.noise_before.n_dpsh.value),
-                               Fmt(v.noise_after.n_dpsh.value),
-                               Fmt(v.noise_before.b_dph.value),
-                               Fmt(v.noise_after.b_dph.value),
-                               Fmt(v.noise_before.k_dphpsh.value),
-                               Fmt(v.noise_after.k_dphpsh.value),
+                               Term(v.noise_before.n_dpsh),
+                               Term(v.noise_after.n_dpsh),
+                               Term(v.noise_before.b_dph),
+                               Term(v.noise_after.b_dph),
+                               Term(v.noise_before.k_dphpsh),
+                               Term(v.noise_after.k_dphpsh),
                                Fmt(a.bias),
                                Fmt(a.cv_rmse),
                                Fmt(a.skill),
                                Fmt(a.autopilot_kept),
                                regressors,
                                warnings,
-                               !a.identified ? "" : *a.identified ? "yes" : "no",
+                               !a.identified   ? ""
+                               : *a.identified ? "yes"
+                                               : "no",
                                Fmt(v.outside_share),
                                Fmt(v.mean_before),
                                Fmt(v.mean_after),

@@ -362,6 +362,7 @@ void ReadUnits(const toml::table& root, const Context& c, const std::string& pat
     }
     for (const std::string& log : unit.Strings("calibration")) {
       u.calibration.push_back(Resolve(path, log));
+      u.calibration_as_written.push_back(log);
     }
     if (u.calibration.size() > 1 && m.FitMethod() != drift::Method::kThermal) {
       c.Fail(*unit.Find("calibration"),

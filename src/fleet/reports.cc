@@ -21,6 +21,11 @@ std::string Num(double v, int digits = 4) {
   return std::isnan(v) ? "-" : fmt::format("{:.{}g}", v, digits);
 }
 
+// A noise term the Allan fit did not identify: said, not its 0.
+std::string TermText(const allan::NoiseTerm& t) {
+  return t.identified ? Num(t.value) : "not identified";
+}
+
 std::string Percent(double share) {
   return std::isnan(share) ? "-" : fmt::format("{:.1f} %", 100.0 * share);
 }
@@ -79,11 +84,11 @@ void AddAxisSummary(html::HtmlReport& report, const Manifest& m, const AxisResul
     for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
     table.rows.push_back({std::filesystem::path(v.log).filename().string(),
                           std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
-                          Num(v.std_before), Num(v.std_after),
-                          Num(v.drift_rms_before), Num(v.drift_rms_after),
-                          Percent(v.truth_removed), Num(v.noise_after.n_dpsh.value),
-                          Num(v.noise_before.b_dph.value), Num(v.noise_after.b_dph.value),
-                          Percent(v.outside_share), failures.empty() ? "none" : failures});
+                          Num(v.std_before), Num(v.std_after), Num(v.drift_rms_before),
+                          Num(v.drift_rms_after), Percent(v.truth_removed),
+                          TermText(v.noise_after.n_dpsh), TermText(v.noise_before.b_dph),
+                          TermText(v.noise_after.b_dph), Percent(v.outside_share),
+                          failures.empty() ? "none" : failures});
   }
   table.caption = fmt::format(
       "Residual drift: RMS of the output's {:g}-s means about their mean, {}. True drift "

@@ -47,6 +47,34 @@ const TimeAxis* RegularAxis(const CsvTable& table) {
   return axis && axis->complete() && axis->increasing() && axis->rows() >= 2 ? axis : nullptr;
 }
 
+// The clock's step: the mean of the steps within 1 % of the median step. Large time stamps (epoch
+// seconds) round every step to a representable difference, so the median step of a 100 Hz log
+// stamped near 1.76e9 s is 0.0099999905 s (100.0000954 Hz), while the mean of such steps carries
+// no such rounding. A step further off is a gap, a late, an extra or a missed sample, which the
+// median ignores and the mean would not. The median stands where the two agree to 1e-9, so a
+// decimal clock (steps of 0.1 s, each a bit off in binary) keeps its decimal rate.
+double ClockStep(const CsvTable& table, const TimeAxis* axis, double median) {
+  const double lo = 0.99 * median, hi = 1.01 * median;
+  double mean = 0.0;
+  if (axis) {
+    mean = axis->MeanStepWithin(lo, hi);
+  } else {
+    const Eigen::VectorXd& t = table.ColumnRef("time_s");
+    long double sum = 0.0L;
+    Eigen::Index count = 0;
+    for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
+      const double step = t[i + 1] - t[i];
+      if (step >= lo && step <= hi) {
+        sum += step;
+        ++count;
+      }
+    }
+    mean = static_cast<double>(sum / static_cast<long double>(count));
+  }
+  // No step within 1 % (an even count whose middle two straddle it): the median.
+  return std::abs(mean / median - 1.0) > 1e-9 ? mean : median;
+}
+
 // Whether the caller's user sets the log options as flags (--gaps) rather than manifest keys.
 bool SpeltAsFlags(const LogOptions& options) { return options.gaps_name.rfind("--", 0) == 0; }
 
@@ -325,7 +353,7 @@ double ResolveSampleRate(const CsvTable& table, double given, std::string* how) 
                     " s: it must increase to give the sample rate (or give rate_hz)");
   }
   *how = "time_s";
-  const double rate = 1.0 / median;
+  const double rate = 1.0 / ClockStep(table, axis, median);
   if (!(rate >= 1e-9 && rate <= 1e6)) {
     throw DataError(table.source() + ": column 'time_s' has a median step of " +
                     FormatValue(median) + " s, a sample rate of " + FormatValue(rate) +

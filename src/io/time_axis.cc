@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace gyrodrift::io {
 
@@ -72,6 +73,19 @@ Eigen::Index TimeAxis::StepsBelow(double limit) const {
     if (s.value < limit) below += s.count;
   }
   return below;
+}
+
+double TimeAxis::MeanStepWithin(double lo, double hi) const {
+  long double sum = 0.0L;
+  Eigen::Index within = 0;
+  for (const Step& s : steps_) {
+    if (s.value >= lo && s.value <= hi) {
+      sum += static_cast<long double>(s.count) * s.value;
+      within += s.count;
+    }
+  }
+  return within > 0 ? static_cast<double>(sum / static_cast<long double>(within))
+                    : std::numeric_limits<double>::quiet_NaN();
 }
 
 TimeAxis::Step TimeAxis::Shortest() const {

@@ -162,8 +162,17 @@ FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
         progress(static_cast<int>(i), fraction, step);
       };
     }
-    axis.model = drift::FitDriftModel(run.rows.rows.col(i), temperature, r.options,
-                                      run.rows.record_starts, execution, run.rows.logged);
+    try {
+      axis.model = drift::FitDriftModel(run.rows.rows.col(i), temperature, r.options,
+                                        run.rows.record_starts, execution, run.rows.logged);
+    } catch (const DataError& e) {
+      // The library sees arrays ("target", "temperature"): the columns and logs are named here,
+      // so that a fleet's unit of several axes says which one.
+      throw DataError(
+          fmt::format("fitting '{}'{} ({}): {}", axis.info.target_column,
+                      temperature_column.empty() ? "" : " on '" + temperature_column + "'",
+                      run.source, e.what()));
+    }
     r.axes.push_back(std::move(axis));
   }
   return r;

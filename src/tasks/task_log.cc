@@ -29,7 +29,7 @@ bool SpeltAsFlags(const io::LogOptions& log) { return log.gaps_name.rfind("--", 
 std::string RateSourceText(const std::string& how, bool flags) {
   const std::string rate = flags ? "--rate-hz" : "rate_hz";
   return how == "given"    ? "given by " + rate
-         : how == "time_s" ? "from the median step of time_s"
+         : how == "time_s" ? "from the steps of time_s"
                            : "assumed: no " + rate + " and no time_s column";
 }
 

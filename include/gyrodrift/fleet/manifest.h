@@ -84,6 +84,10 @@ struct UnitSpec {
   std::vector<std::string> calibration;   // resolved paths, fitted as records of one run
   std::vector<std::string> verification;  // resolved paths
   int line = 0;
+  // As the manifest names them: the model file's training.source, the same whichever folder or
+  // runner (calibrate, Python, Dask) the run starts from. Empty (a spec built in code): the
+  // resolved paths.
+  std::vector<std::string> calibration_as_written;
 };
 
 struct Manifest {

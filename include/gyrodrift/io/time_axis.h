@@ -33,6 +33,8 @@ class TimeAxis {
   double LargestStep() const;
   // The number of steps below `limit`.
   Eigen::Index StepsBelow(double limit) const;
+  // The mean of the steps in [lo, hi] (NaN when there are none).
+  double MeanStepWithin(double lo, double hi) const;
   // The smallest step and the 0-based index i of its first occurrence (t[i+1] - t[i]).
   struct Step {
     double value = 0.0;

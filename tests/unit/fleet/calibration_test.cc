@@ -340,6 +340,9 @@ TEST(Rows, EveryCellComesFromTheResult) {
   v.noise_after.b_dph.value = 0.01;
   v.noise_before.k_dphpsh.value = 0.002;
   v.noise_after.k_dphpsh.value = 0.001;
+  for (allan::NoiseTerms* t : {&v.noise_before, &v.noise_after}) {
+    t->n_dpsh.identified = t->b_dph.identified = t->k_dphpsh.identified = true;
+  }
   v.failures = {"residual drift 0.05 > 0.04"};
   a.verification = {v};
   u.axes = {a};
@@ -385,6 +388,10 @@ TEST(Rows, EveryCellComesFromTheResult) {
     EXPECT_EQ(FleetColumns()[i], expected[i].first);
     EXPECT_EQ(row.cells[i], expected[i].second) << expected[i].first;
   }
+  // A noise term the fit did not identify is empty, not its 0 (nor in the outliers' statistics).
+  u.axes[0].verification[0].noise_after.b_dph = allan::NoiseTerm{};
+  EXPECT_EQ(Cell(Rows(u).at(0), "bias_instability_after_dph"), "");
+  u.axes[0].verification[0].noise_after.b_dph = v.noise_after.b_dph;
   // No drift before: the share removed is not applicable rather than a division by zero.
   u.axes[0].verification[0].drift_rms_before = 0.0;
   u.axes[0].verification[0].failures.clear();
@@ -438,6 +445,30 @@ TEST_F(FleetCalibration, AFailingUnitIsReportedAndTheOthersGoOn) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4) << csv;
   EXPECT_NE(csv.find("\nSNX,,,error,"), std::string::npos) << csv;
   EXPECT_TRUE(test::CheckReportHtml(io::ReadTextFile(out + "/fleet.html")).ok());
+}
+
+// A unit that becomes an error loses what an earlier run wrote for it (a model and a page from
+// logs the manifest no longer names, which its error row would contradict); a file of the user's
+// in its folder stays.
+TEST_F(FleetCalibration, AUnitThatBecomesAnErrorLosesItsEarlierResults) {
+  const std::string out = Dir() + "/out_retract";
+  const Manifest good = Make("", {{"SNR", "SN1_cal.csv", "SN1_ver.csv"}});
+  ASSERT_EQ(RunUnit(good, good.units[0], out, false, test::FakeDygraphs()).what, "calibrated");
+  // The model names its logs as the manifest does, whatever folder the run starts from.
+  EXPECT_NE(io::ReadTextFile(out + "/SNR/model.json").find("\"source\": \"SN1_cal.csv\""),
+            std::string::npos);
+  const Manifest bad = Make("", {{"SNR", "SN1_cal.csv", "SNX_ver.csv"}});
+  EXPECT_EQ(RunUnit(bad, bad.units[0], out, false, test::FakeDygraphs()).what, "error");
+  EXPECT_FALSE(test::FileExists(out + "/SNR"));
+  // Again, with a note of the user's in the folder: the unit's files go, the note stays.
+  ASSERT_EQ(RunUnit(good, good.units[0], out, false, test::FakeDygraphs()).what, "calibrated");
+  io::WriteFileAtomically(out + "/SNR/notes.txt", "checked by hand\n");
+  EXPECT_EQ(RunUnit(bad, bad.units[0], out, false, test::FakeDygraphs()).what, "error");
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(out + "/SNR")) {
+    left.push_back(entry.path().filename().string());
+  }
+  EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
 }
 
 TEST_F(FleetCalibration, AFinishedUnitIsSkippedAndADamagedOneRedone) {

@@ -128,6 +128,8 @@ VerificationResult Verification(const std::string& log, double drift_after, doub
   v.noise_after.n_dpsh.value = 0.00458;
   v.noise_before.b_dph.value = 0.5;
   v.noise_after.b_dph.value = 0.0125;
+  v.noise_after.n_dpsh.identified = v.noise_before.b_dph.identified = true;
+  v.noise_after.b_dph.identified = true;
   v.tau_s = (Eigen::VectorXd(3) << 1.0, 2.0, 4.0).finished();
   v.adev_before = (Eigen::VectorXd(3) << 0.5, 0.375, 0.25).finished();
   v.adev_after = (Eigen::VectorXd(3) << 0.25, 0.125, 0.0625).finished();

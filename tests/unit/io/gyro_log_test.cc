@@ -2,11 +2,14 @@
 // by linear interpolation under an explicit policy.
 #include "gyrodrift/io/gyro_log.h"
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <optional>
 
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/common/statistics.h"
 #include "gyrodrift/io/files.h"
 #include "support/test_support.h"
 
@@ -206,6 +209,41 @@ TEST(GyroLog, ACallerNamingItsColumnsGetsTheSameChecksWithoutTheTimeColumn) {
                                        "(shortest 0.2 s, before data row 3)"),
             std::string::npos)
       << NonUniformTimeNote(t);
+}
+
+// The rate is the clock's: epoch time stamps round every step (a 100 Hz log stamped near 1.76e9 s
+// has a median step of 0.0099999905 s, 100.0000954 Hz: `--taus 1` was refused as not a whole
+// number of periods), a decimal clock keeps its decimal rate, and an extra sample does not move it.
+TEST(GyroLog, TheRateIsTheClocksWhateverItsStampsRoundTo) {
+  auto rate_of = [](const std::string& path, bool whole) {
+    const CsvTable t = whole ? ReadLog(path) : ReadLog(path, {}, nullptr, nullptr, {"r"});
+    EXPECT_EQ(t.time_axis() == nullptr, whole) << path;
+    std::string how;
+    const double rate = ResolveSampleRate(t, 0.0, &how);
+    EXPECT_EQ(how, "time_s");
+    return rate;
+  };
+  std::string epoch = "time_s,r\n", decimal = "time_s,r\n";
+  for (int i = 0; i < 3000; ++i) {
+    epoch += fmt::format("{:.6f},{}\n", 1764230400.0 + i / 100.0, i % 7);
+    decimal += fmt::format("{:.1f},{}\n", i / 10.0, i % 7);
+  }
+  // Write clears the folder: one file at a time.
+  const std::string epoch_path = Write("epoch.csv", epoch);
+  // What the median step gave.
+  EXPECT_GT(std::abs(1.0 / MedianStep(ReadLog(epoch_path).Column("time_s")) - 100.0), 1e-5);
+  EXPECT_NEAR(rate_of(epoch_path, false), 100.0, 1e-6);
+  EXPECT_NEAR(rate_of(epoch_path, true), 100.0, 1e-6);
+  const std::string decimal_path = Write("decimal.csv", decimal);
+  const double decimal_rate = 1.0 / MedianStep(ReadLog(decimal_path).Column("time_s"));
+  EXPECT_EQ(rate_of(decimal_path, false), decimal_rate);
+  EXPECT_EQ(rate_of(decimal_path, true), decimal_rate);
+  // One extra sample in a 1-Hz log (steps 1, 0.2, 0.8, 1, ...): still 1 Hz.
+  std::string extra = "time_s,r\n0,1\n1,2\n1.2,3\n";
+  for (int i = 2; i < 40; ++i) extra += fmt::format("{},{}\n", i, i % 5);
+  const std::string extra_path = Write("extra.csv", extra);
+  EXPECT_EQ(rate_of(extra_path, false), 1.0);
+  EXPECT_EQ(rate_of(extra_path, true), 1.0);
 }
 
 TEST(GyroLog, TheDelimiterCanBeNamed) {

@@ -58,6 +58,17 @@ TEST(TimeAxis, StepsAreTheColumnsStepsBitForBit) {
         EXPECT_EQ(axis.Shortest().value, shortest);
         EXPECT_EQ(axis.Shortest().first, first);
         EXPECT_EQ(axis.LargestStep(), largest);
+        long double sum = 0.0L;
+        Eigen::Index within = 0;
+        for (Eigen::Index i = 0; i + 1 < n; ++i) {
+          const double step = t[i + 1] - t[i];
+          if (step >= 0.99 * median && step <= 1.01 * median) {
+            sum += step;
+            ++within;
+          }
+        }
+        EXPECT_NEAR(axis.MeanStepWithin(0.99 * median, 1.01 * median),
+                    static_cast<double>(sum / within), 1e-15 * median);
       }
     }
   }

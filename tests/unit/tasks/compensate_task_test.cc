@@ -130,7 +130,7 @@ TEST(CompensateTask, RefusesALogAtAnotherSampleRate) {
     FAIL() << "a 10 Hz log ran through a 1 Hz model";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find(
-                  "fast.csv is sampled at 10 Hz (from the median step of time_s), m.json was "
+                  "fast.csv is sampled at 10 Hz (from the steps of time_s), m.json was "
                   "fitted at 1 Hz: its thermal lags and temperature rates would run 10 times too "
                   "fast (resample the log to 1 Hz, fit the model on a log at 10 Hz, or give "
                   "--rate-hz if time_s is wrong)"),
