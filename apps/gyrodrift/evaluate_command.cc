@@ -103,7 +103,7 @@ void Run(const EvaluateArgs& a) {
   for (const std::string* note : {&log.gap_note, &log.time_note}) {
     if (!note->empty()) notes += *note + (note->back() == '\n' ? "" : "\n");
   }
-  notes += tasks::EvaluateNotes(run.result);
+  notes += tasks::EvaluateNotes(run);
   io::WriteFilesAtomically({{a.output, tasks::EvaluateTableCsv(run.result)},
                             {SidecarPath(a.output), sidecar.dump(2) + "\n"}});
   if (a.quiet) return;
@@ -155,10 +155,11 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
                               "scored")
                   ->capture_default_str(),
               {"methods"});
-  BindSetting(
-      cmd->add_option("--repeats,-r", args->evaluation.repeats, "seeds seed..seed+R-1; mean and std over them")
-          ->capture_default_str(),
-      {"repeats"});
+  BindSetting(cmd->add_option("--repeats,-r", args->evaluation.repeats,
+                              "repeats: the first with --seed, repeat r > 0 with a seed derived "
+                              "from --seed and r; mean and std over them")
+                  ->capture_default_str(),
+              {"repeats"});
   BindSetting(
       cmd->add_option("--window,-W", args->evaluation.window, "causal protocol: trailing window W, samples")
           ->capture_default_str(),

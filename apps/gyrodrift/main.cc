@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
       "  gyrodrift export model.json --format c -o gyro_comp.h  # the model as C99 for firmware\n"
       "  gyrodrift demo                                        # everything, with an HTML report\n"
       "Run 'gyrodrift SUBCOMMAND --help' for each subcommand. Exit codes: 0 ok, 2 usage,\n"
-      "3 data, 4 file I/O, 1 internal error (see docs/errors.md).");
+      "3 data, 4 file I/O, 5 a fleet unit did not pass (calibrate), 1 internal error\n"
+      "(see docs/errors.md).");
   app.set_version_flag("--version", std::string("gyrodrift ") + gyrodrift::kVersion);
   app.require_subcommand(1);
   auto& commands = gyrodrift::cli::Commands();

@@ -61,8 +61,9 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
   WarnOfTemperatures(temperature, TemperatureNames(temperature.cols()));
   Eigen::VectorXd truth;
   if (truth_in) truth = ToVector(*truth_in, "truth");
-  drift::EvaluationResult result;
-  call.Run([&] { result = tasks::RunEvaluate(y, temperature, truth, settings, call.Hook()).result; });
+  tasks::EvaluateRun run;
+  call.Run([&] { run = tasks::RunEvaluate(y, temperature, truth, settings, call.Hook()); });
+  const drift::EvaluationResult& result = run.result;
 
   py::list rows;
   for (const drift::EvaluationRow& r : result.rows) {
@@ -92,6 +93,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
       py::make_tuple(result.training_temperature_min_c, result.training_temperature_max_c);
   out["test_outside_training_temperature_share"] = result.test_outside_training_temperature_share;
   out["table"] = result.Table();
+  out["notes"] = tasks::EvaluateNotes(run);  // the CLI's notes after its table
   return out;
 }
 

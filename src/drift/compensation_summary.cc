@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <vector>
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/records.h"
 
 namespace gyrodrift::drift {
 namespace {
@@ -34,36 +36,64 @@ Eigen::VectorXd BlockMeans(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::In
   return out;
 }
 
-SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block) {
-  RequireFiniteSignal("signal", x, 1);
+SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block,
+                        const std::vector<bool>& logged) {
+  CheckLogged(logged, x.size());
+  RequireFiniteLogged("signal", x, logged, 1);
+  block = std::max<Eigen::Index>(1, block);
   SignalSummary s;
-  s.mean = x.mean();
-  s.std = RmsAboutMean(x);
-  s.rms = std::sqrt(x.squaredNorm() / static_cast<double>(x.size()));
-  s.slow = x.size() / std::max<Eigen::Index>(1, block) >= 2
-               ? RmsAboutMean(BlockMeans(x, block))
-               : std::numeric_limits<double>::quiet_NaN();
+  if (logged.empty()) {
+    s.mean = x.mean();
+    s.std = RmsAboutMean(x);
+    s.rms = std::sqrt(x.squaredNorm() / static_cast<double>(x.size()));
+    s.blocks = x.size() / block;
+    s.slow = s.blocks >= 2 ? RmsAboutMean(BlockMeans(x, block))
+                           : std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  const Eigen::VectorXd kept = LoggedRows(x, logged);
+  s.mean = kept.mean();
+  s.std = RmsAboutMean(kept);
+  s.rms = std::sqrt(kept.squaredNorm() / static_cast<double>(kept.size()));
+  // Blocks of the time grid (a last partial one dropped), each the mean of its logged samples; a
+  // block with none is left out.
+  std::vector<double> means;
+  for (Eigen::Index b = 0; b + 1 <= x.size() / block; ++b) {
+    double sum = 0.0;
+    Eigen::Index count = 0;
+    for (Eigen::Index i = b * block; i < (b + 1) * block; ++i) {
+      if (!logged[static_cast<size_t>(i)]) continue;
+      sum += x[i];
+      ++count;
+    }
+    if (count > 0) means.push_back(sum / static_cast<double>(count));
+  }
+  s.blocks = static_cast<Eigen::Index>(means.size());
+  s.slow = s.blocks >= 2 ? RmsAboutMean(Eigen::Map<const Eigen::VectorXd>(means.data(), s.blocks))
+                         : std::numeric_limits<double>::quiet_NaN();
   return s;
 }
 
 CompensationSummary SummariseCompensation(const Eigen::Ref<const Eigen::VectorXd>& y,
                                           const Eigen::Ref<const Eigen::VectorXd>& compensated,
-                                          double rate_hz, double block_s) {
+                                          double rate_hz, double block_s,
+                                          const std::vector<bool>& logged) {
   RequireInRange("rate_hz", rate_hz, 1e-9, 1e6);
   RequireInRange("block_s", block_s, 1e-6, 1e9);
-  RequireFiniteSignal("output", y, 1);
-  RequireFiniteSignal("compensated output", compensated, 1);
+  CheckLogged(logged, y.size());
+  RequireFiniteLogged("output", y, logged, 1);
+  RequireFiniteLogged("compensated output", compensated, logged, 1);
   if (compensated.size() != y.size()) {
     throw DataError("compensation summary: the output has " + std::to_string(y.size()) +
                     " samples, the compensated output " + std::to_string(compensated.size()));
   }
   CompensationSummary s;
-  s.samples = y.size();
+  s.samples = CountLogged(logged, y.size());
   s.block_s = block_s;
   s.block = std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(block_s * rate_hz)));
-  s.blocks = y.size() / s.block;
-  s.before = Summarise(y, s.block);
-  s.after = Summarise(compensated, s.block);
+  s.before = Summarise(y, s.block, logged);
+  s.after = Summarise(compensated, s.block, logged);
+  s.blocks = s.before.blocks;
   return s;
 }
 

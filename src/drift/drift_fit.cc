@@ -15,6 +15,7 @@
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
 #include "gyrodrift/drift/drift_model.h"
+#include "gyrodrift/drift/records.h"
 
 namespace gyrodrift::drift {
 namespace internal {
@@ -121,7 +122,7 @@ void FitLearners(DriftModel& model, const Eigen::Ref<const Eigen::MatrixXd>& ser
   assert(logged.empty() || (o.mode == Mode::kCompensate &&
                             static_cast<Eigen::Index>(logged.size()) == fit_end));
   const Execution learners{.threads = threads};
-  model.training_samples = fit_end;
+  model.training_samples = CountLogged(logged, fit_end);  // the samples fitted, not the grid's
   const size_t groups = model.sub_models.size();
   if (IdentifiesThermalModel(o)) {
     // Every sub-series chooses its own thermal states: fast rate terms for the noise and mixed
@@ -234,7 +235,7 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
     DriftModel model;
     model.options = o;
     model.lags = o.mode == Mode::kPredict ? 1 : 0;
-    model.training_samples = y.size();
+    model.training_samples = CountLogged(logged, y.size());
     auto baseline = std::make_shared<const Baseline>(FitBaseline(o.method, y));
     model.sub_models.push_back({.name = "signal", .has_residue = true, .baseline = std::move(baseline)});
     if (model.uses_temperature()) {

@@ -53,8 +53,11 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   Trial trial;
   auto start = std::chrono::steady_clock::now();
   DriftModel model;
-  // Paper protocol: the whole record is decomposed (and grouped) before the split.
-  const bool decompose_all = protocol == Protocol::kPaper && UsesDecomposition(o.method);
+  // Paper protocol: the whole record is decomposed (and grouped) before the split. Predict mode
+  // only: in compensate mode that would fit the model on the test block's output, which the
+  // estimate (from temperature alone) must never see (until 2026-11-27 it did).
+  const bool decompose_all =
+      protocol == Protocol::kPaper && UsesDecomposition(o.method) && o.mode == Mode::kPredict;
   Eigen::MatrixXd series_all;
   Eigen::MatrixXd thermal_all;
   if (thermal_needed && !IdentifiesThermalModel(o)) {
@@ -91,7 +94,10 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
         horizon, Protocol::kCausal, causal, windows);
   }
   trial.predict_s = Seconds(start);
-  if (protocol == Protocol::kCausal) trial.note = CausalWindowNote(model, causal.window);
+  // A compensate-mode estimate reads no window of the output.
+  if (protocol == Protocol::kCausal && o.mode == Mode::kPredict) {
+    trial.note = CausalWindowNote(model, causal.window);
+  }
   return trial;
 }
 
@@ -322,10 +328,12 @@ EvaluationResult Evaluate(const Eigen::Ref<const Eigen::VectorXd>& y,
                                           static_cast<size_t>(options.repeats))};
   double done = 0;
   for (Method method : methods) {
-    // Single models never decompose: both protocols are the same computation, run once.
+    // Single models never decompose, and in compensate mode nothing is decomposed past the
+    // training block: both protocols are the same computation, run once.
+    const bool one_computation = !UsesDecomposition(method) || base.mode == Mode::kCompensate;
     std::vector<EvaluationRow> computed;
     for (Protocol protocol : options.protocols) {
-      if (!UsesDecomposition(method) && !computed.empty()) {
+      if (one_computation && !computed.empty()) {
         EvaluationRow row = computed.front();
         row.protocol = protocol;
         result.rows.push_back(row);

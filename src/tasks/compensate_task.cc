@@ -62,8 +62,8 @@ std::string AxisText(const io::LoadedModel& loaded, const AxisCompensation& c,
   // Files before format 4 did not record the unit: the table then names none.
   std::string text =
       model.Summary() + "\n" + c.summary.Table(loaded.info.target_column, loaded.info.rate_unit);
-  // Filled gaps: the figures leave the made-up rows out (the slow variation's blocks then hold
-  // consecutive logged samples, which span more time).
+  // Filled gaps: the figures leave the made-up rows out (the slow variation's blocks are blocks
+  // of time, each the mean of its logged samples).
   if (!logged.empty()) {
     text += fmt::format("{}: statistics over the {} logged rows ({} made up left out)\n",
                         loaded.info.target_column, c.summary.samples,
@@ -164,14 +164,14 @@ AxisCompensation CompensateAxis(const io::LoadedModel& loaded, const Eigen::Vect
   c.sd = estimate_sd.col(1);
   c.compensated = y_all - c.estimate;
   c.identified = model.identified();
-  const Eigen::VectorXd y = drift::LoggedRows(y_all, logged);
   const Eigen::VectorXd estimate = drift::LoggedRows(c.estimate, logged);
-  const Eigen::VectorXd compensated = drift::LoggedRows(c.compensated, logged);
   // The mean, RMS, std and slow variation before and after (a calibration mostly moves the
-  // bias, which the std alone hides), blocks timed at the model's sample rate unless given.
+  // bias, which the std alone hides), over the logged rows, blocks timed at the model's sample
+  // rate unless given.
   c.summary = drift::SummariseCompensation(
-      y, compensated, settings.rate_hz > 0.0 ? settings.rate_hz : model.options.features.rate_hz,
-      settings.drift_window_s);
+      y_all, c.compensated,
+      settings.rate_hz > 0.0 ? settings.rate_hz : model.options.features.rate_hz,
+      settings.drift_window_s, logged);
   // Against a known drift: how much of its RMS the estimate removes, RMS about zero (the
   // drift's offset is part of it).
   if (truth_all.size() > 0) {

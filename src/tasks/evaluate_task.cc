@@ -162,12 +162,22 @@ json EvaluateRecord(const EvaluateRun& run, const EvaluateInput& in) {
   return j;
 }
 
-std::string EvaluateNotes(const drift::EvaluationResult& result) {
+std::string EvaluateNotes(const EvaluateRun& run) {
+  const drift::EvaluationResult& result = run.result;
   std::string notes;
   for (const auto& r : result.rows) {
     for (const std::string& note : r.notes) {
       notes += std::string(drift::ToString(r.method)) + ", " + note + "\n";
     }
+  }
+  // The recursion of an H-step prediction reads the temperature of each step it predicts: a
+  // temperature known ahead (a chamber's programme), which the baselines do not read.
+  if (result.mode == drift::Mode::kPredict && run.options.horizon > 1 &&
+      run.base.uses_temperature()) {
+    notes += fmt::format(
+        "note: the {}-step predictions of the methods given a temperature read it up to the "
+        "predicted sample (a temperature programme known ahead); the baselines read none\n",
+        run.options.horizon);
   }
   // Test temperatures beyond the training block's make every thermal model extrapolate.
   const double outside = result.test_outside_training_temperature_share;

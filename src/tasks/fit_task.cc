@@ -97,6 +97,13 @@ void CheckFitRun(const FitRun& run, const drift::DriftOptions& o, const io::LogO
                             "'thermal' only (a decomposition or lags would run across the breaks)",
                             method, why));
   }
+  if (!run.rows.logged.empty() && !o.linear_compensation) {
+    throw UsageError(flags ? "--nonlinear: the nonlinear correction needs every sample logged, not "
+                             "the gaps carried (--gaps carry): use --gaps interpolate or leave "
+                             "--nonlinear out"
+                           : "nonlinear: the nonlinear correction needs every sample logged, not "
+                             "the gaps carried (logged rows only)");
+  }
   if (!run.rows.logged.empty() &&
       (o.mode != drift::Mode::kCompensate || drift::UsesDecomposition(o.method))) {
     const std::string mode(drift::ToString(o.mode));
@@ -165,6 +172,10 @@ FitResult RunFit(const FitRun& run, const drift::FitSettings& settings,
     try {
       axis.model = drift::FitDriftModel(run.rows.rows.col(i), temperature, r.options,
                                         run.rows.record_starts, execution, run.rows.logged);
+    } catch (const OptionError& e) {
+      // The library names its setting; the CLI's user typed the flag.
+      if (e.option() != "temperature" || !SpeltAsFlags(log)) throw;
+      throw OptionError("--temperature", e.value(), e.rule());
     } catch (const DataError& e) {
       // The library sees arrays ("target", "temperature"): the columns and logs are named here,
       // so that a fleet's unit of several axes says which one.

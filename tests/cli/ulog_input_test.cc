@@ -18,15 +18,15 @@ namespace {
 constexpr double kRadsPerDph = M_PI / 180.0 / 3600.0;
 
 // A 40-min thermal log as a ULog: x the log's rate, y its opposite, z half of it.
-std::string WriteLog(const std::string& dir) {
-  io::WriteFileAtomically(dir + "/log.csv", test::ThermalLogCsv(2400, 11));
+std::string WriteLog(const std::string& dir, const std::string& name = "log", int seed = 11) {
+  io::WriteFileAtomically(dir + "/" + name + ".csv", test::ThermalLogCsv(2400, seed));
   std::vector<std::string> header;
-  const Eigen::MatrixXd m = test::ReadCsvMatrix(dir + "/log.csv", &header);
+  const Eigen::MatrixXd m = test::ReadCsvMatrix(dir + "/" + name + ".csv", &header);
   EXPECT_EQ(header[1], "rate_dph");
   Eigen::MatrixXd xyz(m.rows(), 3);
   xyz << m.col(1) * kRadsPerDph, -m.col(1) * kRadsPerDph, 0.5 * m.col(1) * kRadsPerDph;
-  test::WriteSensorGyroUlog(dir + "/log.ulg", m.col(0), xyz, m.col(2), 2490378, 1);
-  return dir + "/log.ulg";
+  test::WriteSensorGyroUlog(dir + "/" + name + ".ulg", m.col(0), xyz, m.col(2), 2490378, 1);
+  return dir + "/" + name + ".ulg";
 }
 
 std::string Read(const std::string& path) { return io::ReadTextFile(path); }
@@ -69,10 +69,10 @@ TEST(UlogInputCli, CalibrateReadsAUlogAsFitDoes) {
   for (const char* axis : {"x_dph", "y_dph", "z_dph"}) {
     manifest += std::string("[[axis]]\ntarget = \"") + axis + "\"\ntemperature = \"temperature_c\"\n";
   }
-  // The verification a copy: one file cannot be both (FitUnit refuses it).
-  std::filesystem::copy_file(ulg, d + "/ver.ulg");
-  manifest += "[[unit]]\nserial = \"IMU\"\ncalibration = \"" + ulg + "\"\nverification = \"" + d +
-              "/ver.ulg\"\n";
+  // The verification another run (a copy of the calibration is refused: FitUnit).
+  const std::string ver = WriteLog(d, "ver", 12);
+  manifest +=
+      "[[unit]]\nserial = \"IMU\"\ncalibration = \"" + ulg + "\"\nverification = \"" + ver + "\"\n";
   io::WriteFileAtomically(d + "/fleet.toml", manifest);
   const test::CommandResult cal =
       test::RunCli("calibrate '" + d + "/fleet.toml' -o '" + d + "/out' -q");

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 namespace gyrodrift::drift {
 
@@ -30,28 +31,35 @@ struct SignalSummary {
   double rms = 0.0;  // about zero: sqrt(mean^2 + std^2)
   double std = 0.0;  // about the mean (population)
   double slow = 0.0;  // slow variation (header comment); NaN for fewer than 2 blocks
+  Eigen::Index blocks = 0;  // the blocks the slow variation is over
 };
 
-// Figures of x (non-empty, finite) with blocks of `block` samples (>= 1).
-SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block);
+// Figures of x (finite where logged) with blocks of `block` samples (>= 1). `logged` (empty, or
+// one flag per sample, false on a row made up across a gap: --gaps carry) keeps the figures to
+// the logged samples; the blocks stay blocks of the time grid, each the mean of its logged
+// samples, and a block with none is left out (until 2026-11-27 the blocks were counted in logged
+// samples: with 5 s logged of every 300 s, a "600-s block" spanned 10 h).
+SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index block,
+                        const std::vector<bool>& logged = {});
 
 struct CompensationSummary {
   SignalSummary before, after;
   Eigen::Index samples = 0;
   double block_s = kSlowVariationBlockS;  // of the slow variation
   Eigen::Index block = 1;                 // samples per block: round(block_s rate_hz), >= 1
-  Eigen::Index blocks = 0;                // full blocks in the log
+  Eigen::Index blocks = 0;                // the blocks of the slow variation (Summarise)
   // Several lines: a table of the four figures before and after, named by `target` and `unit`
   // ("" = none), each line ending in a newline.
   std::string Table(const std::string& target, const std::string& unit) const;
 };
 
-// The figures of the output y and of compensated (same length, >= 1 sample, finite), sampled at
-// rate_hz, with the slow variation over blocks of block_s seconds. Throws DataError for empty or
-// non-finite signals or unequal lengths, OptionError for rate_hz outside [1e-9, 1e6] Hz or
-// block_s outside [1e-6, 1e9] s.
+// The figures of the output y and of compensated (same length, >= 1 sample, finite where
+// logged), sampled at rate_hz, with the slow variation over blocks of block_s seconds, over the
+// `logged` samples (Summarise). Throws DataError for empty or non-finite signals or unequal
+// lengths, OptionError for rate_hz outside [1e-9, 1e6] Hz or block_s outside [1e-6, 1e9] s.
 CompensationSummary SummariseCompensation(const Eigen::Ref<const Eigen::VectorXd>& y,
                                           const Eigen::Ref<const Eigen::VectorXd>& compensated,
-                                          double rate_hz, double block_s = kSlowVariationBlockS);
+                                          double rate_hz, double block_s = kSlowVariationBlockS,
+                                          const std::vector<bool>& logged = {});
 
 }  // namespace gyrodrift::drift

@@ -76,8 +76,9 @@ struct EvaluateInput {
 // The sidecar (but for its header): options (the drift options in full) and result.
 nlohmann::json EvaluateRecord(const EvaluateRun& run, const EvaluateInput& in);
 
-// The notes of the rows ("<method>, <note>") and, when test temperatures lie beyond the training
+// The notes of the rows ("<method>, <note>"), the note that predictions several steps ahead read
+// the temperature up to the predicted sample, and, when test temperatures lie beyond the training
 // block's, the note that thermal models extrapolate; one line each.
-std::string EvaluateNotes(const drift::EvaluationResult& result);
+std::string EvaluateNotes(const EvaluateRun& run);
 
 }  // namespace gyrodrift::tasks

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <vector>
 
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/random.h"
@@ -35,6 +37,32 @@ TEST(CompensationSummary, FiguresOfAHandMadeSignal) {
   // One block: no slow variation to measure.
   EXPECT_TRUE(std::isnan(Summarise(x, 4).slow));
   EXPECT_THROW(Summarise(Eigen::VectorXd(), 2), DataError);
+}
+
+// With a logged mask (--gaps carry) the figures are the logged samples', and the blocks stay blocks
+// of time, each the mean of its logged samples; a block with none is left out.
+TEST(CompensationSummary, BlocksOfALogWithGapsAreBlocksOfTime) {
+  // 12 samples, blocks of 4; logged: 0 1 | 4 | (none) ; the made-up rows hold 1000.
+  const Eigen::VectorXd x =
+      Eigen::Vector<double, 12>(1, 3, 1000, 1000, 5, 1000, 1000, 1000, 1000, 1000, 1000, 1000);
+  const std::vector<bool> logged = {true,  true,  false, false, true,  false,
+                                    false, false, false, false, false, false};
+  const SignalSummary s = Summarise(x, 4, logged);
+  EXPECT_DOUBLE_EQ(s.mean, 3.0);
+  EXPECT_DOUBLE_EQ(s.std, std::sqrt(8.0 / 3.0));
+  EXPECT_EQ(s.blocks, 2);         // the third block holds no logged sample
+  EXPECT_DOUBLE_EQ(s.slow, 1.5);  // means 2 and 5 about 3.5
+  // Without the mask every row counts.
+  EXPECT_EQ(Summarise(x, 4).blocks, 3);
+  const CompensationSummary c = SummariseCompensation(x, x, 1.0, 4.0, logged);
+  EXPECT_EQ(c.samples, 3);
+  EXPECT_EQ(c.blocks, 2);
+  EXPECT_DOUBLE_EQ(c.after.slow, 1.5);
+  // A NaN on a made-up row is not a sample of the log.
+  Eigen::VectorXd holed = x;
+  holed[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_DOUBLE_EQ(Summarise(holed, 4, logged).slow, 1.5);
+  EXPECT_THROW(Summarise(x, 4, std::vector<bool>(5, true)), DataError);
 }
 
 TEST(CompensationSummary, AMovedBiasShowsThoughTheStdStays) {

@@ -471,6 +471,17 @@ TEST_F(FleetCalibration, AUnitThatBecomesAnErrorLosesItsEarlierResults) {
   EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
 }
 
+// A verification log that is a copy of the calibration log would judge the model on what it was
+// fitted on: an error row, as for the same file named twice.
+TEST_F(FleetCalibration, ACopyOfTheCalibrationLogIsNoVerification) {
+  io::WriteFileAtomically(Dir() + "/SN1_copy.csv", io::ReadTextFile(Dir() + "/SN1_cal.csv"));
+  const Manifest m = Make("", {{"SNC", "SN1_cal.csv", "SN1_copy.csv"}});
+  const UnitOutputs out = CalibrateUnit(m, m.units[0], test::FakeDygraphs());
+  EXPECT_NE(out.result.error.find("SN1_copy.csv holds the bytes of calibration log"),
+            std::string::npos)
+      << out.result.error;
+}
+
 TEST_F(FleetCalibration, AFinishedUnitIsSkippedAndADamagedOneRedone) {
   const std::string out = Dir() + "/out_rerun";
   const Manifest m = Make("", {Good("SN3")});
