@@ -171,9 +171,10 @@ const RegisterCommand kRegister("allan", 40, [](CLI::App& app) {
       ->check(kInputFile);
   cmd->add_option("--column,-c", args->column, "column name or 1-based index")->required();
   args->rate_option = BindSetting(
-      cmd->add_option("--rate-hz", args->settings.rate_hz,
-                      "sample rate in Hz (tau0 = 1 / rate); not given: 1 / the median step of the "
-                      "time_s column (a log without one needs it)"),
+      cmd->add_option(
+          "--rate-hz", args->settings.rate_hz,
+          "sample rate in Hz (tau0 = 1 / rate); not given: 1 / the mean step of the "
+          "time_s column (its steps within 1 % of the median; a log without one needs it)"),
       {"rate_hz"});
   cmd->add_option("-o,--output", args->output, "output CSV (a .json sidecar is written beside it)")
       ->required();

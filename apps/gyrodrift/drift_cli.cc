@@ -91,7 +91,7 @@ void AddModelOptions(CLI::App* cmd, DriftArgs* a) {
                               "the default) or a fixed L"),
               {"hidden"});
   a->rate_option = BindSetting(cmd->add_option("--rate-hz", a->settings.rate_hz,
-                                               "sample rate, Hz (default: from the median step "
+                                               "sample rate, Hz (default: from the steps "
                                                "of a time_s column, else 1)"),
                                {"rate_hz"});
   BindSetting(cmd->add_option("--thermal-features", a->settings.thermal_features,

@@ -136,8 +136,9 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       "compensate mode: error of the drift estimate. paper = decompose the whole record before\n"
       "splitting (test sub-series see the future, as in the literature); causal = only past\n"
       "samples reach a prediction. The references none (zero estimate) and constant (training\n"
-      "mean) are always scored first. Single models and baselines never decompose, so their\n"
-      "two rows are the same run. Writes table.csv (method,protocol,rmse,rmse_std,mae,max_abs,\n"
+      "mean) are always scored first. Single models and baselines never decompose, and in\n"
+      "compensate mode only the training block is decomposed, so their two rows are the same run. "
+      "Writes table.csv (method,protocol,rmse,rmse_std,mae,max_abs,\n"
       "rmse_measured,slow_removed,train_s,predict_s) and table.csv.json.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/false);
   cmd->add_option("--truth", args->truth, "column to score against (e.g. drift_dph)");

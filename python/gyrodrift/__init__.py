@@ -477,8 +477,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     (against the output itself), slow_removed (share of the slow variation, 10-min block means,
     removed; nan on a test block shorter than 10 min), train_s, predict_s, the last repeat's
     ``estimate`` on the test block, model_summary, notes), ``first_test_sample``, ``reference``
-    (what the rows were scored against), ``table`` (text), ``notes`` (the lines the CLI prints
-    after its table).
+    (what the rows were scored against), ``table`` (text), ``notes`` (a list: the lines the CLI
+    prints after its table).
 
     >>> import gyrodrift as gd
     >>> sim = gd.simulate(duration=7200, seed=3)

@@ -1,4 +1,6 @@
 // evaluate: the methods compared on a chronological split, as `gyrodrift evaluate`.
+#include <sstream>
+
 #include "bindings.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
@@ -93,7 +95,11 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
       py::make_tuple(result.training_temperature_min_c, result.training_temperature_max_c);
   out["test_outside_training_temperature_share"] = result.test_outside_training_temperature_share;
   out["table"] = result.Table();
-  out["notes"] = tasks::EvaluateNotes(run);  // the CLI's notes after its table
+  // The CLI's notes after its table, one line each (as read_log's notes).
+  std::vector<std::string> notes;
+  std::istringstream lines(tasks::EvaluateNotes(run));
+  for (std::string line; std::getline(lines, line);) notes.push_back(line);
+  out["notes"] = notes;
   return out;
 }
 

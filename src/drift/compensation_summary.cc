@@ -42,7 +42,7 @@ SignalSummary Summarise(const Eigen::Ref<const Eigen::VectorXd>& x, Eigen::Index
   RequireFiniteLogged("signal", x, logged, 1);
   block = std::max<Eigen::Index>(1, block);
   SignalSummary s;
-  if (logged.empty()) {
+  if (CountLogged(logged, x.size()) == x.size()) {  // every row logged: the same bits as no mask
     s.mean = x.mean();
     s.std = RmsAboutMean(x);
     s.rms = std::sqrt(x.squaredNorm() / static_cast<double>(x.size()));

@@ -236,7 +236,8 @@ DriftModel FitDriftModel(const Eigen::Ref<const Eigen::VectorXd>& y,
     model.options = o;
     model.lags = o.mode == Mode::kPredict ? 1 : 0;
     model.training_samples = CountLogged(logged, y.size());
-    auto baseline = std::make_shared<const Baseline>(FitBaseline(o.method, y));
+    // Carry: the logged rows only, as every fit (the made-up rows are not data).
+    auto baseline = std::make_shared<const Baseline>(FitBaseline(o.method, y_logged));
     model.sub_models.push_back({.name = "signal", .has_residue = true, .baseline = std::move(baseline)});
     if (model.uses_temperature()) {
       model.temperature_min_c = temperature_c.col(0).minCoeff();

@@ -75,8 +75,8 @@ std::vector<std::string> Failures(const Limits& limits, const VerificationResult
                                     limits.residual_drift_rms));
   }
   if (!std::isnan(limits.bias_instability_dph)) {
-    // Unidentified, B is reported as 0; what bounds it is the curve's flattest point read by the
-    // IEEE 952 slope method (min sigma / 0.664), so that bound must meet the limit.
+    // Unidentified, B has no value (an empty cell); what bounds it is the curve's flattest point
+    // read by the IEEE 952 slope method (min sigma / 0.664), so that bound must meet the limit.
     const allan::NoiseTerm& b = v.noise_after.b_dph;
     const double figure = b.identified ? b.value : b.slope_reading;
     if (!(figure <= limits.bias_instability_dph)) {
@@ -365,28 +365,44 @@ bool ReadFinished(const std::string& folder, const std::string& fingerprint,
 // would contradict (a model.json from logs the manifest no longer names, a page saying PASS). The
 // summary goes first, so that a removal cut short leaves an unfinished unit, not a finished one
 // that is wrong; then the files it lists and the ones every unit has, nothing else of the folder,
-// and the folder when that leaves it empty.
-void RetractUnit(const std::string& folder) {
+// and the folder when that leaves it empty. Returns what could not be removed ("" when all was).
+std::string RetractUnit(const std::string& folder) {
   const fs::path summary = fs::path(folder) / kSummaryFile;
   std::error_code ec;
-  if (!fs::is_regular_file(summary, ec)) return;
+  if (fs::is_symlink(folder, ec) || !fs::is_regular_file(summary, ec)) return "";
   std::set<std::string> names = {"model.json", "allan.csv", "report.html"};
   try {
     const json j = json::parse(io::ReadTextFile(summary.string()));
     for (const auto& [name, hash] : j.at("files").items()) names.insert(name);
   } catch (const std::exception&) {
-    // A damaged summary: the files every unit has.
+    // A damaged summary: the names every unit's files have (below).
   }
-  fs::remove(summary, ec);
+  for (const auto& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("verification_", 0) == 0 && name.ends_with("_compensated.csv"))
+      names.insert(name);
+  }
+  std::string failed;
+  auto remove = [&failed](const fs::path& path) {
+    std::error_code error;
+    if (!fs::remove(path, error) && error) failed += (failed.empty() ? "" : ", ") + path.string();
+  };
+  remove(summary);
   for (const std::string& name : names) {
     // Only names of the folder's own files (an edited summary could name others).
     if (name.empty() || fs::path(name).filename() != fs::path(name) || name == "." ||
         name == "..") {
       continue;
     }
-    fs::remove(fs::path(folder) / name, ec);
+    remove(fs::path(folder) / name);
   }
   fs::remove(folder, ec);  // fails, leaving it, unless it is empty
+  return failed;
+}
+
+// What an error row adds when an earlier run's files stayed.
+std::string Unretracted(const std::string& failed) {
+  return failed.empty() ? "" : " (an earlier run's files could not be removed: " + failed + ")";
 }
 
 }  // namespace
@@ -454,9 +470,9 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     UnitResult failed;
     failed.serial = unit.serial;
     failed.error = e.what();
+    failed.error += Unretracted(RetractUnit(folder));
     run.rows = Rows(failed);
     run.what = "error";
-    RetractUnit(folder);
     return run;
   }
   if (!force && ReadFinished(folder, fingerprint, &run.rows)) {
@@ -466,8 +482,9 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
   UnitOutputs outputs = CalibrateUnit(m, unit, assets);
   run.rows = Rows(outputs.result);
   if (!outputs.result.error.empty()) {
+    outputs.result.error += Unretracted(RetractUnit(folder));
+    run.rows = Rows(outputs.result);
     run.what = "error";
-    RetractUnit(folder);
     return run;
   }
   json hashes = json::object();
@@ -489,10 +506,9 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     run.what = "calibrated";
     run.seconds = outputs.result.seconds;
   } catch (const Error& e) {
-    outputs.result.error = e.what();
+    outputs.result.error = e.what() + Unretracted(RetractUnit(folder));
     run.rows = Rows(outputs.result);
     run.what = "error";
-    RetractUnit(folder);
   }
   return run;
 }

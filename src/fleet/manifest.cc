@@ -488,18 +488,23 @@ nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
     logs.push_back({{"path", named ? (relative.empty() ? absolute : relative).string() : log},
                     {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
-  return {{"settings", tasks::SettingsToJson(m.fit, m.log)},
-          {"fleet",
-           {{"rate_unit", allan::ToString(m.rate_unit)},
-            {"rate_hz", m.rate_hz},
-            {"drift_window_s", m.drift_window_s},
-            {"limits",
-             {{"residual_drift_rms", limit(m.limits.residual_drift_rms)},
-              {"bias_instability_dph", limit(m.limits.bias_instability_dph)},
-              {"removed_share_min", limit(m.limits.removed_share_min)}}},
-            {"axes", axes}}},
-          {"unit",
-           {{"serial", u.serial}, {"calibration_logs", u.calibration.size()}, {"logs", logs}}}};
+  // Raised when a unit's files change for the same logs and settings, so that a rerun redoes the
+  // units an older tool finished (2: 2026-11-27, unidentified noise terms empty, model.json's
+  // source as the manifest spells it, epoch time stamps' rate, a copied verification refused).
+  constexpr int kResultsVersion = 2;
+  return {
+      {"results_version", kResultsVersion},
+      {"settings", tasks::SettingsToJson(m.fit, m.log)},
+      {"fleet",
+       {{"rate_unit", allan::ToString(m.rate_unit)},
+        {"rate_hz", m.rate_hz},
+        {"drift_window_s", m.drift_window_s},
+        {"limits",
+         {{"residual_drift_rms", limit(m.limits.residual_drift_rms)},
+          {"bias_instability_dph", limit(m.limits.bias_instability_dph)},
+          {"removed_share_min", limit(m.limits.removed_share_min)}}},
+        {"axes", axes}}},
+      {"unit", {{"serial", u.serial}, {"calibration_logs", u.calibration.size()}, {"logs", logs}}}};
 }
 
 std::string UnitFingerprint(const Manifest& m, const UnitSpec& u) {

@@ -46,9 +46,10 @@ void ParseTaus(const std::string& text, al::AllanOptions* o) {
 void RequireWholeSamples(const std::vector<double>& taus, double rate_hz) {
   for (double tau : taus) {
     const double m = tau * rate_hz;
-    // Absolute in samples (a relative test would let half a sample through at large factors),
-    // loose enough for decimal taus such as 0.1 s at 10 Hz.
-    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 + 1e-12 * m) {
+    // Absolute in samples, loose enough for decimal taus such as 0.1 s at 10 Hz, plus the
+    // rate's own uncertainty when time_s gave it (epoch stamps of a 200-s log at 100 Hz:
+    // about 1e-9 of the rate); half a sample would pass only past 5e7 samples.
+    if (m < 1.0 - 1e-9 || std::abs(m - std::round(m)) > 1e-6 + 1e-8 * m) {
       ThrowOption("taus", fmt::format("{:g}", tau),
                   fmt::format("a whole number of sample periods at {:g} Hz (nearest: {:g} s)",
                               rate_hz, std::max(1.0, std::round(m)) / rate_hz));

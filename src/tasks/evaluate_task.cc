@@ -7,6 +7,7 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/drift/baseline.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/model_file.h"
 
@@ -172,8 +173,10 @@ std::string EvaluateNotes(const EvaluateRun& run) {
   }
   // The recursion of an H-step prediction reads the temperature of each step it predicts: a
   // temperature known ahead (a chamber's programme), which the baselines do not read.
-  if (result.mode == drift::Mode::kPredict && run.options.horizon > 1 &&
-      run.base.uses_temperature()) {
+  const bool reads_temperature = run.base.uses_temperature() &&
+                                 std::any_of(run.options.methods.begin(), run.options.methods.end(),
+                                             [](drift::Method m) { return !drift::IsBaseline(m); });
+  if (result.mode == drift::Mode::kPredict && run.options.horizon > 1 && reads_temperature) {
     notes += fmt::format(
         "note: the {}-step predictions of the methods given a temperature read it up to the "
         "predicted sample (a temperature programme known ahead); the baselines read none\n",

@@ -128,6 +128,24 @@ TEST_F(EvaluateCli, HorizonScoresPredictionsAhead) {
   EXPECT_EQ(json["options"]["horizon"], 8);
 }
 
+// Predictions several steps ahead by a method given the temperature read it up to the predicted
+// sample: a note says so, and only where such a method is scored.
+TEST_F(EvaluateCli, AHorizonWithTemperatureIsNoted) {
+  const std::string run = "evaluate '" + input_ +
+                          "' -t rate_dph -T temperature_c --truth drift_dph --mode predict "
+                          "--protocol causal --horizon 3 -o '" +
+                          dir_ + "/noted.csv' --methods ";
+  const auto poly = test::RunCli(run + "poly");
+  ASSERT_EQ(poly.exit_code, 0) << poly.err;
+  const std::string note =
+      "3-step predictions of the methods given a temperature read it up to "
+      "the predicted sample";
+  EXPECT_NE(poly.out.find(note), std::string::npos) << poly.out;
+  const auto smoother = test::RunCli(run + "trailing-mean");
+  ASSERT_EQ(smoother.exit_code, 0) << smoother.err;
+  EXPECT_EQ(smoother.out.find(note), std::string::npos) << smoother.out;
+}
+
 TEST_F(EvaluateCli, RepeatsGiveASpreadOnlyWhereTheSeedMatters) {
   const std::string out = dir_ + "/t.csv";
   const auto r = test::RunCli("evaluate '" + input_ +

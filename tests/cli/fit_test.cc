@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 
 #include "gyrodrift/drift/thermal_coefficients.h"
 #include "gyrodrift/io/csv.h"
@@ -283,8 +284,26 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
     microseconds += std::to_string(i) + "e-7," + std::to_string((i * 37) % 11) + "\n";
   }
   io::WriteFileAtomically(dir_ + "/microseconds.csv", microseconds);
+  std::string constant = "time_s,rate_dph,temperature_c\n";
+  for (int i = 0; i < 100; ++i)
+    constant += std::to_string(i) + "," + std::to_string(i % 7) + ",30\n";
+  io::WriteFileAtomically(dir_ + "/constant.csv", constant);
+  // 60 rows missing after the 100th: a gap.
+  std::string gap, line;
+  std::istringstream lines(test::ThermalLogCsv(400, 3));
+  for (int row = 0; std::getline(lines, line); ++row) {
+    if (row <= 100 || row > 160) gap += line + "\n";
+  }
+  io::WriteFileAtomically(dir_ + "/gap.csv", gap);
   const std::string ok = "-t rate_dph -T temperature_c --mode compensate -I 10";
   const std::vector<BadCase> cases = {
+      {"constant temperature, named", "fit %DIR%/constant.csv " + ok, 3,
+       "fitting 'rate_dph' on 'temperature_c' ("},
+      {"two temperatures for poly",
+       "fit %IN% -t rate_dph -T temperature_c,drift_dph --mode compensate -m poly", 2,
+       "--temperature = 2 channels: must be one for method poly"},
+      {"nonlinear with carry", "fit %DIR%/gap.csv " + ok + " --nonlinear --gaps carry", 2,
+       "--nonlinear: the nonlinear correction needs every sample logged"},
       {"missing file", "fit %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
       {"missing mode", "fit %IN% -t rate_dph", 2, "--mode is required"},
       {"rate from time_s out of range", "fit %DIR%/microseconds.csv -t rate_dph --mode predict", 3,

@@ -85,9 +85,11 @@ CsvTable ReadLog(const std::string& path, const LogOptions& options = {},
                  const std::vector<std::string>& columns = {},
                  std::vector<bool>* logged = nullptr);
 
-// The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / (median step of a time_s
-// column, which the table must have kept) (*how = "time_s"); else 1 Hz (*how = "default"). Throws DataError naming time_s when
-// its median step is not positive or gives a rate outside [1e-9, 1e6] Hz.
+// The sample rate of a log: `given` when > 0 (*how = "given"); else 1 / the clock's step of a
+// time_s column (*how = "time_s": the mean of its steps within 1 % of the median step, which
+// epoch time stamps round; the median where the two agree to 1e-9); else 1 Hz (*how = "default").
+// Throws DataError naming time_s when its median step is not positive or gives a rate outside
+// [1e-9, 1e6] Hz.
 double ResolveSampleRate(const CsvTable& table, double given, std::string* how);
 
 // Logs fitted together as records of one calibration need one sample rate: throws DataError

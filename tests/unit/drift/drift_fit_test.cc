@@ -236,6 +236,14 @@ TEST(DriftModel, AMaskOfLoggedRowsKeepsTheFitToThem) {
                UsageError);
   EXPECT_THROW(FitDriftModel(log.rate, log.temperature, o, {}, {}, std::vector<bool>(10, true)),
                DataError);
+  // The model says how many samples it was fitted on: the logged ones.
+  EXPECT_EQ(masked.training_samples, 300);
+  // The constant too is the logged rows' (it was the grid's until 2026-11-27).
+  const DriftModel constant = FitDriftModel(
+      spoiled, log.temperature, Fast(Mode::kCompensate, Method::kConstant), {}, {}, logged);
+  EXPECT_EQ(constant.training_samples, 300);
+  EXPECT_DOUBLE_EQ(EstimateDrift(constant, log.temperature)[0],
+                   LoggedRows(log.rate, logged).mean());
 }
 
 // Options are plain values: a model holds the options it was fitted with (the thermal time

@@ -79,6 +79,27 @@ TEST(Evaluation, ScoresPredictionsAheadWithAHorizon) {
   EXPECT_THROW(eo.Validate(), OptionError);
 }
 
+// Compensate mode: no protocol decomposes the test block (the estimate reads temperature only):
+// ms-elm's rows do not move when only the test block's output changes (the paper row did until
+// 2026-11-27), both are one computation, and no causal-window note is given.
+TEST(Evaluation, CompensateModeNeverSeesTheTestBlocksOutput) {
+  const Log log = MakeLog(1000, 9);
+  EvaluationOptions eo;
+  eo.methods = {Method::kMsElm};
+  const DriftOptions o = Fast(Mode::kCompensate, Method::kMsElm);
+  const EvaluationResult a = Evaluate(log.rate, log.temperature, log.drift, o, eo);
+  Eigen::VectorXd changed = log.rate;
+  changed.tail(300) += Eigen::VectorXd::LinSpaced(300, 0.0, 1.0);
+  const EvaluationResult b = Evaluate(changed, log.temperature, log.drift, o, eo);
+  ASSERT_EQ(a.rows.size(), 6u);
+  ASSERT_EQ(a.rows[4].method, Method::kMsElm);
+  for (size_t i = 4; i < 6; ++i) {
+    EXPECT_EQ(a.rows[i].estimate, b.rows[i].estimate) << i;
+    EXPECT_TRUE(a.rows[i].notes.empty()) << i;
+  }
+  EXPECT_EQ(a.rows[4].estimate, a.rows[5].estimate);
+}
+
 TEST(Evaluation, SaysWhereTheTestTemperatureLeavesTheTrainingRange) {
   Log log = MakeLog(1000, 9);
   // A slow warming on top of the cycle: the last 300 samples reach above anything before them.
