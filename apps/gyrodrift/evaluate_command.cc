@@ -137,9 +137,9 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       "splitting (test sub-series see the future, as in the literature); causal = only past\n"
       "samples reach a prediction. The references none (zero estimate) and constant (training\n"
       "mean) are always scored first. Single models and baselines never decompose, and in\n"
-      "compensate mode only the training block is decomposed, so their two rows are the same run. "
-      "Writes table.csv (method,protocol,rmse,rmse_std,mae,max_abs,\n"
-      "rmse_measured,slow_removed,train_s,predict_s) and table.csv.json.");
+      "compensate mode only the training block is decomposed: their two rows are the same run.\n"
+      "Writes table.csv (method,protocol,rmse,rmse_std,mae,max_abs,rmse_measured,slow_removed,\n"
+      "train_s,predict_s) and table.csv.json.");
   AddDriftOptions(cmd, args.get(), /*split_records=*/false);
   cmd->add_option("--truth", args->truth, "column to score against (e.g. drift_dph)");
   BindSetting(
