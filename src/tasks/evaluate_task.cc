@@ -65,8 +65,16 @@ std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mod
     drift::Method m;
     try {
       m = drift::MethodFromString(item);
-    } catch (const UsageError& e) {
-      throw UsageError(std::string(name) + " = '" + text + "': " + e.what());
+    } catch (const UsageError&) {
+      // The names this mode takes, as fit's refusal lists them (a method of the other mode is
+      // refused below with its reason).
+      std::string allowed;
+      std::vector<drift::Method> names = drift::AllMethods(mode);
+      for (drift::Method r : drift::ReferenceMethods()) names.push_back(r);
+      for (drift::Method n : names) allowed += ", " + std::string(drift::ToString(n));
+      ThrowOption(name, "'" + text + "'",
+                  fmt::format("all or a comma-separated list of {} ({} mode; '{}' is none of them)",
+                              allowed.substr(2), drift::ToString(mode), item));
     }
     if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
       ThrowOption(name, "'" + text + "'", "a list without repeats");

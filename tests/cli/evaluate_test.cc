@@ -181,7 +181,7 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
   const std::string p = "evaluate %IN% -t rate_dph --mode predict -I 10 ";
   const std::vector<BadCase> cases = {
       {"missing file", "evaluate %DIR%/nope.csv -t rate_dph --mode predict", 2, "no such file"},
-      {"unknown method", p + "--methods elm,lstm", 2, "method = 'lstm'"},
+      {"unknown method", p + "--methods elm,lstm", 2, "'lstm' is none of them"},
       {"zero horizon", p + "--horizon 0", 2, "--horizon = 0"},
       {"horizon in compensate mode",
        "evaluate %IN% -t rate_dph -T temperature_c --mode compensate --horizon 2", 2,
