@@ -166,6 +166,20 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log) {
       ->capture_default_str();
 }
 
+std::string MadeUpRowsPredictionNote(const std::vector<bool>& logged) {
+  long made_up = 0, gaps = 0;
+  for (size_t i = 0; i < logged.size(); ++i) {
+    if (logged[i]) continue;
+    ++made_up;
+    gaps += i == 0 || logged[i - 1];
+  }
+  if (made_up == 0) return "";
+  return fmt::format(
+      "note: the predictions of the {} rows --gaps interpolate made up ({} gap{}), and the first "
+      "after each gap, read the logged sample after the gap: they are not causal\n",
+      made_up, gaps, gaps == 1 ? "" : "s");
+}
+
 io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* notes,
                      std::vector<Eigen::Index>* record_starts,
                      const std::vector<std::string>& columns, std::vector<bool>* logged) {

@@ -79,6 +79,11 @@ io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* n
                      const std::vector<std::string>& columns = {},
                      std::vector<bool>* logged = nullptr);
 
+// Predict mode on a log whose gaps --gaps interpolate filled (`logged`: false on a made-up row):
+// the note that the predictions of the made-up rows, and the first after each gap, read the
+// logged sample after the gap, so they are not causal; "" for a log without made-up rows.
+std::string MadeUpRowsPredictionNote(const std::vector<bool>& logged);
+
 // Binds `flag` to the names under which the library refers to what it sets (a
 // drift::FitSettings setting such as "lags", an options field such as "ensemble_size"), where
 // the flag is declared: an OptionError naming one of them is then reported with the flag.

@@ -103,6 +103,7 @@ void Run(const EvaluateArgs& a) {
   for (const std::string* note : {&log.gap_note, &log.time_note}) {
     if (!note->empty()) notes += *note + (note->back() == '\n' ? "" : "\n");
   }
+  if (run.result.mode == drift::Mode::kPredict) notes += MadeUpRowsPredictionNote(log.logged);
   notes += tasks::EvaluateNotes(run);
   io::WriteFilesAtomically({{a.output, tasks::EvaluateTableCsv(run.result)},
                             {SidecarPath(a.output), sidecar.dump(2) + "\n"}});

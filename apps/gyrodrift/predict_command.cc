@@ -38,7 +38,9 @@ void Run(const PredictArgs& a) {
   tasks::RequirePredictMode(loaded, a.model);
   a.log.RequireOneRecord("predict", "a prediction from the output's own past runs across the gaps");
   std::string notes;
-  const io::CsvTable table = ReadLog(a.input, a.log, &notes);
+  std::vector<bool> logged;
+  const io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {}, &logged);
+  notes += MadeUpRowsPredictionNote(logged);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;

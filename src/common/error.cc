@@ -75,9 +75,19 @@ void RequireUsableSample(std::string_view what, Eigen::Index number, double valu
 
 void RequireVaryingSignal(std::string_view what, const Eigen::Ref<const Eigen::VectorXd>& x,
                           std::string_view consequence) {
-  if (x.size() == 0 || (x.array() != x[0]).any()) return;
-  throw DataError(std::string(what) + " is constant (every sample is " + FormatValue(x[0]) +
-                  "): " + std::string(consequence));
+  if (x.size() == 0) return;
+  if (!(x.array() != x[0]).any()) {
+    throw DataError(std::string(what) + " is constant (every sample is " + FormatValue(x[0]) +
+                    "): " + std::string(consequence));
+  }
+  // The mirror of kLargestSampleMagnitude: no instrument logs only magnitudes this small, and
+  // their squares underflow to 0 (a decomposition's scaling by the std gave NaN, exit 0).
+  constexpr double kSmallestLargestMagnitude = 1e-100;
+  const double largest = x.cwiseAbs().maxCoeff();
+  if (!(largest < kSmallestLargestMagnitude)) return;
+  throw DataError(std::string(what) + " varies only below " +
+                  FormatValue(kSmallestLargestMagnitude) + " in magnitude (its largest sample is " +
+                  FormatValue(largest) + "): its squares underflow to 0; rescale it");
 }
 
 }  // namespace gyrodrift

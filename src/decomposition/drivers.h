@@ -50,8 +50,15 @@ void RequireNoiseStateFits(double ensemble, Eigen::Index n, double vectors_per_r
 // Sample standard deviation (N - 1), as MATLAB's std.
 double SampleStd(const double* x, Eigen::Index n);
 
+// A residue that varies by no more than the rounding of its magnitude (a large offset under a
+// small oscillation, once the oscillation is out) holds nothing but rounding: each further IMF
+// would be rounding too, and its extrema would never run out (EMD and ICEEMDAN ran without end on
+// 1e12 + sin). True, with the report's stop reason set, for such a residue.
+bool ResidueAtRounding(const Eigen::VectorXd& r, DecompositionReport& report);
+
 // emd.m's main loop on r (in place): IMFs are appended until the residue has < 3 extrema, is
-// negligible against r's initial amplitude, or max_imfs (0 = no cap) IMFs are in `imfs`.
+// negligible against r's initial amplitude or at its own rounding (ResidueAtRounding), the next
+// IMF would not change it, or max_imfs (0 = no cap) IMFs are in `imfs`.
 void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen::VectorXd>& imfs,
              DecompositionReport& report);
 Decomposition AssembleResult(std::vector<Eigen::VectorXd> imfs, Eigen::VectorXd residue,

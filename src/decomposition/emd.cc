@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 #include "decomposition/drivers.h"
 
@@ -61,6 +62,16 @@ bool NoiseModes::Next(Sifter& sifter, double* out) {
   return true;
 }
 
+bool ResidueAtRounding(const Eigen::VectorXd& r, DecompositionReport& report) {
+  const double magnitude = MaxAbs(r.data(), r.size());
+  if (!(r.maxCoeff() - r.minCoeff() <=
+        1024.0 * std::numeric_limits<double>::epsilon() * magnitude)) {
+    return false;
+  }
+  report.stop_reason = "residue varies by no more than the rounding of its magnitude";
+  return true;
+}
+
 void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen::VectorXd>& imfs,
              DecompositionReport& report) {
   const Eigen::Index n = r.size();
@@ -78,9 +89,19 @@ void EmdLoop(Sifter& sifter, Eigen::VectorXd& r, int max_imfs, std::vector<Eigen
       report.stop_reason = "residue below 1e-10 of the input amplitude";
       return;
     }
+    if (ResidueAtRounding(r, report)) return;
     Eigen::VectorXd imf(n);  // extracted where it is kept: no buffer and copy beside the modes
     const SiftOutcome outcome = sifter.ExtractImf(r.data(), imf.data());
-    r -= imf;
+    bool changed = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double next = r[i] - imf[i];
+      changed |= next != r[i];
+      r[i] = next;
+    }
+    if (!changed) {  // an IMF below the residue's rounding: the same residue again, without end
+      report.stop_reason = "the next IMF is below the rounding of the residue";
+      return;
+    }
     imfs.push_back(std::move(imf));
     if (n >= kReleaseNodeBuffersSamples) sifter.ReleaseNodeBuffers();
     report.sifts_per_imf.push_back(outcome.sifts);

@@ -54,7 +54,7 @@ bool StagesEnd(const DecompositionOptions& o, size_t modes, const Eigen::VectorX
     report.stop_reason = "residue has fewer than 3 extrema";
     return true;
   }
-  return false;
+  return check_extrema && ResidueAtRounding(r, report);
 }
 
 std::vector<Worker> MakeWorkers(int ensemble, const Job& job, Eigen::Index n) {

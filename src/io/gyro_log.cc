@@ -51,8 +51,8 @@ const TimeAxis* RegularAxis(const CsvTable& table) {
 // seconds) round every step to a representable difference, so the median step of a 100 Hz log
 // stamped near 1.76e9 s is 0.0099999905 s (100.0000954 Hz), while the mean of such steps carries
 // no such rounding. A step further off is a gap, a late, an extra or a missed sample, which the
-// median ignores and the mean would not. The median stands where the two agree to 1e-9, so a
-// decimal clock (steps of 0.1 s, each a bit off in binary) keeps its decimal rate.
+// median ignores and the mean would not. The median stands where the two agree to 1e-9, so the
+// rate of every log whose stamps round only in their last bits (a decimal clock) is what it was.
 double ClockStep(const CsvTable& table, const TimeAxis* axis, double median) {
   const double lo = 0.99 * median, hi = 1.01 * median;
   double mean = 0.0;

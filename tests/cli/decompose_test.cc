@@ -89,6 +89,8 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
   io::WriteFileAtomically(dir_ + "/nan.csv", "x\n1\n2\nnan\n4\n5\n");
   io::WriteFileAtomically(dir_ + "/text.csv", "x\n1\n2\nabc\n4\n5\n");
   io::WriteFileAtomically(dir_ + "/short.csv", "x\n1\n2\n3\n");
+  // Squares that underflow: the CEEMDAN family's scaling gave NaN IMFs, exit 0.
+  io::WriteFileAtomically(dir_ + "/tiny.csv", "x\n1e-200\n3e-200\n2e-200\n5e-200\n1e-200\n");
   io::WriteFileAtomically(dir_ + "/empty.csv", "");
   io::WriteFileAtomically(dir_ + "/ragged.csv", "a,b\n1,2\n3\n");
   io::WriteFileAtomically(dir_ + "/w_short.csv", "w0\n1\n2\n");
@@ -123,6 +125,8 @@ TEST_F(DecomposeCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"inf cell", "decompose %DIR%/inf.csv -c x", 3, "data row 2"},
       {"negative threads", "decompose %IN% -c 2 -j -3", 2, "threads"},
       {"constant column", "decompose %DIR%/constant.csv -c x", 3, "column 'x' is constant"},
+      {"tiny magnitudes", "decompose %DIR%/tiny.csv -c x -m iceemdan", 3,
+       "column 'x' varies only below 1e-100 in magnitude"},
   };
   const std::string out = dir_ + "/bad.csv";
   for (const auto& c : cases) {

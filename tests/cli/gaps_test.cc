@@ -161,6 +161,20 @@ TEST_F(GapsCli, EveryCommandTakesTheFourModesAndSpellsTheFlagAsTyped) {
   EXPECT_NE(r.err.find("--gaps"), std::string::npos) << r.err;
 }
 
+// Predict mode on interpolated rows: the predictions there, and the first after each gap, read
+// the sample after the gap; evaluate and predict say so, compensate mode has nothing to say.
+TEST_F(GapsCli, PredictionsOfMadeUpRowsAreNotedAsNotCausal) {
+  const std::string note = "rows --gaps interpolate made up (";
+  const std::string evaluate = "evaluate " + Path("holed.csv") +
+                               " -t rate_dph --gaps interpolate -o " + Path("ev.csv") + " --mode ";
+  auto r = test::RunCli(evaluate + "predict --methods persistence");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(note), std::string::npos) << r.out;
+  r = test::RunCli(evaluate + "compensate --methods poly -T temperature_c");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find(note), std::string::npos) << r.out;
+}
+
 TEST_F(GapsCli, AllanRefusesAColumnConstantWhereLoggedWhateverTheGaps) {
   // The break between joined records (split) or a made-up row (carry) is no variation: a stuck
   // sensor's log with a hole is refused as the same log without it is.

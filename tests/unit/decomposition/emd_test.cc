@@ -41,6 +41,30 @@ TEST(Emd, SampleStdIsMatlabsWithNMinusOne) {
   EXPECT_DOUBLE_EQ(internal::SampleStd(x, 4), std::sqrt(5.0 / 3.0));
 }
 
+// A small oscillation on a large offset: once it is out, the residue is the offset's rounding, and
+// EMD and ICEEMDAN added rounding IMFs without end (a hang with growing memory at 1e12 + sin).
+// They stop, complete to the offset's rounding.
+TEST(Emd, AResidueAtItsRoundingEndsTheDecomposition) {
+  Eigen::VectorXd x(50);
+  for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = 1e12 + std::sin(static_cast<double>(i) / 3.0);
+  for (const Method method : {Method::kEmd, Method::kIceemdan, Method::kBeemdan}) {
+    DecompositionOptions o;
+    o.method = method;
+    o.ensemble_size = 10;
+    const Decomposition d = Decompose(x, o);
+    EXPECT_GE(d.imfs.cols(), 1) << ToString(method);
+    EXPECT_LE(d.imfs.cols(), 8) << ToString(method);
+    const Eigen::VectorXd sum = d.imfs.rowwise().sum() + d.residue;
+    EXPECT_LE((sum - x).cwiseAbs().maxCoeff(), 1e-3) << ToString(method);  // ulp(1e12) = 1.2e-4
+  }
+  DecompositionOptions emd;
+  emd.method = Method::kEmd;
+  const std::string reason = Decompose(x, emd).report.stop_reason;
+  EXPECT_TRUE(reason == "residue varies by no more than the rounding of its magnitude" ||
+              reason == "the next IMF is below the rounding of the residue")
+      << reason;
+}
+
 TEST(Emd, DrawsNoNoiseSoEnsembleFieldsDoNotMatter) {
   const Eigen::VectorXd x = Noisy(1000);
   DecompositionOptions o;
