@@ -463,6 +463,13 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
   const std::string folder = (fs::path(output_dir) / unit.serial).string();
   const std::string summary = (fs::path(folder) / kSummaryFile).string();
   UnitRun run;
+  // Every way a unit fails: its row says why, and what an earlier run wrote for it goes.
+  auto fail = [&](UnitResult result) {
+    result.error += Unretracted(RetractUnit(folder));
+    run.rows = Rows(result);
+    run.what = "error";
+    return run;
+  };
   std::string fingerprint;
   try {
     fingerprint = UnitFingerprint(m, unit);
@@ -470,23 +477,15 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     UnitResult failed;
     failed.serial = unit.serial;
     failed.error = e.what();
-    failed.error += Unretracted(RetractUnit(folder));
-    run.rows = Rows(failed);
-    run.what = "error";
-    return run;
+    return fail(std::move(failed));
   }
   if (!force && ReadFinished(folder, fingerprint, &run.rows)) {
     run.what = "skipped";
     return run;
   }
   UnitOutputs outputs = CalibrateUnit(m, unit, assets);
+  if (!outputs.result.error.empty()) return fail(std::move(outputs.result));
   run.rows = Rows(outputs.result);
-  if (!outputs.result.error.empty()) {
-    outputs.result.error += Unretracted(RetractUnit(folder));
-    run.rows = Rows(outputs.result);
-    run.what = "error";
-    return run;
-  }
   json hashes = json::object();
   std::vector<std::pair<std::string, std::string>> files;
   std::error_code ec;
@@ -506,9 +505,8 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
     run.what = "calibrated";
     run.seconds = outputs.result.seconds;
   } catch (const Error& e) {
-    outputs.result.error = e.what() + Unretracted(RetractUnit(folder));
-    run.rows = Rows(outputs.result);
-    run.what = "error";
+    outputs.result.error = e.what();
+    return fail(std::move(outputs.result));
   }
   return run;
 }
