@@ -20,7 +20,7 @@ test = gd.simulate(duration=8 * 3600, profile="chamber-b", seed=2)
 
 model = gd.DriftModel().fit(train["rate_dph"], train["temperature_c"], mode="compensate", seed=1)
 print(model.summary)
-compensated = model.compensate(test["temperature_c"], test["rate_dph"])
+compensated = model.compensate(test["rate_dph"], test["temperature_c"])
 
 fig, ax = plt.subplots(figsize=(6, 4))
 for label, x in (("before", test["rate_dph"]), ("after", compensated)):

@@ -11,7 +11,7 @@ Example::
     imfs, residue, report = gd.decompose(sim["rate_dph"], method="beemdan", seed=7)
     a = gd.allan(sim["rate_dph"], rate_hz=1.0)
     model = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"], mode="compensate")
-    compensated = model.compensate(sim["temperature_c"], sim["rate_dph"])
+    compensated = model.compensate(sim["rate_dph"], sim["temperature_c"])
 
 Errors are ``UsageError`` (a bad option, a ValueError), ``DataError`` (data that cannot be
 processed, a ValueError) and ``FileError`` (an OSError), with the library's one-line messages.
@@ -256,7 +256,7 @@ class DriftModel:
     >>> m.method
     'thermal'
     >>> est, sd = m.estimate(sim["temperature_c"])
-    >>> out = m.compensate(sim["temperature_c"], sim["rate_dph"])   # rate_dph - est
+    >>> out = m.compensate(sim["rate_dph"], sim["temperature_c"])   # rate_dph - est
     """
 
     def __init__(self, _core=None):
@@ -304,12 +304,13 @@ class DriftModel:
         on its own, as ``gyrodrift compensate --gaps split`` does after each gap."""
         return self._core.estimate(temperature, record_starts=list(record_starts))
 
-    def compensate(self, temperature, y, *, record_starts=()):
+    def compensate(self, y, temperature, *, record_starts=()):
         """Compensate mode: ``y - estimate(temperature)``, the ``compensated`` column of
-        ``gyrodrift compensate``."""
+        ``gyrodrift compensate``. The output first, then its temperature, as ``fit`` and
+        ``predict`` take them."""
         return self._core.compensate(temperature, y, record_starts=list(record_starts))
 
-    def compensation_summary(self, temperature, y, *, record_starts=(), drift_window_s=600.0,
+    def compensation_summary(self, y, temperature, *, record_starts=(), drift_window_s=600.0,
                              logged=None, truth=None):
         """Compensate mode: what compensating ``y`` does to it, the figures ``gyrodrift
         compensate`` prints and keeps in its sidecar. Returns a dict: ``before`` and ``after``

@@ -214,7 +214,7 @@ def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():
     # And before evaluate and compensate, as the CLI's commands warn.
     kelvin = sim["temperature_c"] + 273.15
     with pytest.warns(UserWarning, match=r"^temperature column 'temp_raw' runs from"):
-        model.compensate(counts, sim["rate_dph"])
+        model.compensate(sim["rate_dph"], counts)
     with pytest.warns(UserWarning, match=r"^temperature column 'temperature_c' runs from .* kelvin\?"):
         gd.evaluate(sim["rate_dph"], kelvin, mode="compensate", methods="constant")
     assert gd.temperature_warning(sim["temperature_c"]) == ""

@@ -108,11 +108,11 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     estimate, sd = model.estimate(temperature)
     assert np.array_equal(estimate, comp["drift_est"])
     assert np.array_equal(sd, comp["drift_sd"])
-    assert np.array_equal(model.compensate(temperature, y), comp["compensated"])
+    assert np.array_equal(model.compensate(y, temperature), comp["compensated"])
     # And the CLI's file, loaded in Python, compensates the same.
     loaded = gd.DriftModel.load(tmp_path / "cli_model.json")
     assert loaded.summary == model.summary
-    assert np.array_equal(loaded.compensate(temperature, y), comp["compensated"])
+    assert np.array_equal(loaded.compensate(y, temperature), comp["compensated"])
     thermal = loaded.sub_models[0]["thermal"]
     assert thermal is not None
     assert len(thermal["regressors"]) == len(thermal["coefficients"]) == len(thermal["sd"])
@@ -120,7 +120,7 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     assert np.all(np.isfinite(thermal["sd"]))
     # What compensation did, as the CLI printed and kept it (drift::SummariseCompensation).
     side = read_json(tmp_path / "comp.csv.json")
-    summary = loaded.compensation_summary(temperature, y)
+    summary = loaded.compensation_summary(y, temperature)
     for when in ("before", "after"):
         for figure in ("mean", "rms", "std", "slow_variation"):
             assert summary[when][figure] == side[when][figure], (when, figure)
@@ -132,7 +132,7 @@ def test_fit_and_compensate_match_cli(cli, sim_csv, tmp_path):
     cli("compensate", tmp_path / "cli_model.json", sim_csv, "--truth", "drift_dph", "-q", "-o",
         tmp_path / "truth.csv")
     side = read_json(tmp_path / "truth.csv.json")["truth"]
-    summary = loaded.compensation_summary(temperature, y, truth=log["drift_dph"])
+    summary = loaded.compensation_summary(y, temperature, truth=log["drift_dph"])
     assert summary["truth_rms"] == side["rms"]
     assert summary["residual_rms"] == side["residual_rms"]
     assert 100.0 * summary["truth_removed"] == side["removed_percent"]

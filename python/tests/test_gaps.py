@@ -39,7 +39,7 @@ def test_carry_matches_cli(cli, tmp_path, method):
     cli("compensate", tmp_path / "cli.json", tmp_path / "bursts.csv", "--gaps", "carry", "-q",
         "-o", tmp_path / "carried.csv")
     side = json.loads((tmp_path / "carried.csv.json").read_text())
-    summary = m.compensation_summary(filled["temperature_c"], filled["rate_dph"], logged=logged)
+    summary = m.compensation_summary(filled["rate_dph"], filled["temperature_c"], logged=logged)
     assert summary["samples"] == side["samples"] == keep.sum()
     for when in ("before", "after"):
         for figure in ("mean", "rms", "std"):

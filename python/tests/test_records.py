@@ -34,7 +34,7 @@ def test_records_match_cli(cli, tmp_path):
     cli("compensate", tmp_path / "cli.json", tmp_path / "gap.csv", "--gaps", "split", "-q",
         "-o", tmp_path / "c.csv")
     out = read_csv(tmp_path / "c.csv")
-    assert np.array_equal(m.compensate(t, y, record_starts=starts), out["compensated"])
+    assert np.array_equal(m.compensate(y, t, record_starts=starts), out["compensated"])
     est, _ = m.estimate(t, record_starts=starts)
     assert np.array_equal(est, out["drift_est"])
 
