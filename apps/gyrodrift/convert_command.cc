@@ -48,9 +48,11 @@ void Run(ConvertArgs& a) {
     try {
       std::size_t used = 0;
       instance = std::stoi(a.instance, &used);
-      if (used != a.instance.size() || instance < 0 || instance > 255) throw std::out_of_range("");
+      if (used != a.instance.size() || instance < 0 || instance > io::kMaxUlogInstance)
+        throw std::out_of_range("");
     } catch (const std::logic_error&) {
-      throw OptionError("--instance", a.instance, "an integer in [0, 255] or all");
+      throw OptionError("--instance", a.instance,
+                        fmt::format("an integer in [0, {}] or all", io::kMaxUlogInstance));
     }
   }
   const io::Ulog log = io::ReadUlog(a.input, {a.conversion.topic});

@@ -168,7 +168,7 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
   const DecompositionContext& context = job.context;
   options.Validate();
   context.execution.Validate();
-  RequireFiniteSignal("input signal", x, 4);
+  RequireFiniteSignal("input signal", x, kMinDecomposeSamples);
   const Eigen::Index n = x.size();
   if (job.noise) {
     const auto& w = *job.noise;

@@ -178,7 +178,7 @@ CsvTable ReadTable(const std::string& path, const LogOptions& options,
                       .bad_lines = options.bad_lines};
   if (!IsUlogFile(path)) return ReadColumns(path, read);
   if (!columns.empty()) read.columns.push_back("time_s");
-  RequireInRange("ulog_instance", options.ulog_instance, 0, 255);
+  RequireInRange("ulog_instance", options.ulog_instance, 0, kMaxUlogInstance);
   if (!options.names.empty() || options.skip_rows != 0) {
     throw UsageError(fmt::format(
         "{} is a ULog: {} apply to CSV logs only", path,

@@ -67,6 +67,10 @@ void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise
 }
 
 void RequireDecomposable(const Eigen::VectorXd& x, std::string_view signal_name) {
+  if (x.size() < dec::kMinDecomposeSamples) {
+    throw DataError(fmt::format("{} has {} sample{}: decompose needs at least {}", signal_name,
+                                x.size(), x.size() == 1 ? "" : "s", dec::kMinDecomposeSamples));
+  }
   RequireVaryingSignal(signal_name, x, "it has no oscillation to decompose");
   if (x.size() > kMaxDecomposeSamples) {
     throw DataError(fmt::format(

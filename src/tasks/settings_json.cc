@@ -6,6 +6,7 @@
 
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
+#include "gyrodrift/io/ulog.h"
 
 namespace gyrodrift::tasks {
 namespace {
@@ -142,9 +143,13 @@ const std::vector<Field<LO>>& LogFields() {
       {"ulog_temperature", [](const LO& o) { return json(o.ulog.temperature); },
        [](const json& v, LO& o) { o.ulog.temperature = String("ulog_temperature", v); }},
       {"ulog_units", [](const LO& o) { return json(allan::ToString(o.ulog.units)); },
-       [](const json& v, LO& o) { o.ulog.units = Enum("ulog_units", v, allan::RateUnitFromString); }},
+       [](const json& v, LO& o) {
+         o.ulog.units = Enum("ulog_units", v, allan::RateUnitFromString);
+       }},
       {"ulog_instance", [](const LO& o) { return json(o.ulog_instance); },
-       [](const json& v, LO& o) { o.ulog_instance = Integer("ulog_instance", v, 0, 255); }},
+       [](const json& v, LO& o) {
+         o.ulog_instance = Integer("ulog_instance", v, 0, io::kMaxUlogInstance);
+       }},
   };
   return kFields;
 }

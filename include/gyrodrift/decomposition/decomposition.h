@@ -198,8 +198,11 @@ class NoiseEmds {
   std::vector<Realisation> realisations_;
 };
 
+// The shortest signal with extrema to sift between: two ends and an interior maximum and minimum.
+inline constexpr Eigen::Index kMinDecomposeSamples = 4;
+
 // Decomposes x with options.method. Throws UsageError (bad options or context) or DataError
-// (fewer than 4 samples, a non-finite sample).
+// (fewer than kMinDecomposeSamples samples, a non-finite sample).
 Decomposition Decompose(const Eigen::Ref<const Eigen::VectorXd>& x,
                         const DecompositionOptions& options,
                         const DecompositionContext& context = {});

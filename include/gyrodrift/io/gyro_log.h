@@ -49,7 +49,7 @@ struct LogOptions {
   // `gyrodrift convert` writes it: the series of ulog.topic and ulog_instance as time_s,
   // <axis>_<units> and temperature_c; the CSV settings above do not apply to it.
   UlogConversion ulog = {};
-  int ulog_instance = 0;  // [0, 255]
+  int ulog_instance = 0;  // [0, kMaxUlogInstance]
   bool operator==(const LogOptions&) const = default;
 };
 

@@ -32,6 +32,9 @@
 
 namespace gyrodrift::io {
 
+// The largest multi-instance id: ULog writes it in one byte.
+inline constexpr int kMaxUlogInstance = 255;
+
 // One multi-instance subscription of a topic: its numeric fields (arrays and nested formats
 // flattened: "accel[0]", "esc.rpm"; strings and padding left out) and, when decoded, its samples.
 struct UlogSeries {

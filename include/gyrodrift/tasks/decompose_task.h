@@ -64,8 +64,9 @@ void RequireNoiseTaken(const DecomposeSettings& settings, std::string_view noise
 // working vectors of the signal's length per thread (measured peaks in docs/errors.md).
 inline constexpr Eigen::Index kMaxDecomposeSamples = 20'000'000;
 
-// DataError naming `signal_name` for a constant x (nothing to decompose) or one longer than
-// kMaxDecomposeSamples. RunDecompose checks it; a front end may check it as soon as it has x.
+// DataError naming `signal_name` for an x shorter than dec::kMinDecomposeSamples or longer than
+// kMaxDecomposeSamples, or constant (nothing to decompose). RunDecompose checks it; a front end may
+// check it as soon as it has x.
 void RequireDecomposable(const Eigen::VectorXd& x, std::string_view signal_name);
 
 // The decomposition of x (RequireDecomposable); with `noise` not empty (one white-noise
