@@ -22,14 +22,13 @@ void StateOf(const Eigen::Ref<const Eigen::VectorXd>& t, double tau_s, int order
   }
 }
 
-// z to the power p, continued along its tangent beyond [lo, hi] for p >= 2.
+}  // namespace
+
 double TangentPower(double z, int p, double lo, double hi) {
   if (p == 1) return z;
   const double edge = std::clamp(z, lo, hi);
   return std::pow(edge, p) + p * std::pow(edge, p - 1) * (z - edge);
 }
-
-}  // namespace
 
 // H_w of a state's level (degC) for each half-width w (K): (s - P_w[s]) / w, the play operator
 // P_w starting at the level of each record's first sample.

@@ -10,6 +10,9 @@
 
 namespace gyrodrift::drift::internal {
 
+// z to the power p, continued along its tangent beyond [lo, hi] for p >= 2.
+double TangentPower(double z, int p, double lo, double hi);
+
 // H_w of a state's level (degC) for each half-width w (K): (s - P_w[s]) / w, the play operator
 // P_w starting at the level of each record's first sample.
 void HysteresisColumns(const Eigen::Ref<const Eigen::VectorXd>& level,

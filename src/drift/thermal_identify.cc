@@ -241,6 +241,7 @@ struct Search {
   Eigen::MatrixXd x;
   Eigen::VectorXd yc;  // the target centred on its logged mean, 0 where not logged
   std::unique_ptr<internal::FoldScores> scores;
+  internal::SteadySupport steady;
   internal::SearchResult result;
   internal::RunRegimes regimes;
 };
@@ -292,9 +293,13 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   // (scoring or gating on them chose worse models on the family: docs/drift.md 4.8).
   search.scores = std::make_unique<internal::FoldScores>(
       search.x, search.yc, weight, folds, 1u << internal::kTimeBlocks, report.prior_samples);
-  search.result = internal::SearchStructure(
-      *search.scores, search.layout,
-      {options.max_states, options.max_condition, options.standard_errors, heating != cooling});
+  search.steady = internal::SteadySupportOf(temperatures_c, search.yc, weight,
+                                            BlockSamples(kBlockS, model.rate_hz, n), model,
+                                            search.layout, search.candidates);
+  search.result =
+      internal::SearchStructure(*search.scores, search.layout,
+                                {options.max_states, options.max_condition, options.standard_errors,
+                                 heating != cooling, &search.steady});
   const internal::Subset& best = search.result.chosen;
   model.static_power.assign(static_cast<size_t>(channels), best.static_power);
   for (int j : best.states) model.states.push_back(search.candidates[static_cast<size_t>(j)]);
@@ -476,13 +481,16 @@ void FitAutopilotForm(const Eigen::Ref<const Eigen::VectorXd>& temperature_c,
     cols.back().push_back(search.layout.StaticColumn(0, p));
   }
   std::vector<Eigen::VectorXd> fold_scores;
+  std::vector<bool> supported;
   size_t best = 0;
   for (size_t p = 0; p < cols.size(); ++p) {
     fold_scores.push_back(scores.Scores(cols[p]));
-    if (scores.Mean(fold_scores[p]) < scores.Mean(fold_scores[best])) best = p;
+    supported.push_back(p == 0 || search.steady.Holds(scores.FullWeights(cols[p]), cols[p]));
+    if (supported[p] && scores.Mean(fold_scores[p]) < scores.Mean(fold_scores[best])) best = p;
   }
   size_t degree = best;
   for (size_t p = 0; p < best; ++p) {
+    if (!supported[p]) continue;
     const Eigen::VectorXd d = fold_scores[p] - fold_scores[best];
     if (scores.Mean(d) <= standard_errors * scores.StandardError(d)) {
       degree = p;
@@ -574,8 +582,7 @@ ThermalRegression IdentifyThermalModel(const Eigen::Ref<const Eigen::MatrixXd>& 
                                  .eigenvalues();
   model.report.condition =
       ev[0] > 0.0 ? ev[ev.size() - 1] / ev[0] : std::numeric_limits<double>::infinity();
-  internal::AddWarnings(model, options, search.result.fell_back_to_constant, search.regimes,
-                        model.report);
+  internal::AddWarnings(model, options, search.result, search.regimes, model.report);
   model.Validate();
   return model;
 }

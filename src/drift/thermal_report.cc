@@ -151,9 +151,10 @@ void AddRunWarnings(const ThermalRegression& model, const ThermalModelOptions& o
 }
 
 // What limits the model the run gave: how far its states can lag, how little it beats a constant
-// bias, how collinear its regressors are.
+// bias, what the run's temperatures could not support, how collinear its regressors are.
 void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                      bool fell_back_to_constant, CalibrationReport& report) {
+                      const SearchResult& search, CalibrationReport& report) {
+  const bool fell_back_to_constant = search.fell_back_to_constant;
   auto& w = report.warnings;
   auto& advice = report.advice;
   // The slowest candidate state's mean delay: order x tau.
@@ -186,6 +187,14 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
         "is close to a constant bias",
         100.0 * report.skill));
   }
+  if (search.best_unsupported_score < search.chosen.score) {
+    w.push_back(Format(
+        "a richer structure fitted the held-out blocks better (RMSE %.4g against %.4g) but its "
+        "steady-state drift leaves the band the run showed: the run's temperatures cannot "
+        "support its curvature (the levels between or beyond them are not logged); see the "
+        "advice",
+        std::sqrt(search.best_unsupported_score), std::sqrt(search.chosen.score)));
+  }
   if (report.regime_rmse > report.regime_rmse_constant && report.level > 0) {
     w.push_back(Format(
         "on held-out regimes and range ends the model does worse than a constant bias (RMSE %.4g "
@@ -201,9 +210,9 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
 }  // namespace
 
 void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                 bool fell_back_to_constant, const RunRegimes& regimes, CalibrationReport& report) {
+                 const SearchResult& search, const RunRegimes& regimes, CalibrationReport& report) {
   AddRunWarnings(model, options, regimes, report);
-  AddModelWarnings(model, options, fell_back_to_constant, report);
+  AddModelWarnings(model, options, search, report);
 }
 
 }  // namespace internal

@@ -9,6 +9,7 @@
 
 #include "../common/format.h"
 #include "gyrodrift/drift/thermal_model.h"
+#include "thermal_search.h"
 
 namespace gyrodrift::drift::internal {
 
@@ -41,9 +42,9 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
                        const std::vector<ThermalSegment>& segments,
                        const std::vector<Eigen::Index>& record_starts, CalibrationReport& report);
 
-// The warnings of what the run cannot identify, and the advice of what to add.
+// The warnings of what the run cannot identify (`search`: what the structure search left out),
+// and the advice of what to add.
 void AddWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
-                 bool fell_back_to_constant, const RunRegimes& regimes,
-                 CalibrationReport& report);
+                 const SearchResult& search, const RunRegimes& regimes, CalibrationReport& report);
 
 }  // namespace gyrodrift::drift::internal

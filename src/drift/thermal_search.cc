@@ -1,5 +1,5 @@
-// The structure search of the thermal identification: fold moments, held-out scores, the nested
-// ladder and the one-standard-error rule (thermal_search.h).
+// The structure search of the thermal identification: fold moments, held-out scores, the steady
+// support, the nested ladder and the one-standard-error rule (thermal_search.h).
 #include "thermal_search.h"
 
 #include <Eigen/Cholesky>
@@ -7,11 +7,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+
+#include "thermal_columns.h"
 
 namespace gyrodrift::drift::internal {
 namespace {
 
 constexpr double kRelativeRidge = 1e-10;  // on the unit-diagonal Gram of a subset
+// Steady temperatures at which a candidate's drift is held to the run's band (SteadySupportOf).
+constexpr Eigen::Index kSteadyPoints = 61;
 
 // Calls f(begin, length) for every run of logged rows (weight > 0) within [begin, end).
 template <typename F>
@@ -105,6 +110,66 @@ FoldScores::FoldScores(const Eigen::MatrixXd& x, const Eigen::VectorXd& yc,
 
 Eigen::VectorXd FoldScores::Weights(const Fold& f, const std::vector<int>& cols) const {
   return SolveSubset(f.g_train, f.b_train, cols, prior_samples_);
+}
+
+Eigen::VectorXd FoldScores::FullWeights(const std::vector<int>& cols) const {
+  return SolveSubset(g_total_, b_total_, cols, prior_samples_);
+}
+
+bool SteadySupport::Holds(const Eigen::VectorXd& w, const std::vector<int>& cols) const {
+  const double margin = high - low;
+  for (Eigen::Index r = 0; r < design.rows(); ++r) {
+    double drift = 0.0;
+    for (size_t i = 0; i < cols.size(); ++i) {
+      drift += w[static_cast<Eigen::Index>(i)] * design(r, cols[i]);
+    }
+    if (!(drift >= low - margin && drift <= high + margin)) return false;
+  }
+  return true;
+}
+
+SteadySupport SteadySupportOf(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                              const Eigen::VectorXd& yc, const Eigen::VectorXd& weight,
+                              Eigen::Index block, const ThermalRegression& model,
+                              const DesignLayout& layout,
+                              const std::vector<ThermalState>& candidates) {
+  SteadySupport support;
+  support.design = Eigen::MatrixXd::Zero(kSteadyPoints, layout.StateColumn(layout.candidates, 0));
+  for (Eigen::Index g = 0; g < kSteadyPoints; ++g) {
+    const double t = static_cast<double>(g) / (kSteadyPoints - 1);
+    auto row = support.design.row(g);
+    row[0] = 1.0;
+    auto z = [&](int c) {
+      const auto col = temperatures_c.col(c);
+      const double lo = col.minCoeff(), hi = col.maxCoeff();
+      const auto cu = static_cast<size_t>(c);
+      return (lo + t * (hi - lo) - model.centre_c[cu]) / model.scale_k[cu];
+    };
+    for (int c = 0; c < layout.channels; ++c) {
+      const auto cu = static_cast<size_t>(c);
+      for (int p = 1; p <= layout.static_powers; ++p) {
+        row[layout.StaticColumn(c, p)] =
+            TangentPower(z(c), p, model.static_min[cu], model.static_max[cu]);
+      }
+    }
+    for (int j = 0; j < layout.candidates; ++j) {
+      const ThermalState& s = candidates[static_cast<size_t>(j)];
+      for (int p = 1; p < layout.state_columns; ++p) {  // the level's powers; the rate stays 0
+        row[layout.StateColumn(j, p - 1)] = TangentPower(z(s.channel), p, s.level_min, s.level_max);
+      }
+    }
+  }
+  support.low = std::numeric_limits<double>::infinity();
+  support.high = -support.low;
+  for (Eigen::Index begin = 0; begin < yc.size(); begin += block) {
+    const Eigen::Index length = std::min(block, yc.size() - begin);
+    const double logged = weight.segment(begin, length).sum();
+    if (logged <= 0.0) continue;
+    const double mean = yc.segment(begin, length).sum() / logged;  // yc is 0 where not logged
+    support.low = std::min(support.low, mean);
+    support.high = std::max(support.high, mean);
+  }
+  return support;
 }
 
 Eigen::VectorXd FoldScores::Scores(const std::vector<int>& cols, bool every_fold) const {
@@ -206,10 +271,16 @@ class Ladder {
   Ladder(const FoldScores& scores, const DesignLayout& layout, const SearchRules& rules)
       : scores_(scores), layout_(layout), rules_(rules) {}
 
-  // s scored, kept when it is the best of its level so far.
+  // s scored, kept when it is the best of its level so far and the steady support holds it.
   Subset Consider(Subset s) {
     s.fold_scores = scores_.Scores(s.cols);
     s.score = scores_.Mean(s.fold_scores);
+    if (rules_.steady && s.cols.size() > 1 &&
+        !rules_.steady->Holds(scores_.FullWeights(s.cols), s.cols)) {
+      ++unsupported_;
+      best_unsupported_score_ = std::min(best_unsupported_score_, s.score);
+      return s;
+    }
     if (s.score < best_[static_cast<size_t>(s.level)].score)
       best_[static_cast<size_t>(s.level)] = s;
     return s;
@@ -227,6 +298,8 @@ class Ladder {
   }
 
   const LevelBests& best() const { return best_; }
+  int unsupported() const { return unsupported_; }
+  double best_unsupported_score() const { return best_unsupported_score_; }
 
  private:
   // The lag states `chosen`: one state's level powers, or one or two states with their rates;
@@ -273,6 +346,8 @@ class Ladder {
   const DesignLayout& layout_;
   const SearchRules& rules_;
   LevelBests best_{};
+  int unsupported_ = 0;
+  double best_unsupported_score_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace
@@ -339,6 +414,8 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
   std::vector<int> chosen;
   ladder.VisitStates(chosen, 0, std::min(rules.max_states, layout.candidates));
   ChooseLevel(scores, rules, ladder.best(), result);
+  result.unsupported = ladder.unsupported();
+  result.best_unsupported_score = ladder.best_unsupported_score();
   return result;
 }
 

@@ -49,6 +49,8 @@ class FoldScores {
   const Eigen::MatrixXd& gram() const { return g_total_; }  // of every logged row
   // The training part's least-squares weights of fold f on the columns `cols`.
   Eigen::VectorXd Weights(const Fold& f, const std::vector<int>& cols) const;
+  // The least-squares weights of the columns `cols` on every logged row.
+  Eigen::VectorXd FullWeights(const std::vector<int>& cols) const;
   // Held-out mean square error of every scored fold (NaN at the others, which `every_fold`
   // scores too: the search needs the scored folds only, the report the rest for three subsets).
   Eigen::VectorXd Scores(const std::vector<int>& cols, bool every_fold = false) const;
@@ -108,7 +110,33 @@ struct SearchResult {
   int best_level = 0;
   double best_score = 0.0;             // of the best level
   bool fell_back_to_constant = false;  // the constant, although a richer level scored best
+  // The subsets SteadySupport left out, and the least held-out score among them.
+  int unsupported = 0;
+  double best_unsupported_score = std::numeric_limits<double>::infinity();
 };
+
+// What the calibration's temperatures support at steady state: the candidate design's columns at
+// steady temperatures (every state at its channel's temperature, rates and hysteresis 0) on a grid
+// over the calibrated range, and the band the centred target's block means spanned. A fit whose
+// steady-state drift leaves that band, widened by its own width on either side, claims a curve the
+// run never showed: two plateaus, between which a cubic is free to swing [choice, docs/drift.md
+// 4.10: the grid and the widening measured on family units 1-20].
+struct SteadySupport {
+  Eigen::MatrixXd design;  // grid points x candidate columns
+  double low = 0.0, high = 0.0;
+  // Whether the weights w of the columns `cols` keep the steady-state drift within the band.
+  bool Holds(const Eigen::VectorXd& w, const std::vector<int>& cols) const;
+};
+
+// The steady support of a candidate design (CandidateDesign's layout and candidates): 61 steady
+// temperatures across the calibrated range, every channel along its own range together (the
+// channels of one gyro warm together), and the band of the means of the centred target yc over
+// the logged samples of each `block` samples.
+SteadySupport SteadySupportOf(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
+                              const Eigen::VectorXd& yc, const Eigen::VectorXd& weight,
+                              Eigen::Index block, const ThermalRegression& model,
+                              const DesignLayout& layout,
+                              const std::vector<ThermalState>& candidates);
 
 struct SearchRules {
   int max_states = 2;
@@ -118,6 +146,8 @@ struct SearchRules {
   // (two states, or a state beside the static term), whose sign follows the direction, nor a
   // hysteresis term, which tells the directions apart.
   bool one_direction = false;
+  // Subsets that SteadySupport rejects are not candidates (null: no check).
+  const SteadySupport* steady = nullptr;
 };
 
 // The best subset of each level of the ladder (CalibrationReport's levels, the constant first).

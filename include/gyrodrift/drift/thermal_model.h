@@ -32,10 +32,12 @@
 // top and the bottom fifth of the temperature range held out, are scored and reported beside
 // (choosing or gating on them chose worse models on the family's one-way heat-ups:
 // docs/drift.md 4.8). Columns that are nearly collinear (condition of the scaled Gram above
-// max_condition: two states of close time constants) never enter together. A run that showed one
-// direction of temperature change only (no cooling ramp, or no heating ramp) takes no lag
-// difference (two states, or a state beside the static term: its sign follows the direction) and
-// no hysteresis term.
+// max_condition: two states of close time constants) never enter together, nor does a subset
+// whose steady-state drift across the calibrated range leaves the band of the run's 10-min means
+// widened by its width (two plateaus leave a cubic free between them; docs/drift.md 4.10). A run
+// that showed one direction of temperature change only (no cooling ramp, or no heating ramp)
+// takes no lag difference (two states, or a state beside the static term: its sign follows the
+// direction) and no hysteresis term.
 //
 // Support: the model keeps the calibration's range of every static level, state level and state
 // rate. Beyond a level's range its powers >= 2 continue along their tangent (a model does not

@@ -43,6 +43,24 @@ SearchResult Choose(const LevelBests& best) {
   return result;
 }
 
+// The steady support holds a steady-state drift within the band the run's block means spanned,
+// widened by its width on either side, and nothing beyond (nor a fit that is not finite).
+TEST(SteadySupport, HoldsACurveWithinTheBandWidenedByItsWidth) {
+  SteadySupport support;
+  support.design.resize(3, 3);
+  support.design << 1.0, -1.0, 1.0,  // the intercept, z, z^2 at z = -1, 0, 1
+      1.0, 0.0, 0.0,                 //
+      1.0, 1.0, 1.0;
+  support.low = -1.0;
+  support.high = 1.0;  // allowed: [-3, 3]
+  const std::vector<int> line{0, 1}, parabola{0, 2};
+  EXPECT_TRUE(support.Holds(Eigen::Vector2d(0.0, 3.0), line));
+  EXPECT_FALSE(support.Holds(Eigen::Vector2d(0.0, 3.5), line));
+  EXPECT_TRUE(support.Holds(Eigen::Vector2d(-2.0, 5.0), parabola));  // -2 .. 3
+  EXPECT_FALSE(support.Holds(Eigen::Vector2d(-3.5, 5.0), parabola));
+  EXPECT_FALSE(support.Holds(Eigen::Vector2d(0.0, std::numeric_limits<double>::quiet_NaN()), line));
+}
+
 // Unit 54 of the family's 16-h calibrations, in miniature: one state with its rate comes within a
 // standard error of the best (two states) but has one bad fold, so it does not beat the constant;
 // the two states beat the constant on every fold. The choice passes to the two states (before:
