@@ -21,6 +21,7 @@ See docs/python.md.
 import inspect
 import numbers
 import os
+import warnings
 
 from . import _gyrodrift
 from ._gyrodrift import DataError, FileError, UsageError, __version__
@@ -289,13 +290,19 @@ class DriftModel:
         over every row, the fit uses the logged ones only (compensate mode, a method without a
         decomposition; ``y`` on the made-up rows is ignored and may be NaN). Score and report on
         the logged rows too. ``progress``: a callable given the fraction of the fit done, as for
-        ``decompose`` (Ctrl-C stops the fit at its next report). Returns self.
+        ``decompose`` (Ctrl-C stops the fit at its next report). What the calibration run could
+        not identify is a ``UserWarning`` each, as ``gyrodrift fit`` prints it ("calibration run
+        (signal): no cooling ramp: ..."; also in ``sub_models[g]["thermal"]["warnings"]``, beside
+        the ``advice``). Returns self.
         """
         self._core.fit(y, temperature, mode=mode, target=target,
                        temperature_columns=temperature_columns, source=source, units=units,
                        record_starts=list(record_starts),
                        logged=_flags(logged),
                        progress=progress, **settings)
+        for sub in self._core.sub_models:
+            for text in (sub.get("thermal") or {}).get("warnings", []):
+                warnings.warn(f"calibration run ({sub['name']}): {text}", UserWarning, stacklevel=2)
         return self
 
     def estimate(self, temperature, *, record_starts=()):

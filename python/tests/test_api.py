@@ -235,3 +235,11 @@ def test_export_takes_fitted_models_as_their_files(tmp_path):
         gd.export([x, tmp_path / "y.json"])
     with pytest.raises(gd.UsageError, match="not fitted"):
         gd.export(gd.DriftModel())
+
+
+def test_what_the_calibration_cannot_identify_is_a_user_warning_as_fit_prints_it():
+    sim = gd.simulate(duration=3 * 3600, seed=3)
+    with pytest.warns(UserWarning, match=r"^calibration run \(signal\): thermal states could lag"):
+        model = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"])
+    assert any(w.startswith("thermal states could lag")
+               for w in model.sub_models[0]["thermal"]["warnings"])
