@@ -405,15 +405,20 @@ std::string Unretracted(const std::string& failed) {
   return failed.empty() ? "" : " (an earlier run's files could not be removed: " + failed + ")";
 }
 
-}  // namespace
-
-void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::string& folder) {
+// The manifest and the logs of `unit` (of every unit when null).
+std::vector<std::string> InputsOf(const Manifest& m, const UnitSpec* unit) {
   std::vector<std::string> inputs = {m.path};
   for (const UnitSpec& u : m.units) {
     if (unit && &u != unit) continue;
     for (const std::string& log : u.Logs()) inputs.push_back(log);
   }
-  io::RequireInputsOutsideFolder(inputs, folder);
+  return inputs;
+}
+
+}  // namespace
+
+void RequireInputsOutside(const Manifest& m, const UnitSpec* unit, const std::string& folder) {
+  io::RequireInputsOutsideFolder(InputsOf(m, unit), folder);
 }
 
 bool AxisResult::pass() const {
@@ -501,7 +506,7 @@ UnitRun RunUnit(const Manifest& m, const UnitSpec& unit, const std::string& outp
                   {"files", hashes}};
   files.push_back({summary, s.dump(1) + "\n"});
   try {
-    io::WriteFilesAtomically(files);
+    io::WriteFilesAtomically(files, InputsOf(m, &unit));
     run.what = "calibrated";
     run.seconds = outputs.result.seconds;
   } catch (const Error& e) {
@@ -553,7 +558,8 @@ FleetResult FinishFleet(const Manifest& m, const std::string& output_dir,
   fleet.seconds = seconds;
   io::WriteFilesAtomically(
       {{(fs::path(output_dir) / kFleetTableFile).string(), csv},
-       {(fs::path(output_dir) / kFleetReportFile).string(), RenderFleetReport(m, fleet, assets)}});
+       {(fs::path(output_dir) / kFleetReportFile).string(), RenderFleetReport(m, fleet, assets)}},
+      InputsOf(m, nullptr));
   return fleet;
 }
 

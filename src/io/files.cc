@@ -1,8 +1,10 @@
 #include "gyrodrift/io/files.h"
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -26,7 +28,19 @@ void RequireFileTarget(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::file_status link = fs::symlink_status(path, ec);
-  if (ec || !fs::exists(link)) return;
+  if (ec || !fs::exists(link)) {
+    // The temporary is created in the target's folder: one that is missing or not writable would
+    // fail the write after the work.
+    const fs::path folder =
+        fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
+    if (!fs::is_directory(folder, ec)) {
+      throw IoError(path + ": cannot open for writing (no folder " + folder.string() + ")");
+    }
+    if (::access(folder.c_str(), W_OK) != 0) {
+      throw IoError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
+    }
+    return;
+  }
   const fs::file_status target = fs::status(path, ec);
   if (fs::is_symlink(link) && (ec || !fs::exists(target))) {
     throw IoError(path + ": is a symbolic link to nothing: name the file to write");
@@ -37,6 +51,27 @@ void RequireFileTarget(const std::string& path) {
                   ": is not a regular file (a device, a pipe or a socket): gyrodrift writes a "
                   "whole file and renames it into place; name a file");
   }
+}
+
+// The inputs this process has checked its outputs against: the clean-up of stale temporaries
+// never removes one of them, whatever its name.
+struct CheckedInputs {
+  std::mutex mutex;
+  std::vector<std::string> paths;  // guarded by mutex
+};
+
+CheckedInputs& Inputs() {
+  static CheckedInputs* inputs = new CheckedInputs;  // never destroyed: writers run to the end
+  return *inputs;
+}
+
+bool IsCheckedInput(const std::filesystem::path& path) {
+  const std::lock_guard<std::mutex> lock(Inputs().mutex);
+  for (const std::string& in : Inputs().paths) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(in, path, ec) && !ec) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -50,6 +85,12 @@ void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
   for (const std::string& in : inputs) {
     std::error_code ec;
     if (in.empty() || !fs::exists(in, ec)) continue;
+    {
+      const std::string path = fs::absolute(in, ec).string();
+      const std::lock_guard<std::mutex> lock(Inputs().mutex);
+      auto& paths = Inputs().paths;
+      if (std::find(paths.begin(), paths.end(), path) == paths.end()) paths.push_back(path);
+    }
     for (const std::string& out : outputs) {
       if (out.empty() || !fs::exists(out, ec)) continue;
       if (fs::equivalent(in, out, ec) && !ec) {
@@ -150,6 +191,7 @@ void RemoveStaleTemporaries(const std::vector<std::string>& targets) {
       }
       if (owner <= 0 || owner == ::getpid()) continue;
       if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+      if (IsCheckedInput(it->path())) continue;  // named like ours, but the user's input
       stale.push_back(it->path());
     }
   }
@@ -249,6 +291,9 @@ std::vector<std::string> WriteTemporaries(const std::vector<StreamedFile>& files
       throw IoError(path + ": cannot open for writing (" + reason + ")");
     }
     temps.push_back(temp);
+    // A replaced file keeps its permissions (a private 0600 output stays private).
+    struct stat existing;
+    if (::stat(targets[i].c_str(), &existing) == 0) ::fchmod(::fileno(f), existing.st_mode & 07777);
     try {
       write(f);
     } catch (...) {
@@ -355,6 +400,14 @@ void WriteStreamedFilesAtomically(const std::vector<StreamedFile>& files) {
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   WriteFilesAtomically({{path, contents}});
+}
+
+void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files,
+                          const std::vector<std::string>& inputs) {
+  std::vector<std::string> paths;
+  for (const auto& file : files) paths.push_back(file.first);
+  RequireOutputsAreNotInputs(inputs, paths);
+  WriteFilesAtomically(files);
 }
 
 }  // namespace gyrodrift::io

@@ -155,7 +155,7 @@ DemoRun RunDemo(const DemoSettings& settings, const StudyContext& context) {
   if (context.progress) context.progress(kStudyStages, 0.0, "writing " + settings.output);
   run.files = RenderStudyFiles(run.result, assets);
   run.files.push_back({"demo.json", DemoRecord(settings, run.result).dump(2) + "\n"});
-  WriteStudyFiles(settings.output, run.files);
+  WriteStudyFiles(settings.output, run.files, {settings.input});
   run.seconds = Seconds(start);
   return run;
 }

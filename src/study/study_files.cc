@@ -159,7 +159,8 @@ void RequireUsableOutputFolder(const std::string& folder) {
   }
 }
 
-void WriteStudyFiles(const std::string& folder, const std::vector<StudyFile>& files) {
+void WriteStudyFiles(const std::string& folder, const std::vector<StudyFile>& files,
+                     const std::vector<std::string>& inputs) {
   namespace fs = std::filesystem;
   std::set<fs::path> folders{fs::path(folder)};
   std::vector<std::pair<std::string, std::string>> targets;
@@ -174,7 +175,7 @@ void WriteStudyFiles(const std::string& folder, const std::vector<StudyFile>& fi
     fs::create_directories(dir, ec);
     if (ec) throw IoError(folder + ": cannot create the output folder (" + ec.message() + ")");
   }
-  io::WriteFilesAtomically(targets);
+  io::WriteFilesAtomically(targets, inputs);
 }
 
 }  // namespace gyrodrift::study

@@ -25,8 +25,11 @@ namespace gyrodrift::io {
 // (each output's sidecar included: pass both) is one of the inputs, however spelled (relative,
 // "./", a symbolic or a hard link: the same file by device and inode). Inputs that do not exist
 // or are empty strings are skipped. Also throws IoError for an output that exists and is not a
-// regular file or a link to one (a directory, /dev/null, a pipe, a dangling link), which the
-// write would refuse after the work. Called before any work.
+// regular file or a link to one (a directory, /dev/null, a pipe, a dangling link), or that does
+// not exist in a folder that is missing or not writable, which the write would refuse after the
+// work. Called before any work. The inputs are remembered for the
+// process: no later write's clean-up of a killed writer's temporaries removes one of them, even
+// one named like a temporary.
 void RequireOutputsAreNotInputs(const std::vector<std::string>& inputs,
                                 const std::vector<std::string>& outputs);
 
@@ -55,6 +58,11 @@ std::string ReadTextFile(const std::string& path);
 // so if a restore itself failed).
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 void WriteFileAtomically(const std::string& path, const std::string& contents);
+// The same after RequireOutputsAreNotInputs(inputs, the files' paths): for the writers of a folder
+// (demo, calibrate), whose files are named at the end, where a link left in the folder could lead
+// to an input.
+void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files,
+                          const std::vector<std::string>& inputs);
 
 // One file of an output set whose contents are streamed into the temporary file by `write`
 // rather than held in memory (a decomposition of 1e7 samples renders to gigabytes of text).

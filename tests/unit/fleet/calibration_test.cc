@@ -471,6 +471,23 @@ TEST_F(FleetCalibration, AUnitThatBecomesAnErrorLosesItsEarlierResults) {
   EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
 }
 
+// A link left in a unit's folder never leads a write to the unit's own log: an error row, the log
+// untouched (the writer would have replaced the file the link points to).
+TEST_F(FleetCalibration, ALinkInTheOutputFolderNeverLeadsAWriteToAnInput) {
+  const std::string out = Dir() + "/out_link";
+  const Manifest m = Make("", {{"SNL", "SN1_cal.csv", "SN1_ver.csv"}});
+  const std::string log = io::ReadTextFile(Dir() + "/SN1_cal.csv");
+  fs::create_directories(out + "/SNL");
+  fs::create_symlink(fs::absolute(Dir() + "/SN1_cal.csv"), out + "/SNL/report.html");
+  const UnitRun run = RunUnit(m, m.units[0], out, false, test::FakeDygraphs());
+  EXPECT_EQ(run.what, "error");
+  ASSERT_FALSE(run.rows.empty());
+  std::string cells;
+  for (const std::string& c : run.rows[0].cells) cells += c + "|";
+  EXPECT_NE(cells.find("is the input"), std::string::npos) << cells;
+  EXPECT_EQ(io::ReadTextFile(Dir() + "/SN1_cal.csv"), log);
+}
+
 // A verification log that is a copy of the calibration log would judge the model on what it was
 // fitted on: an error row, as for the same file named twice.
 TEST_F(FleetCalibration, ACopyOfTheCalibrationLogIsNoVerification) {

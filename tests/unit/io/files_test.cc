@@ -280,6 +280,23 @@ TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
   EXPECT_EQ(ReadTextFile(dir + "/x.csv"), "complete");
   for (const auto& name : stale) EXPECT_FALSE(test::FileExists(dir + "/" + name)) << name;
   for (const auto& name : kept) EXPECT_EQ(ReadTextFile(dir + "/" + name), "other") << name;
+  // A user's input named like a dead writer's temporary is checked as an input, then kept.
+  const std::string input = dir + "/x.csv.gyrodrift-tmp." + dead;
+  WriteFileAtomically(input, "the user's log");
+  RequireOutputsAreNotInputs({input}, {dir + "/x.csv"});
+  WriteFileAtomically(dir + "/x.csv", "again");
+  EXPECT_EQ(ReadTextFile(input), "the user's log");
+}
+
+TEST(WriteFileAtomically, AReplacedFileKeepsItsPermissions) {
+  const std::string dir = test::TempDir("files_mode");
+  WriteFileAtomically(dir + "/private.csv", "first\n");
+  ::chmod((dir + "/private.csv").c_str(), 0600);
+  WriteFileAtomically(dir + "/private.csv", "second\n");
+  struct stat st;
+  ASSERT_EQ(::stat((dir + "/private.csv").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0600u);
+  EXPECT_EQ(ReadTextFile(dir + "/private.csv"), "second\n");
 }
 
 }  // namespace

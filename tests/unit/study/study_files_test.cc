@@ -243,6 +243,19 @@ TEST(WriteStudyFiles, WritesTheSetWithItsSubfolders) {
   EXPECT_THROW(WriteStudyFiles(dir + "/a.csv/sub", {{"b.csv", "y\n"}}), IoError);
 }
 
+// A link in the folder that leads to the study's input log is refused before anything is written.
+TEST(WriteStudyFiles, NeverWritesThroughALinkToAnInput) {
+  const std::string dir = test::TempDir("study_files_link");
+  io::WriteFileAtomically(dir + "/log.csv", "x\n1\n");
+  fs::create_directories(dir + "/out");
+  fs::create_symlink(fs::absolute(dir + "/log.csv"), dir + "/out/imfs.csv");
+  EXPECT_THROW(
+      WriteStudyFiles(dir + "/out", {{"a.csv", "y\n"}, {"imfs.csv", "z\n"}}, {dir + "/log.csv"}),
+      UsageError);
+  EXPECT_EQ(io::ReadTextFile(dir + "/log.csv"), "x\n1\n");
+  EXPECT_FALSE(fs::exists(dir + "/out/a.csv"));
+}
+
 TEST(WriteStudyFiles, AFailingFileChangesNoneOfTheSet) {
   const std::string dir = test::TempDir("study_files_set");
   WriteStudyFiles(dir, {{"a.csv", "old\n"}, {"models/m.json", "{}\n"}});
