@@ -267,7 +267,7 @@ class CWriter {
       const Chain& chain = plan_.chains[c];
       out_ += fmt::format("  /* lags of {}, tau {:.4g} s, gain 1 - exp(-{} s / tau) */\n",
                           CommentText(plan_.channels[static_cast<size_t>(chain.channel)]),
-                          chain.tau_s, 1.0 / plan_.rate_hz);
+                          chain.tau_s, chain.dt_s);
       out_ += fmt::format("  d = t[{0}] - s->temperature_c[{0}];\n", chain.channel);
       for (int k = 0; k < chain.stages; ++k) {
         const int i = chain.first + k;

@@ -45,11 +45,14 @@ State PlanState(const drift::ThermalRegression& t, const drift::ThermalState& ts
                 Eigen::Index& k, Plan& plan) {
   const auto cu = static_cast<size_t>(ts.channel);
   const double dt_s = 1.0 / t.rate_hz;  // as ThermalRegression::Regressors
+  // Axes share a chain only at the same gain: rates that agree to RequireExportable's tolerance
+  // still give each model its own (the gain of its own rate, as its fit).
+  const double gain = drift::FirstOrderLagGain(ts.tau_s, dt_s);
   auto chain = std::find_if(plan.chains.begin(), plan.chains.end(), [&](const Chain& c) {
-    return c.channel == channel && c.tau_s == ts.tau_s;
+    return c.channel == channel && c.tau_s == ts.tau_s && c.gain == gain;
   });
   if (chain == plan.chains.end()) {
-    plan.chains.push_back({channel, ts.tau_s, drift::FirstOrderLagGain(ts.tau_s, dt_s), 0, 0});
+    plan.chains.push_back({channel, ts.tau_s, dt_s, gain, 0, 0});
     chain = plan.chains.end() - 1;
   }
   chain->stages = std::max(chain->stages, t.order);
@@ -75,7 +78,7 @@ Sub PlanSub(const std::string& name, const drift::ThermalRegression& t,
             const std::vector<int>& global, double reference_c, Plan& plan) {
   Sub s;
   s.name = name;
-  plan.rate_hz = t.rate_hz;
+  if (plan.rate_hz == 0.0) plan.rate_hz = t.rate_hz;  // the first axis's; each chain keeps its own
   Eigen::Index k = 0;
   s.intercept = t.coefficients[k++];
   for (int c = 0; c < t.channels(); ++c) {

@@ -18,6 +18,7 @@ using io::LoadedModel;
 struct Chain {
   int channel = 0;  // global channel index
   double tau_s = 0.0;
+  double dt_s = 0.0;  // the sample period of the model it serves
   double gain = 0.0;  // 1 - exp(-dt/tau)
   int stages = 0;
   int first = 0;  // index of its first stage in the state's lag array
@@ -73,7 +74,7 @@ struct Axis {
 };
 
 struct Plan {
-  double rate_hz = 0.0;
+  double rate_hz = 0.0;  // of the first axis (the header's RATE_HZ); each chain keeps its own gain
   std::vector<std::string> channels;
   std::vector<Chain> chains;
   std::vector<Axis> axes;

@@ -324,6 +324,30 @@ TEST_F(FirmwareExport, AxesShareTheChannelsAndLagsTheyHaveInCommon) {
   EXPECT_NE(three.Line().find("3 axes, 2 temperature channels"), std::string::npos) << three.Line();
 }
 
+// One logger's rate read from two logs' time stamps differs in its last digits: export takes both,
+// and each axis's lags run at its own model's gain (sharing the first one's was 1e-6 off).
+TEST_F(FirmwareExport, AxesAtRatesThatDifferInTheLastDigitsKeepTheirOwnGains) {
+  drift::DriftOptions o = Compensate(Method::kThermal);
+  o.features.rate_hz = 1.0 + 9e-7;
+  const LoadedModel faster = Fit(MakeLog(3000, 3), o, 1, "rate_y_dph");
+  const auto& states = faster.model.sub_models.front().thermal->states;
+  const auto& first = thermal_->model.sub_models.front().thermal->states;
+  ASSERT_FALSE(states.empty());
+  ASSERT_EQ(states.size(), first.size());
+  for (size_t i = 0; i < states.size(); ++i) ASSERT_EQ(states[i].tau_s, first[i].tau_s);
+  const json j = json::parse(RenderCoefficientsJson({*thermal_, faster}, kJson));
+  const Log test = MakeLog(1500, 10);
+  const Eigen::MatrixXd got = EvaluateCoefficients(j, test.temperature.leftCols(1));
+  EXPECT_LT(MaxRelativeError(got.col(0),
+                             drift::EstimateDrift(thermal_->model, test.temperature.leftCols(1))),
+            1e-12);
+  EXPECT_LT(MaxRelativeError(got.col(1),
+                             drift::EstimateDrift(faster.model, test.temperature.leftCols(1))),
+            1e-12);
+  EXPECT_EQ(SummariseExport({*thermal_, faster}).lag_stages,
+            2 * SummariseExport({*thermal_}).lag_stages);
+}
+
 // The header is C: the only test of its text is a compiler (the system's, as a user's would be).
 // Several axes with two channels, ms-elm, a reference, a hysteresis term, a heat-up's model (a
 // cooling rate beyond its edge) and a model without states (no lag stage) in one header, and that
