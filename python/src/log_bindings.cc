@@ -132,7 +132,10 @@ py::dict UlogColumns(const std::string& path, const std::string& topic, int inst
                                       .temperature = temperature_field,
                                       .units = allan::RateUnitFromString(units)};
   // One series: "every instance" (a negative one to SeriesWithSamples) is not an answer here.
-  if (instance < 0) ThrowOption("instance", std::to_string(instance), "an integer >= 0");
+  if (instance < 0 || instance > io::kMaxUlogInstance) {
+    ThrowOption("instance", std::to_string(instance),
+                "an integer in [0, " + std::to_string(io::kMaxUlogInstance) + "]");
+  }
   const io::Ulog log = io::ReadUlog(path, {topic});
   const io::UlogSeries& s = *io::SeriesWithSamples(log, path, topic, instance).front();
   py::dict d;

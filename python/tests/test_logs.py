@@ -45,8 +45,9 @@ def test_a_damaged_logs_text_and_bad_arguments_raise_gyrodrift_errors(tmp_path):
     assert gd.read_ulog(str(damaged))["info"]["sys_name"] == "\ufffdX4"
     with pytest.raises(gd.FileError, match="is a directory"):
         gd.read_ulog(str(tmp_path))
-    with pytest.raises(gd.UsageError, match=r"instance = -1: must be an integer >= 0"):
-        gd.ulog_columns(str(LOG), instance=-1)
+    for bad in (-1, 256):
+        with pytest.raises(gd.UsageError, match=rf"instance = {bad}: must be an integer in \[0, 255\]"):
+            gd.ulog_columns(str(LOG), instance=bad)
     with pytest.raises(gd.UsageError, match="named twice"):
         gd.ulog_columns(str(LOG), instance=0, axes=("x", "x"))
 

@@ -121,6 +121,21 @@ std::string CompensationSummary::Table(const std::string& target, const std::str
                   block_s);
   }
   row("slow variation", before.slow, after.slow, note);
+  // What a user without the truth can see of a compensation that made the gyro worse [choice,
+  // docs/drift.md 1.5: on family units 700-739 it marked 21 of the 26 compensations worse than
+  // doing nothing, and 11 of the 214 better].
+  constexpr double kRiseWarned = 1.25;
+  if (after.slow > kRiseWarned * before.slow) {
+    char rise[64];
+    if (before.slow > 0.0) {
+      std::snprintf(rise, sizeof(rise), "by %.3g %%", 100.0 * (after.slow / before.slow - 1.0));
+    } else {
+      std::snprintf(rise, sizeof(rise), "from 0 to %s", Cell(after.slow).c_str());
+    }
+    out += std::string("  warning: compensation raised the slow variation ") + rise +
+           ": on this log the model does worse than none at the drift's time scale (see its "
+           "calibration's warnings)\n";
+  }
   return out;
 }
 

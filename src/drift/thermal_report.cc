@@ -16,6 +16,7 @@ constexpr double kShortestDwellS = 600.0;
 // Calibration sufficiency: warnings below these (docs/drift.md 4.5, 4.8).
 constexpr double kShortestSpanK = 15.0;
 constexpr double kLeastSkill = 0.2;
+// Above ThermalModelOptions::max_condition's default (1e8): it warns a caller who raised that.
 constexpr double kLargestCondition = 1e10;
 // Shorter than this, a log is not a calibration run: no regime can be held out.
 constexpr double kShortestCalibrationS = 3600.0;
@@ -187,13 +188,15 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
         "is close to a constant bias",
         100.0 * report.skill));
   }
-  if (search.best_unsupported_score < search.chosen.score) {
+  if (search.best_unsupported_score < search.best_score) {
     w.push_back(Format(
-        "a richer structure fitted the held-out blocks better (RMSE %.4g against %.4g) but its "
-        "steady-state drift leaves the band the run showed: the run's temperatures cannot "
-        "support its curvature (the levels between or beyond them are not logged); see the "
-        "advice",
-        std::sqrt(search.best_unsupported_score), std::sqrt(search.chosen.score)));
+        "the structure of least held-out error (RMSE %.4g, against %.4g of the best kept) was left "
+        "out: its steady-state drift leaves the band the run showed, a curve between the logged "
+        "temperatures that the run cannot support",
+        std::sqrt(search.best_unsupported_score), std::sqrt(search.best_score)));
+    advice.push_back(
+        "temperatures between the logged ones: log the range between them (a ramp across it, or "
+        "a dwell in it)");
   }
   if (report.regime_rmse > report.regime_rmse_constant && report.level > 0) {
     w.push_back(Format(

@@ -135,15 +135,15 @@ SteadySupport SteadySupportOf(const Eigen::Ref<const Eigen::MatrixXd>& temperatu
                               const std::vector<ThermalState>& candidates) {
   SteadySupport support;
   support.design = Eigen::MatrixXd::Zero(kSteadyPoints, layout.StateColumn(layout.candidates, 0));
+  const Eigen::VectorXd lo = temperatures_c.colwise().minCoeff().transpose();
+  const Eigen::VectorXd hi = temperatures_c.colwise().maxCoeff().transpose();
   for (Eigen::Index g = 0; g < kSteadyPoints; ++g) {
     const double t = static_cast<double>(g) / (kSteadyPoints - 1);
     auto row = support.design.row(g);
     row[0] = 1.0;
     auto z = [&](int c) {
-      const auto col = temperatures_c.col(c);
-      const double lo = col.minCoeff(), hi = col.maxCoeff();
       const auto cu = static_cast<size_t>(c);
-      return (lo + t * (hi - lo) - model.centre_c[cu]) / model.scale_k[cu];
+      return (lo[c] + t * (hi[c] - lo[c]) - model.centre_c[cu]) / model.scale_k[cu];
     };
     for (int c = 0; c < layout.channels; ++c) {
       const auto cu = static_cast<size_t>(c);
@@ -159,13 +159,13 @@ SteadySupport SteadySupportOf(const Eigen::Ref<const Eigen::MatrixXd>& temperatu
       }
     }
   }
+  // Whole blocks, as the skill's and the summaries' (a last partial block dropped).
   support.low = std::numeric_limits<double>::infinity();
   support.high = -support.low;
-  for (Eigen::Index begin = 0; begin < yc.size(); begin += block) {
-    const Eigen::Index length = std::min(block, yc.size() - begin);
-    const double logged = weight.segment(begin, length).sum();
+  for (Eigen::Index begin = 0; begin + block <= yc.size(); begin += block) {
+    const double logged = weight.segment(begin, block).sum();
     if (logged <= 0.0) continue;
-    const double mean = yc.segment(begin, length).sum() / logged;  // yc is 0 where not logged
+    const double mean = yc.segment(begin, block).sum() / logged;  // yc is 0 where not logged
     support.low = std::min(support.low, mean);
     support.high = std::max(support.high, mean);
   }
@@ -271,10 +271,15 @@ class Ladder {
   Ladder(const FoldScores& scores, const DesignLayout& layout, const SearchRules& rules)
       : scores_(scores), layout_(layout), rules_(rules) {}
 
-  // s scored, kept when it is the best of its level so far and the steady support holds it.
+  // s scored, kept when it is the best of its level so far, well conditioned (ConsiderStates checks
+  // the states' subsets before their hysteresis variants) and held by the steady support.
   Subset Consider(Subset s) {
     s.fold_scores = scores_.Scores(s.cols);
     s.score = scores_.Mean(s.fold_scores);
+    if ((s.level == CalibrationReport::kStatic || s.level == CalibrationReport::kHysteresis) &&
+        Condition(scores_.gram(), s.cols) > rules_.max_condition) {
+      return s;
+    }
     if (rules_.steady && s.cols.size() > 1 &&
         !rules_.steady->Holds(scores_.FullWeights(s.cols), s.cols)) {
       ++unsupported_;

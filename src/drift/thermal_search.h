@@ -128,10 +128,10 @@ struct SteadySupport {
   bool Holds(const Eigen::VectorXd& w, const std::vector<int>& cols) const;
 };
 
-// The steady support of a candidate design (CandidateDesign's layout and candidates): 61 steady
-// temperatures across the calibrated range, every channel along its own range together (the
-// channels of one gyro warm together), and the band of the means of the centred target yc over
-// the logged samples of each `block` samples.
+// The steady support of a candidate design (CandidateDesign's layout and candidates): steady
+// temperatures across the calibrated range (kSteadyPoints), every channel along its own range
+// together (the channels of one gyro warm together), and the band of the means of the centred
+// target yc over the logged samples of each whole block of `block` samples.
 SteadySupport SteadySupportOf(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
                               const Eigen::VectorXd& yc, const Eigen::VectorXd& weight,
                               Eigen::Index block, const ThermalRegression& model,

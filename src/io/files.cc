@@ -24,21 +24,26 @@ namespace {
 // Refuses a target that exists and is not a regular file or a link to one: a device (/dev/null),
 // a pipe or a socket would be replaced by the rename that places the file, and a link that leads
 // nowhere would be replaced rather than followed.
+// The temporary is created in the folder of the file written (a link's target's): one that is
+// missing or not writable would fail the write after the work.
+void RequireWritableFolder(const std::string& path, const std::filesystem::path& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  if (!fs::is_directory(folder, ec)) {
+    throw IoError(path + ": cannot open for writing (no folder " + folder.string() + ")");
+  }
+  if (::access(folder.c_str(), W_OK) != 0) {
+    throw IoError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
+  }
+}
+
 void RequireFileTarget(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::file_status link = fs::symlink_status(path, ec);
   if (ec || !fs::exists(link)) {
-    // The temporary is created in the target's folder: one that is missing or not writable would
-    // fail the write after the work.
-    const fs::path folder =
-        fs::path(path).parent_path().empty() ? fs::path(".") : fs::path(path).parent_path();
-    if (!fs::is_directory(folder, ec)) {
-      throw IoError(path + ": cannot open for writing (no folder " + folder.string() + ")");
-    }
-    if (::access(folder.c_str(), W_OK) != 0) {
-      throw IoError(path + ": cannot open for writing (" + std::strerror(errno) + ")");
-    }
+    RequireWritableFolder(path, path);
     return;
   }
   const fs::file_status target = fs::status(path, ec);
@@ -51,6 +56,7 @@ void RequireFileTarget(const std::string& path) {
                   ": is not a regular file (a device, a pipe or a socket): gyrodrift writes a "
                   "whole file and renames it into place; name a file");
   }
+  RequireWritableFolder(path, fs::canonical(path, ec));
 }
 
 // The inputs this process has checked its outputs against: the clean-up of stale temporaries

@@ -49,7 +49,8 @@ struct CompensationSummary {
   Eigen::Index block = 1;                 // samples per block: round(block_s rate_hz), >= 1
   Eigen::Index blocks = 0;                // the blocks of the slow variation (Summarise)
   // Several lines: a table of the four figures before and after, named by `target` and `unit`
-  // ("" = none), each line ending in a newline.
+  // ("" = none), each line ending in a newline; then a warning when the compensation raised the
+  // slow variation by more than a quarter (docs/drift.md 1.5).
   std::string Table(const std::string& target, const std::string& unit) const;
 };
 

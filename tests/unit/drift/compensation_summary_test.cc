@@ -95,6 +95,28 @@ TEST(CompensationSummary, AMovedBiasShowsThoughTheStdStays) {
   EXPECT_NE(table.find("6 means of 600-s blocks"), std::string::npos) << table;
 }
 
+// A compensation that raises the slow variation by more than a quarter says so under the table,
+// by its share, or from 0 for an output that had none (a stuck axis); within a quarter, nothing.
+TEST(CompensationSummary, ARiseOfTheSlowVariationIsWarned) {
+  const Eigen::Index n = 4000;  // 4 blocks of 1000 samples at 1 Hz with 1000-s blocks
+  Eigen::VectorXd y(n), step(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    y[i] = i < n / 2 ? 1.0 : -1.0;     // block means +1, +1, -1, -1: slow variation 1
+    step[i] = i < n / 2 ? 3.0 : -3.0;  // 3
+  }
+  auto table = [&](const Eigen::VectorXd& before, const Eigen::VectorXd& after) {
+    return SummariseCompensation(before, after, 1.0, 1000.0).Table("g", "");
+  };
+  EXPECT_NE(table(y, step).find("warning: compensation raised the slow variation by 200 %"),
+            std::string::npos)
+      << table(y, step);
+  EXPECT_EQ(table(y, 1.2 * y).find("warning"), std::string::npos);
+  EXPECT_EQ(table(step, y).find("warning"), std::string::npos);
+  const Eigen::VectorXd flat = Eigen::VectorXd::Constant(n, 5.0);
+  EXPECT_NE(table(flat, step).find("raised the slow variation from 0 to 3"), std::string::npos)
+      << table(flat, step);
+}
+
 TEST(CompensationSummary, AShortLogHasNoSlowVariationAndBadInputIsRefused) {
   const Eigen::VectorXd y = Eigen::VectorXd::LinSpaced(100, 0.0, 1.0);
   const CompensationSummary s = SummariseCompensation(y, y, 1.0);

@@ -288,6 +288,20 @@ TEST(Files, StaleTemporariesOfKilledWritersAreRemovedByTheNextWrite) {
   EXPECT_EQ(ReadTextFile(input), "the user's log");
 }
 
+// Checked before the work: an output in a folder that does not exist is refused up front (the
+// write would fail after an hour of decomposition), and one beside the working folder is not.
+TEST(RequireOutputsAreNotInputs, AnOutputWithoutItsFolderIsRefusedBeforeTheWork) {
+  const std::string dir = test::TempDir("files_folder");
+  try {
+    RequireOutputsAreNotInputs({}, {dir + "/nodir/x.csv"});
+    ADD_FAILURE() << "no refusal";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              dir + "/nodir/x.csv: cannot open for writing (no folder " + dir + "/nodir)");
+  }
+  EXPECT_NO_THROW(RequireOutputsAreNotInputs({}, {dir + "/x.csv", "relative_output.csv"}));
+}
+
 TEST(WriteFileAtomically, AReplacedFileKeepsItsPermissions) {
   const std::string dir = test::TempDir("files_mode");
   WriteFileAtomically(dir + "/private.csv", "first\n");
