@@ -169,13 +169,35 @@ void WriteStudyFiles(const std::string& folder, const std::vector<StudyFile>& fi
     folders.insert(path.parent_path());
     targets.push_back({path.string(), f.contents});
   }
+  // The folders this call creates, parents first: a failed write removes them again (empty), so
+  // that a refused or failed run leaves nothing behind, not even an empty models/.
+  std::vector<fs::path> created;
+  auto remove_created = [&created] {
+    for (auto it = created.rbegin(); it != created.rend(); ++it) {
+      std::error_code ignored;
+      fs::remove(*it, ignored);  // only an empty folder goes
+    }
+  };
   for (const fs::path& dir : folders) {
     if (dir.empty()) continue;  // a file directly in the working folder
+    std::vector<fs::path> missing;
     std::error_code ec;
+    for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+      missing.push_back(p);
+    }
     fs::create_directories(dir, ec);
-    if (ec) throw IoError(folder + ": cannot create the output folder (" + ec.message() + ")");
+    created.insert(created.end(), missing.rbegin(), missing.rend());
+    if (ec) {
+      remove_created();
+      throw IoError(folder + ": cannot create the output folder (" + ec.message() + ")");
+    }
   }
-  io::WriteFilesAtomically(targets, inputs);
+  try {
+    io::WriteFilesAtomically(targets, inputs);
+  } catch (...) {
+    remove_created();
+    throw;
+  }
 }
 
 }  // namespace gyrodrift::study

@@ -40,7 +40,8 @@ nlohmann::json StudyRecord(const StudyResult& result);
 void RequireUsableOutputFolder(const std::string& folder);
 
 // Creates `folder` and the subfolders the files name, then writes every file with
-// io::WriteFilesAtomically: all are written or none is changed. Throws IoError, and UsageError
+// io::WriteFilesAtomically: all are written or none is changed (and the folders it created are
+// removed again). Throws IoError, and UsageError
 // (no file written) when a file's path leads to one of `inputs` (a link left in the folder).
 void WriteStudyFiles(const std::string& folder, const std::vector<StudyFile>& files,
                      const std::vector<std::string>& inputs = {});

@@ -254,6 +254,12 @@ TEST(WriteStudyFiles, NeverWritesThroughALinkToAnInput) {
       UsageError);
   EXPECT_EQ(io::ReadTextFile(dir + "/log.csv"), "x\n1\n");
   EXPECT_FALSE(fs::exists(dir + "/out/a.csv"));
+  // Nor does the refused set leave the subfolders it made (the folder that was there stays).
+  EXPECT_THROW(WriteStudyFiles(dir + "/out", {{"models/deep/m.json", "{}\n"}, {"imfs.csv", "z\n"}},
+                               {dir + "/log.csv"}),
+               UsageError);
+  EXPECT_FALSE(fs::exists(dir + "/out/models"));
+  EXPECT_TRUE(fs::exists(dir + "/out/imfs.csv"));
 }
 
 TEST(WriteStudyFiles, AFailingFileChangesNoneOfTheSet) {
