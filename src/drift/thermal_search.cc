@@ -282,7 +282,6 @@ class Ladder {
     }
     if (rules_.steady && s.cols.size() > 1 &&
         !rules_.steady->Holds(scores_.FullWeights(s.cols), s.cols)) {
-      ++unsupported_;
       best_unsupported_score_ = std::min(best_unsupported_score_, s.score);
       return s;
     }
@@ -303,7 +302,6 @@ class Ladder {
   }
 
   const LevelBests& best() const { return best_; }
-  int unsupported() const { return unsupported_; }
   double best_unsupported_score() const { return best_unsupported_score_; }
 
  private:
@@ -351,7 +349,6 @@ class Ladder {
   const DesignLayout& layout_;
   const SearchRules& rules_;
   LevelBests best_{};
-  int unsupported_ = 0;
   double best_unsupported_score_ = std::numeric_limits<double>::infinity();
 };
 
@@ -419,7 +416,6 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
   std::vector<int> chosen;
   ladder.VisitStates(chosen, 0, std::min(rules.max_states, layout.candidates));
   ChooseLevel(scores, rules, ladder.best(), result);
-  result.unsupported = ladder.unsupported();
   result.best_unsupported_score = ladder.best_unsupported_score();
   return result;
 }

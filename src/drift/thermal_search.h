@@ -110,8 +110,7 @@ struct SearchResult {
   int best_level = 0;
   double best_score = 0.0;             // of the best level
   bool fell_back_to_constant = false;  // the constant, although a richer level scored best
-  // The subsets SteadySupport left out, and the least held-out score among them.
-  int unsupported = 0;
+  // The least held-out score among the subsets SteadySupport left out.
   double best_unsupported_score = std::numeric_limits<double>::infinity();
 };
 

@@ -21,9 +21,6 @@ namespace gyrodrift::io {
 
 namespace {
 
-// Refuses a target that exists and is not a regular file or a link to one: a device (/dev/null),
-// a pipe or a socket would be replaced by the rename that places the file, and a link that leads
-// nowhere would be replaced rather than followed.
 // The temporary is created in the folder of the file written (a link's target's): one that is
 // missing or not writable would fail the write after the work.
 void RequireWritableFolder(const std::string& path, const std::filesystem::path& file) {
@@ -38,6 +35,10 @@ void RequireWritableFolder(const std::string& path, const std::filesystem::path&
   }
 }
 
+// Refuses a target that exists and is not a regular file or a link to one: a device (/dev/null),
+// a pipe or a socket would be replaced by the rename that places the file, and a link that leads
+// nowhere would be replaced rather than followed. Also refuses one whose folder
+// RequireWritableFolder refuses.
 void RequireFileTarget(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
