@@ -279,8 +279,9 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   const double logged = weight.sum();
   report.hysteresis_tried = options.TriesHysteresis(logged / model.rate_hz);
   if (report.hysteresis_tried) search.widths_k = options.hysteresis_widths_k;
-  search.layout = {channels, options.max_power, static_cast<int>(search.candidates.size()),
-                   options.max_power + 1, static_cast<int>(search.widths_k.size())};
+  if (search.regimes.mid_range_s < internal::kCurveSupportS) model.max_power = 1;
+  search.layout = {channels, model.max_power, static_cast<int>(search.candidates.size()),
+                   model.max_power + 1, static_cast<int>(search.widths_k.size())};
   const bool heating = report.max_heating_k_per_min >= 2.0 * options.ramp_rate_k_per_min;
   const bool cooling = report.max_cooling_k_per_min >= 2.0 * options.ramp_rate_k_per_min;
   search.x = CandidateDesign(temperatures_c, model.rate_hz, run.record_starts, model,
@@ -296,10 +297,12 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   search.steady = internal::SteadySupportOf(temperatures_c, search.yc, weight,
                                             BlockSamples(kBlockS, model.rate_hz, n), model,
                                             search.layout, search.candidates);
+  // Holds without a ramp (two plateaus as two logs) show no response to change: a lag state is
+  // its temperature there, and what it adds is the settling of a sensor (docs/drift.md 4.11).
   search.result =
       internal::SearchStructure(*search.scores, search.layout,
-                                {options.max_states, options.max_condition, options.standard_errors,
-                                 heating != cooling, &search.steady});
+                                {heating || cooling ? options.max_states : 0, options.max_condition,
+                                 options.standard_errors, !(heating && cooling), &search.steady});
   const internal::Subset& best = search.result.chosen;
   model.static_power.assign(static_cast<size_t>(channels), best.static_power);
   for (int j : best.states) model.states.push_back(search.candidates[static_cast<size_t>(j)]);

@@ -71,6 +71,11 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
   // A ramp's rate is its steepest (the programme's; a sensor behind a case approaches the end of
   // a ramp slowly), a dwell's level its mean.
   RunRegimes regimes;
+  const double low = t0.minCoeff(), high = t0.maxCoeff();
+  const double margin = 0.5 * (1.0 - kMidRangeShare) * (high - low);
+  regimes.mid_range_s =
+      static_cast<double>(((t0.array() > low + margin) && (t0.array() < high - margin)).count()) *
+      dt;
   const double level_step = std::max(kDistinctLevelK, kDistinctLevelShare * report.span_k[0]);
   for (const ThermalSegment& s : segments) {
     const double length_s = static_cast<double>(s.end - s.begin) * dt;
@@ -148,6 +153,15 @@ void AddRunWarnings(const ThermalRegression& model, const ThermalModelOptions& o
   }
   if (report.ramps + report.dwells < 3) {
     w.push_back("fewer than 3 thermal regimes (ramps and dwells): nothing new to hold out");
+  }
+  if (model.max_power < options.max_power) {
+    w.push_back(Format(
+        "the run spent %.3g min in the middle half of its temperature range (%.0f min show a "
+        "curve): the levels enter linearly, a line between the temperatures it held",
+        regimes.mid_range_s / 60.0, kCurveSupportS / 60.0));
+    advice.push_back(
+        "mid-range: dwell 30 min or more in the middle of the range, or ramp across it at 0.5 "
+        "K/min or slower");
   }
 }
 
@@ -271,7 +285,7 @@ std::string CalibrationReport::Summary() const {
   return Format(
              "%.3g h%s, span %s K, rates +%.2g/-%.2g K/min, %d ramps, %d dwells, %d time folds, %d "
              "regime folds, %d range folds; structure: %s (best held-out: %s); held-out RMSE %.4g "
-             "(against the constant %s, the static cubic %s; on held-out regimes %s and %s); "
+             "(against the constant %s, the static polynomial %s; on held-out regimes %s and %s); "
              "cross-validated RMSE %.4g (constant %.4g), %s, condition %.2g; hysteresis term %s",
              duration_s / 3600.0, records > 1 ? Format(" in %d records", records).c_str() : "",
              span.c_str(), max_heating_k_per_min, max_cooling_k_per_min, ramps, dwells, folds,

@@ -34,7 +34,9 @@
 // docs/drift.md 4.8). Columns that are nearly collinear (condition of the scaled Gram above
 // max_condition: two states of close time constants) never enter together, nor does a subset
 // whose steady-state drift across the calibrated range leaves the band of the run's 10-min means
-// widened by its width (two plateaus leave a cubic free between them; docs/drift.md 4.10). A run
+// widened by its width (two plateaus leave a cubic free between them; docs/drift.md 4.10), and
+// every level (static or lagged) enters linearly when the run spent less than 30 min in the middle
+// half of its temperature range (a step between two holds: docs/drift.md 4.11). A run
 // that showed one direction of temperature change only (no cooling ramp, or no heating ramp)
 // takes no lag difference (two states, or a state beside the static term: its sign follows the
 // direction) and no hysteresis term.
@@ -58,7 +60,7 @@
 // the time-block folds, kept only when it lowers the cross-validated error.
 //
 // Calibration sufficiency (CalibrationReport): temperature span, heating and cooling rates,
-// dwells, regimes, cross-validated skill against the constant and the static cubic, the
+// dwells, regimes, cross-validated skill against the constant and the static polynomial, the
 // conditioning of the chosen regressors and how far the candidate states can lag, with warnings
 // where the run cannot identify the model, each saying which regime to add.
 // Cost: O(N M^2) for the fold moments (M = 1 + C Q + C G (P + 1 + W) columns for G grid constants
@@ -104,7 +106,8 @@ struct ThermalModelOptions {
   double longest_tau_share = 0.0625;
   int max_states = 2;  // thermal states per model, in [0, 4]
   int state_order = 2;  // cascaded lags per state, in [1, 4]
-  int max_power = 3;    // powers of each state's level, in [1, 3]
+  int max_power =
+      3;  // powers of each level (static and states'), in [1, 3]; 1 below 30 min mid-range
   // Cross-validation folds, in [2, 64]: contiguous blocks of equal duration (2 h of a 16-h run),
   // each holding whole ramps and dwells, or, with folds_at_regimes, cut at the regime boundaries
   // nearest to those (measured worse on the family: docs/drift.md 4.5).
@@ -176,7 +179,8 @@ struct CalibrationReport {
   double cv_rmse = 0.0;                        // of the chosen model, target units
   double cv_rmse_constant = 0.0;               // of the intercept alone
   // Held-out RMSE over the time blocks (each block weighing equally) of the chosen model, the
-  // constant and the static cubic in T: what the choice and the guarantee compare.
+  // constant and the static polynomial in T of the model's max_power (the cubic unless the run
+  // supports a line only): what the choice and the guarantee compare.
   double held_out_rmse = 0.0, held_out_rmse_constant = 0.0, held_out_rmse_static = 0.0;
   double held_out_rmse_best = 0.0;             // of the best level, before the rule
   // The same three on the held-out regimes and range ends (reported, not chosen on; 0: no such

@@ -345,6 +345,49 @@ TEST(ThermalModel, AOneWayHeatUpTakesNoLagDifferenceAndHalvesCoolingRates) {
   EXPECT_TRUE((e.col(1).array() >= unheld.array().abs() - 1e-12).all());
 }
 
+// A step between two holds shows the drift at two temperatures and the few minutes between: the
+// levels enter linearly (a curve there would rest on the step's settling alone), the run is told
+// so with its advice, and a mission between the holds is compensated better than not at all. A
+// heat-up whose ramp crosses the middle half of its range in 30 min or more keeps its powers.
+TEST(ThermalModel, AStepBetweenTwoHoldsGetsALine) {
+  const Eigen::Index n = 8 * 3600;
+  Eigen::VectorXd step(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    step[i] =
+        std::min(40.0, 2.0 / 60.0 * static_cast<double>(std::max<Eigen::Index>(0, i - 14400)));
+  }
+  auto drift = [](const Eigen::VectorXd& t) {
+    const Eigen::VectorXd coil = State(t, 600.0);
+    return Eigen::VectorXd(0.1 + 4e-3 * (coil.array() - 20.0) +
+                           5e-5 * (coil.array() - 20.0).square() + 0.02 * (t - coil).array());
+  };
+  Rng rng(12, 0);
+  Eigen::VectorXd y = drift(step);
+  for (Eigen::Index i = 0; i < n; ++i) y[i] += 0.1 * rng.Normal();
+  const ThermalRegression m = IdentifyThermalModel(step, y, 1.0, ThermalModelOptions{});
+  EXPECT_EQ(m.max_power, 1) << m.Summary();
+  EXPECT_LE(m.static_power[0], 1) << m.Summary();
+  std::string warnings, advice;
+  for (const std::string& w : m.report.warnings) warnings += w + "\n";
+  for (const std::string& a : m.report.advice) advice += a + "\n";
+  EXPECT_NE(warnings.find("min in the middle half of its temperature range (30 min show a curve)"),
+            std::string::npos)
+      << warnings;
+  EXPECT_NE(advice.find("mid-range: dwell 30 min or more"), std::string::npos) << advice;
+  const Eigen::VectorXd mission = Programme(8.0).array() * 0.25 + 15.0;  // 10..30 degC
+  const Eigen::VectorXd truth = drift(mission);
+  const Eigen::VectorXd e = m.Estimate(mission);
+  const double none = std::sqrt(truth.squaredNorm() / static_cast<double>(n));
+  EXPECT_LT(std::sqrt((e - truth).squaredNorm() / static_cast<double>(n)), 0.5 * none)
+      << m.Summary();
+
+  Eigen::VectorXd ramp(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    ramp[i] = std::min(40.0, 0.6 / 60.0 * static_cast<double>(std::max<Eigen::Index>(0, i - 3600)));
+  }
+  EXPECT_EQ(IdentifyThermalModel(ramp, drift(ramp), 1.0, ThermalModelOptions{}).max_power, 3);
+}
+
 // The guarantee: a gyro without temperature dependence gets the constant, whatever the
 // temperature did; the report says so.
 TEST(ThermalModel, NoTemperatureDependenceGivesTheConstant) {
