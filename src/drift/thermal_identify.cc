@@ -297,11 +297,13 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   search.steady = internal::SteadySupportOf(temperatures_c, search.yc, weight,
                                             BlockSamples(kBlockS, model.rate_hz, n), model,
                                             search.layout, search.candidates);
-  // Holds without a ramp (two plateaus as two logs) show no response to change: a lag state is
-  // its temperature there, and what it adds is the settling of a sensor (docs/drift.md 4.11).
+  // Holds (plateaus logged apart) show no response to change: a lag state is its temperature
+  // there, and what it adds is the settling of a sensor (docs/drift.md 4.11).
+  const bool holds =
+      !heating && !cooling && search.regimes.widest_record_k < internal::kShortestSpanK;
   search.result =
       internal::SearchStructure(*search.scores, search.layout,
-                                {heating || cooling ? options.max_states : 0, options.max_condition,
+                                {holds ? 0 : options.max_states, options.max_condition,
                                  options.standard_errors, !(heating && cooling), &search.steady});
   const internal::Subset& best = search.result.chosen;
   model.static_power.assign(static_cast<size_t>(channels), best.static_power);
@@ -320,7 +322,7 @@ void ReportHeldOut(const Search& search, CalibrationReport& report) {
   report.best_level = s.best_level;
   report.held_out_rmse = std::sqrt(s.chosen.score);
   report.held_out_rmse_constant = std::sqrt(s.constant.score);
-  report.held_out_rmse_static = std::sqrt(s.static_cubic.score);
+  report.held_out_rmse_static = std::sqrt(s.static_full.score);
   report.held_out_rmse_best = std::sqrt(s.best_score);
   if (report.regime_folds + report.range_folds == 0) return;
   auto regimes = [&](const internal::Subset& subset) {
@@ -332,7 +334,7 @@ void ReportHeldOut(const Search& search, CalibrationReport& report) {
   };
   report.regime_rmse = regimes(s.chosen);
   report.regime_rmse_constant = regimes(s.constant);
-  report.regime_rmse_static = regimes(s.static_cubic);
+  report.regime_rmse_static = regimes(s.static_full);
 }
 
 // Least squares of ys on the unit-scaled columns xn (the intercept first) by QR, with the ridge

@@ -14,7 +14,6 @@ constexpr double kRateSmoothingS = 60.0;  // smoothing of the rate that tells ra
 constexpr double kShortestSegmentS = 300.0;
 constexpr double kShortestDwellS = 600.0;
 // Calibration sufficiency: warnings below these (docs/drift.md 4.5, 4.8).
-constexpr double kShortestSpanK = 15.0;
 constexpr double kLeastSkill = 0.2;
 // Above ThermalModelOptions::max_condition's default (1e8): it warns a caller who raised that.
 constexpr double kLargestCondition = 1e10;
@@ -71,11 +70,17 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
   // A ramp's rate is its steepest (the programme's; a sensor behind a case approaches the end of
   // a ramp slowly), a dwell's level its mean.
   RunRegimes regimes;
+  // Every row counts, made-up ones included: the time the temperature spent, which a duty-cycled
+  // log's bursts sample (counting logged rows only would take every such log for a step).
   const double low = t0.minCoeff(), high = t0.maxCoeff();
   const double margin = 0.5 * (1.0 - kMidRangeShare) * (high - low);
   regimes.mid_range_s =
       static_cast<double>(((t0.array() > low + margin) && (t0.array() < high - margin)).count()) *
       dt;
+  ForEachRecord(t0.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
+    const auto t = t0.segment(begin, length);
+    regimes.widest_record_k = std::max(regimes.widest_record_k, t.maxCoeff() - t.minCoeff());
+  });
   const double level_step = std::max(kDistinctLevelK, kDistinctLevelShare * report.span_k[0]);
   for (const ThermalSegment& s : segments) {
     const double length_s = static_cast<double>(s.end - s.begin) * dt;
@@ -96,8 +101,8 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
 
 namespace {
 
-// What the calibration run lacks (duration, span, ramps both ways, dwells, regimes), in that
-// order.
+// What the calibration run lacks (duration, span, ramps both ways, dwells, regimes, time in the
+// middle of its range), in that order.
 void AddRunWarnings(const ThermalRegression& model, const ThermalModelOptions& options,
                     const RunRegimes& regimes, CalibrationReport& report) {
   auto& w = report.warnings;
@@ -159,9 +164,10 @@ void AddRunWarnings(const ThermalRegression& model, const ThermalModelOptions& o
         "the run spent %.3g min in the middle half of its temperature range (%.0f min show a "
         "curve): the levels enter linearly, a line between the temperatures it held",
         regimes.mid_range_s / 60.0, kCurveSupportS / 60.0));
-    advice.push_back(
-        "mid-range: dwell 30 min or more in the middle of the range, or ramp across it at 0.5 "
-        "K/min or slower");
+    advice.push_back(Format(
+        "mid-range: dwell %.0f min or more in the middle of the range, or ramp across it at %.2g "
+        "K/min or slower",
+        kCurveSupportS / 60.0, kMidRangeShare * report.span_k[0] / (kCurveSupportS / 60.0)));
   }
 }
 
@@ -208,9 +214,12 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
         "out: its steady-state drift leaves the band the run showed, a curve between the logged "
         "temperatures that the run cannot support",
         std::sqrt(search.best_unsupported_score), std::sqrt(search.best_score)));
-    advice.push_back(
-        "temperatures between the logged ones: log the range between them (a ramp across it, or "
-        "a dwell in it)");
+    // A run that never sat mid-range has the mid-range advice already.
+    if (model.max_power == options.max_power) {
+      advice.push_back(
+          "temperatures between the logged ones: log the range between them (a ramp across it, or "
+          "a dwell in it)");
+    }
   }
   if (report.regime_rmse > report.regime_rmse_constant && report.level > 0) {
     w.push_back(Format(

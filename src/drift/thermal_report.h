@@ -31,18 +31,23 @@ inline constexpr double kDistinctLevelShare = 0.1;
 inline constexpr double kDistinctLevelK = 5.0;
 
 // Powers >= 2 of a level claim a curve between the ends of the calibrated range; the run shows
-// one only where it spent this long in the middle half of channel 0's range (one ramp across it
-// at 0.5 K/min, or a dwell). A step between two holds spends 9-24 min there, a one-way heat-up
-// 34-152 [choice, docs/drift.md 4.11: measured on family units 1-40 of both].
+// one only where it spent this long in the middle half of channel 0's range (a dwell, or a ramp
+// across it no faster than kMidRangeShare x span / 30 min). A step between two holds spends 9-26
+// min there, a one-way heat-up 34-152 [choice, docs/drift.md 4.11: family units 1-40 of both].
 inline constexpr double kCurveSupportS = 1800.0;
 inline constexpr double kMidRangeShare = 0.5;
+// A temperature span narrower than this identifies nothing beyond it (a warning); a run none of
+// whose records spans it, without a ramp, is a run of holds (thermal_model.h, Structure).
+inline constexpr double kShortestSpanK = 15.0;
 
 // The distinct regimes of a run, what a calibration plan asks for (gyrodrift plan): the mean
 // rates of its heating and cooling ramps (K/min, positive) and the levels of its dwells (degC);
-// and the time channel 0 spent in the middle kMidRangeShare of its range, s.
+// the time channel 0 spent in the middle kMidRangeShare of its range, s, and its widest span
+// within one record, K.
 struct RunRegimes {
   std::vector<double> heating_k_per_min, cooling_k_per_min, dwell_levels_c;
   double mid_range_s = 0.0;
+  double widest_record_k = 0.0;
 };
 
 // Span of every channel, heating and cooling rates, ramps and dwells (channel 0 for the latter);

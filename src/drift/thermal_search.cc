@@ -410,7 +410,7 @@ SearchResult SearchStructure(const FoldScores& scores, const DesignLayout& layou
       for (int q = 1; q <= p; ++q) s.cols.push_back(layout.StaticColumn(c, q));
     }
     const Subset scored = ladder.Consider(std::move(s));
-    if (p == layout.static_powers) result.static_cubic = scored;
+    if (p == layout.static_powers) result.static_full = scored;
   }
   // Then the lag states' subsets.
   std::vector<int> chosen;

@@ -106,7 +106,7 @@ struct Subset {
 // What the search found: the chosen subset, the best of each level, and the two references.
 struct SearchResult {
   Subset chosen;
-  Subset constant, static_cubic;
+  Subset constant, static_full;  // static_full: powers of T up to the layout's static_powers
   int best_level = 0;
   double best_score = 0.0;             // of the best level
   bool fell_back_to_constant = false;  // the constant, although a richer level scored best

@@ -36,7 +36,9 @@
 // whose steady-state drift across the calibrated range leaves the band of the run's 10-min means
 // widened by its width (two plateaus leave a cubic free between them; docs/drift.md 4.10), and
 // every level (static or lagged) enters linearly when the run spent less than 30 min in the middle
-// half of its temperature range (a step between two holds: docs/drift.md 4.11). A run
+// half of its temperature range (a step between two holds: docs/drift.md 4.11). A run of holds
+// (no ramp, and no record spanning 15 K: plateaus logged apart) takes no lag state: a state is
+// its temperature there, and what it would add is a sensor's settling (4.11). A run
 // that showed one direction of temperature change only (no cooling ramp, or no heating ramp)
 // takes no lag difference (two states, or a state beside the static term: its sign follows the
 // direction) and no hysteresis term.
@@ -104,10 +106,10 @@ struct ThermalModelOptions {
   // Constants longer than this share of the calibration run are not candidates, in (0, 1]: a
   // slower lag is a trend over the run, which its rate random walk imitates (1 h of a 16-h run).
   double longest_tau_share = 0.0625;
-  int max_states = 2;  // thermal states per model, in [0, 4]
+  // Thermal states per model, in [0, 4] (none for a run of holds: header comment, Structure).
+  int max_states = 2;
   int state_order = 2;  // cascaded lags per state, in [1, 4]
-  int max_power =
-      3;  // powers of each level (static and states'), in [1, 3]; 1 below 30 min mid-range
+  int max_power = 3;    // powers of each level (static and states'), in [1, 3]
   // Cross-validation folds, in [2, 64]: contiguous blocks of equal duration (2 h of a 16-h run),
   // each holding whole ramps and dwells, or, with folds_at_regimes, cut at the regime boundaries
   // nearest to those (measured worse on the family: docs/drift.md 4.5).
@@ -236,6 +238,7 @@ struct AutopilotForm {
 // A fitted thermal drift model (see the header comment).
 struct ThermalRegression {
   double rate_hz = 1.0;
+  // The options' max_power, or 1 where the run supports no curve (header comment, Structure).
   int order = 2, max_power = 3;
   std::vector<double> centre_c, scale_k;  // per channel
   // Per channel: the highest static power of z_c among the regressors (0: none), and the range

@@ -366,7 +366,6 @@ TEST(ThermalModel, AStepBetweenTwoHoldsGetsALine) {
   for (Eigen::Index i = 0; i < n; ++i) y[i] += 0.1 * rng.Normal();
   const ThermalRegression m = IdentifyThermalModel(step, y, 1.0, ThermalModelOptions{});
   EXPECT_EQ(m.max_power, 1) << m.Summary();
-  EXPECT_LE(m.static_power[0], 1) << m.Summary();
   std::string warnings, advice;
   for (const std::string& w : m.report.warnings) warnings += w + "\n";
   for (const std::string& a : m.report.advice) advice += a + "\n";
@@ -386,6 +385,40 @@ TEST(ThermalModel, AStepBetweenTwoHoldsGetsALine) {
     ramp[i] = std::min(40.0, 0.6 / 60.0 * static_cast<double>(std::max<Eigen::Index>(0, i - 3600)));
   }
   EXPECT_EQ(IdentifyThermalModel(ramp, drift(ramp), 1.0, ThermalModelOptions{}).max_power, 3);
+}
+
+// Two plateaus logged apart show no response to change: no lag state, a line between them. A
+// run that heats and cools slower than the ramp threshold shows no direction: no lag difference
+// (two states, or a state beside T) and no hysteresis term, as in a one-way run.
+TEST(ThermalModel, HoldsTakeNoStateAndARunWithoutRampsNoLagDifference) {
+  const Eigen::Index n = 4 * 3600;
+  Eigen::VectorXd t(2 * n), y(2 * n);
+  Rng rng(13, 0);
+  for (Eigen::Index i = 0; i < 2 * n; ++i) {
+    t[i] = (i < n ? 0.0 : 40.0) + 0.05 * rng.Normal();
+    y[i] = 0.1 + 4e-3 * (t[i] - 20.0) + 0.1 * rng.Normal();
+  }
+  const ThermalRegression holds =
+      IdentifyThermalModel(t, y, 1.0, ThermalModelOptions{}, {.record_starts = {n}});
+  EXPECT_TRUE(holds.states.empty()) << holds.Summary();
+  EXPECT_EQ(holds.max_power, 1) << holds.Summary();
+
+  Eigen::VectorXd slow(4 * n);  // 0 -> 40 degC at 0.1 K/min, 1 h at 40, back down, hold at 0
+  for (Eigen::Index i = 0; i < slow.size(); ++i) {
+    const double sec = static_cast<double>(i);
+    slow[i] =
+        sec < 27600.0 ? std::min(40.0, sec / 600.0) : std::max(0.0, 40.0 - (sec - 27600.0) / 600.0);
+  }
+  const Eigen::VectorXd coil = State(slow, 900.0);
+  Eigen::VectorXd ys(slow.size());
+  for (Eigen::Index i = 0; i < slow.size(); ++i) {
+    ys[i] = 0.1 + 3e-3 * (coil[i] - 20.0) + 0.02 * (slow[i] - coil[i]) + 0.1 * rng.Normal();
+  }
+  const ThermalRegression m = IdentifyThermalModel(slow, ys, 1.0, ThermalModelOptions{});
+  EXPECT_LT(m.report.max_heating_k_per_min, 0.2) << m.report.Summary();
+  EXPECT_LE(m.states.size(), 1u) << m.Summary();
+  EXPECT_FALSE(!m.states.empty() && m.static_power[0] > 0) << m.Summary();
+  EXPECT_FALSE(m.has_hysteresis()) << m.Summary();
 }
 
 // The guarantee: a gyro without temperature dependence gets the constant, whatever the
