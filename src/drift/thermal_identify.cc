@@ -279,6 +279,7 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   const double logged = weight.sum();
   report.hysteresis_tried = options.TriesHysteresis(logged / model.rate_hz);
   if (report.hysteresis_tried) search.widths_k = options.hysteresis_widths_k;
+  // A run that never sat in the middle of its range shows no curve there (docs/drift.md 4.11).
   if (search.regimes.mid_range_s < internal::kCurveSupportS) model.max_power = 1;
   search.layout = {channels, model.max_power, static_cast<int>(search.candidates.size()),
                    model.max_power + 1, static_cast<int>(search.widths_k.size())};

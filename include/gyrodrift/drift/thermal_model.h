@@ -39,7 +39,7 @@
 // half of its temperature range (a step between two holds: docs/drift.md 4.11). A run of holds
 // (no ramp, and no record spanning 15 K: plateaus logged apart) takes no lag state: a state is
 // its temperature there, and what it would add is a sensor's settling (4.11). A run
-// that showed one direction of temperature change only (no cooling ramp, or no heating ramp)
+// that showed one direction of temperature change or none (no cooling ramp, or no heating ramp)
 // takes no lag difference (two states, or a state beside the static term: its sign follows the
 // direction) and no hysteresis term.
 //
