@@ -1,13 +1,14 @@
 // The one-standard-error rule of the thermal identification on hand-made fold scores
 // (drift/thermal_search.h, ChooseLevel; docs/drift.md 4.8).
+#include "drift/thermal_search.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <initializer_list>
 #include <limits>
 #include <vector>
-
-#include "drift/thermal_search.h"
 
 namespace gyrodrift::drift::internal {
 namespace {
@@ -59,6 +60,48 @@ TEST(SteadySupport, HoldsACurveWithinTheBandWidenedByItsWidth) {
   EXPECT_TRUE(support.Holds(Eigen::Vector2d(-2.0, 5.0), parabola));  // -2 .. 3
   EXPECT_FALSE(support.Holds(Eigen::Vector2d(-3.5, 5.0), parabola));
   EXPECT_FALSE(support.Holds(Eigen::Vector2d(0.0, std::numeric_limits<double>::quiet_NaN()), line));
+}
+
+// SteadySupportOf: the grid runs from the channel's lowest to its highest temperature (61
+// points), each static and state column its power of the standardised level there (the rate 0),
+// and the band spans the means of the whole blocks with a logged sample, over their logged
+// samples (a block made up across a gap, and the last partial block, do not count).
+TEST(SteadySupport, OfARunIsItsGridAndTheBandOfItsBlockMeans) {
+  const Eigen::Index n = 105, block = 10;
+  Eigen::VectorXd t(n), yc(n), weight = Eigen::VectorXd::Ones(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    t[i] = 40.0 * static_cast<double>(i) / 99.0;         // 0..40 degC over the whole blocks
+    yc[i] = static_cast<double>(i / block) * 0.1 - 0.3;  // block means -0.3 .. 0.6
+  }
+  t.tail(5).setConstant(20.0);  // the last partial block: inside the range, its mean ignored
+  yc.tail(5).setConstant(9.0);
+  weight.segment(40, 10).setZero();  // block 4 made up
+  yc.segment(40, 10).setZero();      // (yc is 0 where not logged)
+  weight[5] = 0.0;  // a made-up row in block 0: its mean is the others' (-0.27 over all 10)
+  yc[5] = 0.0;
+  ThermalRegression model;
+  model.centre_c = {20.0};
+  model.scale_k = {10.0};
+  model.static_min = {-2.0};
+  model.static_max = {2.0};
+  ThermalState state;
+  state.level_min = -2.0;
+  state.level_max = 2.0;
+  const DesignLayout layout{1, 3, 1, 4, 0};
+  const SteadySupport s = SteadySupportOf(t, yc, weight, block, model, layout, {state});
+  ASSERT_EQ(s.design.rows(), 61);
+  ASSERT_EQ(s.design.cols(), 1 + 3 + 4);
+  for (Eigen::Index g : {Eigen::Index{0}, Eigen::Index{30}, Eigen::Index{60}}) {
+    const double z = -2.0 + 4.0 * static_cast<double>(g) / 60.0;
+    EXPECT_DOUBLE_EQ(s.design(g, 0), 1.0);
+    for (int p = 1; p <= 3; ++p) {
+      EXPECT_NEAR(s.design(g, layout.StaticColumn(0, p)), std::pow(z, p), 1e-12) << g << " " << p;
+      EXPECT_NEAR(s.design(g, layout.StateColumn(0, p - 1)), std::pow(z, p), 1e-12) << g;
+    }
+    EXPECT_EQ(s.design(g, layout.StateColumn(0, 3)), 0.0);  // the rate
+  }
+  EXPECT_DOUBLE_EQ(s.low, -0.3);
+  EXPECT_NEAR(s.high, 0.6, 1e-12);
 }
 
 // Unit 54 of the family's 16-h calibrations, in miniature: one state with its rate comes within a
