@@ -305,7 +305,7 @@ void ChooseStructure(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
   search.result =
       internal::SearchStructure(*search.scores, search.layout,
                                 {holds ? 0 : options.max_states, options.max_condition,
-                                 options.standard_errors, !(heating && cooling), &search.steady});
+                                 options.standard_errors, heating && cooling, &search.steady});
   const internal::Subset& best = search.result.chosen;
   model.static_power.assign(static_cast<size_t>(channels), best.static_power);
   for (int j : best.states) model.states.push_back(search.candidates[static_cast<size_t>(j)]);

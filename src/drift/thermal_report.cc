@@ -54,33 +54,30 @@ RunRegimes DescribeRun(const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c, 
   for (Eigen::Index c = 0; c < temperatures_c.cols(); ++c) {
     report.span_k.push_back(temperatures_c.col(c).maxCoeff() - temperatures_c.col(c).minCoeff());
   }
-  // Channel 0's 60-s smoothed rate, K/min, restarting with every record.
+  // Channel 0's 60-s smoothed rate, K/min, restarting with every record, and its widest span
+  // within one record.
   const auto t0 = temperatures_c.col(0);
   Eigen::VectorXd rate(t0.size());
+  RunRegimes regimes;
   ForEachRecord(t0.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
     const auto t = t0.segment(begin, length);
     Eigen::VectorXd smooth(length);
     FirstOrderLag(t, kRateSmoothingS, dt, smooth);
     rate.segment(begin, length) = (t - smooth) * (60.0 / kRateSmoothingS);
+    regimes.widest_record_k = std::max(regimes.widest_record_k, t.maxCoeff() - t.minCoeff());
   });
   if (rate.size() > 0) {
     report.max_heating_k_per_min = std::max(0.0, rate.maxCoeff());
     report.max_cooling_k_per_min = std::max(0.0, -rate.minCoeff());
   }
-  // A ramp's rate is its steepest (the programme's; a sensor behind a case approaches the end of
-  // a ramp slowly), a dwell's level its mean.
-  RunRegimes regimes;
   // Every row counts, made-up ones included: the time the temperature spent, which a duty-cycled
   // log's bursts sample (counting logged rows only would take every such log for a step).
-  const double low = t0.minCoeff(), high = t0.maxCoeff();
-  const double margin = 0.5 * (1.0 - kMidRangeShare) * (high - low);
+  const double low = t0.minCoeff() + 0.5 * (1.0 - kMidRangeShare) * report.span_k[0];
+  const double high = low + kMidRangeShare * report.span_k[0];
   regimes.mid_range_s =
-      static_cast<double>(((t0.array() > low + margin) && (t0.array() < high - margin)).count()) *
-      dt;
-  ForEachRecord(t0.size(), record_starts, [&](Eigen::Index begin, Eigen::Index length) {
-    const auto t = t0.segment(begin, length);
-    regimes.widest_record_k = std::max(regimes.widest_record_k, t.maxCoeff() - t.minCoeff());
-  });
+      static_cast<double>(((t0.array() > low) && (t0.array() < high)).count()) * dt;
+  // A ramp's rate is its steepest (the programme's; a sensor behind a case approaches the end of
+  // a ramp slowly), a dwell's level its mean.
   const double level_step = std::max(kDistinctLevelK, kDistinctLevelShare * report.span_k[0]);
   for (const ThermalSegment& s : segments) {
     const double length_s = static_cast<double>(s.end - s.begin) * dt;

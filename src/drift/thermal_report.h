@@ -33,7 +33,7 @@ inline constexpr double kDistinctLevelK = 5.0;
 // Powers >= 2 of a level claim a curve between the ends of the calibrated range; the run shows
 // one only where it spent this long in the middle half of channel 0's range (a dwell, or a ramp
 // across it no faster than kMidRangeShare x span / 30 min). A step between two holds spends 9-26
-// min there, a one-way heat-up 34-152 [choice, docs/drift.md 4.11: family units 1-40 of both].
+// min there, a one-way heat-up 34-152 [choice, docs/drift.md 4.11: family units 1-60 of both].
 inline constexpr double kCurveSupportS = 1800.0;
 inline constexpr double kMidRangeShare = 0.5;
 // A temperature span narrower than this identifies nothing beyond it (a warning); a run none of

@@ -311,7 +311,7 @@ class Ladder {
     for (int with_linear : {0, 1}) {
       for (bool rates : {false, true}) {
         if (!rates && chosen.size() > 1) continue;
-        if (rules_.one_direction && (chosen.size() > 1 || with_linear)) continue;
+        if (!rules_.both_directions && (chosen.size() > 1 || with_linear)) continue;
         Subset s;
         s.states = chosen;
         s.static_power = with_linear;
@@ -330,7 +330,7 @@ class Ladder {
         if (Condition(scores_.gram(), s.cols) > rules_.max_condition) continue;
         Consider(s);
         // A hysteresis term tells heating from cooling: a one-way run cannot identify it.
-        if (!rates || rules_.one_direction) continue;
+        if (!rates || !rules_.both_directions) continue;
         for (size_t k = 0; k < chosen.size(); ++k) {
           for (int w = 0; w < layout_.widths; ++w) {
             Subset h = s;

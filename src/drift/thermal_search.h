@@ -141,10 +141,10 @@ struct SearchRules {
   int max_states = 2;
   double max_condition = 1e8;
   double standard_errors = 1.0;
-  // The run showed one direction of temperature change or none: no structure holds a lag
-  // difference (two states, or a state beside the static term), whose sign follows the direction,
-  // nor a hysteresis term, which tells the directions apart.
-  bool one_direction = false;
+  // The run showed both directions of temperature change (a heating and a cooling ramp); else no
+  // structure holds a lag difference (two states, or a state beside the static term), whose sign
+  // follows the direction, nor a hysteresis term, which tells the directions apart.
+  bool both_directions = true;
   // Subsets that SteadySupport rejects are not candidates (null: no check).
   const SteadySupport* steady = nullptr;
 };

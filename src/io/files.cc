@@ -57,7 +57,8 @@ void RequireFileTarget(const std::string& path) {
                   ": is not a regular file (a device, a pipe or a socket): gyrodrift writes a "
                   "whole file and renames it into place; name a file");
   }
-  RequireWritableFolder(path, fs::canonical(path, ec));
+  const fs::path resolved = fs::canonical(path, ec);  // a link's target's folder
+  RequireWritableFolder(path, ec ? fs::path(path) : resolved);
 }
 
 // The inputs this process has checked its outputs against: the clean-up of stale temporaries

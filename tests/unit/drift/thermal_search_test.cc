@@ -64,8 +64,8 @@ TEST(SteadySupport, HoldsACurveWithinTheBandWidenedByItsWidth) {
 
 // SteadySupportOf: the grid runs from the channel's lowest to its highest temperature (61
 // points), each static and state column its power of the standardised level there (the rate 0),
-// and the band spans the means of the whole blocks with a logged sample, over their logged
-// samples (a block made up across a gap, and the last partial block, do not count).
+// and the band spans the means of whole blocks over their logged samples (the last partial block
+// does not count).
 TEST(SteadySupport, OfARunIsItsGridAndTheBandOfItsBlockMeans) {
   const Eigen::Index n = 105, block = 10;
   Eigen::VectorXd t(n), yc(n), weight = Eigen::VectorXd::Ones(n);
@@ -75,10 +75,8 @@ TEST(SteadySupport, OfARunIsItsGridAndTheBandOfItsBlockMeans) {
   }
   t.tail(5).setConstant(20.0);  // the last partial block: inside the range, its mean ignored
   yc.tail(5).setConstant(9.0);
-  weight.segment(40, 10).setZero();  // block 4 made up
-  yc.segment(40, 10).setZero();      // (yc is 0 where not logged)
   weight[5] = 0.0;  // a made-up row in block 0: its mean is the others' (-0.27 over all 10)
-  yc[5] = 0.0;
+  yc[5] = 0.0;      // (yc is 0 where not logged)
   ThermalRegression model;
   model.centre_c = {20.0};
   model.scale_k = {10.0};
