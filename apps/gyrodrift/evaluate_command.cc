@@ -166,6 +166,11 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
       cmd->add_option("--window,-W", args->evaluation.window, "causal protocol: trailing window W, samples")
           ->capture_default_str(),
       {"causal.window"});
+  BindSetting(cmd->add_option("--mirror", args->evaluation.mirror,
+                              "causal protocol: share of the window mirrored past its end before "
+                              "its decomposition, in [0, 1]")
+                  ->capture_default_str(),
+              {"causal.mirror"});
   BindSetting(cmd->add_option("--horizon,-H", args->evaluation.horizon,
                               "predict mode: score H-step-ahead predictions (recursive for H > 1)")
                   ->capture_default_str(),

@@ -111,6 +111,11 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       cmd->add_option("--window,-W", args->settings.window, "causal protocol: trailing window W, samples")
           ->capture_default_str(),
       {"window"});
+  BindSetting(cmd->add_option("--mirror", args->settings.mirror,
+                              "causal protocol: share of the window mirrored past its end before "
+                              "its decomposition, in [0, 1]")
+                  ->capture_default_str(),
+              {"mirror"});
   BindSetting(
       cmd->add_option("--horizon,-H", args->settings.horizon,
                       "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")

@@ -349,13 +349,14 @@ class DriftModel:
         return self._core.coefficients(reference_temperature=reference_temperature)
 
     def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=2048,
-                threads=0, progress=None):
+                mirror=0.5, threads=0, progress=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
         horizon-step-ahead predictions of y[first:], first being the model's history.
-        ``progress``: a callable given the fraction of the causal windows decomposed, as for
-        ``decompose``."""
+        ``window`` and ``mirror`` as ``--window`` and ``--mirror``. ``progress``: a callable
+        given the fraction of the causal windows decomposed, as for ``decompose``."""
         return self._core.predict(y, temperature, horizon=horizon, protocol=protocol,
-                                  window=window, threads=threads, progress=progress)
+                                  window=window, mirror=mirror, threads=threads,
+                                  progress=progress)
 
     def save(self, path):
         """Writes the model file ``gyrodrift fit`` writes (JSON, exact doubles, checksummed)."""
@@ -472,7 +473,8 @@ def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisatio
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
-             split=0.7, repeats=1, horizon=1, window=2048, progress=None, **settings):
+             split=0.7, repeats=1, horizon=1, window=2048, mirror=0.5, progress=None,
+             **settings):
     """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
     paper and causal protocols (predict mode), against ``truth`` when given (else the output).
@@ -480,7 +482,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     ``methods`` is "all" or a list (or comma-separated string) of method names; the references
     "none" (a zero estimate) and "constant" (the training mean) are always scored first. The model
     settings are ``DriftModel.fit``'s settings keywords but ``method`` (``fit_defaults()``);
-    ``progress`` as for ``decompose``. Returns a dict:
+    ``window`` and ``mirror`` as ``--window`` and ``--mirror``; ``progress`` as for
+    ``decompose``. Returns a dict:
     ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, rmse_measured
     (against the output itself), slow_removed (share of the slow variation, 10-min block means,
     removed; nan on a test block shorter than 10 min), train_s, predict_s, the last repeat's
@@ -498,7 +501,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     return _call(
         _gyrodrift.evaluate,
         y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,
-        repeats=repeats, horizon=horizon, window=window, progress=progress, **settings)
+        repeats=repeats, horizon=horizon, window=window, mirror=mirror, progress=progress,
+        **settings)
 
 
 def fit_defaults():

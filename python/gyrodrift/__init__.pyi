@@ -106,8 +106,8 @@ class DriftModel:
     ) -> list[dict[str, Any]]: ...
     def predict(
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *, horizon: int = ...,
-        protocol: Literal["causal", "paper"] = ..., window: int = ..., threads: int = ...,
-        progress: Callable[[float], object] | None = ...,
+        protocol: Literal["causal", "paper"] = ..., window: int = ..., mirror: float = ...,
+        threads: int = ..., progress: Callable[[float], object] | None = ...,
     ) -> tuple[int, Array]: ...
     def save(self, path: str | PathLike[str]) -> None: ...
     @classmethod
@@ -155,7 +155,7 @@ def evaluate(
     mode: Literal["predict", "compensate"] = ...,
     methods: Literal["all"] | str | Sequence[str] = ...,
     protocol: Literal["both", "paper", "causal"] = ..., split: float = ..., repeats: int = ...,
-    horizon: int = ..., window: int = ...,
+    horizon: int = ..., window: int = ..., mirror: float = ...,
     progress: Callable[[float], object] | None = ...,
     **settings: Any,
 ) -> dict[str, Any]: ...

@@ -213,12 +213,15 @@ class PyDriftModel {
 
   // As `gyrodrift predict` (tasks::RunPredict): predictions of y[t] for t = first .. N-1.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
-                    const std::string& protocol, int window, int threads,
+                    const std::string& protocol, int window, double mirror, int threads,
                     const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
     LongCall call(progress);
-    const tasks::PredictSettings settings{
-        .protocol = protocol, .window = window, .horizon = horizon, .threads = threads};
+    const tasks::PredictSettings settings{.protocol = protocol,
+                                          .window = window,
+                                          .mirror = mirror,
+                                          .horizon = horizon,
+                                          .threads = threads};
     settings.Validate();
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
@@ -350,7 +353,8 @@ void BindDriftModel(py::module_& m) {
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
-           arg("window") = pd.window, arg("threads") = pd.threads, arg("progress") = py::none())
+           arg("window") = pd.window, arg("mirror") = pd.mirror, arg("threads") = pd.threads,
+           arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))

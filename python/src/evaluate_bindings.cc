@@ -55,7 +55,8 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const py::object& progress) {
   LongCall call(progress);
   // A refusal names the keyword (window), as the CLI's names its flag.
-  ValidateAsSettings({{"causal.window", "window"}}, [&] { settings.Validate(); });
+  ValidateAsSettings({{"causal.window", "window"}, {"causal.mirror", "mirror"}},
+                     [&] { settings.Validate(); });
   (void)ExecutionOf(settings.fit.threads, call);
   const Eigen::VectorXd y = ToVector(y_in, "y");
   Eigen::MatrixXd temperature;
@@ -114,25 +115,25 @@ void BindEvaluate(py::module_& m) {
       [](const gp::Array& y, const std::optional<gp::Array>& temperature,
          const std::optional<gp::Array>& truth, const std::string& mode, const py::object& methods,
          const std::string& protocol, double split, int repeats, int horizon, int window,
-         const py::object& progress, const py::kwargs& settings) {
+         double mirror, const py::object& progress, const py::kwargs& settings) {
         const gyrodrift::tasks::EvaluateSettings s{
-            .fit = gp::FitSettingsOf(settings,
-                                     {.mode = mode,
-                                      .method = "ms-elm",
-                                      .has_temperature = temperature.has_value()},
-                                     "evaluate", {"method"}),
+            .fit = gp::FitSettingsOf(
+                settings,
+                {.mode = mode, .method = "ms-elm", .has_temperature = temperature.has_value()},
+                "evaluate", {"method"}),
             .methods = gp::MethodList(methods),
             .protocol = protocol,
             .split = split,
             .repeats = repeats,
             .window = window,
+            .mirror = mirror,
             .horizon = horizon};
         return gp::Evaluate(y, temperature, truth, s, progress);
       },
       arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
       arg("mode") = "predict", arg("methods") = ed.methods, arg("protocol") = ed.protocol,
       arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
-      arg("window") = ed.window, arg("progress") = py::none());
+      arg("window") = ed.window, arg("mirror") = ed.mirror, arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

@@ -26,6 +26,9 @@ void CausalOptions::Validate() const {
     ThrowOption("ensemble_size", std::to_string(ensemble_size),
                 "an integer in [0, 100000] (0 = the model's)");
   }
+  if (!(mirror >= 0.0 && mirror <= 1.0)) {
+    ThrowOption("mirror", FormatValue(mirror), "a share of the window in [0, 1]");
+  }
 }
 
 namespace internal {
@@ -51,15 +54,20 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   decomposition::DecompositionContext full_window = one_thread;
   const Eigen::Index last_origin = origin + count - 1;
   const Eigen::Index full_windows = last_origin - std::max<Eigen::Index>(origin, causal.window) + 1;
+  // A window of `length` samples is decomposed with its mirrored tail: `length + tail` samples.
+  const auto tail = [&](Eigen::Index length) {
+    return std::min<Eigen::Index>(length - 1, std::llround(causal.mirror * length));
+  };
+  const Eigen::Index full_length = causal.window + tail(causal.window);
   const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
-                             decomposition::NoiseEmds::RowsPerRealisation(causal.window) *
-                             static_cast<double>(causal.window) * sizeof(double);
+                             decomposition::NoiseEmds::RowsPerRealisation(full_length) *
+                             static_cast<double>(full_length) * sizeof(double);
   // Shared, the noise EMDs are computed to the end; a window computes only the rows it uses
   // (few, when BEEMDAN's bound stops early): sharing pays from a few windows on.
   if (decomposition::UsesNoiseEmds(dopt.method) && full_windows >= 16 && cache_bytes <= 256e6) {
     full_window.noise_emds = std::make_shared<const decomposition::NoiseEmds>(
-        causal.window, dopt, execution);  // its progress is not called
-    assert(full_window.noise_emds->Matches(causal.window, dopt));
+        full_length, dopt, execution);  // its progress is not called
+    assert(full_window.noise_emds->Matches(full_length, dopt));
   }
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
@@ -72,9 +80,13 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
     const Eigen::Index end = origin + r;  // the window ends just before the origin
     const Eigen::Index start = std::max<Eigen::Index>(0, end - causal.window);
     const Eigen::Index length = end - start;
+    Eigen::VectorXd window(length + tail(length));
+    window.head(length) = y.segment(start, length);
+    window.tail(window.size() - length) =
+        y.segment(end - 1 - (window.size() - length), window.size() - length).reverse();
     const Eigen::MatrixXd series = GroupSeries(
-        model, decomposition::Decompose(y.segment(start, length), dopt,
-                                        length == causal.window ? full_window : one_thread));
+        model,
+        decomposition::Decompose(window, dopt, length == causal.window ? full_window : one_thread));
     for (size_t g = 0; g < groups; ++g) {
       for (int k = 0; k < p; ++k) {
         lags[g](r, k) = series(length - 1 - k, static_cast<Eigen::Index>(g));

@@ -22,7 +22,8 @@ Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
 
 // Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
-// trailing window y[o-W .. o-1] alone: lags[g](r, k) = s_g[o - 1 - k] of that window's groups
+// trailing window y[o-W .. o-1] alone, followed by its mirrored tail y[o-2], y[o-3], ...
+// (round(causal.mirror x W) samples): lags[g](r, k) = s_g[o - 1 - k] of that window's groups
 // (count x lags per sub-model g). Windows run in parallel on execution.threads, which reports
 // the fraction of windows done ("causal windows").
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,

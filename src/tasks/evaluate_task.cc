@@ -99,6 +99,7 @@ drift::EvaluationOptions EvaluateSettings::Options(std::string_view methods_name
   e.methods = ParseMethods(methods, mode, methods_name);
   e.protocols = ParseProtocols(protocol);
   e.causal.window = window;
+  e.causal.mirror = mirror;
   e.causal.ensemble_size = causal_ensemble;
   e.horizon = horizon;
   e.Validate();
@@ -153,6 +154,7 @@ json EvaluateRecord(const EvaluateRun& run, const EvaluateInput& in) {
                   {"methods", methods},
                   {"protocols", protocols},
                   {"window", run.options.causal.window},
+                  {"mirror", run.options.causal.mirror},
                   {"horizon", run.options.horizon},
                   {"rate_hz_from", in.rate_hz_from},
                   {"threads", run.threads},

@@ -8,11 +8,16 @@
 
 namespace gyrodrift::tasks {
 
+drift::CausalOptions PredictSettings::Causal() const {
+  drift::CausalOptions causal;
+  causal.window = window;
+  causal.mirror = mirror;
+  return causal;
+}
+
 void PredictSettings::Validate() const {
   (void)drift::ProtocolFromString(protocol);
-  if (window < 16 || window > 1000000) {
-    ThrowOption("window", std::to_string(window), "an integer in [16, 1000000]");
-  }
+  Causal().Validate();
   ValidateThreads(threads);
 }
 
@@ -38,8 +43,7 @@ PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y
                     " samples: the model needs more than " + std::to_string(r.first) +
                     " (its history) to predict any");
   }
-  drift::CausalOptions causal;
-  causal.window = settings.window;
+  const drift::CausalOptions causal = settings.Causal();
   // The threads never change the result.
   const Execution execution{.threads = settings.threads, .progress = std::move(progress)};
   r.prediction = drift::PredictAhead(model, y, temperature, r.first, settings.horizon, protocol,
@@ -56,7 +60,8 @@ nlohmann::json PredictRecord(const PredictResult& r, const io::LoadedModel& load
   const drift::DriftModel& model = loaded.model;
   nlohmann::json j;
   j["options"] = {{"model", model_path}, {"input", input},     {"protocol", s.protocol},
-                  {"window", s.window},  {"horizon", s.horizon}, {"threads", s.threads}};
+                  {"window", s.window},  {"mirror", s.mirror}, {"horizon", s.horizon},
+                  {"threads", s.threads}};
   j["model"] = {{"summary", model.Summary()},
                 {"method", drift::ToString(model.options.method)},
                 {"target_column", loaded.info.target_column},

@@ -235,8 +235,14 @@ struct CausalOptions {
   // EMDs: the causal evaluation of an 8-h record, its fit and 8,640 windows, took 204 s CPU at
   // 2048), and docs/drift.md shows what 20 instead of 100 costs in accuracy.
   int ensemble_size = 20;
+  // Share of the window mirrored past its end before the decomposition, in [0, 1]: the window
+  // y[t-W..t-1] is followed by y[t-2], y[t-3], ... (round(mirror x W) samples), so that the end
+  // the sub-models read lies inside the decomposed series instead of at its edge, where the
+  // envelopes are extrapolated (the EMD end effect). 0 = no mirror. Default 0.5 [choice,
+  // measured, docs/drift.md 4.3].
+  double mirror = 0.5;
 
-  void Validate() const;  // throws OptionError for a window or ensemble size out of range
+  void Validate() const;  // throws OptionError for a window, ensemble size or mirror out of range
   bool operator==(const CausalOptions&) const = default;
 };
 

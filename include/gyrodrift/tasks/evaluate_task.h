@@ -31,6 +31,7 @@ struct EvaluateSettings {
   double split = internal::kEvaluationDefaults.split;
   int repeats = internal::kEvaluationDefaults.repeats;
   int window = internal::kEvaluationDefaults.causal.window;
+  double mirror = internal::kEvaluationDefaults.causal.mirror;  // causal protocol, [0, 1]
   int horizon = internal::kEvaluationDefaults.horizon;
   // Causal protocol: realisations of each window's decomposition, in [0, 100000]; 0 = the models'
   // ensemble. The study sets it to its ensemble; the CLI and Python keep the library's default.
@@ -38,7 +39,7 @@ struct EvaluateSettings {
 
   // The evaluation's options, validated; `methods_name` names the method list in messages
   // ("methods", or the flag "--methods"). OptionError naming the field (split, repeats, protocol,
-  // causal.window, causal.ensemble_size, horizon, methods) or UsageError.
+  // causal.window, causal.mirror, causal.ensemble_size, horizon, methods) or UsageError.
   drift::EvaluationOptions Options(std::string_view methods_name = "methods") const;
   void Validate(std::string_view methods_name = "methods") const;  // Options() and fit's
 };

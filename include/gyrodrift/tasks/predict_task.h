@@ -20,10 +20,12 @@ namespace gyrodrift::tasks {
 struct PredictSettings {
   std::string protocol = "causal";                  // drift::Protocol name: causal | paper
   int window = drift::CausalOptions{}.window;       // causal protocol: trailing window, samples
+  double mirror = drift::CausalOptions{}.mirror;    // causal protocol: share mirrored past its end
   int horizon = 1;                                  // steps ahead, in [1, 100000]
   int threads = 0;                                  // [0, 1024]; 0 = every core
-  // OptionError naming the field (protocol, window: [16, 1000000], threads).
+  // OptionError naming the field (protocol, window: [16, 1000000], mirror: [0, 1], threads).
   void Validate() const;
+  drift::CausalOptions Causal() const;  // the causal protocol's options (unvalidated)
 };
 
 struct PredictResult {

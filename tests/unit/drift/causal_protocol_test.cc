@@ -1,12 +1,15 @@
 // The causal protocol (causal_protocol.cc): nothing after a prediction's origin reaches it,
-// windows sharing the white-noise EMDs predict as windows decomposed alone, the ensemble and
-// progress options, the note on sub-models a window cannot feed, and the option ranges.
+// windows sharing the white-noise EMDs predict as windows decomposed alone, each window is
+// decomposed with its mirrored tail, the ensemble and progress options, the note on sub-models a
+// window cannot feed, and the option ranges.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
+#include "drift/prediction_steps.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/drift/drift_model.h"
 #include "unit/drift/drift_fixtures.h"
@@ -65,6 +68,36 @@ TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
                                                  Protocol::kCausal, causal);
     ASSERT_EQ(alone.size(), 1);
     EXPECT_EQ(alone[0], all[t - 500]) << t;
+  }
+}
+
+// Each window y[o-W .. o-1] is decomposed followed by round(mirror x W) samples of itself
+// reversed, y[o-2], y[o-3], ...: the lags are the group series' values at the window's own end,
+// for full windows (sharing their noise EMDs) and the short ones at the record's start alike;
+// mirror 0 decomposes the window alone.
+TEST(DriftModel, CausalWindowsAreDecomposedWithTheirMirroredTail) {
+  auto [log, model, causal] = MakeCausalCase(8);
+  const Eigen::Index origin = 40, count = 60;  // origins 40-63 have short windows
+  for (double mirror : {0.5, 0.0, 0.3}) {
+    causal.mirror = mirror;
+    const std::vector<Eigen::MatrixXd> lags =
+        internal::CausalLags(model, log.rate, origin, count, causal, {.threads = 2});
+    for (Eigen::Index o : {40, 63, 64, 99}) {
+      const Eigen::Index length = std::min<Eigen::Index>(o, causal.window);
+      const Eigen::Index tail = std::llround(mirror * static_cast<double>(length));
+      Eigen::VectorXd window(length + tail);
+      for (Eigen::Index i = 0; i < length; ++i) window[i] = log.rate[o - length + i];
+      for (Eigen::Index j = 0; j < tail; ++j) window[length + j] = log.rate[o - 2 - j];
+      decomposition::DecompositionOptions dopt = internal::DecompositionFor(model);
+      dopt.ensemble_size = causal.ensemble_size;
+      const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(window, dopt));
+      for (size_t g = 0; g < lags.size(); ++g) {
+        for (Eigen::Index k = 0; k < model.lags; ++k) {
+          EXPECT_EQ(lags[g](o - origin, k), series(length - 1 - k, static_cast<Eigen::Index>(g)))
+              << "mirror " << mirror << ", origin " << o << ", group " << g << ", lag " << k;
+        }
+      }
+    }
   }
 }
 
@@ -158,7 +191,7 @@ TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   }
 }
 
-TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
+TEST(CausalOptions, ValidateNamesTheWindowMirrorAndEnsembleOutsideTheirRanges) {
   // The option error's message, "" when the options are accepted.
   auto refusal = [](const CausalOptions& c) -> std::string {
     try {
@@ -177,6 +210,14 @@ TEST(CausalOptions, ValidateNamesTheWindowAndTheEnsembleOutsideTheirRanges) {
     const std::string message = refusal(c);
     EXPECT_TRUE(allowed ? message.empty() : message.find("window = ") != std::string::npos)
         << window << ": " << message;
+  }
+  for (double mirror : {0.0, 1.0, -0.01, 1.01, std::nan("")}) {
+    CausalOptions c;
+    c.mirror = mirror;
+    const bool allowed = mirror >= 0.0 && mirror <= 1.0;
+    const std::string message = refusal(c);
+    EXPECT_TRUE(allowed ? message.empty() : message.find("mirror = ") != std::string::npos)
+        << mirror << ": " << message;
   }
   for (int ensemble : {0, 100000, -1, 100001}) {  // 0 = the model's own
     CausalOptions c;
