@@ -147,6 +147,12 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
                   ->capture_default_str()
                   ->group("Advanced"),
               {"causal_window"});
+  BindSetting(cmd->add_option("--mirror", args->settings.mirror,
+                              "advanced: share of each causal window mirrored past its end, "
+                              "in [0, 1]")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_mirror"});
   BindSetting(cmd->add_option("--methods", args->settings.methods,
                               "advanced: all, or a list such as ms-elm,elm,poly")
                   ->capture_default_str()

@@ -171,7 +171,7 @@ def demo(
     output: str | PathLike[str] = ..., *, input: str | PathLike[str] | None = ...,
     target: str | None = ..., temperature: str | None = ..., rate_hz: float | None = ...,
     units: Literal["dph", "dps", "rads"] = ..., duration: float = ..., ensemble: int = ...,
-    realisations: int = ..., window: int = ..., methods: str = ..., seed: int = ...,
-    threads: int = ..., gaps: Literal["error", "interpolate"] = ...,
+    realisations: int = ..., window: int = ..., mirror: float = ..., methods: str = ...,
+    seed: int = ..., threads: int = ..., gaps: Literal["error", "interpolate"] = ...,
     progress: Callable[[float], object] | None = ...,
 ) -> dict[str, Any]: ...

@@ -56,8 +56,9 @@ void BindDemo(py::module_& m) {
       "demo",
       [](const std::string& output, const std::string& input, const std::string& target,
          const std::string& temperature, std::optional<double> rate_hz, const std::string& units,
-         double duration, int ensemble, int realisations, int window, const std::string& methods,
-         std::uint64_t seed, int threads, const std::string& gaps, const py::object& progress) {
+         double duration, int ensemble, int realisations, int window, double mirror,
+         const std::string& methods, std::uint64_t seed, int threads, const std::string& gaps,
+         const py::object& progress) {
         study::DemoSettings s{.output = output,
                               .input = input,
                               .target = target,
@@ -68,6 +69,7 @@ void BindDemo(py::module_& m) {
                               .ensemble = ensemble,
                               .realisations = realisations,
                               .window = window,
+                              .mirror = mirror,
                               .methods = methods,
                               .seed = seed,
                               .threads = threads,
@@ -78,8 +80,8 @@ void BindDemo(py::module_& m) {
       arg("output") = d.output, py::kw_only(), arg("input") = d.input, arg("target") = d.target,
       arg("temperature") = d.temperature, arg("rate_hz") = py::none(), arg("units") = d.units,
       arg("duration") = d.duration_s, arg("ensemble") = d.ensemble,
-      arg("realisations") = d.realisations, arg("window") = d.window, arg("methods") = d.methods,
-      arg("seed") = d.seed, arg("threads") = d.threads,
+      arg("realisations") = d.realisations, arg("window") = d.window, arg("mirror") = d.mirror,
+      arg("methods") = d.methods, arg("seed") = d.seed, arg("threads") = d.threads,
       arg("gaps") = std::string(io::ToString(d.log.gaps)), arg("progress") = py::none());
 }
 

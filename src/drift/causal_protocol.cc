@@ -1,7 +1,8 @@
 // The causal protocol: each test sample's sub-series come from decomposing its trailing window
-// alone (CausalLags: one decomposition per origin, windows in parallel, full windows sharing one
-// set of white-noise EMDs), its options (CausalOptions::Validate), and the note on sub-models a
-// window is too short to feed (CausalWindowNote). PredictAhead (prediction.cc) runs it.
+// alone, followed by its mirrored tail (CausalLags: one decomposition per origin, windows in
+// parallel, full windows sharing one set of white-noise EMDs), its options (CausalOptions), and
+// the note on sub-models a window is too short to feed (CausalWindowNote). PredictAhead
+// (prediction.cc) runs it.
 #include <algorithm>
 #include <atomic>
 #include <cassert>
@@ -17,6 +18,11 @@
 #include "gyrodrift/drift/drift_model.h"
 
 namespace gyrodrift::drift {
+
+Eigen::Index CausalOptions::DecomposedLength(Eigen::Index length) const {
+  const Eigen::Index tail = std::llround(mirror * static_cast<double>(length));
+  return length + std::clamp<Eigen::Index>(tail, 0, std::max<Eigen::Index>(0, length - 1));
+}
 
 void CausalOptions::Validate() const {
   if (window < 16 || window > 1000000) {
@@ -50,15 +56,12 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   one_thread.execution.threads = 1;
   // Every full window has one length, seed and ensemble, hence the same white-noise EMDs:
   // computed once here instead of once per window (the same bits; about half of each window's
-  // cost), when they take at most 256 MB (about ensemble x log2(W) windows' worth of samples).
+  // cost), when they take at most 256 MB (about ensemble x log2(L) decomposed windows' worth of
+  // samples, L = W plus its mirrored tail).
   decomposition::DecompositionContext full_window = one_thread;
   const Eigen::Index last_origin = origin + count - 1;
   const Eigen::Index full_windows = last_origin - std::max<Eigen::Index>(origin, causal.window) + 1;
-  // A window of `length` samples is decomposed with its mirrored tail: `length + tail` samples.
-  const auto tail = [&](Eigen::Index length) {
-    return std::min<Eigen::Index>(length - 1, std::llround(causal.mirror * length));
-  };
-  const Eigen::Index full_length = causal.window + tail(causal.window);
+  const Eigen::Index full_length = causal.DecomposedLength(causal.window);
   const double cache_bytes = static_cast<double>(dopt.ensemble_size) *
                              decomposition::NoiseEmds::RowsPerRealisation(full_length) *
                              static_cast<double>(full_length) * sizeof(double);
@@ -80,7 +83,7 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
     const Eigen::Index end = origin + r;  // the window ends just before the origin
     const Eigen::Index start = std::max<Eigen::Index>(0, end - causal.window);
     const Eigen::Index length = end - start;
-    Eigen::VectorXd window(length + tail(length));
+    Eigen::VectorXd window(causal.DecomposedLength(length));
     window.head(length) = y.segment(start, length);
     window.tail(window.size() - length) =
         y.segment(end - 1 - (window.size() - length), window.size() - length).reverse();
@@ -107,9 +110,11 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
 
 }  // namespace internal
 
-std::string CausalWindowNote(const DriftModel& model, int window) {
+std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causal) {
+  const int window = causal.window;
   if (!UsesDecomposition(model.options.method) || window < 2) return "";
-  const int resolved = std::max(1, static_cast<int>(std::floor(std::log2(window))) - 1);
+  const double decomposed = static_cast<double>(causal.DecomposedLength(window));
+  const int resolved = std::max(1, static_cast<int>(std::floor(std::log2(decomposed))) - 1);
   std::vector<std::string> names;
   int slowest = 0;
   for (const SubModel& sub : model.sub_models) {
@@ -130,10 +135,16 @@ std::string CausalWindowNote(const DriftModel& model, int window) {
   if (names.size() == 2) list += " and " + names.back();
   if (names.size() > 2) list += " ... " + names.back() + " (" + std::to_string(names.size()) + ")";
   const bool several = names.size() > 1;
-  const long long needed = 1LL << std::min(slowest + 1, 40);
-  return "note: a " + std::to_string(window) + "-sample causal window resolves about " +
-         std::to_string(resolved) + " IMFs; sub-model" + (several ? "s " : " ") + list +
-         (several ? " hold" : " holds") + " slower ones, which fall into the window's residue: " +
+  // The window whose decomposed series has 2^(slowest + 1) samples.
+  const long long needed = static_cast<long long>(
+      std::ceil(std::ldexp(1.0, std::min(slowest + 1, 40)) * window / decomposed));
+  const std::string mirrored =
+      decomposed > window ? " (" + FormatValue(decomposed) + " samples with its mirrored tail)"
+                          : "";
+  return "note: a " + std::to_string(window) + "-sample causal window" + mirrored +
+         " resolves about " + std::to_string(resolved) + " IMFs; sub-model" +
+         (several ? "s " : " ") + list + (several ? " hold" : " holds") +
+         " slower ones, which fall into the window's residue: " +
          (several ? "they see" : "it sees") + " another series than in training (" +
          (needed <= 1000000
               ? "a window of " + std::to_string(needed) + " samples would resolve them"

@@ -96,7 +96,7 @@ Trial RunTrial(const Eigen::Ref<const Eigen::VectorXd>& y,
   trial.predict_s = Seconds(start);
   // A compensate-mode estimate reads no window of the output.
   if (protocol == Protocol::kCausal && o.mode == Mode::kPredict) {
-    trial.note = CausalWindowNote(model, causal.window);
+    trial.note = CausalWindowNote(model, causal);
   }
   return trial;
 }

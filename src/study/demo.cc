@@ -75,6 +75,7 @@ StudyOptions DemoSettings::Options() const {
   o.ensemble_size = ensemble;
   o.realisations = realisations;
   o.causal_window = window;
+  o.causal_mirror = mirror;
   o.seed = seed;
   o.Validate();
   ValidateThreads(threads);
@@ -131,6 +132,7 @@ nlohmann::json DemoRecord(const DemoSettings& s, const StudyResult& result) {
                        {"ensemble", s.ensemble},
                        {"realisations", s.realisations},
                        {"window", s.window},
+                       {"mirror", s.mirror},
                        {"methods", s.methods},
                        {"seed", s.seed},
                        {"threads", s.threads}};

@@ -105,12 +105,13 @@ drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
 }
 
 // The study's evaluation of `methods` ("all" or a comma-separated list) with the models' settings
-// `fit`: the causal protocol's window and ensemble are the study's.
+// `fit`: the causal protocol's window, mirror and ensemble are the study's.
 tasks::EvaluateSettings EvaluationSettings(const StudyOptions& a, drift::FitSettings fit,
                                            std::string methods) {
   return {.fit = std::move(fit),
           .methods = std::move(methods),
           .window = a.causal_window,
+          .mirror = a.causal_mirror,
           .causal_ensemble = a.ensemble_size};
 }
 
@@ -471,7 +472,8 @@ void StudyOptions::Validate() const {
   // refusal names the study's field that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
                       {"selection.monte_carlo.realisations", "realisations"},
-                      {"causal.window", "causal_window"}},
+                      {"causal.window", "causal_window"},
+                      {"causal.mirror", "causal_mirror"}},
                      [&] {
                        internal::StudyDriftOptions(*this, 1.0, true).Validate();
                        // The causal protocol's settings; the study's method list is checked

@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/simulation/gyro_noise.h"
 #include "study_steps.h"
 
@@ -155,7 +156,8 @@ void FillSettingsTable(StudyResult& s) {
                       " and ridge by leave-one-out; SVR/BP/poly library defaults"});
   settings.Add({"predict mode", std::to_string(base.features.lags) +
                                     " lags, split 70/30, causal window " +
-                                    std::to_string(a.causal_window) + " samples"});
+                                    std::to_string(a.causal_window) + " samples, mirrored tail " +
+                                    FormatValue(a.causal_mirror) + " of it"});
   settings.Add(
       {"compensate mode",
        std::string("thermal models identified from the calibration run") +

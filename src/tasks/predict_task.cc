@@ -49,7 +49,7 @@ PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y
   r.prediction = drift::PredictAhead(model, y, temperature, r.first, settings.horizon, protocol,
                                      causal, execution);
   if (protocol == drift::Protocol::kCausal) {
-    r.window_note = drift::CausalWindowNote(model, settings.window);
+    r.window_note = drift::CausalWindowNote(model, causal);
   }
   return r;
 }

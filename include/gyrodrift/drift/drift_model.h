@@ -229,19 +229,20 @@ struct CausalOptions {
   // to a flat minimum at 2048-4096 samples, and 2048 is the cheapest there (docs/drift.md 4.3).
   int window = 2048;
   // Realisations of each window's decomposition (noise-assisted methods), in [0, 100000]; 0 = the
-  // model's own decomposition.ensemble_size. Default 20 [choice]: one decomposition per test
-  // sample is the whole cost of the causal protocol (a window decomposed alone with 20
-  // realisations: about 42 ms CPU at W = 2048, 8 ms at 512; full windows share their white-noise
-  // EMDs: the causal evaluation of an 8-h record, its fit and 8,640 windows, took 204 s CPU at
-  // 2048), and docs/drift.md shows what 20 instead of 100 costs in accuracy.
-  int ensemble_size = 20;
-  // Share of the window mirrored past its end before the decomposition, in [0, 1]: the window
-  // y[t-W..t-1] is followed by y[t-2], y[t-3], ... (round(mirror x W) samples), so that the end
-  // the sub-models read lies inside the decomposed series instead of at its edge, where the
-  // envelopes are extrapolated (the EMD end effect). 0 = no mirror. Default 0.5 [choice,
-  // measured, docs/drift.md 4.3].
+  // model's own decomposition.ensemble_size. Default 10 [choice, measured]: one decomposition per
+  // test sample is the whole cost of the causal protocol, and with the mirrored tail (below) the
+  // residue's end is as close to the drift with 10 realisations as with 20 on the tuning records
+  // (docs/drift.md 4.3), at half the cost (20 until 2026-11-28).
+  int ensemble_size = 10;
+  // Share of the window mirrored past its end before the decomposition, in [0, 1]: a window of L
+  // samples y[t-L..t-1] is followed by y[t-2], y[t-3], ... (min(round(mirror x L), L - 1)
+  // samples), so that the end the sub-models read lies inside the decomposed series instead of at
+  // its edge, where the envelopes are extrapolated (the EMD end effect). 0 = the window alone.
+  // Default 0.5 [choice, measured: docs/drift.md 4.3].
   double mirror = 0.5;
 
+  // Samples a window of `length` is decomposed as: length + its mirrored tail.
+  Eigen::Index DecomposedLength(Eigen::Index length) const;
   void Validate() const;  // throws OptionError for a window, ensemble size or mirror out of range
   bool operator==(const CausalOptions&) const = default;
 };
@@ -269,12 +270,12 @@ Eigen::VectorXd PredictAhead(const DriftModel& model, const Eigen::Ref<const Eig
                              Eigen::Index first, int horizon, Protocol protocol,
                              const CausalOptions& causal = {}, const Execution& execution = {});
 
-// "" unless, under the causal protocol with `window`-sample windows, some sub-model other than
-// the residue's and MS-ELM's noise group sums IMFs a window cannot resolve (a window of W samples
-// gives about log2(W) - 1 IMFs): then a one-line note naming them. Their content falls into the
-// window's residue, so such a sub-model sees at test time another series than the one it was
-// trained on (docs/drift.md 4.3).
-std::string CausalWindowNote(const DriftModel& model, int window);
+// "" unless, under the causal protocol with `causal`'s windows, some sub-model other than the
+// residue's and MS-ELM's noise group sums IMFs a window cannot resolve (a series of L samples,
+// the window with its mirrored tail, gives about log2(L) - 1 IMFs): then a one-line note naming
+// them. Their content falls into the window's residue, so such a sub-model sees at test time
+// another series than the one it was trained on (docs/drift.md 4.3).
+std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causal);
 
 // One-step-ahead predictions of y[t] for t = first .. N-1 (first >= lags; the returned vector has
 // N - first entries): PredictAhead with horizon 1.

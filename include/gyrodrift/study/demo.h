@@ -36,6 +36,7 @@ struct DemoSettings {
   int ensemble = internal::kStudyDefaults.ensemble_size;
   int realisations = internal::kStudyDefaults.realisations;
   int window = internal::kStudyDefaults.causal_window;
+  double mirror = internal::kStudyDefaults.causal_mirror;
   std::string methods = "all";  // "all" or a comma-separated list of compensate-mode methods
   std::uint64_t seed = internal::kStudyDefaults.seed;
   int threads = 0;     // [0, 1024]; 0 = every core

@@ -66,6 +66,8 @@ struct StudyOptions {
   // Trailing window of the causal protocol, samples; CausalOptions' range [16, 1000000].
   // Default 128 (the library's is 2048): the cost of each of the test block's windows.
   int causal_window = 128;
+  // Share of each causal window mirrored past its end; CausalOptions' range [0, 1] and default.
+  double causal_mirror = drift::CausalOptions{}.mirror;
   // The methods compared: each a method of compensate mode (predict mode runs those it
   // supports), none twice (each saves one model file). Default: all, in drift::AllMethods order.
   std::vector<drift::Method> methods = drift::AllMethods(drift::Mode::kCompensate);

@@ -78,13 +78,16 @@ TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
 TEST(DriftModel, CausalWindowsAreDecomposedWithTheirMirroredTail) {
   auto [log, model, causal] = MakeCausalCase(8);
   const Eigen::Index origin = 40, count = 60;  // origins 40-63 have short windows
-  for (double mirror : {0.5, 0.0, 0.3}) {
+  for (double mirror : {0.5, 0.0, 0.3, 1.0}) {
     causal.mirror = mirror;
     const std::vector<Eigen::MatrixXd> lags =
         internal::CausalLags(model, log.rate, origin, count, causal, {.threads = 2});
     for (Eigen::Index o : {40, 63, 64, 99}) {
       const Eigen::Index length = std::min<Eigen::Index>(o, causal.window);
-      const Eigen::Index tail = std::llround(mirror * static_cast<double>(length));
+      // At most the window's samples but its end one: y[o-2] .. y[o-length].
+      const Eigen::Index tail =
+          std::min<Eigen::Index>(length - 1, std::llround(mirror * static_cast<double>(length)));
+      ASSERT_EQ(causal.DecomposedLength(length), length + tail);
       Eigen::VectorXd window(length + tail);
       for (Eigen::Index i = 0; i < length; ++i) window[i] = log.rate[o - length + i];
       for (Eigen::Index j = 0; j < tail; ++j) window[length + j] = log.rate[o - 2 - j];
@@ -126,6 +129,7 @@ TEST(DriftModel, PredictAheadIgnoresSamplesAfterItsOrigin) {
       FitDriftModel(log.rate.head(600), Eigen::VectorXd(), Fast(Mode::kPredict, Method::kMsElm));
   CausalOptions causal;
   causal.window = 128;
+  causal.mirror = 1.0;  // the longest tail: the window's every sample but its end, reversed
   const int horizon = 5;
   const Eigen::VectorXd base =
       PredictAhead(model, log.rate, Eigen::VectorXd(), 600, horizon, Protocol::kCausal, causal);
@@ -142,25 +146,42 @@ TEST(DriftModel, PredictAheadIgnoresSamplesAfterItsOrigin) {
 }
 
 // The causal windows cannot resolve slow IMFs: a note names a sub-model that sums them (not the
-// noise group, whose energy is in its first IMFs, nor the residue's), and the window that would.
+// noise group, whose energy is in its first IMFs, nor the residue's), and the window that would;
+// a window's mirrored tail counts in the series decomposed.
 TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
   DriftModel model;
   model.options.method = Method::kMsElm;
   model.sub_models = {{"noise", {1, 2, 3}, false, nullptr},
                       {"mixed", {4, 5, 6, 7, 8, 9, 10, 11, 12}, false, nullptr},
                       {"drift", {13}, true, nullptr}};
-  const std::string note = CausalWindowNote(model, 512);
-  EXPECT_NE(note.find("resolves about 8 IMFs; sub-model 'mixed' (IMFs 4-12) holds slower ones"),
+  const auto note = [&model](int window, double mirror) {
+    CausalOptions causal;
+    causal.window = window;
+    causal.mirror = mirror;
+    return CausalWindowNote(model, causal);
+  };
+  std::string text = note(512, 0.0);
+  EXPECT_NE(text.find("a 512-sample causal window resolves about 8 IMFs; sub-model 'mixed' "
+                      "(IMFs 4-12) holds slower ones"),
             std::string::npos)
-      << note;
-  EXPECT_NE(note.find("a window of 8192 samples would resolve them"), std::string::npos) << note;
-  EXPECT_EQ(CausalWindowNote(model, 8192), "");
+      << text;
+  EXPECT_NE(text.find("a window of 8192 samples would resolve them"), std::string::npos) << text;
+  EXPECT_EQ(note(8192, 0.0), "");
+  // 512 + 256 mirrored samples: 768, still 8 IMFs; 5462 + 2731 = 8193 samples resolve IMF 12.
+  text = note(512, 0.5);
+  EXPECT_NE(text.find("a 512-sample causal window (768 samples with its mirrored tail) resolves "
+                      "about 8 IMFs"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("a window of 5462 samples would resolve them"), std::string::npos) << text;
+  EXPECT_EQ(note(5462, 0.5), "");
+  EXPECT_NE(note(5460, 0.5), "");
   model.sub_models = {{"noise", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13}, false, nullptr},
                       {"drift", {}, true, nullptr}};
-  EXPECT_EQ(CausalWindowNote(model, 512), "");  // the default grouping on a 1 Hz FOG log
+  EXPECT_EQ(note(512, 0.5), "");  // the default grouping on a 1 Hz FOG log
   model.options.method = Method::kElm;
   model.sub_models = {{"signal", {}, true, nullptr}};
-  EXPECT_EQ(CausalWindowNote(model, 16), "");
+  EXPECT_EQ(note(16, 0.5), "");
 }
 
 TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "gyrodrift/common/error.h"
 
 namespace gyrodrift::tasks {
@@ -21,21 +23,31 @@ TEST(EvaluateTask, DefaultsAreTheLibrarys) {
   EXPECT_EQ(e.methods, drift::AllMethods(drift::Mode::kPredict));
 }
 
-TEST(EvaluateTask, CausalEnsembleSizesTheWindowsDecompositions) {
+TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
   // The study sizes the causal windows' decompositions with its own ensemble.
   EvaluateSettings s = Predict();
   s.window = 64;
+  s.mirror = 0.25;
   s.causal_ensemble = 7;
   const drift::EvaluationOptions e = s.Options();
   EXPECT_EQ(e.causal.window, 64);
+  EXPECT_EQ(e.causal.mirror, 0.25);
   EXPECT_EQ(e.causal.ensemble_size, 7);
-  s.causal_ensemble = -1;
-  try {
-    (void)s.Options();
-    ADD_FAILURE() << "a negative causal ensemble was accepted";
-  } catch (const OptionError& error) {
-    EXPECT_EQ(error.option(), "causal.ensemble_size");
-  }
+  // The option each refusal names.
+  const auto refused = [](const EvaluateSettings& bad) -> std::string {
+    try {
+      (void)bad.Options();
+    } catch (const OptionError& error) {
+      return error.option();
+    }
+    return "(accepted)";
+  };
+  EvaluateSettings bad = s;
+  bad.causal_ensemble = -1;
+  EXPECT_EQ(refused(bad), "causal.ensemble_size");
+  bad = s;
+  bad.mirror = 1.5;
+  EXPECT_EQ(refused(bad), "causal.mirror");
 }
 
 }  // namespace
