@@ -193,6 +193,7 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"bad split", p + "--split 0.99", 2, "--split = 0.99"},
       {"zero repeats", p + "--repeats 0", 2, "--repeats = 0"},
       {"small window", p + "--window 4", 2, "--window = 4"},
+      {"negative mirror", p + "--mirror -0.5", 2, "--mirror = -0.5"},
       {"compensate without temperature", "evaluate %IN% -t rate_dph --mode compensate", 2,
        "needs a temperature channel"},
       {"missing truth", p + "--truth drift", 2, "column 'drift' not found"},

@@ -186,6 +186,8 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"bad protocol", "predict %DIR%/ms.json %DIR%/test.csv --protocol future", 2,
        "protocol = 'future'"},
       {"small window", "predict %DIR%/ms.json %DIR%/test.csv -W 8", 2, "--window = 8"},
+      {"mirror past the window", "predict %DIR%/ms.json %DIR%/test.csv --mirror 1.5", 2,
+       "--mirror = 1.5"},
       {"zero horizon", "predict %DIR%/ms.json %DIR%/test.csv --horizon 0", 2, "--horizon = 0"},
       {"horizon past the file", "predict %DIR%/ms.json %DIR%/test.csv --horizon 110", 3,
        "needs more than 125"},
