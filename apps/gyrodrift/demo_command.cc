@@ -87,7 +87,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "demo", "The whole study in one command: simulate, decompose, model, compensate, report.");
   cmd->footer(
       "Example:\n"
-      "  gyrodrift demo                       # simulated FOG, about 30 s on 2 cores -> "
+      "  gyrodrift demo                       # simulated FOG, about 40 s on 2 cores -> "
       "./gyrodrift-demo/\n"
       "  gyrodrift demo -o /tmp/study\n"
       "  gyrodrift demo --input log.csv --target gyro_x --temperature temp --rate-hz 1\n"

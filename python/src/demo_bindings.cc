@@ -3,6 +3,7 @@
 #include <numeric>
 
 #include "bindings.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/io/gyro_log.h"
 #include "gyrodrift/study/demo.h"
 #include "gyrodrift/study/study_files.h"
@@ -11,6 +12,12 @@ namespace gyrodrift::python {
 namespace {
 
 py::dict Demo(const study::DemoSettings& settings, const py::object& progress) {
+  // A refusal names the keyword, as the CLI's names its flag.
+  ValidateAsSettings({{"causal_mirror", "mirror"},
+                      {"causal_window", "window"},
+                      {"ensemble_size", "ensemble"},
+                      {"duration_s", "duration"}},
+                     [&] { (void)settings.Options(); });
   LongCall call(progress);
   // The study reports (stage, fraction of it); the callable gets the fraction of the whole run,
   // each stage weighed by its measured cost.

@@ -54,7 +54,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const std::optional<Array>& truth_in, const tasks::EvaluateSettings& settings,
                   const py::object& progress) {
   LongCall call(progress);
-  // A refusal names the keyword (window), as the CLI's names its flag.
+  // A refusal names the keyword (window, mirror), as the CLI's names its flag.
   ValidateAsSettings({{"causal.window", "window"}, {"causal.mirror", "mirror"}},
                      [&] { settings.Validate(); });
   (void)ExecutionOf(settings.fit.threads, call);

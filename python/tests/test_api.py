@@ -204,6 +204,10 @@ def test_select_modes_groups_a_decomposition_into_series_that_add_up():
         gd.evaluate(x, window=1)
     with pytest.raises(gd.UsageError, match=r"^mirror = 1.5: must be"):
         gd.evaluate(x, mirror=1.5)
+    with pytest.raises(gd.UsageError, match=r"^mirror = 2: must be"):
+        gd.demo("/nonexistent/never-written", mirror=2)
+    with pytest.raises(gd.UsageError, match=r"^window = 4: must be"):
+        gd.demo("/nonexistent/never-written", window=4)
 
 
 def test_a_temperature_that_is_not_degc_is_warned_of_before_the_fit():

@@ -20,6 +20,7 @@
 namespace gyrodrift::drift {
 
 Eigen::Index CausalOptions::DecomposedLength(Eigen::Index length) const {
+  assert(length >= 0);
   const Eigen::Index tail = std::llround(mirror * static_cast<double>(length));
   return length + std::clamp<Eigen::Index>(tail, 0, std::max<Eigen::Index>(0, length - 1));
 }
@@ -135,12 +136,17 @@ std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causa
   if (names.size() == 2) list += " and " + names.back();
   if (names.size() > 2) list += " ... " + names.back() + " (" + std::to_string(names.size()) + ")";
   const bool several = names.size() > 1;
-  // The window whose decomposed series has 2^(slowest + 1) samples.
-  const long long needed = static_cast<long long>(
-      std::ceil(std::ldexp(1.0, std::min(slowest + 1, 40)) * window / decomposed));
-  const std::string mirrored =
-      decomposed > window ? " (" + FormatValue(decomposed) + " samples with its mirrored tail)"
-                          : "";
+  // The least window whose decomposed series has 2^(slowest + 1) samples: DecomposedLength does
+  // not decrease with the window, so step from the estimate past the tail's rounding and clamp.
+  const auto target = static_cast<Eigen::Index>(std::ldexp(1.0, std::min(slowest + 1, 40)));
+  auto needed =
+      static_cast<Eigen::Index>(std::ceil(static_cast<double>(target) * window / decomposed));
+  while (causal.DecomposedLength(needed) < target) ++needed;
+  while (needed > 1 && causal.DecomposedLength(needed - 1) >= target) --needed;
+  const std::string mirrored = decomposed > window
+                                   ? " (" + std::to_string(causal.DecomposedLength(window)) +
+                                         " samples with its mirrored tail)"
+                                   : "";
   return "note: a " + std::to_string(window) + "-sample causal window" + mirrored +
          " resolves about " + std::to_string(resolved) + " IMFs; sub-model" +
          (several ? "s " : " ") + list + (several ? " hold" : " holds") +

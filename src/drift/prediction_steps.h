@@ -1,6 +1,6 @@
 // Private: the parts of predict mode shared between prediction.cc, causal_protocol.cc and the
 // evaluation: the history rule (how much record a prediction needs) and the causal protocol's
-// lags (each origin's sub-series from its trailing window alone).
+// lags (each origin's sub-series from its trailing window alone, with its mirrored tail).
 #pragma once
 
 #include <Eigen/Core>
@@ -23,7 +23,7 @@ decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
 
 // Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
 // trailing window y[o-W .. o-1] alone, followed by its mirrored tail y[o-2], y[o-3], ...
-// (round(causal.mirror x W) samples): lags[g](r, k) = s_g[o - 1 - k] of that window's groups
+// (causal.DecomposedLength(W) - W samples): lags[g](r, k) = s_g[o - 1 - k] of that window's groups
 // (count x lags per sub-model g). Windows run in parallel on execution.threads, which reports
 // the fraction of windows done ("causal windows").
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,

@@ -168,7 +168,7 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo --duration 90min", 2, "at least 2h"},
       {"demo --ensemble 0", 2, "--ensemble"},
       {"demo --window 4", 2, "--window"},
-      {"demo --mirror nan", 2, "--mirror"},
+      {"demo --mirror nan", 2, "--mirror = nan"},
       {"demo --methods ms-elm,nope", 2, "nope"},
       // Two model files of one name: refused before the work, not half-written after it.
       {"demo --methods elm,poly,elm -o " + dir + "/o", 2, "--methods"},

@@ -19,8 +19,9 @@
 // noise terms; docs/drift.md for the models and protocols.
 // Units: the simulated output is in deg/h, a log's in StudyOptions::units; temperatures in degC
 // (a log's in whatever unit it has); times in s (hours on the time axes of the result).
-// Cost: dominated by the causal protocol, one BEEMDAN of `causal_window` samples per test sample
-// for each decomposing method (ms-elm, emd-elm): the defaults take about 40 s on 2 cores.
+// Cost: dominated by the causal protocol, one BEEMDAN of `causal_window` samples and their
+// mirrored tail per test sample for each decomposing method (ms-elm, emd-elm): the defaults take
+// about 40 s on 2 cores.
 // Nothing here reads files or prints: RunStudy reports through its StudyContext, which also holds
 // the worker threads; StudyOptions are plain values (comparable with ==) that decide the result.
 #pragma once

@@ -204,9 +204,9 @@ TEST(Beemdan, ImfCapSpansBothPhases) {
 
 // The ensemble band (the default bound) on white noise: each tested mode k >= 2 is inside the
 // band of the ensemble's own white-noise mode k with the stated confidence. Over 24 records of
-// 1024 samples (20 realisations each, as a causal window's decomposition) about 1 % of the
-// tested modes are outside the 99 % band and about 5 % outside the 95 % one; a band as wide as
-// Flandrin et al.'s at late modes would leave none outside either.
+// 1024 samples (20 realisations each, a causal window's decomposition until 2026-11-28) about 1 %
+// of the tested modes are outside the 99 % band and about 5 % outside the 95 % one; a band as wide
+// as Flandrin et al.'s at late modes would leave none outside either.
 TEST(Beemdan, EnsembleBandHoldsItsConfidenceOnWhiteNoise) {
   const int records = 24;
   for (const double confidence : {0.99, 0.95}) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drift/prediction_steps.h"
@@ -167,15 +168,26 @@ TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
       << text;
   EXPECT_NE(text.find("a window of 8192 samples would resolve them"), std::string::npos) << text;
   EXPECT_EQ(note(8192, 0.0), "");
-  // 512 + 256 mirrored samples: 768, still 8 IMFs; 5462 + 2731 = 8193 samples resolve IMF 12.
+  // 512 + 256 mirrored samples: 768, still 8 IMFs; 5461 + 2731 = 8192 samples resolve IMF 12
+  // (5460 + 2730 do not). The window named is the least that does, whatever the tail's rounding.
   text = note(512, 0.5);
   EXPECT_NE(text.find("a 512-sample causal window (768 samples with its mirrored tail) resolves "
                       "about 8 IMFs"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("a window of 5462 samples would resolve them"), std::string::npos) << text;
-  EXPECT_EQ(note(5462, 0.5), "");
+  EXPECT_NE(text.find("a window of 5461 samples would resolve them"), std::string::npos) << text;
+  EXPECT_EQ(note(5461, 0.5), "");
   EXPECT_NE(note(5460, 0.5), "");
+  const std::vector<std::pair<int, double>> odd = {{127, 0.5}, {17, 0.5}, {300, 1.0}, {999, 0.3}};
+  for (const auto& [window, mirror] : odd) {
+    text = note(window, mirror);
+    const std::string said = "a window of ";
+    const size_t at = text.find(said);
+    ASSERT_NE(at, std::string::npos) << text;
+    const int named = std::stoi(text.substr(at + said.size()));
+    EXPECT_EQ(note(named, mirror), "") << window << ", " << mirror << ": " << text;
+    EXPECT_NE(note(named - 1, mirror), "") << window << ", " << mirror << ": " << text;
+  }
   model.sub_models = {{"noise", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13}, false, nullptr},
                       {"drift", {}, true, nullptr}};
   EXPECT_EQ(note(512, 0.5), "");  // the default grouping on a 1 Hz FOG log
