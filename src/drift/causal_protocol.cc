@@ -114,8 +114,9 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
 std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causal) {
   const int window = causal.window;
   if (!UsesDecomposition(model.options.method) || window < 2) return "";
-  const double decomposed = static_cast<double>(causal.DecomposedLength(window));
-  const int resolved = std::max(1, static_cast<int>(std::floor(std::log2(decomposed))) - 1);
+  const Eigen::Index decomposed = causal.DecomposedLength(window);
+  const int resolved =
+      std::max(1, static_cast<int>(std::floor(std::log2(static_cast<double>(decomposed)))) - 1);
   std::vector<std::string> names;
   int slowest = 0;
   for (const SubModel& sub : model.sub_models) {
@@ -139,14 +140,13 @@ std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causa
   // The least window whose decomposed series has 2^(slowest + 1) samples: DecomposedLength does
   // not decrease with the window, so step from the estimate past the tail's rounding and clamp.
   const auto target = static_cast<Eigen::Index>(std::ldexp(1.0, std::min(slowest + 1, 40)));
-  auto needed =
-      static_cast<Eigen::Index>(std::ceil(static_cast<double>(target) * window / decomposed));
+  auto needed = static_cast<Eigen::Index>(
+      std::ceil(static_cast<double>(target) * window / static_cast<double>(decomposed)));
   while (causal.DecomposedLength(needed) < target) ++needed;
   while (needed > 1 && causal.DecomposedLength(needed - 1) >= target) --needed;
-  const std::string mirrored = decomposed > window
-                                   ? " (" + std::to_string(causal.DecomposedLength(window)) +
-                                         " samples with its mirrored tail)"
-                                   : "";
+  const std::string mirrored =
+      decomposed > window ? " (" + std::to_string(decomposed) + " samples with its mirrored tail)"
+                          : "";
   return "note: a " + std::to_string(window) + "-sample causal window" + mirrored +
          " resolves about " + std::to_string(resolved) + " IMFs; sub-model" +
          (several ? "s " : " ") + list + (several ? " hold" : " holds") +

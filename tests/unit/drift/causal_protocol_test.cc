@@ -72,9 +72,9 @@ TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
   }
 }
 
-// Each window y[o-W .. o-1] is decomposed followed by round(mirror x W) samples of itself
-// reversed, y[o-2], y[o-3], ...: the lags are the group series' values at the window's own end,
-// for full windows (sharing their noise EMDs) and the short ones at the record's start alike;
+// Each window y[o-L .. o-1] is decomposed followed by min(round(mirror x L), L - 1) samples of
+// itself reversed, y[o-2], y[o-3], ...: the lags are the group series' values at the window's own
+// end, for full windows (sharing their noise EMDs) and the short ones at the record's start alike;
 // mirror 0 decomposes the window alone.
 TEST(DriftModel, CausalWindowsAreDecomposedWithTheirMirroredTail) {
   auto [log, model, causal] = MakeCausalCase(8);
