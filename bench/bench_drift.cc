@@ -2,14 +2,15 @@
 // (navigation preset, builtin programme "chamber", seed 1; 28,800 samples; BEEMDAN defaults:
 // 100 realisations, ensemble-band bound, and every stage noise-assisted for comparison; 1 and 2
 // threads), in both modes, and the causal evaluation of
-// that record (fit on the first 70 %, then one BEEMDAN of the trailing 2048-sample window and its
-// mirrored tail per test sample, 8,640 windows). Targets: fit < 1 s on 2 cores (issue 24), causal
-// evaluation < 2 min. Wall time is the figure (UseRealTime); `process_cpu_s` is the CPU time of
-// every thread of the process per iteration (Google Benchmark's CPU column counts the main thread
-// only). BM_ThermalFit: the compensate-mode default (method thermal: identification of the thermal
-// model, every subset of up to two thermal states scored by blocked cross-validation) on a 16-hour
-// 1 Hz record (57,600 samples; the chamber programme, held after its end). Target: < 10 s on 2
-// cores. Smoke mode (CTest): a 30-minute record and 10 realisations.
+// that record (fit on the first 70 %, then the BEEMDANs of the causal windows with their
+// mirrored tails per test sample, 8,640 origins, with CausalOptions' default windows). Targets: fit
+// < 1 s on 2 cores (issue 24), causal evaluation < 2 min. Wall time is the figure (UseRealTime);
+// `process_cpu_s` is the CPU time of every thread of the process per iteration (Google Benchmark's
+// CPU column counts the main thread only). BM_ThermalFit: the compensate-mode default (method
+// thermal: identification of the thermal model, every subset of up to two thermal states scored by
+// blocked cross-validation) on a 16-hour 1 Hz record (57,600 samples; the chamber programme, held
+// after its end). Target: < 10 s on 2 cores. Smoke mode (CTest): a 30-minute record and 10
+// realisations.
 #include <benchmark/benchmark.h>
 
 #include <ctime>

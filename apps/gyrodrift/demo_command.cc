@@ -143,7 +143,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
           ->group("Advanced"),
       {"realisations"});
   BindSetting(cmd->add_option("--window", args->settings.window,
-                              "advanced: trailing window of the causal protocol, samples")
+                              "advanced: longest trailing window of the causal protocol, samples")
                   ->capture_default_str()
                   ->group("Advanced"),
               {"causal_window"});
@@ -153,6 +153,12 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
                   ->capture_default_str()
                   ->group("Advanced"),
               {"causal_mirror"});
+  BindSetting(cmd->add_option("--windows", args->settings.windows,
+                              "advanced: causal windows decomposed per test sample, from --window "
+                              "down to half of it, their ends averaged, in [1, 16]")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_windows"});
   BindSetting(cmd->add_option("--methods", args->settings.methods,
                               "advanced: all, or a list such as ms-elm,elm,poly")
                   ->capture_default_str()

@@ -90,8 +90,9 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       "it) and prediction, one row per predicted sample: rows before the model has its p lags\n"
       "of history (for ms-elm/emd-elm under the causal protocol, 16 samples to decompose), and\n"
       "H-1 more with --horizon H, are left out. causal (default): the sub-series at t come from\n"
-      "decomposing only the trailing window y[t-W..t-1] (followed by its last samples reversed,\n"
-      "--mirror), what a running system can do. paper:\n"
+      "decomposing only trailing windows y[t-L..t-1], L from W down to W/2 (--windows, their\n"
+      "ends averaged; each followed by its last samples reversed, --mirror), what a running\n"
+      "system can do. paper:\n"
       "the whole file is decomposed once, so predictions see future samples (the literature's\n"
       "protocol, for comparison only). --horizon H: each prediction of y[t] is made at t-H+1\n"
       "from the samples before it, feeding each sub-model its own predictions for the H-1\n"
@@ -108,15 +109,25 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->required();
   BindSetting(cmd->add_option("--protocol", args->settings.protocol, "causal|paper")->capture_default_str(),
               {"protocol"});
-  BindSetting(
-      cmd->add_option("--window,-W", args->settings.window, "causal protocol: trailing window W, samples")
-          ->capture_default_str(),
-      {"window"});
+  BindSetting(cmd->add_option("--window,-W", args->settings.window,
+                              "causal protocol: longest trailing window W, samples")
+                  ->capture_default_str(),
+              {"window"});
   BindSetting(cmd->add_option("--mirror", args->settings.mirror,
                               "causal protocol: share of the window mirrored past its end before "
                               "its decomposition, in [0, 1]")
                   ->capture_default_str(),
               {"mirror"});
+  BindSetting(cmd->add_option("--windows", args->settings.windows,
+                              "causal protocol: windows decomposed per origin, from W down to W/2, "
+                              "their ends averaged, in [1, 16]")
+                  ->capture_default_str(),
+              {"windows"});
+  BindSetting(cmd->add_option("--causal-ensemble", args->settings.causal_ensemble,
+                              "causal protocol: realisations of each window's decomposition, in "
+                              "[0, 100000]; 0 = the model's ensemble")
+                  ->capture_default_str(),
+              {"ensemble_size"});
   BindSetting(
       cmd->add_option("--horizon,-H", args->settings.horizon,
                       "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")

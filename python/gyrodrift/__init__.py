@@ -348,14 +348,16 @@ class DriftModel:
         sub-models (docs/drift.md 1.5)."""
         return self._core.coefficients(reference_temperature=reference_temperature)
 
-    def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=2048,
-                mirror=0.5, threads=0, progress=None):
+    def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=2896,
+                mirror=0.5, windows=6, causal_ensemble=1, threads=0, progress=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
         horizon-step-ahead predictions of y[first:], first being the model's history.
-        ``window`` and ``mirror`` as ``--window`` and ``--mirror``. ``progress``: a callable
-        given the fraction of the causal windows decomposed, as for ``decompose``."""
+        ``window``, ``mirror``, ``windows`` and ``causal_ensemble`` as ``--window``, ``--mirror``,
+        ``--windows`` and ``--causal-ensemble``. ``progress``: a callable given the fraction of the
+        causal origins decomposed, as for ``decompose``."""
         return self._core.predict(y, temperature, horizon=horizon, protocol=protocol,
-                                  window=window, mirror=mirror, threads=threads,
+                                  window=window, mirror=mirror, windows=windows,
+                                  causal_ensemble=causal_ensemble, threads=threads,
                                   progress=progress)
 
     def save(self, path):
@@ -473,7 +475,8 @@ def select_modes(x, imfs, residue, *, criterion="pdf", distance="l2", realisatio
 
 
 def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", protocol="both",
-             split=0.7, repeats=1, horizon=1, window=2048, mirror=0.5, progress=None,
+             split=0.7, repeats=1, horizon=1, window=2896, mirror=0.5, windows=6,
+             causal_ensemble=1, progress=None,
              **settings):
     """Scores methods on one record that cannot cheat, as ``gyrodrift evaluate``: a chronological
     split (fit on the first ``split`` of the record, score on the rest), ``repeats`` seeds, the
@@ -482,7 +485,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     ``methods`` is "all" or a list (or comma-separated string) of method names; the references
     "none" (a zero estimate) and "constant" (the training mean) are always scored first. The model
     settings are ``DriftModel.fit``'s settings keywords but ``method`` (``fit_defaults()``);
-    ``window`` and ``mirror`` as ``--window`` and ``--mirror``; ``progress`` as for
+    ``window``, ``mirror``, ``windows`` and ``causal_ensemble`` as ``--window``, ``--mirror``,
+    ``--windows`` and ``--causal-ensemble``; ``progress`` as for
     ``decompose``. Returns a dict:
     ``rows`` (one dict per method and protocol: rmse, rmse_std, mae, max_abs, rmse_measured
     (against the output itself), slow_removed (share of the slow variation, 10-min block means,
@@ -501,7 +505,8 @@ def evaluate(y, temperature=None, truth=None, *, mode="predict", methods="all", 
     return _call(
         _gyrodrift.evaluate,
         y, temperature, truth, mode=mode, methods=methods, protocol=protocol, split=split,
-        repeats=repeats, horizon=horizon, window=window, mirror=mirror, progress=progress,
+        repeats=repeats, horizon=horizon, window=window, mirror=mirror, windows=windows,
+        causal_ensemble=causal_ensemble, progress=progress,
         **settings)
 
 
@@ -546,15 +551,15 @@ def calibrate(manifest_path, output_dir, *, force=False, threads=0, progress=Non
 
 def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, rate_hz=None,
          units="dph", duration=28800.0, ensemble=20, realisations=20, window=128, mirror=0.5,
-         methods="all", seed=1, threads=0, gaps="error", progress=None):
+         windows=6, methods="all", seed=1, threads=0, gaps="error", progress=None):
     """The whole study of ``gyrodrift demo`` (docs/demo.md): simulate a navigation-grade FOG (or
     study ``input``, a log of your own: its ``target`` and ``temperature`` columns, ``rate_hz``
     or its time_s column, ``units`` of its output, ``gaps``), decompose and group it, compare
     MS-ELM and every baseline in predict and compensate mode, the Allan deviation before and
     after; writes the same folder as the CLI to ``output`` (data, models, tables, demo.json and
     report.html, one atomic set). ``duration`` (s, at least 7200), ``ensemble``,
-    ``realisations``, ``window``, ``mirror`` and ``methods`` size the study as the CLI's flags of
-    those names.
+    ``realisations``, ``window``, ``mirror``, ``windows`` and ``methods`` size the study as the
+    CLI's flags of those names.
     ``progress``: a callable given the fraction of the run done (Ctrl-C stops it).
 
     Returns a dict: ``output``, ``files`` (the names written), ``report`` (its path),
@@ -572,5 +577,6 @@ def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, 
                  target="" if target is None else str(target),
                  temperature="" if temperature is None else str(temperature), rate_hz=rate_hz,
                  units=units, duration=duration, ensemble=ensemble, realisations=realisations,
-                 window=window, mirror=mirror, methods=methods, seed=seed, threads=threads,
+                 window=window, mirror=mirror, windows=windows, methods=methods, seed=seed,
+                 threads=threads,
                  gaps=gaps, progress=progress)

@@ -107,7 +107,8 @@ class DriftModel:
     def predict(
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *, horizon: int = ...,
         protocol: Literal["causal", "paper"] = ..., window: int = ..., mirror: float = ...,
-        threads: int = ..., progress: Callable[[float], object] | None = ...,
+        windows: int = ..., causal_ensemble: int = ..., threads: int = ...,
+        progress: Callable[[float], object] | None = ...,
     ) -> tuple[int, Array]: ...
     def save(self, path: str | PathLike[str]) -> None: ...
     @classmethod
@@ -155,8 +156,8 @@ def evaluate(
     mode: Literal["predict", "compensate"] = ...,
     methods: Literal["all"] | str | Sequence[str] = ...,
     protocol: Literal["both", "paper", "causal"] = ..., split: float = ..., repeats: int = ...,
-    horizon: int = ..., window: int = ..., mirror: float = ...,
-    progress: Callable[[float], object] | None = ...,
+    horizon: int = ..., window: int = ..., mirror: float = ..., windows: int = ...,
+    causal_ensemble: int = ..., progress: Callable[[float], object] | None = ...,
     **settings: Any,
 ) -> dict[str, Any]: ...
 
@@ -171,7 +172,8 @@ def demo(
     output: str | PathLike[str] = ..., *, input: str | PathLike[str] | None = ...,
     target: str | None = ..., temperature: str | None = ..., rate_hz: float | None = ...,
     units: Literal["dph", "dps", "rads"] = ..., duration: float = ..., ensemble: int = ...,
-    realisations: int = ..., window: int = ..., mirror: float = ..., methods: str = ...,
+    realisations: int = ..., window: int = ..., mirror: float = ..., windows: int = ...,
+    methods: str = ...,
     seed: int = ..., threads: int = ..., gaps: Literal["error", "interpolate"] = ...,
     progress: Callable[[float], object] | None = ...,
 ) -> dict[str, Any]: ...

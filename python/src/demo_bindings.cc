@@ -14,6 +14,7 @@ namespace {
 py::dict Demo(const study::DemoSettings& settings, const py::object& progress) {
   // A refusal names the keyword, as the CLI's names its flag.
   ValidateAsSettings({{"causal_mirror", "mirror"},
+                      {"causal_windows", "windows"},
                       {"causal_window", "window"},
                       {"ensemble_size", "ensemble"},
                       {"duration_s", "duration"}},
@@ -63,7 +64,7 @@ void BindDemo(py::module_& m) {
       "demo",
       [](const std::string& output, const std::string& input, const std::string& target,
          const std::string& temperature, std::optional<double> rate_hz, const std::string& units,
-         double duration, int ensemble, int realisations, int window, double mirror,
+         double duration, int ensemble, int realisations, int window, double mirror, int windows,
          const std::string& methods, std::uint64_t seed, int threads, const std::string& gaps,
          const py::object& progress) {
         study::DemoSettings s{.output = output,
@@ -77,6 +78,7 @@ void BindDemo(py::module_& m) {
                               .realisations = realisations,
                               .window = window,
                               .mirror = mirror,
+                              .windows = windows,
                               .methods = methods,
                               .seed = seed,
                               .threads = threads,
@@ -88,8 +90,9 @@ void BindDemo(py::module_& m) {
       arg("temperature") = d.temperature, arg("rate_hz") = py::none(), arg("units") = d.units,
       arg("duration") = d.duration_s, arg("ensemble") = d.ensemble,
       arg("realisations") = d.realisations, arg("window") = d.window, arg("mirror") = d.mirror,
-      arg("methods") = d.methods, arg("seed") = d.seed, arg("threads") = d.threads,
-      arg("gaps") = std::string(io::ToString(d.log.gaps)), arg("progress") = py::none());
+      arg("windows") = d.windows, arg("methods") = d.methods, arg("seed") = d.seed,
+      arg("threads") = d.threads, arg("gaps") = std::string(io::ToString(d.log.gaps)),
+      arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

@@ -3,6 +3,7 @@
 #include "bindings.h"
 #include "gyrodrift/allan/allan.h"
 #include "gyrodrift/allan/noise_fit.h"
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/decomposition/decomposition.h"
 #include "gyrodrift/drift/compensation_summary.h"
 #include "gyrodrift/drift/drift_model.h"
@@ -213,16 +214,19 @@ class PyDriftModel {
 
   // As `gyrodrift predict` (tasks::RunPredict): predictions of y[t] for t = first .. N-1.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
-                    const std::string& protocol, int window, double mirror, int threads,
-                    const py::object& progress) const {
+                    const std::string& protocol, int window, double mirror, int windows,
+                    int causal_ensemble, int threads, const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
     LongCall call(progress);
     const tasks::PredictSettings settings{.protocol = protocol,
                                           .window = window,
                                           .mirror = mirror,
+                                          .windows = windows,
+                                          .causal_ensemble = causal_ensemble,
                                           .horizon = horizon,
                                           .threads = threads};
-    settings.Validate();
+    // A refusal names the keyword, as the CLI's names its flag.
+    ValidateAsSettings({{"ensemble_size", "causal_ensemble"}}, [&] { settings.Validate(); });
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
     if (Loaded().model.uses_temperature()) {
@@ -353,7 +357,8 @@ void BindDriftModel(py::module_& m) {
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
-           arg("window") = pd.window, arg("mirror") = pd.mirror, arg("threads") = pd.threads,
+           arg("window") = pd.window, arg("mirror") = pd.mirror, arg("windows") = pd.windows,
+           arg("causal_ensemble") = pd.causal_ensemble, arg("threads") = pd.threads,
            arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))

@@ -54,8 +54,12 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const std::optional<Array>& truth_in, const tasks::EvaluateSettings& settings,
                   const py::object& progress) {
   LongCall call(progress);
-  // A refusal names the keyword (window, mirror), as the CLI's names its flag.
-  ValidateAsSettings({{"causal.window", "window"}, {"causal.mirror", "mirror"}},
+  // A refusal names the keyword (window, mirror, windows, causal_ensemble), as the CLI's names
+  // its flag.
+  ValidateAsSettings({{"causal.window", "window"},
+                      {"causal.mirror", "mirror"},
+                      {"causal.windows", "windows"},
+                      {"causal.ensemble_size", "causal_ensemble"}},
                      [&] { settings.Validate(); });
   (void)ExecutionOf(settings.fit.threads, call);
   const Eigen::VectorXd y = ToVector(y_in, "y");
@@ -115,7 +119,8 @@ void BindEvaluate(py::module_& m) {
       [](const gp::Array& y, const std::optional<gp::Array>& temperature,
          const std::optional<gp::Array>& truth, const std::string& mode, const py::object& methods,
          const std::string& protocol, double split, int repeats, int horizon, int window,
-         double mirror, const py::object& progress, const py::kwargs& settings) {
+         double mirror, int windows, int causal_ensemble, const py::object& progress,
+         const py::kwargs& settings) {
         const gyrodrift::tasks::EvaluateSettings s{
             .fit = gp::FitSettingsOf(
                 settings,
@@ -127,13 +132,16 @@ void BindEvaluate(py::module_& m) {
             .repeats = repeats,
             .window = window,
             .mirror = mirror,
-            .horizon = horizon};
+            .windows = windows,
+            .horizon = horizon,
+            .causal_ensemble = causal_ensemble};
         return gp::Evaluate(y, temperature, truth, s, progress);
       },
       arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
       arg("mode") = "predict", arg("methods") = ed.methods, arg("protocol") = ed.protocol,
       arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
-      arg("window") = ed.window, arg("mirror") = ed.mirror, arg("progress") = py::none());
+      arg("window") = ed.window, arg("mirror") = ed.mirror, arg("windows") = ed.windows,
+      arg("causal_ensemble") = ed.causal_ensemble, arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

@@ -206,6 +206,12 @@ def test_select_modes_groups_a_decomposition_into_series_that_add_up():
         gd.evaluate(x, mirror=1.5)
     with pytest.raises(gd.UsageError, match=r"^mirror = 2: must be"):
         gd.demo("/nonexistent/never-written", mirror=2)
+    with pytest.raises(gd.UsageError, match=r"^windows = 0: must be"):
+        gd.evaluate(x, windows=0)
+    with pytest.raises(gd.UsageError, match=r"^windows = 17: must be"):
+        gd.demo("/nonexistent/never-written", windows=17)
+    with pytest.raises(gd.UsageError, match=r"^causal_ensemble = -1: must be"):
+        gd.evaluate(x, causal_ensemble=-1)
     with pytest.raises(gd.UsageError, match=r"^window = 4: must be"):
         gd.demo("/nonexistent/never-written", window=4)
 

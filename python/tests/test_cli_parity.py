@@ -224,8 +224,9 @@ def test_two_axis_model_file_matches_cli(cli, tmp_path):
 
 
 def test_causal_predict_matches_cli_and_takes_the_mirror(cli, sim_csv, tmp_path):
-    """`predict --window --mirror` and DriftModel.predict(window=, mirror=) give the same bits; the
-    mirror reaches the windows (none differs from the default)."""
+    """`predict --window --mirror --windows --causal-ensemble` and DriftModel.predict(window=,
+    mirror=, windows=, causal_ensemble=) give the same bits; each reaches the windows (none
+    differs from the default)."""
     log = read_csv(sim_csv)
     y = log["rate_dph"][:1200]
     model = gd.DriftModel().fit(y[:900], mode="predict", method="ms-elm", ensemble=10,
@@ -233,19 +234,26 @@ def test_causal_predict_matches_cli_and_takes_the_mirror(cli, sim_csv, tmp_path)
     model.save(tmp_path / "m.json")
     write_csv(tmp_path / "log.csv", {"time_s": log["time_s"][:1200], "rate_dph": y})
     cli("predict", tmp_path / "m.json", tmp_path / "log.csv", "--window", "64", "--mirror",
-        "0.25", "-j", "2", "-q", "-o", tmp_path / "p.csv")
-    first, p = model.predict(y, window=64, mirror=0.25, threads=2)
+        "0.25", "--windows", "2", "--causal-ensemble", "3", "-j", "2", "-q", "-o",
+        tmp_path / "p.csv")
+    settings = dict(window=64, mirror=0.25, windows=2, causal_ensemble=3)
+    first, p = model.predict(y, threads=2, **settings)
     assert np.array_equal(p, read_csv(tmp_path / "p.csv")["prediction"][-p.size:])
-    assert not np.array_equal(p, model.predict(y, window=64, threads=2)[1])
+    for name in ("mirror", "windows", "causal_ensemble"):
+        other = {k: v for k, v in settings.items() if k != name}
+        assert not np.array_equal(p, model.predict(y, threads=2, **other)[1]), name
     with pytest.raises(gd.UsageError, match=r"^mirror = -1: must be"):
         model.predict(y, window=64, mirror=-1)
+    with pytest.raises(gd.UsageError, match=r"^causal_ensemble = -1: must be"):
+        model.predict(y, window=64, causal_ensemble=-1)
 
 
 @pytest.mark.parametrize("mode,args,kwargs", [
     ("predict", ["--methods", "ms-elm,poly", "--protocol", "both", "--window", "64",
-                 "--mirror", "0.25", "--repeats", "2", "--ensemble", "10", "--realisations", "20"],
-     dict(methods=["ms-elm", "poly"], protocol="both", window=64, mirror=0.25, repeats=2,
-          ensemble=10, realisations=20)),
+                 "--mirror", "0.25", "--windows", "2", "--causal-ensemble", "3", "--repeats", "2",
+                 "--ensemble", "10", "--realisations", "20"],
+     dict(methods=["ms-elm", "poly"], protocol="both", window=64, mirror=0.25, windows=2,
+          causal_ensemble=3, repeats=2, ensemble=10, realisations=20)),
     ("compensate", ["--methods", "thermal,poly", "--temperature", "temperature_c"],
      dict(methods="thermal,poly")),
     ("predict", ["--methods", "persistence,trailing-mean,exp-smoothing,kalman-level,kalman-trend",

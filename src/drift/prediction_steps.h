@@ -21,11 +21,12 @@ Eigen::Index FirstPredictable(int lags, bool windowed, int horizon);
 // The decomposition a fitted model applies to new data: its options with its seed.
 decomposition::DecompositionOptions DecompositionFor(const DriftModel& model);
 
-// Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing the
-// trailing window y[o-W .. o-1] alone, followed by its mirrored tail y[o-2], y[o-3], ...
-// (causal.DecomposedLength(W) - W samples): lags[g](r, k) = s_g[o - 1 - k] of that window's groups
-// (count x lags per sub-model g). Windows run in parallel on execution.threads, which reports
-// the fraction of windows done ("causal windows").
+// Causal protocol: the lags of each origin o = origin + r, r < count, from decomposing each
+// trailing window y[o-L .. o-1] alone, L the distinct lengths min(L_w, o) of
+// causal.WindowLengths(), followed by its mirrored tail y[o-2], y[o-3], ...
+// (causal.DecomposedLength(L) - L samples): lags[g](r, k) = the mean over those windows of
+// s_g[o - 1 - k] of their groups (count x lags per sub-model g). Origins run in parallel on
+// execution.threads, which reports the fraction of origins done ("causal windows").
 std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                                         const Eigen::Ref<const Eigen::VectorXd>& y,
                                         Eigen::Index origin, Eigen::Index count,

@@ -76,6 +76,7 @@ StudyOptions DemoSettings::Options() const {
   o.realisations = realisations;
   o.causal_window = window;
   o.causal_mirror = mirror;
+  o.causal_windows = windows;
   o.seed = seed;
   o.Validate();
   ValidateThreads(threads);
@@ -133,6 +134,7 @@ nlohmann::json DemoRecord(const DemoSettings& s, const StudyResult& result) {
                        {"realisations", s.realisations},
                        {"window", s.window},
                        {"mirror", s.mirror},
+                       {"windows", s.windows},
                        {"methods", s.methods},
                        {"seed", s.seed},
                        {"threads", s.threads}};

@@ -105,14 +105,15 @@ drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
 }
 
 // The study's evaluation of `methods` ("all" or a comma-separated list) with the models' settings
-// `fit`: the causal protocol's window, mirror and ensemble are the study's.
+// `fit`: the causal protocol's window, mirror and window count are the study's (each window's
+// ensemble the library's).
 tasks::EvaluateSettings EvaluationSettings(const StudyOptions& a, drift::FitSettings fit,
                                            std::string methods) {
   return {.fit = std::move(fit),
           .methods = std::move(methods),
           .window = a.causal_window,
           .mirror = a.causal_mirror,
-          .causal_ensemble = a.ensemble_size};
+          .windows = a.causal_windows};
 }
 
 // `methods` scored in `mode` on the record through the evaluate task (against `truth` when not
@@ -468,12 +469,13 @@ std::string GroupOf(const sel::SelectionResult& selection, int k) {
 
 void StudyOptions::Validate() const {
   // Ranges the library owns are its own Validate's, one home: the drift options' first, so that
-  // ensemble_size, which also sizes the causal windows, is named as the decomposition's; a
+  // ensemble_size is named as the decomposition's; a
   // refusal names the study's field that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
                       {"selection.monte_carlo.realisations", "realisations"},
                       {"causal.window", "causal_window"},
-                      {"causal.mirror", "causal_mirror"}},
+                      {"causal.mirror", "causal_mirror"},
+                      {"causal.windows", "causal_windows"}},
                      [&] {
                        internal::StudyDriftOptions(*this, 1.0, true).Validate();
                        // The causal protocol's settings; the study's method list is checked

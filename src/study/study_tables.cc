@@ -146,18 +146,26 @@ void FillSettingsTable(StudyResult& s) {
   settings.Add({"seed", std::to_string(a.seed) +
                             (s.simulated ? " (run A), " + std::to_string(RunBSeed(a.seed)) + " (run B)"
                                          : " (decomposition and learners)")});
-  settings.Add(
-      {"decomposition", "BEEMDAN, ensemble " + std::to_string(a.ensemble_size) +
-                            " (also in each causal window), noise 0.2, energy-band bound"});
+  settings.Add({"decomposition",
+                "BEEMDAN, ensemble " + std::to_string(a.ensemble_size) +
+                    ", noise 0.2, noise assistance bounded by the ensemble's white-noise band"});
   settings.Add({"selection", "PDF similarity (L2), Monte-Carlo level from " +
                                  std::to_string(a.realisations) + " white-noise realisations"});
   settings.Add(
       {"learner", "ELM sigmoid, hidden units <= " + std::to_string(base.learner.elm.hidden_units) +
                       " and ridge by leave-one-out; SVR/BP/poly library defaults"});
-  settings.Add({"predict mode", std::to_string(base.features.lags) +
-                                    " lags, split 70/30, causal window " +
-                                    std::to_string(a.causal_window) + " samples, mirrored tail " +
-                                    FormatValue(a.causal_mirror) + " of it"});
+  const drift::CausalOptions causal{
+      .window = a.causal_window, .mirror = a.causal_mirror, .windows = a.causal_windows};
+  const std::vector<Eigen::Index> lengths = causal.WindowLengths();
+  settings.Add({"predict mode",
+                std::to_string(base.features.lags) + " lags, split 70/30, causal window" +
+                    (lengths.size() > 1 ? "s of " + std::to_string(lengths.front()) + " down to " +
+                                              std::to_string(lengths.back()) + " samples (" +
+                                              std::to_string(lengths.size()) + ", ends averaged)"
+                                        : " " + std::to_string(lengths.front()) + " samples") +
+                    ", each with a mirrored tail " + FormatValue(a.causal_mirror) + " of it and " +
+                    std::to_string(causal.ensemble_size) +
+                    (causal.ensemble_size == 1 ? " realisation" : " realisations")});
   settings.Add(
       {"compensate mode",
        std::string("thermal models identified from the calibration run") +

@@ -100,6 +100,7 @@ drift::EvaluationOptions EvaluateSettings::Options(std::string_view methods_name
   e.protocols = ParseProtocols(protocol);
   e.causal.window = window;
   e.causal.mirror = mirror;
+  e.causal.windows = windows;
   e.causal.ensemble_size = causal_ensemble;
   e.horizon = horizon;
   e.Validate();
@@ -155,6 +156,8 @@ json EvaluateRecord(const EvaluateRun& run, const EvaluateInput& in) {
                   {"protocols", protocols},
                   {"window", run.options.causal.window},
                   {"mirror", run.options.causal.mirror},
+                  {"windows", run.options.causal.windows},
+                  {"causal_ensemble", run.options.causal.ensemble_size},
                   {"horizon", run.options.horizon},
                   {"rate_hz_from", in.rate_hz_from},
                   {"threads", run.threads},

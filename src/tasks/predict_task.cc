@@ -12,6 +12,8 @@ drift::CausalOptions PredictSettings::Causal() const {
   drift::CausalOptions causal;
   causal.window = window;
   causal.mirror = mirror;
+  causal.windows = windows;
+  causal.ensemble_size = causal_ensemble;
   return causal;
 }
 
@@ -59,8 +61,14 @@ nlohmann::json PredictRecord(const PredictResult& r, const io::LoadedModel& load
                              const std::string& model_path, const std::string& input) {
   const drift::DriftModel& model = loaded.model;
   nlohmann::json j;
-  j["options"] = {{"model", model_path}, {"input", input},     {"protocol", s.protocol},
-                  {"window", s.window},  {"mirror", s.mirror}, {"horizon", s.horizon},
+  j["options"] = {{"model", model_path},
+                  {"input", input},
+                  {"protocol", s.protocol},
+                  {"window", s.window},
+                  {"mirror", s.mirror},
+                  {"windows", s.windows},
+                  {"causal_ensemble", s.causal_ensemble},
+                  {"horizon", s.horizon},
                   {"threads", s.threads}};
   j["model"] = {{"summary", model.Summary()},
                 {"method", drift::ToString(model.options.method)},

@@ -169,6 +169,7 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo --ensemble 0", 2, "--ensemble"},
       {"demo --window 4", 2, "--window"},
       {"demo --mirror nan", 2, "--mirror = nan"},
+      {"demo --windows 0", 2, "--windows = 0"},
       {"demo --methods ms-elm,nope", 2, "nope"},
       // Two model files of one name: refused before the work, not half-written after it.
       {"demo --methods elm,poly,elm -o " + dir + "/o", 2, "--methods"},

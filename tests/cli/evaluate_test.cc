@@ -194,6 +194,8 @@ TEST_F(EvaluateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"zero repeats", p + "--repeats 0", 2, "--repeats = 0"},
       {"small window", p + "--window 4", 2, "--window = 4"},
       {"negative mirror", p + "--mirror -0.5", 2, "--mirror = -0.5"},
+      {"too many windows", p + "--windows 17", 2, "--windows = 17"},
+      {"huge causal ensemble", p + "--causal-ensemble 100001", 2, "--causal-ensemble = 100001"},
       {"compensate without temperature", "evaluate %IN% -t rate_dph --mode compensate", 2,
        "needs a temperature channel"},
       {"missing truth", p + "--truth drift", 2, "column 'drift' not found"},

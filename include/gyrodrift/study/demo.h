@@ -37,6 +37,7 @@ struct DemoSettings {
   int realisations = internal::kStudyDefaults.realisations;
   int window = internal::kStudyDefaults.causal_window;
   double mirror = internal::kStudyDefaults.causal_mirror;
+  int windows = internal::kStudyDefaults.causal_windows;
   std::string methods = "all";  // "all" or a comma-separated list of compensate-mode methods
   std::uint64_t seed = internal::kStudyDefaults.seed;
   int threads = 0;     // [0, 1024]; 0 = every core

@@ -19,9 +19,9 @@
 // noise terms; docs/drift.md for the models and protocols.
 // Units: the simulated output is in deg/h, a log's in StudyOptions::units; temperatures in degC
 // (a log's in whatever unit it has); times in s (hours on the time axes of the result).
-// Cost: dominated by the causal protocol, one BEEMDAN of `causal_window` samples and their
-// mirrored tail per test sample for each decomposing method (ms-elm, emd-elm): the defaults take
-// about 40 s on 2 cores.
+// Cost: dominated by the causal protocol, `causal_windows` BEEMDANs of up to `causal_window`
+// samples and their mirrored tails per test sample for each decomposing method (ms-elm,
+// emd-elm): the defaults take about 30 s on 2 cores.
 // Nothing here reads files or prints: RunStudy reports through its StudyContext, which also holds
 // the worker threads; StudyOptions are plain values (comparable with ==) that decide the result.
 #pragma once
@@ -57,18 +57,21 @@ struct StudyOptions {
   // at a new level: the chamber programme ramps from 30 to 70 min; on shorter runs the level and
   // rate responses cannot be told apart). Default 8 h. Not used for a log.
   double duration_s = 8 * 3600.0;
-  // BEEMDAN ensemble size, also of each causal window's decomposition; in [1, 10000] (tighter
-  // than DecompositionOptions' 100000: it multiplies the cost of every causal window). Default
-  // 20 (the library's is 100).
+  // BEEMDAN ensemble size of the study's decompositions (the causal windows take CausalOptions'
+  // own, 1 realisation; the study's 20 until 2026-11-28); in [1, 10000] (tighter than
+  // DecompositionOptions' 100000). Default 20 (the library's is 100).
   int ensemble_size = 20;
   // White-noise realisations of the selection's Monte-Carlo level; MonteCarloOptions' range
   // [20, 100000]. Default 20, the least the level estimator accepts.
   int realisations = 20;
-  // Trailing window of the causal protocol, samples; CausalOptions' range [16, 1000000].
-  // Default 128 (the library's is 2048): the cost of each of the test block's windows.
+  // Longest trailing window of the causal protocol, samples; CausalOptions' range [16, 1000000].
+  // Default 128 (the library's is 2896): the cost of each of the test block's windows.
   int causal_window = 128;
   // Share of each causal window mirrored past its end; CausalOptions' range [0, 1] and default.
   double causal_mirror = drift::CausalOptions{}.mirror;
+  // Causal windows decomposed per test sample, from causal_window down to half of it, their ends
+  // averaged; CausalOptions' range [1, 16] and default. Each has CausalOptions' default ensemble.
+  int causal_windows = drift::CausalOptions{}.windows;
   // The methods compared: each a method of compensate mode (predict mode runs those it
   // supports), none twice (each saves one model file). Default: all, in drift::AllMethods order.
   std::vector<drift::Method> methods = drift::AllMethods(drift::Mode::kCompensate);

@@ -32,14 +32,16 @@ struct EvaluateSettings {
   int repeats = internal::kEvaluationDefaults.repeats;
   int window = internal::kEvaluationDefaults.causal.window;
   double mirror = internal::kEvaluationDefaults.causal.mirror;  // causal protocol, [0, 1]
+  int windows = internal::kEvaluationDefaults.causal.windows;   // causal protocol, [1, 16]
   int horizon = internal::kEvaluationDefaults.horizon;
   // Causal protocol: realisations of each window's decomposition, in [0, 100000]; 0 = the models'
-  // ensemble. The study sets it to its ensemble; the CLI and Python keep the library's default.
+  // ensemble.
   int causal_ensemble = internal::kEvaluationDefaults.causal.ensemble_size;
 
   // The evaluation's options, validated; `methods_name` names the method list in messages
   // ("methods", or the flag "--methods"). OptionError naming the field (split, repeats, protocol,
-  // causal.window, causal.mirror, causal.ensemble_size, horizon, methods) or UsageError.
+  // causal.window, causal.mirror, causal.windows, causal.ensemble_size, horizon, methods) or
+  // UsageError.
   drift::EvaluationOptions Options(std::string_view methods_name = "methods") const;
   void Validate(std::string_view methods_name = "methods") const;  // Options() and fit's
 };

@@ -3,7 +3,8 @@
 // its sidecar holds. `gyrodrift predict` and the Python package's DriftModel.predict call these
 // and nothing below them.
 //
-// Cost: drift::PredictAhead's (the causal protocol decomposes one trailing window per sample).
+// Cost: drift::PredictAhead's (the causal protocol decomposes CausalOptions::windows trailing
+// windows per sample).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,9 +22,13 @@ struct PredictSettings {
   std::string protocol = "causal";                  // drift::Protocol name: causal | paper
   int window = drift::CausalOptions{}.window;       // causal protocol: trailing window, samples
   double mirror = drift::CausalOptions{}.mirror;    // causal protocol: share mirrored past its end
+  int windows = drift::CausalOptions{}.windows;     // causal protocol: windows averaged per origin
+  // causal protocol: realisations of each window's decomposition; 0 = the model's ensemble
+  int causal_ensemble = drift::CausalOptions{}.ensemble_size;
   int horizon = 1;                                  // steps ahead, in [1, 100000]
   int threads = 0;                                  // [0, 1024]; 0 = every core
-  // OptionError naming the field (protocol, window: [16, 1000000], mirror: [0, 1], threads).
+  // OptionError naming the field (protocol, window: [16, 1000000], mirror: [0, 1], windows: [1,
+  // 16], ensemble_size: [0, 100000], threads).
   void Validate() const;
   drift::CausalOptions Causal() const;  // the causal protocol's options (unvalidated)
 };

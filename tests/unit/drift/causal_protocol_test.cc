@@ -1,7 +1,7 @@
 // The causal protocol (causal_protocol.cc): nothing after a prediction's origin reaches it,
 // windows sharing the white-noise EMDs predict as windows decomposed alone, each window is
 // decomposed with its mirrored tail, the ensemble and progress options, the note on sub-models a
-// window cannot feed, and the option ranges.
+// window cannot feed, the averaging of several windows, and the option ranges.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -73,36 +73,71 @@ TEST(DriftModel, CausalWindowsSharingTheNoiseEmdsPredictAsAloneWindows) {
 }
 
 // Each window y[o-L .. o-1] is decomposed followed by min(round(mirror x L), L - 1) samples of
-// itself reversed, y[o-2], y[o-3], ...: the lags are the group series' values at the window's own
-// end, for full windows (sharing their noise EMDs) and the short ones at the record's start alike;
-// mirror 0 decomposes the window alone.
-TEST(DriftModel, CausalWindowsAreDecomposedWithTheirMirroredTail) {
+// itself reversed, y[o-2], y[o-3], ...; the lags are the mean of the group series' values at the
+// windows' own end over the distinct lengths min(L, o) of CausalOptions::WindowLengths, for full
+// windows (sharing their noise EMDs) and the short ones at the record's start alike; mirror 0
+// decomposes a window alone, and one window is that window's values.
+TEST(DriftModel, CausalWindowsAreDecomposedWithTheirMirroredTailAndAveraged) {
   auto [log, model, causal] = MakeCausalCase(8);
   const Eigen::Index origin = 40, count = 60;  // origins 40-63 have short windows
-  for (double mirror : {0.5, 0.0, 0.3, 1.0}) {
+  const std::vector<std::pair<int, double>> cases = {{1, 0.5}, {1, 0.0}, {1, 0.3},
+                                                     {1, 1.0}, {3, 0.5}, {2, 0.0}};
+  for (const auto& [windows, mirror] : cases) {
+    causal.windows = windows;
     causal.mirror = mirror;
     const std::vector<Eigen::MatrixXd> lags =
         internal::CausalLags(model, log.rate, origin, count, causal, {.threads = 2});
     for (Eigen::Index o : {40, 63, 64, 99}) {
-      const Eigen::Index length = std::min<Eigen::Index>(o, causal.window);
-      // At most the window's samples but its end one: y[o-2] .. y[o-length].
-      const Eigen::Index tail =
-          std::min<Eigen::Index>(length - 1, std::llround(mirror * static_cast<double>(length)));
-      ASSERT_EQ(causal.DecomposedLength(length), length + tail);
-      Eigen::VectorXd window(length + tail);
-      for (Eigen::Index i = 0; i < length; ++i) window[i] = log.rate[o - length + i];
-      for (Eigen::Index j = 0; j < tail; ++j) window[length + j] = log.rate[o - 2 - j];
-      decomposition::DecompositionOptions dopt = internal::DecompositionFor(model);
-      dopt.ensemble_size = causal.ensemble_size;
-      const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(window, dopt));
+      std::vector<Eigen::Index> lengths;  // the distinct windows at o
+      for (Eigen::Index full : causal.WindowLengths()) {
+        const Eigen::Index length = std::min(o, full);
+        if (lengths.empty() || lengths.back() != length) lengths.push_back(length);
+      }
+      std::vector<Eigen::MatrixXd> expected(lags.size(), Eigen::MatrixXd::Zero(1, model.lags));
+      for (const Eigen::Index length : lengths) {
+        // At most the window's samples but its end one: y[o-2] .. y[o-length].
+        const Eigen::Index tail =
+            std::min<Eigen::Index>(length - 1, std::llround(mirror * static_cast<double>(length)));
+        ASSERT_EQ(causal.DecomposedLength(length), length + tail);
+        Eigen::VectorXd window(length + tail);
+        for (Eigen::Index i = 0; i < length; ++i) window[i] = log.rate[o - length + i];
+        for (Eigen::Index j = 0; j < tail; ++j) window[length + j] = log.rate[o - 2 - j];
+        decomposition::DecompositionOptions dopt = internal::DecompositionFor(model);
+        dopt.ensemble_size = causal.ensemble_size;
+        const Eigen::MatrixXd series = GroupSeries(model, decomposition::Decompose(window, dopt));
+        for (size_t g = 0; g < lags.size(); ++g) {
+          for (Eigen::Index k = 0; k < model.lags; ++k) {
+            expected[g](0, k) += series(length - 1 - k, static_cast<Eigen::Index>(g));
+          }
+        }
+      }
       for (size_t g = 0; g < lags.size(); ++g) {
         for (Eigen::Index k = 0; k < model.lags; ++k) {
-          EXPECT_EQ(lags[g](o - origin, k), series(length - 1 - k, static_cast<Eigen::Index>(g)))
-              << "mirror " << mirror << ", origin " << o << ", group " << g << ", lag " << k;
+          EXPECT_EQ(lags[g](o - origin, k), expected[g](0, k) / static_cast<double>(lengths.size()))
+              << windows << " windows, mirror " << mirror << ", origin " << o << ", group " << g
+              << ", lag " << k;
         }
       }
     }
   }
+}
+
+// n windows run from W down to W/2, evenly spaced in log, rounded, at least 16 samples (or W if
+// shorter), each length once.
+TEST(CausalOptions, WindowLengthsSpanOneOctaveDown) {
+  const auto lengths = [](int window, int windows) {
+    CausalOptions c;
+    c.window = window;
+    c.windows = windows;
+    return c.WindowLengths();
+  };
+  using V = std::vector<Eigen::Index>;
+  EXPECT_EQ(lengths(2896, 1), V({2896}));
+  EXPECT_EQ(lengths(2896, 2), V({2896, 1448}));
+  EXPECT_EQ(lengths(2896, 3), V({2896, 2048, 1448}));
+  EXPECT_EQ(lengths(2896, 6), V({2896, 2521, 2195, 1911, 1663, 1448}));
+  EXPECT_EQ(lengths(20, 3), V({20, 16}));  // 14 and 10 are raised to 16
+  EXPECT_EQ(lengths(16, 16), V({16}));
 }
 
 // Ensemble 0 is the model's own (the fit's decomposition.ensemble_size), to the bit; another
@@ -155,10 +190,11 @@ TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
   model.sub_models = {{"noise", {1, 2, 3}, false, nullptr},
                       {"mixed", {4, 5, 6, 7, 8, 9, 10, 11, 12}, false, nullptr},
                       {"drift", {13}, true, nullptr}};
-  const auto note = [&model](int window, double mirror) {
+  const auto note = [&model](int window, double mirror, int windows = 1) {
     CausalOptions causal;
     causal.window = window;
     causal.mirror = mirror;
+    causal.windows = windows;
     return CausalWindowNote(model, causal);
   };
   std::string text = note(512, 0.0);
@@ -188,6 +224,17 @@ TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
     EXPECT_EQ(note(named, mirror), "") << window << ", " << mirror << ": " << text;
     EXPECT_NE(note(named - 1, mirror), "") << window << ", " << mirror << ": " << text;
   }
+  // Several windows: the shortest (W/2) decides, and the W named is the least whose shortest does.
+  text = note(1024, 0.5, 3);
+  EXPECT_NE(text.find("the shortest of the 3 causal windows (512 samples; 768 samples with its "
+                      "mirrored tail) resolves about 8 IMFs"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("windows from 10921 samples down (window = 10921) would resolve them"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(note(10921, 0.5, 3), "");  // its shortest: 5460.5, rounded to 5461
+  EXPECT_NE(note(10920, 0.5, 3), "");
   model.sub_models = {{"noise", {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13}, false, nullptr},
                       {"drift", {}, true, nullptr}};
   EXPECT_EQ(note(512, 0.5), "");  // the default grouping on a 1 Hz FOG log
@@ -224,7 +271,7 @@ TEST(DriftModel, CausalPredictionsIgnoreTheFuture) {
   }
 }
 
-TEST(CausalOptions, ValidateNamesTheWindowMirrorAndEnsembleOutsideTheirRanges) {
+TEST(CausalOptions, ValidateNamesTheWindowMirrorWindowsAndEnsembleOutsideTheirRanges) {
   // The option error's message, "" when the options are accepted.
   auto refusal = [](const CausalOptions& c) -> std::string {
     try {
@@ -251,6 +298,14 @@ TEST(CausalOptions, ValidateNamesTheWindowMirrorAndEnsembleOutsideTheirRanges) {
     const std::string message = refusal(c);
     EXPECT_TRUE(allowed ? message.empty() : message.find("mirror = ") != std::string::npos)
         << mirror << ": " << message;
+  }
+  for (int windows : {1, 16, 0, 17}) {
+    CausalOptions c;
+    c.windows = windows;
+    const bool allowed = windows >= 1 && windows <= 16;
+    const std::string message = refusal(c);
+    EXPECT_TRUE(allowed ? message.empty() : message.find("windows = ") != std::string::npos)
+        << windows << ": " << message;
   }
   for (int ensemble : {0, 100000, -1, 100001}) {  // 0 = the model's own
     CausalOptions c;

@@ -223,7 +223,8 @@ TEST(SettingsTable, RowsSayHowTheRunWasSetUp) {
   EXPECT_EQ(Csv(t, 2, "value"), "7 (run A), " + std::to_string(RunBSeed(7)) + " (run B)");
   EXPECT_NE(Csv(t, 3, "value").find("ensemble 12"), std::string::npos);
   EXPECT_NE(Csv(t, 4, "value").find("30 white-noise realisations"), std::string::npos);
-  EXPECT_NE(Csv(t, 6, "value").find("causal window 64 samples"), std::string::npos);
+  EXPECT_NE(Csv(t, 6, "value").find("causal windows of 64 down to 32 samples (6, ends averaged)"),
+            std::string::npos);
   EXPECT_NE(Csv(t, 7, "value").find("equilibrium at 20 degC"), std::string::npos);
   EXPECT_EQ(Csv(t, 8, "value"), "all cores");
   // Text cells are shown as they are written.

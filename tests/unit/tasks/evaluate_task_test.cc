@@ -24,14 +24,16 @@ TEST(EvaluateTask, DefaultsAreTheLibrarys) {
 }
 
 TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
-  // The study sizes the causal windows' decompositions with its own ensemble.
+  // --window, --mirror, --windows and --causal-ensemble (the study sets the first three).
   EvaluateSettings s = Predict();
   s.window = 64;
   s.mirror = 0.25;
+  s.windows = 5;
   s.causal_ensemble = 7;
   const drift::EvaluationOptions e = s.Options();
   EXPECT_EQ(e.causal.window, 64);
   EXPECT_EQ(e.causal.mirror, 0.25);
+  EXPECT_EQ(e.causal.windows, 5);
   EXPECT_EQ(e.causal.ensemble_size, 7);
   // The option each refusal names.
   const auto refused = [](const EvaluateSettings& bad) -> std::string {
@@ -48,6 +50,9 @@ TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
   bad = s;
   bad.mirror = 1.5;
   EXPECT_EQ(refused(bad), "causal.mirror");
+  bad = s;
+  bad.windows = 0;
+  EXPECT_EQ(refused(bad), "causal.windows");
 }
 
 }  // namespace
