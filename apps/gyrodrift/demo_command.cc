@@ -81,6 +81,49 @@ void Run(const DemoArgs& a) {
   }
 }
 
+// The study's size options (the "Advanced" group of --help).
+void AddAdvancedOptions(CLI::App* cmd, DemoArgs& a) {
+  BindSetting(
+      cmd->add_option("--duration", a.duration,
+                      "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
+          ->default_str(FormatValue(study::DemoSettings{}.duration_s / 3600.0) + "h")
+          ->group("Advanced"),
+      {"duration_s"});
+  BindSetting(cmd->add_option("--ensemble", a.settings.ensemble, "advanced: BEEMDAN ensemble size")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"ensemble_size"});
+  BindSetting(
+      cmd->add_option(
+             "--realisations", a.settings.realisations,
+             "advanced: white-noise realisations of the selection's Monte-Carlo level (>= 20)")
+          ->capture_default_str()
+          ->group("Advanced"),
+      {"realisations"});
+  BindSetting(cmd->add_option("--window", a.settings.window,
+                              "advanced: longest trailing window of the causal protocol, samples")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_window"});
+  BindSetting(cmd->add_option("--mirror", a.settings.mirror,
+                              "advanced: share of each causal window mirrored past its end, "
+                              "in [0, 1]")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_mirror"});
+  BindSetting(cmd->add_option("--windows", a.settings.windows,
+                              "advanced: causal windows decomposed per test sample, from --window "
+                              "down to half of it, their ends averaged, in [1, 16]")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"causal_windows"});
+  BindSetting(cmd->add_option("--methods", a.settings.methods,
+                              "advanced: all, or a list such as ms-elm,elm,poly")
+                  ->capture_default_str()
+                  ->group("Advanced"),
+              {"methods"});
+}
+
 const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
   auto args = std::make_shared<DemoArgs>();
   CLI::App* cmd = app.add_subcommand(
@@ -124,46 +167,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       {"threads"});
   AddLogOptions(cmd, &args->log);
   cmd->add_flag("--quiet,-q", args->quiet, "no progress bar and no tables on the terminal");
-  BindSetting(
-      cmd->add_option("--duration", args->duration,
-                      "advanced: length of each simulated run, at least 2h (2h, 150min, 8h)")
-          ->default_str(FormatValue(study::DemoSettings{}.duration_s / 3600.0) + "h")
-          ->group("Advanced"),
-      {"duration_s"});
-  BindSetting(
-      cmd->add_option("--ensemble", args->settings.ensemble, "advanced: BEEMDAN ensemble size")
-          ->capture_default_str()
-          ->group("Advanced"),
-      {"ensemble_size"});
-  BindSetting(
-      cmd->add_option(
-             "--realisations", args->settings.realisations,
-             "advanced: white-noise realisations of the selection's Monte-Carlo level (>= 20)")
-          ->capture_default_str()
-          ->group("Advanced"),
-      {"realisations"});
-  BindSetting(cmd->add_option("--window", args->settings.window,
-                              "advanced: longest trailing window of the causal protocol, samples")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal_window"});
-  BindSetting(cmd->add_option("--mirror", args->settings.mirror,
-                              "advanced: share of each causal window mirrored past its end, "
-                              "in [0, 1]")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal_mirror"});
-  BindSetting(cmd->add_option("--windows", args->settings.windows,
-                              "advanced: causal windows decomposed per test sample, from --window "
-                              "down to half of it, their ends averaged, in [1, 16]")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal_windows"});
-  BindSetting(cmd->add_option("--methods", args->settings.methods,
-                              "advanced: all, or a list such as ms-elm,elm,poly")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"methods"});
+  AddAdvancedOptions(cmd, *args);
   cmd->callback([args] { Run(*args); });
 });
 
