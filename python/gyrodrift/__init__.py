@@ -550,7 +550,7 @@ def calibrate(manifest_path, output_dir, *, force=False, threads=0, progress=Non
 
 
 def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, rate_hz=None,
-         units="dph", duration=28800.0, ensemble=20, realisations=20, window=128, mirror=0.5,
+         units="dph", duration=28800.0, ensemble=20, realisations=20, window=256, mirror=0.5,
          windows=6, methods="all", seed=1, threads=0, gaps="error", progress=None):
     """The whole study of ``gyrodrift demo`` (docs/demo.md): simulate a navigation-grade FOG (or
     study ``input``, a log of your own: its ``target`` and ``temperature`` columns, ``rate_hz``
