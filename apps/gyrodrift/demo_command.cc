@@ -130,7 +130,7 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "demo", "The whole study in one command: simulate, decompose, model, compensate, report.");
   cmd->footer(
       "Example:\n"
-      "  gyrodrift demo                       # simulated FOG, about 40 s on 2 cores -> "
+      "  gyrodrift demo                       # simulated FOG, about 30 s on 2 cores -> "
       "./gyrodrift-demo/\n"
       "  gyrodrift demo -o /tmp/study\n"
       "  gyrodrift demo --input log.csv --target gyro_x --temperature temp --rate-hz 1\n"
@@ -138,7 +138,8 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "compensate_table.csv, predict_estimates.csv, compensate_estimates.csv, allan.csv,\n"
       "noise_terms.csv, models/<method>_compensate.json, demo.json and report.html (open it in a\n"
       "browser; it works offline). The study's size options (--duration, --ensemble, --window,\n"
-      "--realisations, --methods) trade fidelity for time; docs/demo.md lists the defaults' cost.");
+      "--windows, --realisations, --methods) trade fidelity for time; docs/demo.md lists the\n"
+      "defaults' cost.");
   cmd->add_option("-o,--output", args->settings.output, "output folder (created if needed)")
       ->capture_default_str();
   cmd->add_option("--input", args->settings.input,
