@@ -47,7 +47,7 @@ void Run(const PredictArgs& a) {
   if (loaded.model.uses_temperature()) temperature = table.Column(loaded.info.temperature_column);
   tasks::PredictResult r;
   {
-    // Causal prediction decomposes one trailing window per sample: minutes on a long log.
+    // Causal prediction decomposes several trailing windows per sample: minutes on a long log.
     const bool windows = a.settings.protocol == "causal" &&
                          drift::UsesDecomposition(loaded.model.options.method);
     ProgressBar progress({1.0}, windows && IsTerminal() && !a.quiet);  // Finish() on every path

@@ -223,7 +223,7 @@ def test_two_axis_model_file_matches_cli(cli, tmp_path):
     assert gd.DriftModel.load(tmp_path / "cli.json", axis="gyro_y").summary == models[1].summary
 
 
-def test_causal_predict_matches_cli_and_takes_the_mirror(cli, sim_csv, tmp_path):
+def test_causal_predict_matches_cli_and_takes_its_window_options(cli, sim_csv, tmp_path):
     """`predict --window --mirror --windows --causal-ensemble` and DriftModel.predict(window=,
     mirror=, windows=, causal_ensemble=) give the same bits; each reaches the windows (none
     differs from the default)."""

@@ -77,7 +77,7 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
   // mirrored tail). Shared, the noise EMDs are computed to the end; a window computes only the
   // rows it uses (few, when BEEMDAN's bound stops early): sharing pays from a few windows on.
   const std::vector<Eigen::Index> lengths = causal.WindowLengths();
-  std::vector<decomposition::DecompositionContext> full_window(lengths.size(), one_thread);
+  std::vector<decomposition::DecompositionContext> shared_noise(lengths.size(), one_thread);
   const Eigen::Index last_origin = origin + count - 1;
   double cache_bytes = 0.0;
   for (size_t w = 0; w < lengths.size() && decomposition::UsesNoiseEmds(dopt.method); ++w) {
@@ -88,14 +88,14 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
                          static_cast<double>(decomposed) * sizeof(double);
     if (full_windows < 16 || cache_bytes + bytes > 256e6) continue;
     cache_bytes += bytes;
-    full_window[w].noise_emds = std::make_shared<const decomposition::NoiseEmds>(
+    shared_noise[w].noise_emds = std::make_shared<const decomposition::NoiseEmds>(
         decomposed, dopt, execution);  // its progress is not called
-    assert(full_window[w].noise_emds->Matches(decomposed, dopt));
+    assert(shared_noise[w].noise_emds->Matches(decomposed, dopt));
   }
   const int p = model.lags;
   const size_t groups = model.sub_models.size();
   std::vector<Eigen::MatrixXd> lags(groups, Eigen::MatrixXd::Zero(count, p));
-  std::atomic<Eigen::Index> windows_done{0};
+  std::atomic<Eigen::Index> origins_done{0};
   std::mutex progress_mutex;
   double reported = 0.0;
   const Eigen::Index report_every = std::max<Eigen::Index>(1, count / 200);
@@ -113,17 +113,17 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
       window.head(length) = y.segment(end - length, length);
       window.tail(window.size() - length) =
           y.segment(end - 1 - (window.size() - length), window.size() - length).reverse();
-      const Eigen::MatrixXd series =
-          GroupSeries(model, decomposition::Decompose(
-                                 window, dopt, length == lengths[w] ? full_window[w] : one_thread));
+      const Eigen::MatrixXd series = GroupSeries(
+          model, decomposition::Decompose(window, dopt,
+                                          length == lengths[w] ? shared_noise[w] : one_thread));
       for (size_t g = 0; g < groups; ++g) {
         for (int k = 0; k < p; ++k) {
           lags[g](r, k) += series(length - 1 - k, static_cast<Eigen::Index>(g));
         }
       }
     }
-    for (size_t g = 0; g < groups; ++g) lags[g].row(r) /= decomposed;
-    const Eigen::Index done = ++windows_done;
+    for (size_t g = 0; g < groups; ++g) lags[g].row(r) /= static_cast<double>(decomposed);
+    const Eigen::Index done = ++origins_done;
     if (execution.progress && (done % report_every == 0 || done == count)) {
       std::lock_guard<std::mutex> lock(progress_mutex);
       const double fraction = static_cast<double>(done) / static_cast<double>(count);
@@ -193,8 +193,8 @@ std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causa
          " slower ones, which fall into the window's residue: " +
          (several ? "they see" : "it sees") + " another series than in training (" +
          (needed > 1000000 ? "no window up to 1000000 samples resolves them"
-          : count > 1      ? "windows from " + std::to_string(needed) + " samples down (window = " +
-                            std::to_string(needed) + ") would resolve them"
+          : count > 1      ? "window = " + std::to_string(needed) +
+                            ", the longest of the windows, would resolve them"
                       : "a window of " + std::to_string(needed) + " samples would resolve them") +
          ")";
 }

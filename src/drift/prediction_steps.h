@@ -1,6 +1,6 @@
 // Private: the parts of predict mode shared between prediction.cc, causal_protocol.cc and the
 // evaluation: the history rule (how much record a prediction needs) and the causal protocol's
-// lags (each origin's sub-series from its trailing window alone, with its mirrored tail).
+// lags (each origin's sub-series from its trailing windows alone, each with its mirrored tail).
 #pragma once
 
 #include <Eigen/Core>

@@ -65,8 +65,9 @@ struct Notifier {
 };
 
 // Evaluate reports the share of its trials done; the trials differ in cost by orders of magnitude
-// (a causal MS-ELM trial decomposes one window per test sample), so the trial index is mapped to
-// a share of the expected cost instead. Weights: measured shares of the default demo.
+// (a causal MS-ELM trial decomposes windows for every test sample), so the trial index is mapped
+// to a share of the expected cost instead. Weights: measured shares of the default demo before
+// its six causal windows of one realisation (2026-11-28), which made causal trials cheaper.
 std::function<void(double, std::string_view)> TrialProgress(
     const Notifier& notify, int stage, const std::vector<drift::Method>& methods, drift::Mode mode,
     const std::string& prefix) {
@@ -468,9 +469,8 @@ std::string GroupOf(const sel::SelectionResult& selection, int k) {
 }  // namespace internal
 
 void StudyOptions::Validate() const {
-  // Ranges the library owns are its own Validate's, one home: the drift options' first, so that
-  // ensemble_size is named as the decomposition's; a
-  // refusal names the study's field that set it.
+  // Ranges the library owns are its own Validate's, one home; a refusal names the study's field
+  // that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
                       {"selection.monte_carlo.realisations", "realisations"},
                       {"causal.window", "causal_window"},

@@ -217,8 +217,8 @@ Eigen::VectorXd PredictFromSeries(const DriftModel& model,
 // How a predict-mode model gets its test-time sub-series.
 enum class Protocol {
   kPaper,   // decompose the whole record once (what the literature does; sees the future)
-  kCausal,  // for each t, decompose the trailing window y[t-W .. t-1] only (H steps ahead:
-            // the window ending at t-H)
+  kCausal,  // for each t, decompose only trailing windows y[t-L .. t-1], L from W down to W/2
+            // (H steps ahead: the windows ending at t-H; CausalOptions)
 };
 std::string_view ToString(Protocol protocol);
 Protocol ProtocolFromString(std::string_view name);  // "paper", "causal"
@@ -230,11 +230,11 @@ struct CausalOptions {
   // to 1448 around 2048 (2048 alone until 2026-11-28; docs/drift.md 4.3).
   int window = 2896;
   // Realisations of each window's decomposition (noise-assisted methods), in [0, 100000]; 0 = the
-  // model's own decomposition.ensemble_size. Default 1 [choice, measured]: the decompositions are
-  // the whole cost of the causal protocol, and the mean over several windows (below) brings the
-  // drift group's end closer to the drift than more realisations of one window do (docs/drift.md
-  // 4.3; 20 until 2026-11-28, then 10 with one window). With fewer than 3 realisations BEEMDAN's
-  // ensemble band has no spread to measure, so only mode 1 is noise-assisted.
+  // model's own. Default 1 [choice, measured for BEEMDAN; EEMD, CEEMDAN, ICEEMDAN want more]: the
+  // decompositions are the whole cost of the causal protocol, and the mean over several windows
+  // brings the drift group's end closer to the drift than more realisations of one window do
+  // (docs/drift.md 4.3; 20 until 2026-11-28, then 10 with one window). With fewer than 3
+  // realisations BEEMDAN's ensemble band has no spread, so only mode 1 is noise-assisted.
   int ensemble_size = 1;
   // Share of the window mirrored past its end before the decomposition, in [0, 1]: a window of L
   // samples y[t-L..t-1] is followed by y[t-2], y[t-3], ... (min(round(mirror x L), L - 1)

@@ -58,8 +58,8 @@ struct StudyOptions {
   // rate responses cannot be told apart). Default 8 h. Not used for a log.
   double duration_s = 8 * 3600.0;
   // BEEMDAN ensemble size of the study's decompositions (the causal windows take CausalOptions'
-  // own, 1 realisation; the study's 20 until 2026-11-28); in [1, 10000] (tighter than
-  // DecompositionOptions' 100000). Default 20 (the library's is 100).
+  // own, 1 realisation; the study's 20 until 2026-11-28); in [1, 10000], a bound on a study's
+  // cost (DecompositionOptions' is 100000). Default 20 (the library's is 100).
   int ensemble_size = 20;
   // White-noise realisations of the selection's Monte-Carlo level; MonteCarloOptions' range
   // [20, 100000]. Default 20, the least the level estimator accepts.
@@ -85,7 +85,7 @@ struct StudyOptions {
   std::uint64_t seed = 1;
 
   // Throws OptionError naming the field (duration_s, ensemble_size, methods) or, for a range the
-  // library owns, the library's name for it (realisations, causal window).
+  // library owns, the library's name for it (realisations, causal window, mirror and windows).
   void Validate() const;
   bool operator==(const StudyOptions&) const = default;
 };

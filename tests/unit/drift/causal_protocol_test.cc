@@ -230,7 +230,7 @@ TEST(DriftModel, CausalWindowNoteNamesSubModelsTheWindowsCannotFeed) {
                       "mirrored tail) resolves about 8 IMFs"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("windows from 10921 samples down (window = 10921) would resolve them"),
+  EXPECT_NE(text.find("window = 10921, the longest of the windows, would resolve them"),
             std::string::npos)
       << text;
   EXPECT_EQ(note(10921, 0.5, 3), "");  // its shortest: 5460.5, rounded to 5461
