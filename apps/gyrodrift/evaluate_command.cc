@@ -162,25 +162,11 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
                               "from --seed and r; mean and std over them")
                   ->capture_default_str(),
               {"repeats"});
-  BindSetting(cmd->add_option("--window,-W", args->evaluation.window,
-                              "causal protocol: longest trailing window W, samples")
-                  ->capture_default_str(),
-              {"causal.window"});
-  BindSetting(cmd->add_option("--mirror", args->evaluation.mirror,
-                              "causal protocol: share of the window mirrored past its end before "
-                              "its decomposition, in [0, 1]")
-                  ->capture_default_str(),
-              {"causal.mirror"});
-  BindSetting(cmd->add_option("--windows", args->evaluation.windows,
-                              "causal protocol: windows decomposed per origin, from W down to W/2, "
-                              "their ends averaged, in [1, 16]")
-                  ->capture_default_str(),
-              {"causal.windows"});
-  BindSetting(cmd->add_option("--causal-ensemble", args->evaluation.causal_ensemble,
-                              "causal protocol: realisations of each window's decomposition, in "
-                              "[0, 100000]; 0 = the model's ensemble")
-                  ->capture_default_str(),
-              {"causal.ensemble_size"});
+  AddCausalWindowOptions(cmd, {.window = &args->evaluation.window,
+                               .mirror = &args->evaluation.mirror,
+                               .windows = &args->evaluation.windows,
+                               .ensemble = &args->evaluation.causal_ensemble,
+                               .prefix = "causal."});
   BindSetting(cmd->add_option("--horizon,-H", args->evaluation.horizon,
                               "predict mode: score H-step-ahead predictions (recursive for H > 1)")
                   ->capture_default_str(),

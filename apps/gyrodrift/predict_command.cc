@@ -109,25 +109,11 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->required();
   BindSetting(cmd->add_option("--protocol", args->settings.protocol, "causal|paper")->capture_default_str(),
               {"protocol"});
-  BindSetting(cmd->add_option("--window,-W", args->settings.window,
-                              "causal protocol: longest trailing window W, samples")
-                  ->capture_default_str(),
-              {"window"});
-  BindSetting(cmd->add_option("--mirror", args->settings.mirror,
-                              "causal protocol: share of the window mirrored past its end before "
-                              "its decomposition, in [0, 1]")
-                  ->capture_default_str(),
-              {"mirror"});
-  BindSetting(cmd->add_option("--windows", args->settings.windows,
-                              "causal protocol: windows decomposed per origin, from W down to W/2, "
-                              "their ends averaged, in [1, 16]")
-                  ->capture_default_str(),
-              {"windows"});
-  BindSetting(cmd->add_option("--causal-ensemble", args->settings.causal_ensemble,
-                              "causal protocol: realisations of each window's decomposition, in "
-                              "[0, 100000]; 0 = the model's ensemble")
-                  ->capture_default_str(),
-              {"ensemble_size"});
+  AddCausalWindowOptions(cmd, {.window = &args->settings.window,
+                               .mirror = &args->settings.mirror,
+                               .windows = &args->settings.windows,
+                               .ensemble = &args->settings.causal_ensemble,
+                               .prefix = ""});
   BindSetting(
       cmd->add_option("--horizon,-H", args->settings.horizon,
                       "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")
