@@ -103,12 +103,12 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
     const Eigen::Index end = origin + r;  // the windows end just before the origin
     // Near the record's start the longer windows are cut to the same length: each length once.
     Eigen::Index previous = -1;
-    int decomposed = 0;
+    int distinct = 0;  // window lengths decomposed at this origin
     for (size_t w = 0; w < lengths.size(); ++w) {
       const Eigen::Index length = std::min(lengths[w], end);
       if (length == previous) continue;
       previous = length;
-      ++decomposed;
+      ++distinct;
       Eigen::VectorXd window(causal.DecomposedLength(length));
       window.head(length) = y.segment(end - length, length);
       window.tail(window.size() - length) =
@@ -122,7 +122,7 @@ std::vector<Eigen::MatrixXd> CausalLags(const DriftModel& model,
         }
       }
     }
-    for (size_t g = 0; g < groups; ++g) lags[g].row(r) /= static_cast<double>(decomposed);
+    for (size_t g = 0; g < groups; ++g) lags[g].row(r) /= static_cast<double>(distinct);
     const Eigen::Index done = ++origins_done;
     if (execution.progress && (done % report_every == 0 || done == count)) {
       std::lock_guard<std::mutex> lock(progress_mutex);
