@@ -39,11 +39,13 @@ json RowRecord(const drift::EvaluationRow& r) {
           {"notes", r.notes}};
 }
 
-// The models' settings: fit's, with "ms-elm" standing in for the method (the list is the
-// evaluation's).
+// The models' settings: fit's, with a method standing in for the list (each row sets its own):
+// ms-elm, which takes every model setting but one. A hidden-unit count in compensate mode is for
+// elm there (ms-elm's sub-models are linear unless --nonlinear), so elm stands in for it.
 drift::FitSettings ModelSettings(const EvaluateSettings& s) {
   drift::FitSettings fit = s.fit;
-  fit.method = "ms-elm";
+  const bool hidden_count = !fit.hidden.empty() && fit.hidden != "auto";
+  fit.method = fit.mode == "compensate" && hidden_count && !fit.nonlinear ? "elm" : "ms-elm";
   return fit;
 }
 

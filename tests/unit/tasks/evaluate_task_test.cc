@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "gyrodrift/common/error.h"
@@ -53,6 +55,35 @@ TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
   bad = s;
   bad.windows = 0;
   EXPECT_EQ(refused(bad), "causal.windows");
+}
+
+TEST(EvaluateTask, HiddenUnitsReachTheElmInCompensateMode) {
+  // docs/cli.md: --hidden changes only the ELM methods. In compensate mode that is elm (ms-elm's
+  // sub-models are linear there): its count was refused as if ms-elm had been asked for.
+  const Eigen::Index n = 2400;
+  Eigen::VectorXd temperature(n), y(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    temperature[i] = 20.0 + 10.0 * std::sin(static_cast<double>(i) / 300.0);
+    y[i] = 0.05 * temperature[i] + 0.01 * std::cos(static_cast<double>(i) * 1.7);
+  }
+  EvaluateSettings s{.fit = {.mode = "compensate", .hidden = "7", .has_temperature = true},
+                     .methods = "elm,poly"};
+  s.fit.threads = 1;
+  const EvaluateRun run = RunEvaluate(y, temperature, Eigen::VectorXd(), s);
+  EXPECT_EQ(run.base.learner.elm.selection, elm::Selection::kFixed);
+  EXPECT_EQ(run.base.learner.elm.hidden_units, 7);
+  const auto elm_rows =
+      std::count_if(run.result.rows.begin(), run.result.rows.end(),
+                    [](const auto& r) { return r.method == drift::Method::kElm; });
+  EXPECT_GT(elm_rows, 0);
+  // Compensate-mode ms-elm itself still refuses a count (fit's rule), naming the setting.
+  try {
+    drift::MakeDriftOptions(
+        {.mode = "compensate", .method = "ms-elm", .hidden = "7", .has_temperature = true});
+    ADD_FAILURE() << "accepted";
+  } catch (const OptionError& error) {
+    EXPECT_EQ(error.option(), "hidden");
+  }
 }
 
 }  // namespace
