@@ -39,14 +39,31 @@ json RowRecord(const drift::EvaluationRow& r) {
           {"notes", r.notes}};
 }
 
-// The models' settings: fit's, with a method standing in for the list (each row sets its own):
-// ms-elm, which takes every model setting but one. A hidden-unit count in compensate mode is for
-// elm there (ms-elm's sub-models are linear unless --nonlinear), so elm stands in for it.
+// The models' settings: fit's, with "ms-elm" standing in for the method (the list is the
+// evaluation's).
 drift::FitSettings ModelSettings(const EvaluateSettings& s) {
   drift::FitSettings fit = s.fit;
-  const bool hidden_count = !fit.hidden.empty() && fit.hidden != "auto";
-  fit.method = fit.mode == "compensate" && hidden_count && !fit.nonlinear ? "elm" : "ms-elm";
+  fit.method = "ms-elm";
   return fit;
+}
+
+// The options every evaluated method starts from (each row sets its own method). A hidden-unit
+// count in compensate mode is elm's (ms-elm's sub-models are linear there and refuse one), so it
+// is checked as elm's, with the thermal settings only the identified methods take left at their
+// defaults, and applied to the ms-elm base.
+drift::DriftOptions BaseOptions(const EvaluateSettings& s) {
+  drift::FitSettings fit = ModelSettings(s);
+  const bool count = !fit.hidden.empty() && fit.hidden != "auto";
+  if (fit.mode != "compensate" || fit.nonlinear || !count) return drift::MakeDriftOptions(fit);
+  drift::FitSettings elm = fit;
+  elm.method = "elm";
+  elm.hysteresis = drift::FitSettings{}.hysteresis;
+  elm.standard_errors = drift::FitSettings{}.standard_errors;
+  const drift::DriftOptions counted = drift::MakeDriftOptions(elm);
+  fit.hidden = "auto";
+  drift::DriftOptions base = drift::MakeDriftOptions(fit);
+  base.learner.elm = counted.learner.elm;
+  return base;
 }
 
 }  // namespace
@@ -94,7 +111,7 @@ std::vector<drift::Method> ParseMethods(const std::string& text, drift::Mode mod
 }
 
 drift::EvaluationOptions EvaluateSettings::Options(std::string_view methods_name) const {
-  const drift::Mode mode = drift::MakeDriftOptions(ModelSettings(*this)).mode;
+  const drift::Mode mode = BaseOptions(*this).mode;
   drift::EvaluationOptions e;
   e.split = split;
   e.repeats = repeats;
@@ -118,9 +135,8 @@ EvaluateRun RunEvaluate(const Eigen::VectorXd& y, const Eigen::MatrixXd& tempera
                         std::function<void(double, std::string_view)> progress,
                         std::string_view methods_name) {
   EvaluateRun run;
-  const drift::FitSettings fit = ModelSettings(settings);
-  run.base = drift::MakeDriftOptions(fit);
-  Execution execution = drift::MakeExecution(fit);
+  run.base = BaseOptions(settings);
+  Execution execution = drift::MakeExecution(ModelSettings(settings));
   run.options = settings.Options(methods_name);
   run.threads = execution.threads;
   execution.progress = std::move(progress);

@@ -23,8 +23,8 @@ inline const drift::EvaluationOptions kEvaluationDefaults{};
 }  // namespace internal
 
 struct EvaluateSettings {
-  // The models' settings, as fit's (the method is the list's: "ms-elm" stands in, or "elm" for a
-  // hidden-unit count in compensate mode).
+  // The models' settings, as fit's (the method is the list's: "ms-elm" stands in; a hidden-unit
+  // count in compensate mode is elm's and checked as such).
   drift::FitSettings fit;
   // "all" (every method of the mode) or a comma-separated list without repeats.
   std::string methods = "all";
