@@ -141,11 +141,14 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
                     "auto for method '" + method +
                         "' (it applies to the ELM methods: ms-elm, emd-elm, elm)");
       }
-      if (compensate && o.method != Method::kElm && o.linear_compensation) {
+      // An identified model reads no ELM setting: its sub-models are linear and its nonlinear
+      // correction chooses its own hidden units.
+      if (compensate && o.method != Method::kElm) {
         ThrowOption("hidden", s.hidden,
                     "auto for compensate-mode " + method +
-                        ", which fits linear sub-models (docs/drift.md 1.2; it applies to mode "
-                        "'predict', method 'elm' and the nonlinear correction)");
+                        ", which fits linear sub-models and chooses its nonlinear correction's "
+                        "units itself (docs/drift.md 1.2; it applies to mode 'predict' and "
+                        "method 'elm')");
       }
       o.learner.elm.selection = elm::Selection::kFixed;
       o.learner.elm.hidden_units = hidden;

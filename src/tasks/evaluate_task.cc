@@ -48,15 +48,16 @@ drift::FitSettings ModelSettings(const EvaluateSettings& s) {
 }
 
 // The options every evaluated method starts from (each row sets its own method). A hidden-unit
-// count in compensate mode is elm's (ms-elm's sub-models are linear there and refuse one), so it
-// is checked as elm's, with the thermal settings only the identified methods take left at their
-// defaults, and applied to the ms-elm base.
+// count in compensate mode is elm's (an identified ms-elm reads none and refuses one), so it is
+// checked as elm's, with the settings only the identified methods take left at their defaults,
+// and applied to the ms-elm base.
 drift::DriftOptions BaseOptions(const EvaluateSettings& s) {
   drift::FitSettings fit = ModelSettings(s);
   const bool count = !fit.hidden.empty() && fit.hidden != "auto";
-  if (fit.mode != "compensate" || fit.nonlinear || !count) return drift::MakeDriftOptions(fit);
+  if (fit.mode != "compensate" || !count) return drift::MakeDriftOptions(fit);
   drift::FitSettings elm = fit;
   elm.method = "elm";
+  elm.nonlinear = drift::FitSettings{}.nonlinear;
   elm.hysteresis = drift::FitSettings{}.hysteresis;
   elm.standard_errors = drift::FitSettings{}.standard_errors;
   const drift::DriftOptions counted = drift::MakeDriftOptions(elm);

@@ -329,6 +329,10 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--hidden 20",
        2, "--hidden = 20: must be auto for method 'thermal'"},
+      {"hidden for the nonlinear correction",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate -m ms-elm --nonlinear "
+       "--hidden 20",
+       2, "--hidden = 20: must be auto for compensate-mode ms-elm, which fits linear sub-models"},
       {"lags in compensate mode",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--lags 8",

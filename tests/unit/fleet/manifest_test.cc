@@ -98,8 +98,7 @@ TEST_F(ManifestTest, EveryFitSettingIsAKeyThroughItsOneMapping) {
   EXPECT_EQ(m.FitOptions().thermal.standard_errors, 0.5);
   EXPECT_EQ(m.fit.mode, "compensate");
   EXPECT_TRUE(m.fit.has_temperature);
-  const drift::DriftOptions o = Parse("method = \"ms-elm\"\nhidden = 20\nnonlinear = true\n")
-                                    .FitOptions();
+  const drift::DriftOptions o = Parse("method = \"elm\"\nhidden = 20\n").FitOptions();
   EXPECT_EQ(o.learner.elm.hidden_units, 20);
   const std::string file = dir_ + "/fleet.toml:";
   EXPECT_EQ(Refusal("seed = 1\nensemble = \"many\"\n"),
