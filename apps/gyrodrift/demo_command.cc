@@ -100,23 +100,23 @@ void AddAdvancedOptions(CLI::App* cmd, DemoArgs& a) {
           ->capture_default_str()
           ->group("Advanced"),
       {"realisations"});
-  BindSetting(cmd->add_option("--window", a.settings.window,
+  BindSetting(cmd->add_option("--window", a.settings.causal.window,
                               "advanced: longest trailing window of the causal protocol, samples")
                   ->capture_default_str()
                   ->group("Advanced"),
-              {"causal_window"});
-  BindSetting(cmd->add_option("--mirror", a.settings.mirror,
+              {"causal.window"});
+  BindSetting(cmd->add_option("--mirror", a.settings.causal.mirror,
                               "advanced: share of each causal window mirrored past its end, "
                               "in [0, 1]")
                   ->capture_default_str()
                   ->group("Advanced"),
-              {"causal_mirror"});
-  BindSetting(cmd->add_option("--windows", a.settings.windows,
+              {"causal.mirror"});
+  BindSetting(cmd->add_option("--windows", a.settings.causal.windows,
                               "advanced: causal windows decomposed per test sample, from --window "
                               "down to half of it, their ends averaged, in [1, 16]")
                   ->capture_default_str()
                   ->group("Advanced"),
-              {"causal_windows"});
+              {"causal.windows"});
   BindSetting(cmd->add_option("--methods", a.settings.methods,
                               "advanced: all, or a list such as ms-elm,elm,poly")
                   ->capture_default_str()

@@ -133,27 +133,26 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 
-void AddCausalWindowOptions(CLI::App* cmd, const CausalWindowFlags& flags) {
-  const std::string& p = flags.prefix;
-  BindSetting(cmd->add_option("--window,-W", *flags.window,
+void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal) {
+  BindSetting(cmd->add_option("--window,-W", causal->window,
                               "causal protocol: longest trailing window W, samples")
                   ->capture_default_str(),
-              {p + "window"});
-  BindSetting(cmd->add_option("--mirror", *flags.mirror,
+              {"causal.window"});
+  BindSetting(cmd->add_option("--mirror", causal->mirror,
                               "causal protocol: share of the window mirrored past its end before "
                               "its decomposition, in [0, 1]")
                   ->capture_default_str(),
-              {p + "mirror"});
-  BindSetting(cmd->add_option("--windows", *flags.windows,
+              {"causal.mirror"});
+  BindSetting(cmd->add_option("--windows", causal->windows,
                               "causal protocol: windows decomposed per origin, from W down to W/2, "
                               "their ends averaged, in [1, 16]")
                   ->capture_default_str(),
-              {p + "windows"});
-  BindSetting(cmd->add_option("--causal-ensemble", *flags.ensemble,
+              {"causal.windows"});
+  BindSetting(cmd->add_option("--causal-ensemble", causal->ensemble_size,
                               "causal protocol: realisations of each window's decomposition, in "
                               "[0, 100000]; 0 = the model's ensemble")
                   ->capture_default_str(),
-              {p + "ensemble_size"});
+              {"causal.ensemble_size"});
 }
 
 drift::FitSettings Settings(const DriftArgs& a, const std::string& method) {

@@ -44,17 +44,9 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
 // The causal protocol's window settings of predict and evaluate (each a field of a task's
 // settings, the library's drift::CausalOptions field name after `prefix`).
-struct CausalWindowFlags {
-  int* window;         // --window, -W
-  double* mirror;      // --mirror
-  int* windows;        // --windows
-  int* ensemble;       // --causal-ensemble (CausalOptions::ensemble_size)
-  std::string prefix;  // "" (predict's settings) or "causal." (evaluate's options)
-};
-
-// Adds --window, --mirror, --windows and --causal-ensemble to cmd, each bound to its
-// CausalOptions field (BindSetting) under flags.prefix.
-void AddCausalWindowOptions(CLI::App* cmd, const CausalWindowFlags& flags);
+// Adds --window (-W), --mirror, --windows and --causal-ensemble to cmd, each bound to its field
+// of `causal` (BindSetting: a refusal of causal.window names --window).
+void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal);
 
 // The settings of the arguments with `method` ("auto" or a method name), before any file is
 // read (drift::MakeDriftOptions maps them; the sample rate is settled later by

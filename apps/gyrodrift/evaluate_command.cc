@@ -162,11 +162,7 @@ const RegisterCommand kRegister("evaluate", 80, [](CLI::App& app) {
                               "from --seed and r; mean and std over them")
                   ->capture_default_str(),
               {"repeats"});
-  AddCausalWindowOptions(cmd, {.window = &args->evaluation.window,
-                               .mirror = &args->evaluation.mirror,
-                               .windows = &args->evaluation.windows,
-                               .ensemble = &args->evaluation.causal_ensemble,
-                               .prefix = "causal."});
+  AddCausalWindowOptions(cmd, &args->evaluation.causal);
   BindSetting(cmd->add_option("--horizon,-H", args->evaluation.horizon,
                               "predict mode: score H-step-ahead predictions (recursive for H > 1)")
                   ->capture_default_str(),

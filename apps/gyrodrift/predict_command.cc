@@ -109,11 +109,7 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
       ->required();
   BindSetting(cmd->add_option("--protocol", args->settings.protocol, "causal|paper")->capture_default_str(),
               {"protocol"});
-  AddCausalWindowOptions(cmd, {.window = &args->settings.window,
-                               .mirror = &args->settings.mirror,
-                               .windows = &args->settings.windows,
-                               .ensemble = &args->settings.causal_ensemble,
-                               .prefix = ""});
+  AddCausalWindowOptions(cmd, &args->settings.causal);
   BindSetting(
       cmd->add_option("--horizon,-H", args->settings.horizon,
                       "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")

@@ -27,7 +27,7 @@ int main() {
                             .rate_source = "given"};
   study::StudyOptions options;  // the demo's defaults, made smaller still
   options.ensemble_size = 4;
-  options.causal_window = 32;
+  options.causal.window = 32;
   options.methods = {gyrodrift::drift::Method::kMsElm, gyrodrift::drift::Method::kPoly};
   study::StudyContext context;
   context.stage_done = [](int, const std::string& summary) { std::fputs(summary.c_str(), stdout); };

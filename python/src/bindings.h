@@ -25,8 +25,10 @@
 #include <variant>
 #include <vector>
 
+#include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/execution.h"
+#include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/drift/fit_settings.h"
 
 namespace gyrodrift::python {
@@ -197,6 +199,20 @@ inline Execution ExecutionOf(int threads, LongCall& call) {
   const Execution execution{.threads = threads, .progress = call.Hook()};
   execution.Validate();
   return execution;
+}
+
+// The causal protocol's keywords (window, mirror, windows, causal_ensemble): a refusal of a
+// drift::CausalOptions field under `causal.` names its keyword, as the CLI's names its flag.
+inline drift::CausalOptions CausalOf(int window, double mirror, int windows, int causal_ensemble) {
+  return {.window = window, .ensemble_size = causal_ensemble, .mirror = mirror, .windows = windows};
+}
+template <typename Validate>
+void ValidateAsCausalKeywords(Validate&& validate) {
+  ValidateAsSettings({{"causal.window", "window"},
+                      {"causal.mirror", "mirror"},
+                      {"causal.windows", "windows"},
+                      {"causal.ensemble_size", "causal_ensemble"}},
+                     std::forward<Validate>(validate));
 }
 
 // The functions of each binding file, called by PYBIND11_MODULE (module.cc).

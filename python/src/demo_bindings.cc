@@ -13,12 +13,8 @@ namespace {
 
 py::dict Demo(const study::DemoSettings& settings, const py::object& progress) {
   // A refusal names the keyword, as the CLI's names its flag.
-  ValidateAsSettings({{"causal_mirror", "mirror"},
-                      {"causal_windows", "windows"},
-                      {"causal_window", "window"},
-                      {"ensemble_size", "ensemble"},
-                      {"duration_s", "duration"}},
-                     [&] { (void)settings.Options(); });
+  ValidateAsSettings({{"ensemble_size", "ensemble"}, {"duration_s", "duration"}},
+                     [&] { ValidateAsCausalKeywords([&] { (void)settings.Options(); }); });
   LongCall call(progress);
   // The study reports (stage, fraction of it); the callable gets the fraction of the whole run,
   // each stage weighed by its measured cost.
@@ -76,9 +72,7 @@ void BindDemo(py::module_& m) {
                               .duration_s = duration,
                               .ensemble = ensemble,
                               .realisations = realisations,
-                              .window = window,
-                              .mirror = mirror,
-                              .windows = windows,
+                              .causal = {.window = window, .mirror = mirror, .windows = windows},
                               .methods = methods,
                               .seed = seed,
                               .threads = threads,
@@ -89,10 +83,10 @@ void BindDemo(py::module_& m) {
       arg("output") = d.output, py::kw_only(), arg("input") = d.input, arg("target") = d.target,
       arg("temperature") = d.temperature, arg("rate_hz") = py::none(), arg("units") = d.units,
       arg("duration") = d.duration_s, arg("ensemble") = d.ensemble,
-      arg("realisations") = d.realisations, arg("window") = d.window, arg("mirror") = d.mirror,
-      arg("windows") = d.windows, arg("methods") = d.methods, arg("seed") = d.seed,
-      arg("threads") = d.threads, arg("gaps") = std::string(io::ToString(d.log.gaps)),
-      arg("progress") = py::none());
+      arg("realisations") = d.realisations, arg("window") = d.causal.window,
+      arg("mirror") = d.causal.mirror, arg("windows") = d.causal.windows,
+      arg("methods") = d.methods, arg("seed") = d.seed, arg("threads") = d.threads,
+      arg("gaps") = std::string(io::ToString(d.log.gaps)), arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

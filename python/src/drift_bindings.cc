@@ -218,15 +218,12 @@ class PyDriftModel {
                     int causal_ensemble, int threads, const py::object& progress) const {
     RequireMode(drift::Mode::kPredict, "predict");
     LongCall call(progress);
-    const tasks::PredictSettings settings{.protocol = protocol,
-                                          .window = window,
-                                          .mirror = mirror,
-                                          .windows = windows,
-                                          .causal_ensemble = causal_ensemble,
-                                          .horizon = horizon,
-                                          .threads = threads};
-    // A refusal names the keyword, as the CLI's names its flag.
-    ValidateAsSettings({{"ensemble_size", "causal_ensemble"}}, [&] { settings.Validate(); });
+    const tasks::PredictSettings settings{
+        .protocol = protocol,
+        .causal = CausalOf(window, mirror, windows, causal_ensemble),
+        .horizon = horizon,
+        .threads = threads};
+    ValidateAsCausalKeywords([&] { settings.Validate(); });
     const Eigen::VectorXd y = ToVector(y_in, "y");
     Eigen::VectorXd temperature;
     if (Loaded().model.uses_temperature()) {
@@ -357,9 +354,9 @@ void BindDriftModel(py::module_& m) {
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
-           arg("window") = pd.window, arg("mirror") = pd.mirror, arg("windows") = pd.windows,
-           arg("causal_ensemble") = pd.causal_ensemble, arg("threads") = pd.threads,
-           arg("progress") = py::none())
+           arg("window") = pd.causal.window, arg("mirror") = pd.causal.mirror,
+           arg("windows") = pd.causal.windows, arg("causal_ensemble") = pd.causal.ensemble_size,
+           arg("threads") = pd.threads, arg("progress") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))

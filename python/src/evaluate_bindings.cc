@@ -54,13 +54,7 @@ py::dict Evaluate(const Array& y_in, const std::optional<Array>& temperature_in,
                   const std::optional<Array>& truth_in, const tasks::EvaluateSettings& settings,
                   const py::object& progress) {
   LongCall call(progress);
-  // A refusal names the keyword (window, mirror, windows, causal_ensemble), as the CLI's names
-  // its flag.
-  ValidateAsSettings({{"causal.window", "window"},
-                      {"causal.mirror", "mirror"},
-                      {"causal.windows", "windows"},
-                      {"causal.ensemble_size", "causal_ensemble"}},
-                     [&] { settings.Validate(); });
+  ValidateAsCausalKeywords([&] { settings.Validate(); });
   (void)ExecutionOf(settings.fit.threads, call);
   const Eigen::VectorXd y = ToVector(y_in, "y");
   Eigen::MatrixXd temperature;
@@ -130,18 +124,16 @@ void BindEvaluate(py::module_& m) {
             .protocol = protocol,
             .split = split,
             .repeats = repeats,
-            .window = window,
-            .mirror = mirror,
-            .windows = windows,
-            .horizon = horizon,
-            .causal_ensemble = causal_ensemble};
+            .causal = gp::CausalOf(window, mirror, windows, causal_ensemble),
+            .horizon = horizon};
         return gp::Evaluate(y, temperature, truth, s, progress);
       },
       arg("y"), arg("temperature") = py::none(), arg("truth") = py::none(), py::kw_only(),
       arg("mode") = "predict", arg("methods") = ed.methods, arg("protocol") = ed.protocol,
       arg("split") = ed.split, arg("repeats") = ed.repeats, arg("horizon") = ed.horizon,
-      arg("window") = ed.window, arg("mirror") = ed.mirror, arg("windows") = ed.windows,
-      arg("causal_ensemble") = ed.causal_ensemble, arg("progress") = py::none());
+      arg("window") = ed.causal.window, arg("mirror") = ed.causal.mirror,
+      arg("windows") = ed.causal.windows, arg("causal_ensemble") = ed.causal.ensemble_size,
+      arg("progress") = py::none());
 }
 
 }  // namespace gyrodrift::python

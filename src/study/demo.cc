@@ -74,9 +74,7 @@ StudyOptions DemoSettings::Options() const {
   o.duration_s = duration_s;
   o.ensemble_size = ensemble;
   o.realisations = realisations;
-  o.causal_window = window;
-  o.causal_mirror = mirror;
-  o.causal_windows = windows;
+  o.causal = causal;
   o.seed = seed;
   o.Validate();
   ValidateThreads(threads);
@@ -135,9 +133,9 @@ nlohmann::json DemoRecord(const DemoSettings& s, const StudyResult& result) {
                        {"duration_s", result.simulated ? result.options.duration_s : 0.0},
                        {"ensemble", s.ensemble},
                        {"realisations", s.realisations},
-                       {"window", s.window},
-                       {"mirror", s.mirror},
-                       {"windows", s.windows},
+                       {"window", s.causal.window},
+                       {"mirror", s.causal.mirror},
+                       {"windows", s.causal.windows},
                        {"methods", s.methods},
                        {"seed", s.seed},
                        {"threads", s.threads}};

@@ -106,15 +106,10 @@ drift::DriftModel FitCompensation(const StudyResult& s, drift::Method method,
 }
 
 // The study's evaluation of `methods` ("all" or a comma-separated list) with the models' settings
-// `fit`: the causal protocol's window, mirror and window count are the study's (each window's
-// ensemble the library's).
+// `fit`: the causal protocol's windows are the study's.
 tasks::EvaluateSettings EvaluationSettings(const StudyOptions& a, drift::FitSettings fit,
                                            std::string methods) {
-  return {.fit = std::move(fit),
-          .methods = std::move(methods),
-          .window = a.causal_window,
-          .mirror = a.causal_mirror,
-          .windows = a.causal_windows};
+  return {.fit = std::move(fit), .methods = std::move(methods), .causal = a.causal};
 }
 
 // `methods` scored in `mode` on the record through the evaluate task (against `truth` when not
@@ -472,10 +467,7 @@ void StudyOptions::Validate() const {
   // Ranges the library owns are its own Validate's, one home; a refusal names the study's field
   // that set it.
   ValidateAsSettings({{"decomposition.ensemble_size", "ensemble_size"},
-                      {"selection.monte_carlo.realisations", "realisations"},
-                      {"causal.window", "causal_window"},
-                      {"causal.mirror", "causal_mirror"},
-                      {"causal.windows", "causal_windows"}},
+                      {"selection.monte_carlo.realisations", "realisations"}},
                      [&] {
                        internal::StudyDriftOptions(*this, 1.0, true).Validate();
                        // The causal protocol's settings; the study's method list is checked

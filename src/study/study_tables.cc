@@ -154,8 +154,7 @@ void FillSettingsTable(StudyResult& s) {
   settings.Add(
       {"learner", "ELM sigmoid, hidden units <= " + std::to_string(base.learner.elm.hidden_units) +
                       " and ridge by leave-one-out; SVR/BP/poly library defaults"});
-  const drift::CausalOptions causal{
-      .window = a.causal_window, .mirror = a.causal_mirror, .windows = a.causal_windows};
+  const drift::CausalOptions& causal = a.causal;
   const std::vector<Eigen::Index> lengths = causal.WindowLengths();
   settings.Add({"predict mode",
                 std::to_string(base.features.lags) + " lags, split 70/30, causal window" +
@@ -163,7 +162,7 @@ void FillSettingsTable(StudyResult& s) {
                                               std::to_string(lengths.back()) + " samples (" +
                                               std::to_string(lengths.size()) + ", ends averaged)"
                                         : " " + std::to_string(lengths.front()) + " samples") +
-                    ", each with a mirrored tail " + FormatValue(a.causal_mirror) + " of it and " +
+                    ", each with a mirrored tail " + FormatValue(causal.mirror) + " of it and " +
                     std::to_string(causal.ensemble_size) +
                     (causal.ensemble_size == 1 ? " realisation" : " realisations")});
   settings.Add(

@@ -118,10 +118,7 @@ drift::EvaluationOptions EvaluateSettings::Options(std::string_view methods_name
   e.repeats = repeats;
   e.methods = ParseMethods(methods, mode, methods_name);
   e.protocols = ParseProtocols(protocol);
-  e.causal.window = window;
-  e.causal.mirror = mirror;
-  e.causal.windows = windows;
-  e.causal.ensemble_size = causal_ensemble;
+  e.causal = causal;
   e.horizon = horizon;
   e.Validate();
   return e;

@@ -8,18 +8,9 @@
 
 namespace gyrodrift::tasks {
 
-drift::CausalOptions PredictSettings::Causal() const {
-  drift::CausalOptions causal;
-  causal.window = window;
-  causal.mirror = mirror;
-  causal.windows = windows;
-  causal.ensemble_size = causal_ensemble;
-  return causal;
-}
-
 void PredictSettings::Validate() const {
   (void)drift::ProtocolFromString(protocol);
-  Causal().Validate();
+  ValidateNested("causal", [&] { causal.Validate(); });
   ValidateThreads(threads);
 }
 
@@ -45,7 +36,7 @@ PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y
                     " samples: the model needs more than " + std::to_string(r.first) +
                     " (its history) to predict any");
   }
-  const drift::CausalOptions causal = settings.Causal();
+  const drift::CausalOptions& causal = settings.causal;
   // The threads never change the result.
   const Execution execution{.threads = settings.threads, .progress = std::move(progress)};
   r.prediction = drift::PredictAhead(model, y, temperature, r.first, settings.horizon, protocol,
@@ -64,10 +55,10 @@ nlohmann::json PredictRecord(const PredictResult& r, const io::LoadedModel& load
   j["options"] = {{"model", model_path},
                   {"input", input},
                   {"protocol", s.protocol},
-                  {"window", s.window},
-                  {"mirror", s.mirror},
-                  {"windows", s.windows},
-                  {"causal_ensemble", s.causal_ensemble},
+                  {"window", s.causal.window},
+                  {"mirror", s.causal.mirror},
+                  {"windows", s.causal.windows},
+                  {"causal_ensemble", s.causal.ensemble_size},
                   {"horizon", s.horizon},
                   {"threads", s.threads}};
   j["model"] = {{"summary", model.Summary()},

@@ -35,9 +35,7 @@ struct DemoSettings {
   double duration_s = internal::kStudyDefaults.duration_s;  // of each simulated run, s
   int ensemble = internal::kStudyDefaults.ensemble_size;
   int realisations = internal::kStudyDefaults.realisations;
-  int window = internal::kStudyDefaults.causal_window;
-  double mirror = internal::kStudyDefaults.causal_mirror;
-  int windows = internal::kStudyDefaults.causal_windows;
+  drift::CausalOptions causal = internal::kStudyDefaults.causal;  // the causal windows
   std::string methods = "all";  // "all" or a comma-separated list of compensate-mode methods
   std::uint64_t seed = internal::kStudyDefaults.seed;
   int threads = 0;     // [0, 1024]; 0 = every core

@@ -19,7 +19,7 @@
 // noise terms; docs/drift.md for the models and protocols.
 // Units: the simulated output is in deg/h, a log's in StudyOptions::units; temperatures in degC
 // (a log's in whatever unit it has); times in s (hours on the time axes of the result).
-// Cost: dominated by the causal protocol, `causal_windows` BEEMDANs of up to `causal_window`
+// Cost: dominated by the causal protocol, `causal.windows` BEEMDANs of up to `causal.window`
 // samples and their mirrored tails per test sample for each decomposing method (ms-elm,
 // emd-elm): the defaults take about 30 s on 2 cores.
 // Nothing here reads files or prints: RunStudy reports through its StudyContext, which also holds
@@ -64,16 +64,11 @@ struct StudyOptions {
   // White-noise realisations of the selection's Monte-Carlo level; MonteCarloOptions' range
   // [20, 100000]. Default 20, the least the level estimator accepts.
   int realisations = 20;
-  // Longest trailing window of the causal protocol, samples; CausalOptions' range [16, 1000000].
-  // Default 256 (the library's is 2896): the cost of each of the test block's windows. 128 until
+  // The causal protocol's windows: CausalOptions' defaults and ranges but the longest window,
+  // 256 samples (the library's is 2896), the cost of each of the test block's windows. 128 until
   // 2026-11-28, when one window of 128 samples with the study's 20 realisations cost more than
   // six of 256 down to 128 with one each (docs/demo.md).
-  int causal_window = 256;
-  // Share of each causal window mirrored past its end; CausalOptions' range [0, 1] and default.
-  double causal_mirror = drift::CausalOptions{}.mirror;
-  // Causal windows decomposed per test sample, from causal_window down to half of it, their ends
-  // averaged; CausalOptions' range [1, 16] and default. Each has CausalOptions' default ensemble.
-  int causal_windows = drift::CausalOptions{}.windows;
+  drift::CausalOptions causal{.window = 256};
   // The methods compared: each a method of compensate mode (predict mode runs those it
   // supports), none twice (each saves one model file). Default: all, in drift::AllMethods order.
   std::vector<drift::Method> methods = drift::AllMethods(drift::Mode::kCompensate);
@@ -84,8 +79,8 @@ struct StudyOptions {
   // Default 1.
   std::uint64_t seed = 1;
 
-  // Throws OptionError naming the field (duration_s, ensemble_size, methods) or, for a range the
-  // library owns, the library's name for it (realisations, causal window, mirror and windows).
+  // Throws OptionError naming the field (duration_s, ensemble_size, realisations, methods,
+  // causal.window, ...).
   void Validate() const;
   bool operator==(const StudyOptions&) const = default;
 };

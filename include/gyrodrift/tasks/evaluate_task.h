@@ -31,13 +31,8 @@ struct EvaluateSettings {
   std::string protocol = "both";  // paper | causal | both
   double split = internal::kEvaluationDefaults.split;
   int repeats = internal::kEvaluationDefaults.repeats;
-  int window = internal::kEvaluationDefaults.causal.window;
-  double mirror = internal::kEvaluationDefaults.causal.mirror;  // causal protocol, [0, 1]
-  int windows = internal::kEvaluationDefaults.causal.windows;   // causal protocol, [1, 16]
+  drift::CausalOptions causal = internal::kEvaluationDefaults.causal;  // the causal windows
   int horizon = internal::kEvaluationDefaults.horizon;
-  // Causal protocol: realisations of each window's decomposition, in [0, 100000]; 0 = the models'
-  // ensemble.
-  int causal_ensemble = internal::kEvaluationDefaults.causal.ensemble_size;
 
   // The evaluation's options, validated; `methods_name` names the method list in messages
   // ("methods", or the flag "--methods"). OptionError naming the field (split, repeats, protocol,

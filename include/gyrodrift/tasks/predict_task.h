@@ -19,18 +19,13 @@
 namespace gyrodrift::tasks {
 
 struct PredictSettings {
-  std::string protocol = "causal";                  // drift::Protocol name: causal | paper
-  int window = drift::CausalOptions{}.window;       // causal protocol: trailing window, samples
-  double mirror = drift::CausalOptions{}.mirror;    // causal protocol: share mirrored past its end
-  int windows = drift::CausalOptions{}.windows;     // causal protocol: windows averaged per origin
-  // causal protocol: realisations of each window's decomposition; 0 = the model's ensemble
-  int causal_ensemble = drift::CausalOptions{}.ensemble_size;
-  int horizon = 1;                                  // steps ahead, in [1, 100000]
-  int threads = 0;                                  // [0, 1024]; 0 = every core
-  // OptionError naming the field (protocol, window: [16, 1000000], mirror: [0, 1], windows: [1,
-  // 16], ensemble_size: [0, 100000], threads).
+  std::string protocol = "causal";  // drift::Protocol name: causal | paper
+  drift::CausalOptions causal;      // the causal protocol's windows
+  int horizon = 1;                  // steps ahead, in [1, 100000]
+  int threads = 0;                  // [0, 1024]; 0 = every core
+  // OptionError naming the field (protocol, causal.window, causal.mirror, causal.windows,
+  // causal.ensemble_size, threads).
   void Validate() const;
-  drift::CausalOptions Causal() const;  // the causal protocol's options (unvalidated)
 };
 
 struct PredictResult {

@@ -33,7 +33,7 @@ const StudyResult& LogStudy() {
   static const StudyResult* const result = [] {
     StudyOptions o;
     o.ensemble_size = 4;
-    o.causal_window = 32;
+    o.causal.window = 32;
     o.methods = {drift::Method::kPoly};
     return new StudyResult(RunStudy(o, ChamberLog(), {.threads = 2}));
   }();

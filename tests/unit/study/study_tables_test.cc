@@ -208,7 +208,7 @@ TEST(SettingsTable, RowsSayHowTheRunWasSetUp) {
   s.options.seed = 7;
   s.options.ensemble_size = 12;
   s.options.realisations = 30;
-  s.options.causal_window = 64;
+  s.options.causal.window = 64;
   s.options.duration_s = 7200.0;
   s.run_a.samples = 7200;
   s.drift_options.reference_c = 20.0;

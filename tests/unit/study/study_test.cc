@@ -37,7 +37,7 @@ StudyOptions Quick(std::vector<drift::Method> methods) {
   StudyOptions o;
   o.ensemble_size = 4;
   o.realisations = 20;
-  o.causal_window = 32;
+  o.causal.window = 32;
   o.duration_s = 2 * 3600.0;
   o.methods = std::move(methods);
   return o;
@@ -73,7 +73,7 @@ TEST(StudyOptions, ValidateNamesTheField) {
             }),
             "methods");
   // Ranges the library owns name the study's field that set them.
-  EXPECT_EQ(refused([](StudyOptions& o) { o.causal_window = 4; }), "causal_window");
+  EXPECT_EQ(refused([](StudyOptions& o) { o.causal.window = 4; }), "causal.window");
   EXPECT_EQ(refused([](StudyOptions& o) { o.realisations = 3; }), "realisations");
 }
 

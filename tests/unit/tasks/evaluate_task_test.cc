@@ -28,10 +28,7 @@ TEST(EvaluateTask, DefaultsAreTheLibrarys) {
 TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
   // --window, --mirror, --windows and --causal-ensemble (the study sets the first three).
   EvaluateSettings s = Predict();
-  s.window = 64;
-  s.mirror = 0.25;
-  s.windows = 5;
-  s.causal_ensemble = 7;
+  s.causal = {.window = 64, .ensemble_size = 7, .mirror = 0.25, .windows = 5};
   const drift::EvaluationOptions e = s.Options();
   EXPECT_EQ(e.causal.window, 64);
   EXPECT_EQ(e.causal.mirror, 0.25);
@@ -47,13 +44,13 @@ TEST(EvaluateTask, CausalSettingsReachTheWindowsDecompositions) {
     return "(accepted)";
   };
   EvaluateSettings bad = s;
-  bad.causal_ensemble = -1;
+  bad.causal.ensemble_size = -1;
   EXPECT_EQ(refused(bad), "causal.ensemble_size");
   bad = s;
-  bad.mirror = 1.5;
+  bad.causal.mirror = 1.5;
   EXPECT_EQ(refused(bad), "causal.mirror");
   bad = s;
-  bad.windows = 0;
+  bad.causal.windows = 0;
   EXPECT_EQ(refused(bad), "causal.windows");
 }
 
