@@ -42,8 +42,6 @@ struct DriftArgs {
 // (AddLogOptions) and --quiet to cmd, each flag bound to its drift::FitSettings setting.
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
-// The causal protocol's window settings of predict and evaluate (each a field of a task's
-// settings, the library's drift::CausalOptions field name after `prefix`).
 // Adds --window (-W), --mirror, --windows and --causal-ensemble to cmd, each bound to its field
 // of `causal` (BindSetting: a refusal of causal.window names --window).
 void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal);
