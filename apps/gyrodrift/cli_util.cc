@@ -55,6 +55,23 @@ std::vector<std::pair<std::string, const CLI::Option*>>& Bindings() {
 
 }  // namespace
 
+void RefuseEmptyNumbers(CLI::App& app) {
+  const CLI::Validator not_empty(
+      [](std::string& value) {
+        return value.empty() ? std::string("an empty value is not a number") : std::string();
+      },
+      "", "NOT_EMPTY");
+  for (CLI::App* sub : app.get_subcommands({})) {
+    for (CLI::Option* option : sub->get_options()) {
+      const std::string type = option->get_type_name();
+      if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0 || type.rfind("FLOAT", 0) == 0) {
+        option->check(not_empty);
+      }
+    }
+    RefuseEmptyNumbers(*sub);
+  }
+}
+
 CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_view> names) {
   for (std::string_view name : names) Bindings().emplace_back(name, flag);
   return flag;

@@ -84,6 +84,10 @@ io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* n
 // logged sample after the gap, so they are not causal; "" for a log without made-up rows.
 std::string MadeUpRowsPredictionNote(const std::vector<bool>& logged);
 
+// Refuses an empty value for every numeric option of app's subcommands: CLI11 reads '' (an unset
+// shell variable) as 0, which would set a reference temperature of 0 degC without a word.
+void RefuseEmptyNumbers(CLI::App& app);
+
 // Binds `flag` to the names under which the library refers to what it sets (a
 // drift::FitSettings setting such as "lags", an options field such as "ensemble_size"), where
 // the flag is declared: an OptionError naming one of them is then reported with the flag.

@@ -50,6 +50,10 @@ Record ReadRecord(const EvaluateArgs& a, const io::CsvTable& table, tasks::Evalu
   r.y = table.Column(a.target);
   if (!a.temperature.empty()) {
     SelectedColumns t = ReadColumns(table, a.temperature, "--temperature");
+    // The target as a model input would score the target against itself (fit refuses it too).
+    if (std::find(t.names.begin(), t.names.end(), in->target_column) != t.names.end()) {
+      throw UsageError("--temperature = " + a.temperature + ": must differ from --target");
+    }
     in->temperature_column = t.joined;
     r.temperature = std::move(t.values);
     r.temperature_names = std::move(t.names);
@@ -85,6 +89,12 @@ void Run(const EvaluateArgs& a) {
     in.truth_column = ColumnName(table, a.truth);
     if (in.truth_column == in.target_column)
       throw UsageError("--truth = " + a.truth + ": must differ from --target");
+    const std::vector<std::string>& inputs = record.temperature_names;
+    if (std::find(inputs.begin(), inputs.end(), in.truth_column) != inputs.end()) {
+      throw UsageError("--truth = " + a.truth +
+                       ": must differ from --temperature (the models "
+                       "would read the truth they are scored against)");
+    }
     record.truth = table.Column(a.truth);
   }
   tasks::EvaluateRun run;

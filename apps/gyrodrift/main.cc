@@ -79,6 +79,7 @@ int main(int argc, char** argv) {
   std::sort(commands.begin(), commands.end(),
             [](const auto& a, const auto& b) { return a.order < b.order; });
   for (auto& command : commands) command.setup(app);
+  gyrodrift::cli::RefuseEmptyNumbers(app);
   // A misspelt command would otherwise read "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

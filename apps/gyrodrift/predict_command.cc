@@ -15,6 +15,7 @@
 #include "gyrodrift/drift/drift_model.h"
 #include "gyrodrift/io/csv.h"
 #include "gyrodrift/io/files.h"
+#include "gyrodrift/io/gyro_log.h"
 #include "gyrodrift/io/model_file.h"
 #include "gyrodrift/tasks/predict_task.h"
 #include "progress.h"
@@ -41,6 +42,9 @@ void Run(const PredictArgs& a) {
   std::vector<bool> logged;
   const io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {}, &logged);
   notes += MadeUpRowsPredictionNote(logged);
+  std::string rate_how;
+  const double log_hz = io::ResolveSampleRate(table, 0.0, &rate_how);
+  tasks::RequirePredictRate(loaded, a.model, a.input, log_hz, rate_how);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
   Eigen::VectorXd temperature;

@@ -180,7 +180,9 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
                       std::to_string(w.cols()) + ": it must have one row per sample (" +
                       std::to_string(n) + ") and at least one realisation column");
     }
-    if (!w.allFinite()) throw DataError("supplied noise contains a non-finite value");
+    for (Eigen::Index j = 0; j < w.cols(); ++j) {
+      RequireFiniteSignal("supplied noise column " + std::to_string(j + 1), w.col(j), 1);
+    }
     for (Eigen::Index j = 0; UsesNoiseEmds(options.method) && j < w.cols(); ++j) {
       // The CEEMDAN family scales each realisation's EMD modes to unit variance: a constant one
       // has no spread, and its stages would divide by a standard deviation of rounding error

@@ -59,7 +59,16 @@ int FeatureOptions::NumThermalFeatures() const {
 
 void FeatureOptions::Validate() const {
   if (lags < 1 || lags > 256) ThrowOption("lags", std::to_string(lags), "an integer in [1, 256]");
-  for (double tau : time_constants_s) RequireInRange("time_constants_s", tau, 1.0, 1e6);
+  for (size_t i = 0; i < time_constants_s.size(); ++i) {
+    RequireInRange("time_constants_s", time_constants_s[i], 1.0, 1e6);
+    // A repeat would add the same lag twice: two identical columns.
+    for (size_t j = 0; j < i; ++j) {
+      if (time_constants_s[j] == time_constants_s[i]) {
+        ThrowOption("time_constants_s", FormatValue(time_constants_s[i]),
+                    "given once (a list without repeats)");
+      }
+    }
+  }
   if (time_constants_s.size() > 32) {
     ThrowOption("time_constants_s", std::to_string(time_constants_s.size()) + " values",
                 "at most 32");

@@ -134,7 +134,7 @@ DriftOptions MakeDriftOptions(const FitSettings& s) {
     o.linear_compensation = false;
   }
   if (!s.hidden.empty()) {
-    const int hidden = AutoOrInteger("hidden", s.hidden, 1, 100000);
+    const int hidden = AutoOrInteger("hidden", s.hidden, 1, elm::kMaxHiddenUnits);
     if (hidden > 0) {
       if (!ElmBased(o.method)) {
         ThrowOption("hidden", s.hidden,

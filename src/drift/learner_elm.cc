@@ -63,6 +63,17 @@ std::unique_ptr<Learner> FitElm(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const LearnerOptions& options, int threads) {
   elm::ElmOptions elm_options = options.elm;
   elm_options.seed = options.seed;
+  // A fixed count beyond one unit per row only fits the rows exactly, at L^2 cost (the automatic
+  // choice keeps to its candidates).
+  if (elm_options.selection == elm::Selection::kFixed && elm_options.hidden_units > x.rows()) {
+    throw DataError("hidden = " + std::to_string(elm_options.hidden_units) +
+                    ": more ELM hidden "
+                    "units than the " +
+                    std::to_string(x.rows()) +
+                    " rows it is fitted on (at "
+                    "most " +
+                    std::to_string(x.rows()) + ", or auto)");
+  }
   elm::ElmFit fit = elm::Fit(x, y, elm_options, Execution{.threads = threads});
   return std::make_unique<ElmLearner>(std::move(fit.model), static_cast<int>(x.rows()),
                                       fit.report.train_rmse);
@@ -86,7 +97,7 @@ std::unique_ptr<Learner> LoadElm(const ParameterReader& reader) {
     reader.Fail(e.what());
   }
   model.options.activation = model.activation;
-  if (reader.Integer("hidden_units", 1, 100000) != l) {
+  if (reader.Integer("hidden_units", 1, elm::kMaxHiddenUnits) != l) {
     reader.Fail("hidden_units = " + FormatShort(reader.Scalar("hidden_units")) + " but " +
                 "input_weights has " + std::to_string(l) + " columns");
   }

@@ -38,8 +38,6 @@ constexpr std::array<std::pair<Selection, std::string_view>, 2> kSelections{{
     {Selection::kAuto, "auto"},
 }};
 
-constexpr int kMaxHiddenUnits = 100000;
-
 std::string FormatShort(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.4g", value);

@@ -39,6 +39,11 @@ namespace {
 
 // A gap: a step of this many median steps or more, so at least one sample is missing.
 constexpr double kGapSteps = 1.5;
+// The most samples gaps are filled with, as a multiple of the logged rows and in all: a
+// duty-cycled log of 5 s in every 300 s fills 59 per logged row; 10,000 rows with a gap of 1e5
+// samples after every third asked for 3e8 rows and ended in "out of memory".
+constexpr double kMostFilledPerLoggedRow = 100.0;
+constexpr double kMostFilledSamples = 1e8;
 
 // The table's time axis (CsvReadOptions::time_axis) when every step of it is counted and > 0:
 // what the checks and the notes can use instead of the time_s column.
@@ -245,6 +250,16 @@ Gaps FindGaps(const std::string& path, const Eigen::VectorXd& t, const LogOption
                             spell(GapPolicy::kSplit))));
     }
     gaps.insert.push_back({i, static_cast<int>(samples)});
+  }
+  const double rows = static_cast<double>(t.size());
+  const auto filled = static_cast<double>(gaps.missing);
+  if (options.gaps != GapPolicy::kSplit &&
+      (filled > kMostFilledPerLoggedRow * rows || filled > kMostFilledSamples)) {
+    throw DataError(fmt::format(
+        "{}: time_s has {} gaps that would be filled with {:g} samples, {:.3g} per logged row "
+        "(at most {:g} per row and {:g} in all): split the log at its gaps ({})",
+        path, gaps.insert.size(), filled, filled / rows, kMostFilledPerLoggedRow,
+        kMostFilledSamples, spell(GapPolicy::kSplit)));
   }
   return gaps;
 }

@@ -129,6 +129,23 @@ void CheckLog(const std::vector<io::LoadedModel>& axes, const TaskLog& log,
                      model_path + " holds " + std::to_string(axes.size()) +
                      " axes; a true drift column scores a one-axis model");
   }
+  // The truth is what the estimate is scored against: the measured target, or a temperature the
+  // estimate is made of, would score the model against its own input.
+  if (!settings.truth.empty()) {
+    const io::CsvTable& table = log.table;
+    const std::string truth =
+        table.header()[static_cast<size_t>(table.ResolveColumn(settings.truth))];
+    const io::LoadedModel& axis = axes.front();
+    std::vector<std::string> inputs{axis.info.target_column};
+    if (axis.model.uses_temperature()) {
+      for (const std::string& c : SplitColumns(axis.info.temperature_column)) inputs.push_back(c);
+    }
+    if (std::find(inputs.begin(), inputs.end(), truth) != inputs.end()) {
+      throw UsageError((SpeltAsFlags(o) ? "--truth = " : "truth = ") + settings.truth +
+                       ": must be another column than the model's target and temperatures (" +
+                       truth + " is one of them)");
+    }
+  }
 }
 
 }  // namespace

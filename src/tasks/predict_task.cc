@@ -1,5 +1,8 @@
 #include "gyrodrift/tasks/predict_task.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <utility>
 
 #include "gyrodrift/common/check.h"
@@ -20,6 +23,19 @@ void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_
                      " is a compensate-mode model: use 'gyrodrift compensate' (predict "
                      "needs a model fitted with --mode predict)");
   }
+}
+
+void RequirePredictRate(const io::LoadedModel& loaded, const std::string& model_path,
+                        const std::string& log_path, double log_hz, const std::string& how) {
+  const double model_hz = loaded.model.options.features.rate_hz;
+  if (how == "default" || std::abs(log_hz / model_hz - 1.0) <= 0.01) return;
+  throw DataError(fmt::format(
+      "{} is sampled at {:g} Hz (from its time_s), {} was fitted at {:g} Hz: its lags and "
+      "windows, counted in samples, would span {:.3g} times {} time than it learnt (resample "
+      "the log to {:g} Hz, or fit a model on a log at {:g} Hz)",
+      log_path, log_hz, model_path, model_hz,
+      log_hz > model_hz ? log_hz / model_hz : model_hz / log_hz,
+      log_hz > model_hz ? "less" : "more", model_hz, log_hz));
 }
 
 PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y,

@@ -173,6 +173,7 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
   no_temp.replace(0, no_temp.find('\n') + 1, "time_s,rate_dph,temp_c,drift_dph\n");
   io::WriteFileAtomically(Dir() + "/no_temp.csv", no_temp);
   io::WriteFileAtomically(Dir() + "/short.csv", test::ThermalLogCsv(12, 4));
+  io::WriteFileAtomically(Dir() + "/ten_hz.csv", test::ThermalLogCsv(200, 4, 0.1));
   io::WriteFileAtomically(Dir() + "/nan.csv", "rate_dph\n1\n2\n3\n4\n5\nnan\n7\n8\n");
   std::string damaged = io::ReadTextFile(Dir() + "/ms.json");
   const size_t digit = damaged.find_first_of("123456789", damaged.find("\"output_weights\""));
@@ -201,6 +202,9 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"temperature column missing", "predict %DIR%/elm.json %DIR%/no_temp.csv", 3,
        "model needs column 'temperature_c' (trained with --temperature temperature_c); "},
       {"too short", "predict %DIR%/ms.json %DIR%/short.csv", 3, "needs more than 16"},
+      {"another sample rate", "predict %DIR%/ms.json %DIR%/ten_hz.csv", 3,
+       "was fitted at 1 Hz: its lags and windows, counted in samples, would span 10 times less "
+       "time"},
       {"file without temperature", "predict %DIR%/elm.json %DIR%/nan.csv", 3,
        "model needs column 'temperature_c'"},
       {"nan target", "predict %DIR%/ms.json %DIR%/nan.csv", 3, "data row 6"},

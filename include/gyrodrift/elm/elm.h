@@ -69,8 +69,13 @@ enum class Selection {
 std::string_view ToString(Selection selection);
 Selection SelectionFromString(std::string_view name);  // "fixed", "auto"; throws UsageError
 
+// The most hidden units an ELM takes: its Gram matrix holds 8 L^2 bytes, 800 MB here (100000,
+// the bound until 2026-11-28, asked for 80 GB and ended in "out of memory").
+inline constexpr int kMaxHiddenUnits = 10000;
+
 struct ElmOptions {
-  // Number of hidden units L, in [1, 100000]. With selection = kAuto: the largest candidate.
+  // Number of hidden units L, in [1, kMaxHiddenUnits]. With selection = kAuto: the largest
+  // candidate.
   // 20 per MS-ELM sub-model is the paper's default.
   int hidden_units = 20;
   Activation activation = Activation::kSigmoid;

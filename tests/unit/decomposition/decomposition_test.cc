@@ -276,6 +276,15 @@ TEST(Decomposition, SuppliedNoiseIsCheckedAndItsColumnsAreTheEnsemble) {
   Eigen::MatrixXd bad = w;
   bad(5, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(DecomposeWithNoise(x, bad, o), DataError);
+  // A magnitude no instrument logs, refused as in the signal (1e200 gave inf IMFs and exit 0).
+  bad(5, 1) = 1e200;
+  try {
+    DecomposeWithNoise(x, bad, o);
+    ADD_FAILURE() << "accepted a noise sample of 1e200";
+  } catch (const DataError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("supplied noise column 2 sample 6 is 1e+200", 0), 0u)
+        << e.what();
+  }
   // A constant realisation (zero or not) cannot be scaled to unit variance: refused by column,
   // for every method of the CEEMDAN family, before any work (it used to run without end). EEMD
   // adds the noise unscaled and takes it (eemd_test: a zero member is plain EMD).

@@ -431,7 +431,7 @@ TEST(Elm, BadOptionsAndDataThrowClearErrors) {
   const Data d = NoisySine(50, 0.1, 121);
   auto fit_with = [&](ElmOptions o) { return [&d, o] { Fit(d.x, d.t, o); }; };
   EXPECT_EQ(ErrorOf<UsageError>(fit_with({.hidden_units = 0})),
-            "hidden_units = 0: must be an integer in [1, 100000]");
+            "hidden_units = 0: must be an integer in [1, 10000]");
   EXPECT_EQ(ErrorOf<UsageError>(fit_with({.ridge_c = 0.0})),
             "ridge_c = 0: must be > 0 (inf = no regularisation, solver qr)");
   EXPECT_EQ(ErrorOf<UsageError>(fit_with({.ridge_c = -1.0})),

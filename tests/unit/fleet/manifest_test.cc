@@ -109,7 +109,7 @@ TEST_F(ManifestTest, EveryFitSettingIsAKeyThroughItsOneMapping) {
             file + "1: lags = 4: must be left unset in mode 'compensate' (a compensate-mode model "
                    "sees temperature only; lags apply to mode 'predict')");
   EXPECT_EQ(Refusal("method = \"ms-elm\"\nhidden = 0\n"),
-            file + "2: hidden = '0': must be auto or an integer in [1, 100000]");
+            file + "2: hidden = '0': must be auto or an integer in [1, 10000]");
   for (const char* fleet_set : {"threads = 2\n", "mode = \"predict\"\n",
                                 "has_temperature = true\n", "reference_temperature = 20\n"}) {
     EXPECT_NE(Refusal(fleet_set).find("unknown key"), std::string::npos) << fleet_set;
