@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -87,7 +88,17 @@ const RegisterCommand kRegister("compensate", 70, [](CLI::App& app) {
               {"drift_window_s"});
   BindSetting(cmd->add_option("--rate-hz", args->settings.rate_hz,
                               "the log's sample rate, Hz, where its time_s does not give it (as "
-                              "fit --rate-hz); it must be the model's (default: from time_s)"),
+                              "fit --rate-hz); it must be the model's (default: from time_s)")
+                  // 0 is the settings' "not given": typed, it is a rate out of range.
+                  ->check(CLI::Validator(
+                      [](std::string& value) {
+                        return std::strtod(value.c_str(), nullptr) == 0.0
+                                   ? std::string(
+                                         "0 is no sample rate (leave the flag out to read "
+                                         "it from time_s)")
+                                   : std::string();
+                      },
+                      "", "NONZERO")),
               {"rate_hz"});
   cmd->add_option("--truth", args->settings.truth,
                   "column of the true drift (e.g. the simulator's drift_dph): also report the "

@@ -55,6 +55,12 @@ void RequireInputSettings(const DemoSettings& s) {
     throw UsageError(fmt::format("{} needs {} (compensate mode models drift from temperature)",
                                  Spell(s, "input"), Spell(s, "temperature")));
   }
+  if (s.duration_s != DemoSettings{}.duration_s) {
+    throw UsageError(
+        fmt::format("{} sets the simulated runs' length: a log given by {} is "
+                    "studied whole",
+                    Spell(s, "duration"), Spell(s, "input")));
+  }
   if (s.log.gaps == io::GapPolicy::kSplit || s.log.gaps == io::GapPolicy::kCarry) {
     throw UsageError(fmt::format(
         "{}: demo needs one uniform record (the study decomposes and splits one record): use {} "

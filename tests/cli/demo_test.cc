@@ -162,6 +162,8 @@ TEST(DemoCli, BadOptionsGiveOneLineAndTheRightExitCode) {
       {"demo --input " + csv + " --temperature temp", 2, "--target"},
       {"demo --input " + csv + " --target rate", 2, "--temperature"},
       {"demo --target rate", 2, "--input"},
+      {"demo --input " + csv + " --target rate --temperature temp --duration 2h", 2,
+       "--duration sets the simulated runs' length: a log given by --input is studied whole"},
       {"demo --input " + dir + "/missing.csv --target a --temperature b", 2, "no such file"},
       {"demo --duration 0s", 2, "--duration"},
       {"demo --duration '8 hours'", 2, "--duration"},
