@@ -28,6 +28,7 @@ struct PredictArgs {
   std::string input;
   std::string output;
   tasks::PredictSettings settings;
+  double rate_hz = 0.0;  // --rate-hz: the log's rate where its time_s is wrong; 0 = from time_s
   LogArgs log;  // --gaps, --delimiter
   bool quiet = false;
 };
@@ -43,7 +44,7 @@ void Run(const PredictArgs& a) {
   const io::CsvTable table = ReadLog(a.input, a.log, &notes, nullptr, {}, &logged);
   notes += MadeUpRowsPredictionNote(logged);
   std::string rate_how;
-  const double log_hz = io::ResolveSampleRate(table, 0.0, &rate_how);
+  const double log_hz = io::ResolveSampleRate(table, a.rate_hz, &rate_how);
   tasks::RequirePredictRate(loaded, a.model, a.input, log_hz, rate_how);
   RequireModelColumns(loaded, table);
   const Eigen::VectorXd y = table.Column(loaded.info.target_column);
@@ -114,6 +115,10 @@ const RegisterCommand kRegister("predict", 60, [](CLI::App& app) {
   BindSetting(cmd->add_option("--protocol", args->settings.protocol, "causal|paper")->capture_default_str(),
               {"protocol"});
   AddCausalWindowOptions(cmd, &args->settings.causal);
+  cmd->add_option("--rate-hz", args->rate_hz,
+                  "the log's sample rate, Hz, where its time_s does not give it; it must be the "
+                  "model's (default: from time_s)")
+      ->check(CLI::PositiveNumber);
   BindSetting(
       cmd->add_option("--horizon,-H", args->settings.horizon,
                       "steps ahead: predict y[t] from the samples up to t-H (recursive for H > 1)")

@@ -63,17 +63,6 @@ std::unique_ptr<Learner> FitElm(const Eigen::Ref<const Eigen::MatrixXd>& x,
                                 const LearnerOptions& options, int threads) {
   elm::ElmOptions elm_options = options.elm;
   elm_options.seed = options.seed;
-  // A fixed count beyond one unit per row only fits the rows exactly, at L^2 cost (the automatic
-  // choice keeps to its candidates).
-  if (elm_options.selection == elm::Selection::kFixed && elm_options.hidden_units > x.rows()) {
-    throw DataError("hidden = " + std::to_string(elm_options.hidden_units) +
-                    ": more ELM hidden "
-                    "units than the " +
-                    std::to_string(x.rows()) +
-                    " rows it is fitted on (at "
-                    "most " +
-                    std::to_string(x.rows()) + ", or auto)");
-  }
   elm::ElmFit fit = elm::Fit(x, y, elm_options, Execution{.threads = threads});
   return std::make_unique<ElmLearner>(std::move(fit.model), static_cast<int>(x.rows()),
                                       fit.report.train_rmse);

@@ -39,10 +39,8 @@ namespace {
 
 // A gap: a step of this many median steps or more, so at least one sample is missing.
 constexpr double kGapSteps = 1.5;
-// The most samples gaps are filled with, as a multiple of the logged rows and in all: a
-// duty-cycled log of 5 s in every 300 s fills 59 per logged row; 10,000 rows with a gap of 1e5
-// samples after every third asked for 3e8 rows and ended in "out of memory".
-constexpr double kMostFilledPerLoggedRow = 100.0;
+// The most samples gaps are filled with in all, as many as the longest log `allan` takes: 10,000
+// rows with a gap of 1e5 samples after every third asked for 3e8 and ended in "out of memory".
 constexpr double kMostFilledSamples = 1e8;
 
 // The table's time axis (CsvReadOptions::time_axis) when every step of it is counted and > 0:
@@ -221,9 +219,15 @@ struct Gaps {
   long missing = 0;
 };
 
+// `record_starts` and `takes_logged`: whether the caller takes records (split) and logged rows
+// (carry), so that a refusal offers only the ways out it has.
 Gaps FindGaps(const std::string& path, const Eigen::VectorXd& t, const LogOptions& options,
-              std::vector<Eigen::Index>* record_starts) {
+              std::vector<Eigen::Index>* record_starts, bool takes_logged) {
   auto spell = [&options](GapPolicy p) { return SpellGaps(options, p); };
+  // Only a caller that takes records (record_starts) can split the log itself.
+  const std::string split = record_starts
+                                ? "split the log at its gaps (" + spell(GapPolicy::kSplit) + ")"
+                                : std::string("split the file at its gaps into logs of their own");
   Gaps gaps{.median = MedianStep(t), .insert = {}, .missing = 0};
   for (Eigen::Index i = 0; i + 1 < t.size(); ++i) {
     const double step = t[i + 1] - t[i];
@@ -242,24 +246,24 @@ Gaps FindGaps(const std::string& path, const Eigen::VectorXd& t, const LogOption
           "{:g} s): {}",
           path, step, i + 2, samples, gaps.median,
           options.gaps == GapPolicy::kError
-              ? fmt::format("fill gaps by linear interpolation ({}, or {} to fit on the logged "
-                            "rows only) or split the log into records at its gaps ({})",
-                            spell(GapPolicy::kInterpolate), spell(GapPolicy::kCarry),
-                            spell(GapPolicy::kSplit))
-              : fmt::format("too long to fill by interpolation: split the log at its gaps ({})",
-                            spell(GapPolicy::kSplit))));
+              ? fmt::format(
+                    "fill gaps by linear interpolation ({}{}){}", spell(GapPolicy::kInterpolate),
+                    takes_logged
+                        ? ", or " + spell(GapPolicy::kCarry) + " to fit on the logged rows only"
+                        : std::string(),
+                    record_starts ? fmt::format(" or split the log into records at its "
+                                                "gaps ({})",
+                                                spell(GapPolicy::kSplit))
+                                  : std::string())
+              : "too long to fill by interpolation: " + split));
     }
     gaps.insert.push_back({i, static_cast<int>(samples)});
   }
-  const double rows = static_cast<double>(t.size());
   const auto filled = static_cast<double>(gaps.missing);
-  if (options.gaps != GapPolicy::kSplit &&
-      (filled > kMostFilledPerLoggedRow * rows || filled > kMostFilledSamples)) {
+  if (options.gaps != GapPolicy::kSplit && filled > kMostFilledSamples) {
     throw DataError(fmt::format(
-        "{}: time_s has {} gaps that would be filled with {:g} samples, {:.3g} per logged row "
-        "(at most {:g} per row and {:g} in all): split the log at its gaps ({})",
-        path, gaps.insert.size(), filled, filled / rows, kMostFilledPerLoggedRow,
-        kMostFilledSamples, spell(GapPolicy::kSplit)));
+        "{}: time_s has {} gaps that would be filled with {:g} samples (at most {:g}): {}", path,
+        gaps.insert.size(), filled, kMostFilledSamples, split));
   }
   return gaps;
 }
@@ -339,7 +343,7 @@ CsvTable ReadLogRows(const std::string& path, const LogOptions& options, std::st
   const Eigen::VectorXd& t = *time;
   RequireIncreasing(path, t);
   if (t.size() < 3) return table;
-  const Gaps gaps = FindGaps(path, t, options, record_starts);
+  const Gaps gaps = FindGaps(path, t, options, record_starts, logged != nullptr);
   const std::string note = GapNote(gaps, options, t.size(),
                                    record_starts ? record_starts->size() + 1 : 1);
   if (gap_note && !note.empty()) *gap_note += (gap_note->empty() ? "" : "\n") + note;

@@ -8,6 +8,7 @@
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/common/execution.h"
+#include "gyrodrift/tasks/task_log.h"
 
 namespace gyrodrift::tasks {
 
@@ -28,14 +29,14 @@ void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_
 void RequirePredictRate(const io::LoadedModel& loaded, const std::string& model_path,
                         const std::string& log_path, double log_hz, const std::string& how) {
   const double model_hz = loaded.model.options.features.rate_hz;
-  if (how == "default" || std::abs(log_hz / model_hz - 1.0) <= 0.01) return;
+  const double ratio = log_hz / model_hz;
+  if (how == "default" || std::abs(ratio - 1.0) <= 0.01) return;
   throw DataError(fmt::format(
-      "{} is sampled at {:g} Hz (from its time_s), {} was fitted at {:g} Hz: its lags and "
-      "windows, counted in samples, would span {:.3g} times {} time than it learnt (resample "
-      "the log to {:g} Hz, or fit a model on a log at {:g} Hz)",
-      log_path, log_hz, model_path, model_hz,
-      log_hz > model_hz ? log_hz / model_hz : model_hz / log_hz,
-      log_hz > model_hz ? "less" : "more", model_hz, log_hz));
+      "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its lags and windows, counted in "
+      "samples, would span {:.3g} times {} time than it learnt (resample the log to {:g} Hz, fit "
+      "a model on a log at {:g} Hz, or give --rate-hz if time_s is wrong)",
+      log_path, log_hz, RateSourceText(how, true), model_path, model_hz,
+      ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "less" : "more", model_hz, log_hz));
 }
 
 PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y,

@@ -253,6 +253,9 @@ TEST_F(CompensateCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"nan temperature", "compensate %DIR%/ms.json %DIR%/nan.csv", 3, "data row 2"},
       {"unknown truth column", "compensate %DIR%/ms.json %DIR%/test.csv --truth truth", 2,
        "column 'truth' not found"},
+      {"truth is a temperature", "compensate %DIR%/ms.json %DIR%/test.csv --truth temperature_c", 2,
+       "--truth = temperature_c: must be another column than the model's target and "
+       "temperatures"},
       {"zero rate", "compensate %DIR%/ms.json %DIR%/test.csv --rate-hz 0", 2,
        "--rate-hz: 0 is no sample rate"},
       {"truth is the target", "compensate %DIR%/ms.json %DIR%/test.csv --truth rate_dph", 2,

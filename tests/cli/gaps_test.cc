@@ -139,6 +139,10 @@ TEST_F(GapsCli, EveryCommandTakesTheFourModesAndSpellsTheFlagAsTyped) {
                            "(--gaps interpolate, or --gaps carry to fit on the logged rows only) "
                            "or split the log into records at its gaps (--gaps split)",
                            Dir() + "/e.json", "a gap refused");
+  // A command that takes neither records nor logged rows offers interpolation alone.
+  r = test::RunCli("decompose " + Path("holed.csv") + " -c rate_dph -o " + Path("d.csv"));
+  test::ExpectCleanFailure(r, 3, "): fill gaps by linear interpolation (--gaps interpolate)\n",
+                           Dir() + "/d.csv", "a gap refused by decompose");
   // Commands that analyse one uniform record refuse split and carry in one line, naming
   // themselves and the way out.
   for (const char* mode : {"split", "carry"}) {

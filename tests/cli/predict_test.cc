@@ -202,6 +202,8 @@ TEST_F(PredictCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"temperature column missing", "predict %DIR%/elm.json %DIR%/no_temp.csv", 3,
        "model needs column 'temperature_c' (trained with --temperature temperature_c); "},
       {"too short", "predict %DIR%/ms.json %DIR%/short.csv", 3, "needs more than 16"},
+      {"another sample rate given", "predict %DIR%/ms.json %DIR%/test.csv --rate-hz 2", 3,
+       "(given by --rate-hz)"},
       {"another sample rate", "predict %DIR%/ms.json %DIR%/ten_hz.csv", 3,
        "was fitted at 1 Hz: its lags and windows, counted in samples, would span 10 times less "
        "time"},

@@ -37,10 +37,10 @@ struct PredictResult {
 // UsageError naming `model_path` unless `loaded` is a predict-mode model.
 void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_path);
 
-// DataError naming the log and the model when the log's time_s gives a sample rate more than 1 %
-// off the model's (`log_hz` and `how` from io::ResolveSampleRate; a rate nobody stated, "default",
-// is not checked): the model's lags, decomposition and thermal lags count samples, so they would
-// span another stretch of time than the model learnt, silently.
+// DataError naming the log and the model when the log's sample rate (`log_hz` and `how` from
+// io::ResolveSampleRate: --rate-hz or time_s; a rate nobody stated, "default", is not checked) is
+// more than 1 % off the model's: the model's lags, decomposition and thermal lags count samples, so
+// they would span another stretch of time than the model learnt, silently.
 void RequirePredictRate(const io::LoadedModel& loaded, const std::string& model_path,
                         const std::string& log_path, double log_hz, const std::string& how);
 

@@ -142,9 +142,13 @@ TEST(GyroLog, MostlyMadeUpRowsAreAWarningThatSuggestsCarry) {
   EXPECT_NE(note.find("--gaps carry fits, scores and reports on the 10 logged rows only"),
             std::string::npos)
       << note;
-  // The error policy names the choices the same way.
+  // The error policy names the choices the same way, those the caller takes: records and logged
+  // rows here, neither for a caller that passes no place for them.
+  const LogOptions error{GapPolicy::kError, Delimiter::kAuto, "--gaps"};
+  std::vector<Eigen::Index> starts;
+  std::vector<bool> logged;
   try {
-    ReadLog(path, {GapPolicy::kError, Delimiter::kAuto, "--gaps"});
+    ReadLog(path, error, nullptr, &starts, {}, &logged);
     ADD_FAILURE() << "a gap was accepted";
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("(--gaps interpolate, or --gaps carry to fit on the "
@@ -152,6 +156,14 @@ TEST(GyroLog, MostlyMadeUpRowsAreAWarningThatSuggestsCarry) {
               std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find("(--gaps split)"), std::string::npos) << e.what();
+  }
+  try {
+    ReadLog(path, error);
+    ADD_FAILURE() << "a gap was accepted";
+  } catch (const DataError& e) {
+    const std::string what = e.what();
+    const std::string only = "fill gaps by linear interpolation (--gaps interpolate)";
+    EXPECT_EQ(what.substr(what.size() - only.size()), only) << what;
   }
   EXPECT_EQ(SpellGaps({}, GapPolicy::kSplit), "gaps = 'split'");
 }
