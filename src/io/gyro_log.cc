@@ -39,8 +39,8 @@ namespace {
 
 // A gap: a step of this many median steps or more, so at least one sample is missing.
 constexpr double kGapSteps = 1.5;
-// The most samples gaps are filled with in all, as many as the longest log `allan` takes: 10,000
-// rows with a gap of 1e5 samples after every third asked for 3e8 and ended in "out of memory".
+// The most samples gaps are filled with in all (800 MB a column): 10,000 rows with a gap of 1e5
+// samples after every third asked for 3e8 and ended in "out of memory".
 constexpr double kMostFilledSamples = 1e8;
 
 // The table's time axis (CsvReadOptions::time_axis) when every step of it is counted and > 0:
