@@ -16,6 +16,7 @@
 
 #include "cli_util.h"
 #include "command.h"
+#include "drift_cli.h"
 #include "gyrodrift/common/check.h"
 #include "gyrodrift/common/error.h"
 #include "gyrodrift/study/demo.h"
@@ -100,23 +101,7 @@ void AddAdvancedOptions(CLI::App* cmd, DemoArgs& a) {
           ->capture_default_str()
           ->group("Advanced"),
       {"realisations"});
-  BindSetting(cmd->add_option("--window", a.settings.causal.window,
-                              "advanced: longest trailing window of the causal protocol, samples")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal.window"});
-  BindSetting(cmd->add_option("--mirror", a.settings.causal.mirror,
-                              "advanced: share of each causal window mirrored past its end, "
-                              "in [0, 1]")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal.mirror"});
-  BindSetting(cmd->add_option("--windows", a.settings.causal.windows,
-                              "advanced: causal windows decomposed per test sample, from --window "
-                              "down to half of it, their ends averaged, in [1, 16]")
-                  ->capture_default_str()
-                  ->group("Advanced"),
-              {"causal.windows"});
+  AddCausalWindowOptions(cmd, &a.settings.causal, "Advanced");
   BindSetting(cmd->add_option("--methods", a.settings.methods,
                               "advanced: all, or a list such as ms-elm,elm,poly")
                   ->capture_default_str()
@@ -138,8 +123,8 @@ const RegisterCommand kRegister("demo", 5, [](CLI::App& app) {
       "compensate_table.csv, predict_estimates.csv, compensate_estimates.csv, allan.csv,\n"
       "noise_terms.csv, models/<method>_compensate.json, demo.json and report.html (open it in a\n"
       "browser; it works offline). The study's size options (--duration, --ensemble, --window,\n"
-      "--windows, --realisations, --methods) trade fidelity for time; docs/demo.md lists the\n"
-      "defaults' cost.");
+      "--windows, --causal-ensemble, --realisations, --methods) trade fidelity for time;\n"
+      "docs/demo.md lists the defaults' cost.");
   cmd->add_option("-o,--output", args->settings.output, "output folder (created if needed)")
       ->capture_default_str();
   cmd->add_option("--input", args->settings.input,

@@ -133,26 +133,27 @@ void AddDriftOptions(CLI::App* cmd, DriftArgs* a, bool split_records) {
   cmd->add_flag("--quiet,-q", a->quiet, "print nothing on success");
 }
 
-void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal) {
-  BindSetting(cmd->add_option("--window,-W", causal->window,
-                              "causal protocol: longest trailing window W, samples")
-                  ->capture_default_str(),
-              {"causal.window"});
-  BindSetting(cmd->add_option("--mirror", causal->mirror,
-                              "causal protocol: share of the window mirrored past its end before "
-                              "its decomposition, in [0, 1]")
-                  ->capture_default_str(),
-              {"causal.mirror"});
-  BindSetting(cmd->add_option("--windows", causal->windows,
-                              "causal protocol: windows decomposed per origin, from W down to W/2, "
-                              "their ends averaged, in [1, 16]")
-                  ->capture_default_str(),
-              {"causal.windows"});
-  BindSetting(cmd->add_option("--causal-ensemble", causal->ensemble_size,
-                              "causal protocol: realisations of each window's decomposition, in "
-                              "[0, 100000]; 0 = the model's ensemble")
-                  ->capture_default_str(),
-              {"causal.ensemble_size"});
+void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal, const std::string& group) {
+  const auto add = [cmd, &group](const std::string& flags, auto& field, const std::string& help,
+                                 const char* setting) {
+    CLI::Option* option = cmd->add_option(flags, field, help)->capture_default_str();
+    if (!group.empty()) option->group(group);
+    BindSetting(option, {setting});
+  };
+  add("--window,-W", causal->window, "causal protocol: longest trailing window W, samples",
+      "causal.window");
+  add("--mirror", causal->mirror,
+      "causal protocol: share of each window mirrored past its end before its decomposition, in "
+      "[0, 1]",
+      "causal.mirror");
+  add("--windows", causal->windows,
+      "causal protocol: windows decomposed per origin (test sample), from W down to W/2, their "
+      "ends averaged, in [1, 16]",
+      "causal.windows");
+  add("--causal-ensemble", causal->ensemble_size,
+      "causal protocol: realisations of each window's decomposition, in [0, 100000]; 0 = the "
+      "model's ensemble",
+      "causal.ensemble_size");
 }
 
 drift::FitSettings Settings(const DriftArgs& a, const std::string& method) {

@@ -43,8 +43,10 @@ struct DriftArgs {
 void AddDriftOptions(CLI::App* cmd, DriftArgs* args, bool split_records);
 
 // Adds --window (-W), --mirror, --windows and --causal-ensemble to cmd, each bound to its field
-// of `causal` (BindSetting: a refusal of causal.window names --window).
-void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal);
+// of `causal` (BindSetting: a refusal of causal.window names --window), under the help group
+// `group` when one is given (the demo's "Advanced").
+void AddCausalWindowOptions(CLI::App* cmd, drift::CausalOptions* causal,
+                            const std::string& group = "");
 
 // The settings of the arguments with `method` ("auto" or a method name), before any file is
 // read (drift::MakeDriftOptions maps them; the sample rate is settled later by

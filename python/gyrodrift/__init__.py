@@ -551,15 +551,16 @@ def calibrate(manifest_path, output_dir, *, force=False, threads=0, progress=Non
 
 def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, rate_hz=None,
          units="dph", duration=28800.0, ensemble=20, realisations=20, window=256, mirror=0.5,
-         windows=6, methods="all", seed=1, threads=0, gaps="error", progress=None):
+         windows=6, causal_ensemble=1, methods="all", seed=1, threads=0, gaps="error",
+         progress=None):
     """The whole study of ``gyrodrift demo`` (docs/demo.md): simulate a navigation-grade FOG (or
     study ``input``, a log of your own: its ``target`` and ``temperature`` columns, ``rate_hz``
     or its time_s column, ``units`` of its output, ``gaps``), decompose and group it, compare
     MS-ELM and every baseline in predict and compensate mode, the Allan deviation before and
     after; writes the same folder as the CLI to ``output`` (data, models, tables, demo.json and
     report.html, one atomic set). ``duration`` (s, at least 7200), ``ensemble``,
-    ``realisations``, ``window``, ``mirror``, ``windows`` and ``methods`` size the study as the
-    CLI's flags of those names.
+    ``realisations``, ``window``, ``mirror``, ``windows``, ``causal_ensemble`` and ``methods``
+    size the study as the CLI's flags of those names.
     ``progress``: a callable given the fraction of the run done (Ctrl-C stops it).
 
     Returns a dict: ``output``, ``files`` (the names written), ``report`` (its path),
@@ -577,6 +578,7 @@ def demo(output="gyrodrift-demo", *, input=None, target=None, temperature=None, 
                  target="" if target is None else str(target),
                  temperature="" if temperature is None else str(temperature), rate_hz=rate_hz,
                  units=units, duration=duration, ensemble=ensemble, realisations=realisations,
-                 window=window, mirror=mirror, windows=windows, methods=methods, seed=seed,
+                 window=window, mirror=mirror, windows=windows, causal_ensemble=causal_ensemble,
+                 methods=methods, seed=seed,
                  threads=threads,
                  gaps=gaps, progress=progress)

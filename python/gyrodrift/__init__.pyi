@@ -173,7 +173,7 @@ def demo(
     target: str | None = ..., temperature: str | None = ..., rate_hz: float | None = ...,
     units: Literal["dph", "dps", "rads"] = ..., duration: float = ..., ensemble: int = ...,
     realisations: int = ..., window: int = ..., mirror: float = ..., windows: int = ...,
-    methods: str = ...,
+    causal_ensemble: int = ..., methods: str = ...,
     seed: int = ..., threads: int = ..., gaps: Literal["error", "interpolate"] = ...,
     progress: Callable[[float], object] | None = ...,
 ) -> dict[str, Any]: ...

@@ -61,8 +61,8 @@ void BindDemo(py::module_& m) {
       [](const std::string& output, const std::string& input, const std::string& target,
          const std::string& temperature, std::optional<double> rate_hz, const std::string& units,
          double duration, int ensemble, int realisations, int window, double mirror, int windows,
-         const std::string& methods, std::uint64_t seed, int threads, const std::string& gaps,
-         const py::object& progress) {
+         int causal_ensemble, const std::string& methods, std::uint64_t seed, int threads,
+         const std::string& gaps, const py::object& progress) {
         study::DemoSettings s{.output = output,
                               .input = input,
                               .target = target,
@@ -72,7 +72,7 @@ void BindDemo(py::module_& m) {
                               .duration_s = duration,
                               .ensemble = ensemble,
                               .realisations = realisations,
-                              .causal = {.window = window, .mirror = mirror, .windows = windows},
+                              .causal = CausalOf(window, mirror, windows, causal_ensemble),
                               .methods = methods,
                               .seed = seed,
                               .threads = threads,
@@ -85,7 +85,8 @@ void BindDemo(py::module_& m) {
       arg("duration") = d.duration_s, arg("ensemble") = d.ensemble,
       arg("realisations") = d.realisations, arg("window") = d.causal.window,
       arg("mirror") = d.causal.mirror, arg("windows") = d.causal.windows,
-      arg("methods") = d.methods, arg("seed") = d.seed, arg("threads") = d.threads,
+      arg("causal_ensemble") = d.causal.ensemble_size, arg("methods") = d.methods,
+      arg("seed") = d.seed, arg("threads") = d.threads,
       arg("gaps") = std::string(io::ToString(d.log.gaps)), arg("progress") = py::none());
 }
 

@@ -149,7 +149,7 @@ std::string CausalWindowNote(const DriftModel& model, const CausalOptions& causa
   const std::vector<Eigen::Index> lengths = causal.WindowLengths();
   if (lengths.empty()) return "";  // windows < 1: refused by Validate
   const Eigen::Index window = lengths.back();
-  const Eigen::Index decomposed = shortest_decomposed(causal.window);
+  const Eigen::Index decomposed = causal.DecomposedLength(window);
   const int resolved =
       std::max(1, static_cast<int>(std::floor(std::log2(static_cast<double>(decomposed)))) - 1);
   std::vector<std::string> names;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -283,39 +284,23 @@ TEST(CausalOptions, ValidateNamesTheWindowMirrorWindowsAndEnsembleOutsideTheirRa
   };
   const CausalOptions defaults;
   EXPECT_EQ(refusal(defaults), "");
-  for (int window : {16, 1000000, 15, 1000001}) {
-    CausalOptions c;
-    c.window = window;
-    const bool allowed = window >= 16 && window <= 1000000;
-    const std::string message = refusal(c);
-    EXPECT_TRUE(allowed ? message.empty() : message.find("window = ") != std::string::npos)
-        << window << ": " << message;
-  }
-  for (double mirror : {0.0, 1.0, -0.01, 1.01, std::nan("")}) {
-    CausalOptions c;
-    c.mirror = mirror;
-    const bool allowed = mirror >= 0.0 && mirror <= 1.0;
-    const std::string message = refusal(c);
-    EXPECT_TRUE(allowed ? message.empty() : message.find("mirror = ") != std::string::npos)
-        << mirror << ": " << message;
-  }
-  for (int windows : {1, 16, 0, 17}) {
-    CausalOptions c;
-    c.windows = windows;
-    const bool allowed = windows >= 1 && windows <= 16;
-    const std::string message = refusal(c);
-    EXPECT_TRUE(allowed ? message.empty() : message.find("windows = ") != std::string::npos)
-        << windows << ": " << message;
-  }
-  for (int ensemble : {0, 100000, -1, 100001}) {  // 0 = the model's own
-    CausalOptions c;
-    c.ensemble_size = ensemble;
-    const bool allowed = ensemble >= 0 && ensemble <= 100000;
-    const std::string message = refusal(c);
-    EXPECT_TRUE(allowed ? message.empty()
-                        : message.find("ensemble_size = ") != std::string::npos)
-        << ensemble << ": " << message;
-  }
+  // Each field at both ends of its range (accepted) and just past them (refused, naming it).
+  const auto expect_range = [&refusal](auto field, const std::string& name, double lowest,
+                                       double highest, std::initializer_list<double> values) {
+    for (double value : values) {
+      CausalOptions c;
+      c.*field = static_cast<std::remove_reference_t<decltype(c.*field)>>(value);
+      const bool allowed = value >= lowest && value <= highest;
+      const std::string message = refusal(c);
+      EXPECT_TRUE(allowed ? message.empty() : message.find(name + " = ") != std::string::npos)
+          << name << " " << value << ": " << message;
+    }
+  };
+  expect_range(&CausalOptions::window, "window", 16, 1000000, {16, 1000000, 15, 1000001});
+  expect_range(&CausalOptions::mirror, "mirror", 0.0, 1.0, {0.0, 1.0, -0.01, 1.01, std::nan("")});
+  expect_range(&CausalOptions::windows, "windows", 1, 16, {1, 16, 0, 17});
+  // 0 = the model's own ensemble.
+  expect_range(&CausalOptions::ensemble_size, "ensemble_size", 0, 100000, {0, 100000, -1, 100001});
 }
 
 }  // namespace
