@@ -137,6 +137,8 @@ void Run(const AllanArgs& a) {
   fmt::print("{}\n", r.curve.Summary());
   if (r.terms) {
     fmt::print("{}", TermTable(*r.terms, r.fit_source));
+    if (!r.terms->note.empty())
+      fmt::print("note: {} (--fit-tau-min, --fit-tau-max)\n", r.terms->note);
   } else {
     fmt::print("noise terms not fitted: {}\n", r.fit_error);
   }

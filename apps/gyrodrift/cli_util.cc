@@ -55,21 +55,54 @@ std::vector<std::pair<std::string, const CLI::Option*>>& Bindings() {
 
 }  // namespace
 
-void RefuseEmptyNumbers(CLI::App& app) {
-  const CLI::Validator not_empty(
+void RefuseEmptyValues(CLI::App& app) {
+  const CLI::Validator not_a_number(
       [](std::string& value) {
         return value.empty() ? std::string("an empty value is not a number") : std::string();
       },
       "", "NOT_EMPTY");
+  const CLI::Validator not_a_path(
+      [](std::string& value) {
+        return value.empty() ? std::string("an empty value is not a path") : std::string();
+      },
+      "", "NOT_EMPTY_PATH");
   for (CLI::App* sub : app.get_subcommands({})) {
     for (CLI::Option* option : sub->get_options()) {
       const std::string type = option->get_type_name();
       if (type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0 || type.rfind("FLOAT", 0) == 0) {
-        option->check(not_empty);
+        option->check(not_a_number);
+      } else if (option->check_lname("output")) {
+        option->check(not_a_path);
       }
     }
-    RefuseEmptyNumbers(*sub);
+    RefuseEmptyValues(*sub);
   }
+}
+
+std::string ConversionMessage(const CLI::App& app, const CLI::ConversionError& error) {
+  static const std::regex kConvert("Could not convert: (\\S+) = (.*)");
+  std::smatch m;
+  const std::string what = error.what();
+  if (!std::regex_match(what, m, kConvert)) return what;
+  const std::string name = m[1], value = m[2];
+  for (const CLI::App* sub : app.get_subcommands()) {
+    for (const CLI::Option* option : sub->get_options()) {
+      if (!option->check_name(name)) continue;
+      const std::string type = option->get_type_name();
+      if (type.rfind("INT", 0) != 0 && type.rfind("UINT", 0) != 0) {
+        return name + " = " + value + ": must be a number";
+      }
+      // "1e3" is a number CLI11 does not read as an integer: say which integer it is.
+      double number = 0.0;
+      const char* end = value.data() + value.size();
+      const auto [ptr, ec] = std::from_chars(value.data(), end, number);
+      const bool whole = ec == std::errc() && ptr == end && std::isfinite(number) &&
+                         number == std::trunc(number) && std::abs(number) < 9.0e15;
+      return name + " = " + value + ": must be an integer" +
+             (whole ? fmt::format(" (write {})", static_cast<long long>(number)) : "");
+    }
+  }
+  return what;
 }
 
 CLI::Option* BindSetting(CLI::Option* flag, std::initializer_list<std::string_view> names) {
@@ -153,10 +186,9 @@ void AddLogOptions(CLI::App* cmd, LogArgs* log) {
       ->capture_default_str();
   cmd->add_flag("--no-header", log->no_header,
                 "the file has no header row: --columns names its columns (a serial capture)");
-  BindSetting(cmd->add_option("--columns", log->columns,
-                              "with --no-header: the names of the file's columns, in order, "
-                              "comma-separated (e.g. temp_c,ax,ay,az,gx,gy,gz)")
-                  ->delimiter(','),
+  BindSetting(AddListOption(cmd, "--columns", &log->columns,
+                            "with --no-header: the names of the file's columns, in order, "
+                            "comma-separated (e.g. temp_c,ax,ay,az,gx,gy,gz)"),
               {"names"});
   cmd->add_option("--skip-rows", log->skip_rows,
                   "lines skipped at the start of the file, before the header or the first row "

@@ -4,9 +4,11 @@
 
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "gyrodrift/allan/allan.h"
@@ -84,9 +86,51 @@ io::CsvTable ReadLog(const std::string& path, const LogArgs& log, std::string* n
 // logged sample after the gap, so they are not causal; "" for a log without made-up rows.
 std::string MadeUpRowsPredictionNote(const std::vector<bool>& logged);
 
-// Refuses an empty value for every numeric option of app's subcommands: CLI11 reads '' (an unset
-// shell variable) as 0, which would set a reference temperature of 0 degC without a word.
-void RefuseEmptyNumbers(CLI::App& app);
+// Refuses an empty value for every numeric option and every --output of app's subcommands: CLI11
+// reads '' (an unset shell variable) as 0, which would set a reference temperature of 0 degC
+// without a word, and an empty output name would fail only after the work, as a file error.
+void RefuseEmptyValues(CLI::App& app);
+
+// Declares a list flag: values comma-separated ("60,300,900"), space-separated or the flag
+// repeated, each converted as CLI11 converts a T. An empty item ("60,,300", "60,") is refused:
+// CLI11's own splitting (Option::delimiter) drops it without a word. The default shown in --help
+// is `values` as declared.
+template <typename T>
+CLI::Option* AddListOption(CLI::App* cmd, const std::string& name, std::vector<T>* values,
+                           const std::string& help) {
+  std::string shown;
+  for (const T& v : *values) shown += (shown.empty() ? "" : ",") + CLI::detail::to_string(v);
+  CLI::Option* option = cmd->add_option_function<std::vector<std::string>>(
+      name,
+      [values, name](const std::vector<std::string>& tokens) {
+        values->clear();
+        for (const std::string& token : tokens) {
+          for (size_t begin = 0, end = 0; begin <= token.size(); begin = end + 1) {
+            end = std::min(token.find(',', begin), token.size());
+            const std::string item = token.substr(begin, end - begin);
+            T value{};
+            if (item.empty()) {
+              throw CLI::ValidationError(name + " = " + token + ": an empty item in the list");
+            }
+            if (!CLI::detail::lexical_cast(item, value)) {
+              throw CLI::ValidationError(name + " = " + token + ": '" + item + "' is not " +
+                                         (std::is_floating_point_v<T> ? "a number"
+                                          : std::is_integral_v<T>     ? "an integer"
+                                                                      : "a value"));
+            }
+            values->push_back(std::move(value));
+          }
+        }
+      },
+      help);
+  option->type_name(CLI::detail::type_name<T>());
+  if (!shown.empty()) option->default_str(shown);
+  return option;
+}
+
+// The message of CLI11's "Could not convert: --flag = value" with what the flag takes ("--ensemble
+// = 1e3: must be an integer (1000)"); CLI11's own message when the flag is not found.
+std::string ConversionMessage(const CLI::App& app, const CLI::ConversionError& error);
 
 // Binds `flag` to the names under which the library refers to what it sets (a
 // drift::FitSettings setting such as "lags", an options field such as "ensemble_size"), where

@@ -87,9 +87,7 @@ const RegisterCommand kRegister("convert", 9, [](CLI::App& app) {
   cmd->add_option("--instance", a->instance,
                   "multi-instance id, or all (one file per instance: OUT_<id>.csv)")
       ->capture_default_str();
-  cmd->add_option("--axes", a->conversion.axes, "the rate fields, rad/s, comma-separated")
-      ->delimiter(',')
-      ->capture_default_str();
+  AddListOption(cmd, "--axes", &a->conversion.axes, "the rate fields, rad/s, comma-separated");
   cmd->add_option("--temperature-field", a->conversion.temperature,
                   "the temperature field, degC (empty: none)")
       ->capture_default_str();

@@ -101,10 +101,9 @@ void AddModelOptions(CLI::App* cmd, DriftArgs* a) {
                               "each lag and its rate); docs/drift.md 1.1")
                   ->capture_default_str(),
               {"thermal_features"});
-  BindSetting(cmd->add_option("--time-constants", a->settings.time_constants,
-                              "time constants of the thermal lags, seconds, comma-separated "
-                              "(default 60,300,900,1800,3600)")
-                  ->delimiter(','),
+  BindSetting(AddListOption(cmd, "--time-constants", &a->settings.time_constants,
+                            "time constants of the thermal lags, seconds, comma-separated "
+                            "(default 60,300,900,1800,3600)"),
               {"time_constants"});
   BindSetting(cmd->add_option("--ensemble,-I", a->settings.ensemble, "decomposition ensemble size")
                   ->capture_default_str(),

@@ -101,10 +101,9 @@ const RegisterCommand kRegister("export", 75, [](CLI::App& app) {
       cmd->add_flag("--float", args->single_precision,
                     "C: float arithmetic instead of double (FPUs without double precision)"),
       {"single_precision"});
-  BindSetting(cmd->add_option("--device-id", args->device_ids,
-                              "px4: each gyro's DEVID, comma-separated, one per model file "
-                              "(convert --list shows sensor_gyro's device_id)")
-                  ->delimiter(','),
+  BindSetting(AddListOption(cmd, "--device-id", &args->device_ids,
+                            "px4: each gyro's DEVID, comma-separated, one per model file "
+                            "(convert --list shows sensor_gyro's device_id)"),
               {"device_ids"});
   cmd->add_flag("--quiet,-q", args->quiet, "print nothing on success");
   cmd->callback([args] { Run(*args); });

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   std::sort(commands.begin(), commands.end(),
             [](const auto& a, const auto& b) { return a.order < b.order; });
   for (auto& command : commands) command.setup(app);
-  gyrodrift::cli::RefuseEmptyNumbers(app);
+  gyrodrift::cli::RefuseEmptyValues(app);
   // A misspelt command would otherwise read "A subcommand is required".
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
@@ -102,6 +102,9 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::ConversionError& e) {
+    fmt::print(stderr, "gyrodrift: error: {}\n", gyrodrift::cli::ConversionMessage(app, e));
+    return gyrodrift::ExitCode(gyrodrift::ErrorKind::kUsage);
   } catch (const CLI::ParseError& e) {
     fmt::print(stderr, "gyrodrift: error: {}\n", e.what());
     return gyrodrift::ExitCode(gyrodrift::ErrorKind::kUsage);

@@ -278,6 +278,19 @@ NoiseTerms IdentifyNoiseImpl(const Eigen::VectorXd& tau_s, const Eigen::VectorXd
         (selected & bit) ? evidence.Rise(selected, j) : evidence.Rise(selected | bit, j);
   }
   ReportTerms(SelectedFit(fits, selected, evidence), p.tau, options.min_share, &out);
+  std::ostringstream note;
+  note.precision(4);
+  if (n <= kTerms) {
+    note << n << " points fitted: at most " << n - 1 << " term" << (n == 2 ? "" : "s")
+         << " can be told apart, and a term the model lacks moves the others; a longer record or "
+            "more taus in the fitted range identify more";
+  } else if (out.chi2_per_dof > kMisfitNote) {
+    note << "the five-term model misses this curve's shape (chi2/dof " << out.chi2_per_dof
+         << " over " << out.tau_min_s << ".." << out.tau_max_s
+         << " s): a sensor's filtering at the short taus or a drift at the long ones; fit a "
+            "narrower tau range";
+  }
+  out.note = note.str();
   SlopeReadings(p.tau, p.dev, p.edf, &out);
   return out;
 }

@@ -151,15 +151,16 @@ LogCurve MakeLogCurve(const Eigen::MatrixXd& columns, const Eigen::VectorXd& var
   return curve;
 }
 
-// Every subset of the five terms (at most n terms). Subsets are visited by size; each starts from
-// the weighted non-negative fit in variance on its terms and from each one-term-smaller fit plus a
-// little of the added term, and keeps the best, so a model never fits worse than the models
-// nested in it.
+// Every subset of the five terms with fewer terms than points (n terms would pass through every
+// point: a misfit of 0 that no test can weigh, so two points would "identify" two terms). Subsets
+// are visited by size; each starts from the weighted non-negative fit in variance on its terms and
+// from each one-term-smaller fit plus a little of the added term, and keeps the best, so a model
+// never fits worse than the models nested in it.
 SubsetFits FitAllSubsets(const LogCurve& d, const Eigen::MatrixXd& a, const Eigen::VectorXd& b,
                          const Eigen::VectorXd& var) {
   SubsetFits fits;
   const Eigen::Index n = d.target.size();
-  for (int size = 1; size <= std::min<Eigen::Index>(kTerms, n); ++size) {
+  for (int size = 1; size <= std::min<Eigen::Index>(kTerms, n - 1); ++size) {
     for (unsigned mask = 1; mask <= kAllTerms; ++mask) {
       if (Size(mask) != size) continue;
       // A term missing from a start begins at 1 % of the most it could be without exceeding the

@@ -25,7 +25,8 @@ constexpr double kNarrowestSpanK = 15.0;
 
 void PlanSettings::Validate() const {
   RequireInRange("hours", hours, 1.0, 240.0);
-  RequireInRange("min_c", min_c, -100.0, 200.0);
+  // The narrowest span below the top: a bottom too high for it is the bottom's fault.
+  RequireInRange("min_c", min_c, -100.0, 200.0 - kNarrowestSpanK);
   RequireInRange("max_c", max_c, min_c + kNarrowestSpanK, 200.0);
   if (rate_k_per_min != 0.0) RequireInRange("rate_k_per_min", rate_k_per_min, kSlowestRate, kFastestRate);
   RequireInRange("shortest_dwell_min", shortest_dwell_min, 10.0, 600.0);

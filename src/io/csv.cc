@@ -189,7 +189,18 @@ class CsvTable::Parser {
                       "endings");
     }
     if (!carry_.empty()) Line(carry_);  // the last line has no newline
+    if (!have_header_ && skip_rows_ > 0 && line_number_ > 0) {
+      throw DataError(table_.source_ + ": skipping its first " + std::to_string(skip_rows_) +
+                      " lines leaves no header (the file has " + std::to_string(line_number_) +
+                      ")");
+    }
     if (!have_header_) throw DataError(table_.source_ + ": empty file (no header row)");
+    if (table_.rows_ == 0 && !table_.skipped_lines_.empty()) {
+      throw DataError(table_.source_ + ": every data row is bad (" +
+                      std::to_string(table_.skipped_lines_.size()) +
+                      " skipped as bad lines, the first at line " +
+                      std::to_string(table_.skipped_lines_.front()) + ")");
+    }
     if (table_.rows_ == 0) throw DataError(table_.source_ + ": header but no data rows");
     for (size_t c = 0; c < table_.columns_.size(); ++c) {
       // Gives back the reserve beyond the last row (realloc shrinks a large block in place).
@@ -298,6 +309,10 @@ class CsvTable::Parser {
 
   void Header(std::string_view line) {
     CsvTable& t = table_;
+    if (line.find('\0') != std::string_view::npos) {
+      throw DataError(t.source_ + ": line " + std::to_string(line_number_) +
+                      " (the header) holds a NUL byte: not a text file");
+    }
     delimiter_ = given_ == Delimiter::kComma       ? ','
                  : given_ == Delimiter::kTab       ? '\t'
                  : given_ == Delimiter::kSemicolon ? ';'

@@ -234,7 +234,8 @@ nlohmann::json NoiseTermsRecord(const al::NoiseTerms& t) {
           {"B", TermJson(t.b_dph, "deg/h")},
           {"K", TermJson(t.k_dphpsh, "deg/h/sqrt(h)")},
           {"R", TermJson(t.r_dphph, "deg/h/h")},
-          {"summary", t.Summary()}};
+          {"summary", t.Summary()},
+          {"note", t.note}};
 }
 
 nlohmann::json AllanRecord(const AllanRun& run, const AllanSettings& settings,

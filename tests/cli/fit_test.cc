@@ -376,6 +376,18 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
       {"gaps that would make up most of memory",
        "fit %DIR%/sparse.csv -t rate_dph -T temperature_c --mode compensate --gaps carry", 3,
        "samples (at most 1e+08): split the log at its gaps (--gaps split)"},
+      {"empty item in a list (CLI11 would drop it)",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--time-constants 60,,300",
+       2, "--time-constants = 60,,300: an empty item in the list"},
+      {"trailing comma in a list",
+       "fit %IN% -t rate_dph -T temperature_c --mode compensate "
+       "--time-constants 60,",
+       2, "--time-constants = 60,: an empty item in the list"},
+      {"integer in exponent form", "fit %IN% -t rate_dph --mode predict --ensemble 1e3", 2,
+       "--ensemble = 1e3: must be an integer (write 1000)"},
+      {"fractional integer", "fit %IN% -t rate_dph --mode predict --ensemble 2.5", 2,
+       "--ensemble = 2.5: must be an integer"},
       {"repeated time constant",
        "fit %IN% -t rate_dph -T temperature_c --mode compensate "
        "--time-constants 60,60",
@@ -400,6 +412,11 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
         test::RunCli(test::Substitute(c.args, {{"%IN%", input_}, {"%DIR%", dir_}}) + " -o " + out);
     test::ExpectCleanFailure(r, c.exit_code, c.message, out, c.name);
   }
+  // An empty output name (an unset shell variable) is a usage error, found before the work.
+  const auto unnamed = Fit(ok, "");
+  EXPECT_EQ(unnamed.exit_code, 2) << unnamed.err;
+  EXPECT_NE(unnamed.err.find("--output: an empty value is not a path"), std::string::npos)
+      << unnamed.err;
   // A device would be replaced by the rename that places the file: refused before the work.
   const auto device = Fit(ok, "/dev/null");
   EXPECT_EQ(device.exit_code, 4) << device.err;

@@ -37,6 +37,9 @@ TEST(PlanCli, APlanThatCannotFitIsRefused) {
   test::ExpectCleanFailure(test::RunCli("plan --min 20 --max 25 -o '" + out + "'"), 2,
                            "--max = 25: must be in [35, 200]",
                            out, "too narrow");
+  // No top can be 15 K above a bottom of 199 degC: the bottom is named, not the top.
+  test::ExpectCleanFailure(test::RunCli("plan --min 199 --max 200 -o '" + out + "'"), 2,
+                           "--min = 199: must be in [-100, 185]", out, "bottom too high");
 }
 
 }  // namespace

@@ -52,6 +52,11 @@ struct NoiseTerm {
   double evidence_chi2 = std::numeric_limits<double>::quiet_NaN();
 };
 
+// A reduced chi-square above this is a curve outside the five-term shape, not scatter: fits of
+// the five terms to their own curves give about 1 (docs/allan.md 4-5), the real FOG curves fitted
+// below 1 s, where they carry the sensors' filtering, hundreds.
+inline constexpr double kMisfitNote = 10.0;
+
 struct NoiseTerms {
   NoiseTerm q_urad;    // quantization Q, microradians (arcsec = urad * 0.206264806)
   NoiseTerm n_dpsh;    // angle random walk N, deg/sqrt(h)
@@ -63,6 +68,10 @@ struct NoiseTerms {
   double chi2_per_dof = 0.0;   // log-variance misfit (independent points) / (points - terms)
   double critical_chi2 = 0.0;  // the test's critical value, chi-square quantile 1 - significance
   double min_dev_dph = 0.0, min_dev_tau_s = 0.0;  // minimum of the curve (deg/h)
+  // What the user should know about the fit ("" for none): a misfit the five terms cannot explain
+  // (chi2_per_dof above kMisfitNote), which a narrower fitted range usually cures, or too few
+  // points to tell the terms apart (five or fewer).
+  std::string note;
   std::string Summary() const;
   // Model Allan deviation in deg/h at tau from the fitted terms.
   double ModelDevDph(double tau_s) const;

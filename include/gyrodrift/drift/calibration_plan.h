@@ -18,8 +18,8 @@ namespace gyrodrift::drift {
 
 struct PlanSettings {
   double hours = 8.0;      // length of the programme, in [1, 240]
-  double min_c = -20.0;    // bottom of the range, degC, in [-100, 200]
-  double max_c = 60.0;     // top, in (min_c + 15, 200]: a narrower range identifies nothing
+  double min_c = -20.0;    // bottom of the range, degC, in [-100, 185]
+  double max_c = 60.0;     // top, in [min_c + 15, 200]: a narrower range identifies nothing
   double rate_k_per_min = 0.0;  // the faster rate r, in [0.5, 2] K/min; 0 = auto
   // The dwells' shortest length, minutes, in [10, 600] [choice: after a 1-K/min ramp the
   // simulator's case sensor still changed by 0.13 K/min 47 min after the ramp's end, above the

@@ -74,6 +74,37 @@ TEST(NoiseFit, DropsTermsThatNeverMatter) {
   EXPECT_NEAR(t.n_dpsh.slope_reading / 0.01, 1.0, 1e-9);
 }
 
+// Points fitted exactly by as many terms are no evidence: two points of a Q + N curve give one term
+// and a note, not two terms with a misfit of 0. A curve the five terms cannot follow (a filter's
+// roll-off below 1 s) gets a note that says so; a clean curve none.
+TEST(NoiseFit, FewPointsOrAMisfitCurveAreTold) {
+  auto fit = [](const std::vector<double>& taus, auto dev) {
+    const Eigen::Index m = static_cast<Eigen::Index>(taus.size());
+    Eigen::VectorXd tau(m), adev(m), edf = Eigen::VectorXd::Constant(m, 1e4);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      tau[i] = taus[static_cast<size_t>(i)];
+      adev[i] = dev(tau[i]);
+    }
+    return IdentifyNoise(tau, adev, edf);
+  };
+  const auto qn = [](double tau) { return ModelAdev(tau, 5.0, 0.01, 0.0, 0.0, 0.0); };
+  const NoiseTerms two = fit({1.0, 2.0}, qn);
+  EXPECT_EQ(two.q_urad.identified + two.n_dpsh.identified + two.b_dph.identified +
+                two.k_dphpsh.identified + two.r_dphph.identified,
+            1);
+  EXPECT_NE(two.note.find("2 points fitted: at most 1 term can be told apart"), std::string::npos)
+      << two.note;
+  std::vector<double> octaves;
+  for (double t = 0.01; t < 1e3; t *= 2) octaves.push_back(t);
+  EXPECT_EQ(fit(octaves, qn).note, "");
+  // A one-pole filter at 10 Hz: white rate noise whose deviation flattens below 0.1 s.
+  const NoiseTerms filtered = fit(octaves, [](double tau) {
+    return ModelAdev(tau, 0.0, 0.01, 0.0, 0.0, 0.0) * std::sqrt(tau / (tau + 0.5));
+  });
+  EXPECT_GT(filtered.chi2_per_dof, kMisfitNote);
+  EXPECT_NE(filtered.note.find("misses this curve's shape"), std::string::npos) << filtered.note;
+}
+
 // Synthetic gyro: quantization (white angle noise), angle random walk (white rate) and rate
 // random walk (integrated white rate), generated with seeded streams; the fit must find the
 // generating values.

@@ -411,6 +411,28 @@ TEST(CsvTable, ATimeAxisIsCheckedAsAKeptColumnButNotStored) {
   EXPECT_FALSE(kept_bad.time_axis()->complete());
 }
 
+// What left no data is said: the lines skipped, the rows all bad, a binary header.
+TEST(CsvCapture, AnEmptyResultSaysWhatEmptiedIt) {
+  auto message = [](const std::string& text, const CsvReadOptions& options) {
+    try {
+      CsvTable::Read(CaptureFile("empty.csv", text), options);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("read");
+  };
+  EXPECT_NE(message("a,b\n1,2\n", {.skip_rows = 5})
+                .find("skipping its first 5 lines leaves no header (the file has 2)"),
+            std::string::npos);
+  EXPECT_NE(message("a,b\nx,2\n1\n", {.bad_lines = BadLines::kSkip})
+                .find("every data row is bad (2 skipped as bad lines, the first at line 2)"),
+            std::string::npos);
+  EXPECT_NE(message("a,b\n", {}).find("header but no data rows"), std::string::npos);
+  EXPECT_NE(message(std::string("a,b\0c\n1,2\n", 10), {})
+                .find("line 1 (the header) holds a NUL byte: not a text file"),
+            std::string::npos);
+}
+
 TEST(CsvCapture, BadOptionsAreRefused) {
   const std::string path = CaptureFile("ok.csv", "1,2\n");
   EXPECT_THROW(CsvTable::Read(path, CsvReadOptions{.names = {"a", "a"}}), OptionError);
