@@ -305,20 +305,25 @@ class DriftModel:
                 warnings.warn(f"calibration run ({sub['name']}): {text}", UserWarning, stacklevel=2)
         return self
 
-    def estimate(self, temperature, *, record_starts=()):
+    def estimate(self, temperature, *, record_starts=(), rate_hz=None):
         """Compensate mode: ``(estimate, sd)`` of the drift at every temperature sample (sd NaN
         for models without an uncertainty band); with ``record_starts`` every record is estimated
-        on its own, as ``gyrodrift compensate --gaps split`` does after each gap."""
-        return self._core.estimate(temperature, record_starts=list(record_starts))
+        on its own, as ``gyrodrift compensate --gaps split`` does after each gap. The samples are
+        taken to be at the model's rate (the ``rate_hz`` property): its lags count samples.
+        ``rate_hz``: the data's rate, Hz, checked against the model's as ``gyrodrift compensate``
+        checks a log's (a ``DataError`` beyond 1 %)."""
+        return self._core.estimate(temperature, record_starts=list(record_starts),
+                                   rate_hz=rate_hz)
 
-    def compensate(self, y, temperature, *, record_starts=()):
+    def compensate(self, y, temperature, *, record_starts=(), rate_hz=None):
         """Compensate mode: ``y - estimate(temperature)``, the ``compensated`` column of
         ``gyrodrift compensate``. The output first, then its temperature, as ``fit`` and
-        ``predict`` take them."""
-        return self._core.compensate(temperature, y, record_starts=list(record_starts))
+        ``predict`` take them. ``rate_hz`` as for ``estimate``."""
+        return self._core.compensate(temperature, y, record_starts=list(record_starts),
+                                     rate_hz=rate_hz)
 
     def compensation_summary(self, y, temperature, *, record_starts=(), drift_window_s=600.0,
-                             logged=None, truth=None):
+                             logged=None, truth=None, rate_hz=None):
         """Compensate mode: what compensating ``y`` does to it, the figures ``gyrodrift
         compensate`` prints and keeps in its sidecar. Returns a dict: ``before`` and ``after``
         (each ``mean``, ``rms`` about zero, ``std`` about the mean and ``slow_variation``, the RMS
@@ -331,10 +336,10 @@ class DriftModel:
         False on rows made up across a gap (``--gaps carry``): the figures use the logged rows
         only. ``truth``: the true drift (the simulator's ``drift_dph``), as ``compensate
         --truth``: adds ``truth_rms``, ``residual_rms`` (of truth - estimate) and
-        ``truth_removed`` = 1 - residual_rms / truth_rms."""
+        ``truth_removed`` = 1 - residual_rms / truth_rms. ``rate_hz`` as for ``estimate``."""
         return self._core.compensation_summary(
             temperature, y, record_starts=list(record_starts), drift_window_s=drift_window_s,
-            logged=_flags(logged), truth=truth)
+            logged=_flags(logged), truth=truth, rate_hz=rate_hz)
 
     def coefficients(self, *, reference_temperature=None):
         """The thermal sub-models' coefficients in physical units, as ``gyrodrift fit`` prints
@@ -349,16 +354,17 @@ class DriftModel:
         return self._core.coefficients(reference_temperature=reference_temperature)
 
     def predict(self, y, temperature=None, *, horizon=1, protocol="causal", window=2896,
-                mirror=0.5, windows=6, causal_ensemble=1, threads=0, progress=None):
+                mirror=0.5, windows=6, causal_ensemble=1, threads=0, progress=None, rate_hz=None):
         """Predict mode, as ``gyrodrift predict``: returns ``(first, prediction)``, the
         horizon-step-ahead predictions of y[first:], first being the model's history.
         ``window``, ``mirror``, ``windows`` and ``causal_ensemble`` as ``--window``, ``--mirror``,
         ``--windows`` and ``--causal-ensemble``. ``progress``: a callable given the fraction of the
-        causal origins decomposed, as for ``decompose``."""
+        causal origins decomposed, as for ``decompose``. ``rate_hz`` as for ``estimate`` (its
+        lags and windows count samples)."""
         return self._core.predict(y, temperature, horizon=horizon, protocol=protocol,
                                   window=window, mirror=mirror, windows=windows,
                                   causal_ensemble=causal_ensemble, threads=threads,
-                                  progress=progress)
+                                  progress=progress, rate_hz=rate_hz)
 
     def save(self, path):
         """Writes the model file ``gyrodrift fit`` writes (JSON, exact doubles, checksummed)."""
@@ -406,6 +412,17 @@ class DriftModel:
     temperature_range_c = property(lambda self: self._core.temperature_range_c,
                                    doc="Training temperature range (min, max), degC.")
     fitted = property(lambda self: self._core.fitted)
+    rate_hz = property(lambda self: self._core.rate_hz,
+                       doc="The sample rate the model was fitted at, Hz (its lags count samples).")
+
+    # Pickled (Dask, multiprocessing, copy.deepcopy) as the model file's text: exact doubles.
+    def __getstate__(self):
+        return {"model_file": self._core.to_text() if self.fitted else None}
+
+    def __setstate__(self, state):
+        text = state["model_file"]
+        self._core = (_gyrodrift.DriftModel.from_text(text) if text is not None
+                      else _gyrodrift.DriftModel())
 
     def __repr__(self):
         return f"DriftModel({self.summary!r})" if self.fitted else "DriftModel(unfitted)"

@@ -86,10 +86,12 @@ class DriftModel:
         **settings: Any,
     ) -> DriftModel: ...
     def estimate(
-        self, temperature: ArrayLike, *, record_starts: Sequence[int] = ...
+        self, temperature: ArrayLike, *, record_starts: Sequence[int] = ...,
+        rate_hz: float | None = ...,
     ) -> tuple[Array, Array]: ...
     def compensate(
-        self, y: ArrayLike, temperature: ArrayLike, *, record_starts: Sequence[int] = ...
+        self, y: ArrayLike, temperature: ArrayLike, *, record_starts: Sequence[int] = ...,
+        rate_hz: float | None = ...,
     ) -> Array: ...
     def compensation_summary(
         self,
@@ -100,6 +102,7 @@ class DriftModel:
         drift_window_s: float = ...,
         logged: Sequence[bool] | None = ...,
         truth: ArrayLike | None = ...,
+        rate_hz: float | None = ...,
     ) -> dict[str, Any]: ...
     def coefficients(
         self, *, reference_temperature: float | None = ...
@@ -108,7 +111,7 @@ class DriftModel:
         self, y: ArrayLike, temperature: ArrayLike | None = ..., *, horizon: int = ...,
         protocol: Literal["causal", "paper"] = ..., window: int = ..., mirror: float = ...,
         windows: int = ..., causal_ensemble: int = ..., threads: int = ...,
-        progress: Callable[[float], object] | None = ...,
+        progress: Callable[[float], object] | None = ..., rate_hz: float | None = ...,
     ) -> tuple[int, Array]: ...
     def save(self, path: str | PathLike[str]) -> None: ...
     @classmethod
@@ -133,6 +136,8 @@ class DriftModel:
     def temperature_range_c(self) -> tuple[float, float]: ...
     @property
     def fitted(self) -> bool: ...
+    @property
+    def rate_hz(self) -> float: ...
 
 def export(
     models: str | PathLike[str] | DriftModel | Sequence[str | PathLike[str]] | Sequence[DriftModel],

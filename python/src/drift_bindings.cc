@@ -111,8 +111,13 @@ class PyDriftModel {
                                        const std::vector<Eigen::Index>& record_starts,
                                        const tasks::CompensateSettings& settings = {},
                                        const std::vector<bool>& logged = {},
-                                       const std::optional<Array>& truth_in = std::nullopt) const {
+                                       const std::optional<Array>& truth_in = std::nullopt,
+                                       std::optional<double> rate_hz = std::nullopt) const {
     RequireMode(drift::Mode::kCompensate, what);
+    if (rate_hz) {
+      RequireInRange("rate_hz", *rate_hz, 1e-9, 1e9);
+      tasks::RequireModelRate({Loaded()}, "the model", "the data", *rate_hz, "given", false);
+    }
     const Eigen::MatrixXd t = ToMatrix(temperature_in, "temperature");
     const Eigen::VectorXd y = y_in ? ToVector(*y_in, "y") : Eigen::VectorXd::Zero(t.rows());
     if (y.size() != t.rows()) {
@@ -130,16 +135,20 @@ class PyDriftModel {
     return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, settings);
   }
 
-  py::tuple Estimate(const Array& temperature_in,
-                     const std::vector<Eigen::Index>& record_starts) const {
-    const tasks::AxisCompensation c = Compensation("estimate", temperature_in, nullptr, record_starts);
+  py::tuple Estimate(const Array& temperature_in, const std::vector<Eigen::Index>& record_starts,
+                     std::optional<double> rate_hz) const {
+    const tasks::AxisCompensation c = Compensation("estimate", temperature_in, nullptr,
+                                                   record_starts, {}, {}, std::nullopt, rate_hz);
     return py::make_tuple(ToArray(c.estimate), ToArray(c.sd));
   }
 
   // y - estimate, as `gyrodrift compensate` writes it.
   py::array_t<double> Compensate(const Array& temperature_in, const Array& y_in,
-                                 const std::vector<Eigen::Index>& record_starts) const {
-    return ToArray(Compensation("compensate", temperature_in, &y_in, record_starts).compensated);
+                                 const std::vector<Eigen::Index>& record_starts,
+                                 std::optional<double> rate_hz) const {
+    return ToArray(Compensation("compensate", temperature_in, &y_in, record_starts, {}, {},
+                                std::nullopt, rate_hz)
+                       .compensated);
   }
 
   // The figures `gyrodrift compensate` prints and keeps in its sidecar for y compensated by this
@@ -147,10 +156,11 @@ class PyDriftModel {
   py::dict CompensationSummary(const Array& temperature_in, const Array& y_in,
                                const std::vector<Eigen::Index>& record_starts,
                                double drift_window_s, const std::vector<bool>& logged,
-                               const std::optional<Array>& truth) const {
+                               const std::optional<Array>& truth,
+                               std::optional<double> rate_hz) const {
     const tasks::AxisCompensation c =
         Compensation("compensation_summary", temperature_in, &y_in, record_starts,
-                     {.drift_window_s = drift_window_s}, logged, truth);
+                     {.drift_window_s = drift_window_s}, logged, truth, rate_hz);
     const drift::CompensationSummary& s = c.summary;
     auto figures = [](const drift::SignalSummary& f) {
       py::dict d;
@@ -215,8 +225,13 @@ class PyDriftModel {
   // As `gyrodrift predict` (tasks::RunPredict): predictions of y[t] for t = first .. N-1.
   py::tuple Predict(const Array& y_in, const std::optional<Array>& temperature_in, int horizon,
                     const std::string& protocol, int window, double mirror, int windows,
-                    int causal_ensemble, int threads, const py::object& progress) const {
+                    int causal_ensemble, int threads, const py::object& progress,
+                    std::optional<double> rate_hz) const {
     RequireMode(drift::Mode::kPredict, "predict");
+    if (rate_hz) {
+      RequireInRange("rate_hz", *rate_hz, 1e-9, 1e9);
+      tasks::RequirePredictRate(Loaded(), "the model", "the data", *rate_hz, "given", false);
+    }
     LongCall call(progress);
     const tasks::PredictSettings settings{
         .protocol = protocol,
@@ -236,6 +251,14 @@ class PyDriftModel {
   }
 
   void Save(const std::string& path) const { io::WriteModelFile(path, {Loaded()}); }
+
+  // The model file's text and back (pickling: a model sent to a Dask worker or a process pool).
+  std::string ToText() const { return io::RenderModelFile({Loaded()}); }
+  static PyDriftModel FromText(const std::string& text) {
+    std::vector<io::LoadedModel> axes = io::ParseModelFileAxes(text, "a pickled DriftModel");
+    if (axes.size() != 1) throw DataError("a pickled DriftModel holds one axis");
+    return PyDriftModel(std::move(axes.front()));
+  }
 
   // One model file of several axes, as `gyrodrift fit --target a,b,c` writes it.
   static void SaveAxes(const std::string& path, const std::vector<const PyDriftModel*>& models) {
@@ -343,21 +366,24 @@ void BindDriftModel(py::module_& m) {
            arg("record_starts") = std::vector<Eigen::Index>{}, arg("logged") = std::vector<bool>{},
            arg("progress") = py::none())
       .def("estimate", &gp::PyDriftModel::Estimate, arg("temperature"), py::kw_only(),
-           arg("record_starts") = std::vector<Eigen::Index>{})
+           arg("record_starts") = std::vector<Eigen::Index>{}, arg("rate_hz") = py::none())
       .def("compensate", &gp::PyDriftModel::Compensate, arg("temperature"), arg("y"), py::kw_only(),
-           arg("record_starts") = std::vector<Eigen::Index>{})
+           arg("record_starts") = std::vector<Eigen::Index>{}, arg("rate_hz") = py::none())
       .def("compensation_summary", &gp::PyDriftModel::CompensationSummary, arg("temperature"),
            arg("y"), py::kw_only(), arg("record_starts") = std::vector<Eigen::Index>{},
            arg("drift_window_s") = gyrodrift::tasks::CompensateSettings{}.drift_window_s,
-           arg("logged") = std::vector<bool>{}, arg("truth") = py::none())
+           arg("logged") = std::vector<bool>{}, arg("truth") = py::none(),
+           arg("rate_hz") = py::none())
       .def("coefficients", &gp::PyDriftModel::Coefficients, py::kw_only(),
            arg("reference_temperature") = py::none())
       .def("predict", &gp::PyDriftModel::Predict, arg("y"), arg("temperature") = py::none(),
            py::kw_only(), arg("horizon") = pd.horizon, arg("protocol") = pd.protocol,
            arg("window") = pd.causal.window, arg("mirror") = pd.causal.mirror,
            arg("windows") = pd.causal.windows, arg("causal_ensemble") = pd.causal.ensemble_size,
-           arg("threads") = pd.threads, arg("progress") = py::none())
+           arg("threads") = pd.threads, arg("progress") = py::none(), arg("rate_hz") = py::none())
       .def("save", &gp::PyDriftModel::Save, arg("path"))
+      .def("to_text", &gp::PyDriftModel::ToText)
+      .def_static("from_text", &gp::PyDriftModel::FromText, arg("text"))
       .def_static("load_axes", &gp::PyDriftModel::LoadAxes, arg("path"))
       .def_static("save_axes", &gp::PyDriftModel::SaveAxes, arg("path"), arg("models"))
       .def_property_readonly("fitted", [](const gp::PyDriftModel& d) { return d.fitted_; })
@@ -375,6 +401,9 @@ void BindDriftModel(py::module_& m) {
           })
       .def_property_readonly(
           "target", [](const gp::PyDriftModel& d) { return d.Loaded().info.target_column; })
+      .def_property_readonly(
+          "rate_hz",
+          [](const gp::PyDriftModel& d) { return d.Loaded().model.options.features.rate_hz; })
       .def_property_readonly("temperature_columns",
                              [](const gp::PyDriftModel& d) {
                                const std::string& t = d.Loaded().info.temperature_column;

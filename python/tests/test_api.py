@@ -255,3 +255,26 @@ def test_what_the_calibration_cannot_identify_is_a_user_warning_as_fit_prints_it
         model = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"])
     assert any(w.startswith("thermal states could lag")
                for w in model.sub_models[0]["thermal"]["warnings"])
+
+
+def test_a_model_pickles_as_its_file_and_checks_a_stated_rate():
+    import copy
+    import pickle
+    sim = gd.simulate(duration=3600, seed=7)
+    with pytest.warns(UserWarning):
+        m = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"])
+    # Sent to a Dask worker or a process pool: the same model, bit for bit, not a shared core.
+    for twin in (pickle.loads(pickle.dumps(m)), copy.deepcopy(m)):
+        assert twin._core is not m._core
+        assert np.array_equal(twin.estimate(sim["temperature_c"])[0],
+                              m.estimate(sim["temperature_c"])[0])
+    assert not pickle.loads(pickle.dumps(gd.DriftModel())).fitted
+    # The lags count samples: data at another rate than the model's is refused when stated.
+    assert m.rate_hz == 1.0
+    with pytest.raises(gd.DataError, match=r"the data is sampled at 10 Hz \(given by rate_hz\), "
+                                           r"the model was fitted at 1 Hz"):
+        m.compensate(sim["rate_dph"], sim["temperature_c"], rate_hz=10)
+    with pytest.raises(gd.UsageError, match="rate_hz = nan"):
+        m.estimate(sim["temperature_c"], rate_hz=float("nan"))
+    assert np.array_equal(m.compensate(sim["rate_dph"], sim["temperature_c"], rate_hz=1.005),
+                          m.compensate(sim["rate_dph"], sim["temperature_c"]))

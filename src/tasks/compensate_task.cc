@@ -231,11 +231,13 @@ void RequireModelRate(const std::vector<io::LoadedModel>& axes, const std::strin
     if (std::abs(ratio - 1.0) <= 0.01) continue;
     throw DataError(fmt::format(
         "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its thermal lags and "
-        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz, fit the "
-        "model on a log at {:g} Hz, or give {} if time_s is wrong)",
+        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz or fit the "
+        "model on a log at {:g} Hz{})",
         log_path, log_hz, RateSourceText(how, flags), model_path, model_hz,
         ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow", model_hz, log_hz,
-        flags ? "--rate-hz" : "rate_hz"));
+        how == "time_s"
+            ? fmt::format("; give {} if time_s is wrong", flags ? "--rate-hz" : "rate_hz")
+            : ""));
   }
 }
 

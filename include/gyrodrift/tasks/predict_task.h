@@ -40,9 +40,11 @@ void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_
 // DataError naming the log and the model when the log's sample rate (`log_hz` and `how` from
 // io::ResolveSampleRate: --rate-hz or time_s; a rate nobody stated, "default", is not checked) is
 // more than 1 % off the model's: the model's lags, decomposition and thermal lags count samples, so
-// they would span another stretch of time than the model learnt, silently.
+// they would span another stretch of time than the model learnt, silently. `flags`: the rate's
+// source spelt as flags (--rate-hz), else as keywords (rate_hz).
 void RequirePredictRate(const io::LoadedModel& loaded, const std::string& model_path,
-                        const std::string& log_path, double log_hz, const std::string& how);
+                        const std::string& log_path, double log_hz, const std::string& how,
+                        bool flags = true);
 
 // The predictions of `y` (named `y_name` in messages: the log, or "y") by `loaded`, reading
 // `temperature` when the model uses it. Throws OptionError (settings), UsageError (a
