@@ -132,7 +132,7 @@ TEST(CompensateTask, RefusesALogAtAnotherSampleRate) {
     EXPECT_NE(std::string(e.what()).find(
                   "fast.csv is sampled at 10 Hz (from the steps of time_s), m.json was "
                   "fitted at 1 Hz: its thermal lags and temperature rates would run 10 times too "
-                  "fast (resample the log to 1 Hz, fit the model on a log at 10 Hz, or give "
+                  "fast (resample the log to 1 Hz or fit the model on a log at 10 Hz; give "
                   "--rate-hz if time_s is wrong)"),
               std::string::npos)
         << e.what();
