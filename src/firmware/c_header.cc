@@ -388,6 +388,7 @@ class CWriter {
 std::string RenderFirmwareC(const std::vector<LoadedModel>& axes, const ExportOptions& options) {
   options.Validate();
   const Plan plan = MakePlan(axes);
+  RequireDistinctAxes(axes);
   return CWriter(plan, options).Render();
 }
 

@@ -24,6 +24,7 @@ std::string RenderCoefficientsJson(const std::vector<LoadedModel>& axes,
                                    const ExportOptions& options) {
   options.Validate();
   const Plan plan = MakePlan(axes);
+  RequireDistinctAxes(axes);
   using nlohmann::json;
   json out_axes = json::array();
   for (const Axis& axis : plan.axes) {

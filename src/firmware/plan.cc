@@ -104,6 +104,19 @@ Sub PlanSub(const std::string& name, const drift::ThermalRegression& t,
 
 }  // namespace
 
+void RequireDistinctAxes(const std::vector<LoadedModel>& axes) {
+  for (size_t a = 0; a < axes.size(); ++a) {
+    for (size_t b = 0; b < a; ++b) {
+      if (axes[a].info.target_column != axes[b].info.target_column) continue;
+      throw UsageError(fmt::format(
+          "{} has the target column of axis {}: the export names its axes by it, and two gyros "
+          "logged alike would share their temperature channels by name; fit each gyro's axes "
+          "under their own column names, or export each gyro on its own with its own prefix",
+          AxisLabel(a, axes[a]), b));
+    }
+  }
+}
+
 Plan MakePlan(const std::vector<LoadedModel>& axes) {
   RequireExportable(axes);
   Plan plan;

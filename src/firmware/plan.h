@@ -87,6 +87,11 @@ struct Plan {
 std::vector<std::string> SplitNames(const std::string& names);
 // "axis 0 (rate_dph)", naming an axis in messages.
 std::string AxisLabel(size_t i, const LoadedModel& m);
+// UsageError when two of `axes` have one target column: the C header and the coefficients name
+// their axes by it, and two gyros logged alike (convert --instance all) would also share their
+// temperature channels by name, each driven by the first gyro's sensor.
+void RequireDistinctAxes(const std::vector<LoadedModel>& axes);
+
 // The plan of `axes` (RequireExportable first).
 Plan MakePlan(const std::vector<LoadedModel>& axes);
 

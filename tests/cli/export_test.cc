@@ -217,6 +217,16 @@ TEST_F(ExportCli, CoefficientsJsonAndRefusals) {
   test::ExpectCleanFailure(
       test::RunCli("export " + Quote(Dir() + "/poly.json") + " -o " + Quote(Dir() + "/poly.h")), 2,
       "sub-model 'signal' is a poly learner on thermal features", Dir() + "/poly.h", "export poly");
+  // Two gyros logged alike (a copy of one model file stands for the second): one axis name for
+  // two axes, and one temperature channel for two sensors. Refused in both formats that name axes.
+  std::filesystem::copy_file(Dir() + "/two.json", Dir() + "/copy.json",
+                             std::filesystem::copy_options::overwrite_existing);
+  for (const char* format : {"c", "json-coefficients"}) {
+    test::ExpectCleanFailure(
+        test::RunCli("export " + Quote(Dir() + "/two.json") + " " + Quote(Dir() + "/copy.json") +
+                     " --format " + format + " -o " + Quote(Dir() + "/twice.h")),
+        2, "axis 1 (rate_dph) has the target column of axis 0", Dir() + "/twice.h", format);
+  }
 }
 
 }  // namespace

@@ -102,6 +102,12 @@ LoadedModel Fit(const Log& log, drift::DriftOptions o, int channels = 1,
   return m;
 }
 
+// `m` as the axis `target` (the export refuses two axes of one name).
+LoadedModel Renamed(LoadedModel m, const std::string& target) {
+  m.info.target_column = target;
+  return m;
+}
+
 // The estimate of every axis from the coefficients JSON, with the equation of docs/firmware.md:
 // per sub-model b0 + sum_c sum_p a_cp P_p(z_c) + sum_j [sum_p g_jp P_p(zs_j) + r_j R(ds_j/dt)]
 // + h H_w(s_k) - reference_estimate, P_p the power continued along its tangent beyond the range and
@@ -296,7 +302,7 @@ TEST_F(FirmwareExport, CoefficientsReproduceTheLibrarysEstimate) {
 
 TEST_F(FirmwareExport, AxesShareTheChannelsAndLagsTheyHaveInCommon) {
   const LoadedModel second = Fit(MakeLog(3000, 9), Compensate(Method::kThermal), 2, "rate_y_dph");
-  const std::vector<LoadedModel> axes{*thermal_, second, *thermal_};
+  const std::vector<LoadedModel> axes{*thermal_, second, Renamed(*thermal_, "rate_z_dph")};
   const json j = json::parse(RenderCoefficientsJson(axes, kJson));
   EXPECT_EQ(j["channels"], (std::vector<std::string>{"case_c", "board_c"}));
   ASSERT_EQ(j["axes"].size(), 3u);
@@ -360,8 +366,9 @@ TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
   ASSERT_TRUE(stateless.model.sub_models[0].thermal->states.empty());
   ASSERT_TRUE(HasBoundedRate(*heat_up_)) << heat_up_->model.Summary();
   ASSERT_TRUE(HasBoundedRate(*cool_down_)) << cool_down_->model.Summary();
-  const std::vector<LoadedModel> axes{*thermal_,  *two_,       *ms_,     *referenced_, *hysteresis_,
-                                      *heat_up_, *cool_down_, stateless};
+  std::vector<LoadedModel> axes{*thermal_,    *two_,     *ms_,        *referenced_,
+                                *hysteresis_, *heat_up_, *cool_down_, stateless};
+  for (size_t a = 0; a < axes.size(); ++a) axes[a] = Renamed(axes[a], "axis" + std::to_string(a));
   const Log test = MakeLog(2000, 4, 8.0);
   const std::string dir = test::TempDir("firmware_header");
   for (const bool single : {false, true}) {
@@ -389,7 +396,7 @@ TEST_F(FirmwareExport, HeadersOfEveryShapeCompileAndMatchTheLibrary) {
 // estimates are the library's on the series with that sample repeated, not NaN ever after.
 TEST_F(FirmwareExport, HeaderHoldsATemperatureThatIsNotFinite) {
   ASSERT_TRUE(std::filesystem::exists(test::kCCompiler)) << "no C compiler was found";
-  const std::vector<LoadedModel> axes{*two_, *hysteresis_};
+  const std::vector<LoadedModel> axes{*two_, Renamed(*hysteresis_, "rate_y_dph")};
   const Log test = MakeLog(1200, 6, 8.0);
   Eigen::MatrixXd glitched = test.temperature, held = test.temperature;
   glitched(400, 0) = std::numeric_limits<double>::quiet_NaN();
