@@ -572,6 +572,10 @@ FleetResult RunFleet(const Manifest& m, const FleetOptions& o, const FleetContex
   if (!fs::is_directory(o.output_dir, ec)) {
     throw IoError(o.output_dir + ": cannot create the output folder");
   }
+  // A folder that exists but cannot be written would fail every unit and then the table.
+  io::RequireOutputsAreNotInputs(InputsOf(m, nullptr),
+                                 {(fs::path(o.output_dir) / kFleetTableFile).string(),
+                                  (fs::path(o.output_dir) / kFleetReportFile).string()});
   const html::DygraphsAssets assets = html::LoadDygraphs();
   const int n = static_cast<int>(m.units.size());
   std::vector<UnitRun> runs(static_cast<size_t>(n));
