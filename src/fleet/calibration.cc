@@ -110,7 +110,7 @@ VerificationResult Verification(const Manifest& m, const std::string& path, doub
                                 const tasks::AxisCompensation& c, const Eigen::VectorXd& y,
                                 const Eigen::VectorXd& truth) {
   VerificationResult v;
-  v.log = path;
+  v.log = PathFromManifest(m, path);
   v.samples = y.size();
   v.rate_hz = rate_hz;
   v.mean_before = c.summary.before.mean;

@@ -111,7 +111,7 @@ std::vector<FleetRow> Rows(const UnitResult& unit) {
                                    : std::numeric_limits<double>::quiet_NaN();
       rows.push_back(FleetRow{{unit.serial,
                                a.target,
-                               fs::path(v.log).filename().string(),
+                               v.log,
                                v.failures.empty() ? "pass" : "fail",
                                failures,
                                "",

@@ -468,6 +468,15 @@ void CheckLogColumns(const Manifest& m) {
   }
 }
 
+std::string PathFromManifest(const Manifest& m, const std::string& log) {
+  std::error_code folder_error, log_error;
+  const fs::path folder = fs::absolute(m.path, folder_error).parent_path();
+  const fs::path absolute = fs::absolute(log, log_error).lexically_normal();
+  if (folder_error || log_error) return log;
+  const fs::path relative = absolute.lexically_relative(folder);
+  return (relative.empty() ? absolute : relative).string();
+}
+
 nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
   nlohmann::json axes = nlohmann::json::array();
   for (const AxisSpec& a : m.axes) {
@@ -480,18 +489,14 @@ nlohmann::json FingerprintJson(const Manifest& m, const UnitSpec& u) {
   // and when the whole tree moves.
   nlohmann::json logs = nlohmann::json::array();
   for (const std::string& log : u.Logs()) {
-    std::error_code folder_error, log_error;
-    const fs::path folder = fs::absolute(m.path, folder_error).parent_path();
-    const fs::path absolute = fs::absolute(log, log_error).lexically_normal();
-    const fs::path relative = absolute.lexically_relative(folder);
-    const bool named = !folder_error && !log_error;  // else the path as the manifest gave it
-    logs.push_back({{"path", named ? (relative.empty() ? absolute : relative).string() : log},
+    logs.push_back({{"path", PathFromManifest(m, log)},
                     {"fnv1a64", fmt::format("{:016x}", io::Fnv1a64(io::ReadTextFile(log)))}});
   }
   // Raised when a unit's files change for the same logs and settings, so that a rerun redoes the
   // units an older tool finished (2: 2026-11-27, unidentified noise terms empty, model.json's
-  // source as the manifest spells it, epoch time stamps' rate, a copied verification refused).
-  constexpr int kResultsVersion = 2;
+  // source as the manifest spells it, epoch time stamps' rate, a copied verification refused;
+  // 3: 2026-11-28, a verification log named by its path from the manifest's folder).
+  constexpr int kResultsVersion = 3;
   return {
       {"results_version", kResultsVersion},
       {"settings", tasks::SettingsToJson(m.fit, m.log)},

@@ -82,8 +82,7 @@ void AddAxisSummary(html::HtmlReport& report, const Manifest& m, const AxisResul
   for (const VerificationResult& v : a.verification) {
     std::string failures;
     for (const std::string& f : v.failures) failures += (failures.empty() ? "" : "; ") + f;
-    table.rows.push_back({std::filesystem::path(v.log).filename().string(),
-                          std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
+    table.rows.push_back({v.log, std::to_string(v.samples), Num(v.mean_before), Num(v.mean_after),
                           Num(v.std_before), Num(v.std_after), Num(v.drift_rms_before),
                           Num(v.drift_rms_after), Percent(v.truth_removed),
                           TermText(v.noise_after.n_dpsh), TermText(v.noise_before.b_dph),

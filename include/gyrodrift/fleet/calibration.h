@@ -40,7 +40,7 @@ namespace gyrodrift::fleet {
 
 // One verification log of one axis.
 struct VerificationResult {
-  std::string log;  // path
+  std::string log;  // path from the manifest's folder (PathFromManifest)
   Eigen::Index samples = 0;
   double rate_hz = 0.0;
   double mean_before = 0.0, mean_after = 0.0;              // rate unit: the bias moved

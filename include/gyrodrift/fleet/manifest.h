@@ -128,6 +128,10 @@ void CheckLogColumns(const Manifest& manifest);
 // the unit (serial, number of calibration logs, each log's path and FNV-1a 64 of its bytes).
 // Before this form (2026-11, issue 25) the fingerprint hashed a hand-made list of some of these;
 // a summary.json of that form never matches, so each unit is calibrated once more.
+// A log's path from the manifest's folder: the same however the manifest was named and from
+// whichever folder or front end the run started (the path as given when it cannot be resolved).
+std::string PathFromManifest(const Manifest& manifest, const std::string& log);
+
 nlohmann::json FingerprintJson(const Manifest& manifest, const UnitSpec& unit);
 std::string UnitFingerprint(const Manifest& manifest, const UnitSpec& unit);
 
