@@ -260,6 +260,16 @@ TEST(ThermalModel, ARunWithoutCoolingOrDwellsIsFlaggedAndBadInputRefused) {
   EXPECT_NE(all.find("spans only"), std::string::npos) << all;
   EXPECT_NE(all.find("no cooling ramp"), std::string::npos) << all;
   EXPECT_NE(all.find("no dwell"), std::string::npos) << all;
+  // The length the advice asks for is one whose grid holds a long enough state: the grid goes in
+  // steps of sqrt(2) from 30 s, and 960 s (lag 1920 s) is the first above 900 s, at 1/16 of 4.27 h.
+  std::string advice;
+  for (const std::string& a : m.report.advice) advice += a + "\n";
+  EXPECT_NE(advice.find("short run: 1 h lets states lag by 339 s at most; 4.27 h reaches 1920 s"),
+            std::string::npos)
+      << advice;
+  const ThermalModelOptions o;
+  const std::vector<double> grid = o.Grid(4.27 * 3600.0);
+  EXPECT_DOUBLE_EQ(grid.back(), 960.0);
 
   ThermalModelOptions bad;
   bad.max_states = 5;
