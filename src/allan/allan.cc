@@ -305,8 +305,14 @@ Eigen::VectorXd AllanResult::dev() const {
 
 std::string AllanResult::Summary() const {
   std::ostringstream s;
-  s << ToString(options.deviation) << " of " << n_samples << " " << ToString(options.data_type)
-    << " samples at " << FormatValue(options.rate_hz) << " Hz: " << points.size() << " taus";
+  s << ToString(options.deviation) << " of ";
+  if (n_logged >= 0 && n_logged < n_samples) {
+    s << n_logged << " logged " << ToString(options.data_type) << " samples (" << n_samples
+      << " on the time grid)";
+  } else {
+    s << n_samples << " " << ToString(options.data_type) << " samples";
+  }
+  s << " at " << FormatValue(options.rate_hz) << " Hz: " << points.size() << " taus";
   if (!points.empty()) {
     const auto it = std::min_element(points.begin(), points.end(),
                                      [](const auto& a, const auto& b) { return a.dev < b.dev; });

@@ -134,6 +134,7 @@ AllanResult ComputeWithGaps(const Eigen::VectorXd& data, const std::vector<bool>
   AllanResult result;
   result.options = options;
   result.n_samples = data.size();
+  result.n_logged = std::count(logged.begin(), logged.end(), true);
   result.n_phase = n;
   for (size_t k = 0; k < ms.size(); ++k) {
     if (terms[k] == 0) {
