@@ -66,6 +66,7 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
       Num(t.critical_chi2));
   s += fmt::format("  curve minimum {} deg/h at tau {} s (B slope reading = minimum / 0.664)\n",
                    Num(t.min_dev_dph), Num(t.min_dev_tau_s));
+  if (!t.note.empty()) s += "note: " + t.note + " (--fit-tau-min, --fit-tau-max)\n";
   return s;
 }
 
@@ -137,8 +138,6 @@ void Run(const AllanArgs& a) {
   fmt::print("{}\n", r.curve.Summary());
   if (r.terms) {
     fmt::print("{}", TermTable(*r.terms, r.fit_source));
-    if (!r.terms->note.empty())
-      fmt::print("note: {} (--fit-tau-min, --fit-tau-max)\n", r.terms->note);
   } else {
     fmt::print("noise terms not fitted: {}\n", r.fit_error);
   }

@@ -412,8 +412,7 @@ class DriftModel:
     temperature_range_c = property(lambda self: self._core.temperature_range_c,
                                    doc="Training temperature range (min, max), degC.")
     fitted = property(lambda self: self._core.fitted)
-    rate_hz = property(lambda self: self._core.rate_hz,
-                       doc="The sample rate the model was fitted at, Hz (its lags count samples).")
+    rate_hz = property(lambda self: self._core.rate_hz, doc="The rate fitted at, Hz.")
 
     # Pickled (Dask, multiprocessing, copy.deepcopy) as the model file's text: exact doubles.
     def __getstate__(self):

@@ -324,7 +324,7 @@ TEST(Rows, EveryCellComesFromTheResult) {
   a.warnings = {"no dwell", "narrow span"};
   a.identified = false;
   VerificationResult v;
-  v.log = "/data/logs/SN7_ver.csv";
+  v.log = "logs/SN7_ver.csv";  // its path from the manifest's folder
   v.samples = 1234;
   v.mean_before = 1.5;
   v.mean_after = -0.125;
@@ -354,7 +354,7 @@ TEST(Rows, EveryCellComesFromTheResult) {
   const std::vector<std::pair<std::string, std::string>> expected = {
       {"serial", "SN7"},
       {"axis", "gyro_x"},
-      {"verification", "SN7_ver.csv"},  // the file name, not the path
+      {"verification", "logs/SN7_ver.csv"},
       {"status", "fail"},
       {"failures", "residual drift 0.05 > 0.04"},
       {"outliers", ""},       // FinishFleet's to fill

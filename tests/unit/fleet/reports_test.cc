@@ -158,8 +158,8 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   x.skill = 0.875;
   x.warnings = {"narrow span"};
   x.identified = false;  // the warning: the run could not identify the model
-  x.verification = {Verification("/data/logs/SN7_ver.csv", 0.0123456, 0.95123),
-                    Verification("/data/logs/SN7_ver2.csv", 0.0625, kNan)};
+  x.verification = {Verification("logs/SN7_ver.csv", 0.0123456, 0.95123),
+                    Verification("logs/SN7_ver2.csv", 0.0625, kNan)};
   x.verification[1].failures = {"residual drift 0.0625 > 0.05", "second"};
   x.verification[1].truth_means.resize(0);  // no truth: no true-drift curve
   AxisResult y = x;
@@ -197,9 +197,9 @@ TEST(UnitReport, ShowsTheResultsFiguresLimitsAndVerdict) {
   const auto rows = TableRows(html, "Verification of gyro_x");
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(Texts(rows[0]),
-            (std::vector<std::string>{"SN7_ver.csv", "7250", "1.5", "-0.25", "0.1235", "0.01235",
-                                      "0.25", "0.01235", "95.1 %", "0.00458", "0.5", "0.0125",
-                                      "12.5 %", "none"}));
+            (std::vector<std::string>{"logs/SN7_ver.csv", "7250", "1.5", "-0.25", "0.1235",
+                                      "0.01235", "0.25", "0.01235", "95.1 %", "0.00458", "0.5",
+                                      "0.0125", "12.5 %", "none"}));
   EXPECT_EQ(Texts(rows[1])[8], "-");  // no truth
   EXPECT_EQ(Texts(rows[1])[13], "residual drift 0.0625 > 0.05; second");
   EXPECT_EQ(Texts(TableRows(html, "Verification of gyro_y")[1])[13], "none");
