@@ -30,6 +30,11 @@ def test_decompose_reports_progress_without_changing_the_result():
     assert len(seen) >= 12  # one report per realisation and stage at least
     assert all(0.0 <= f <= 1.0 for f in seen)
     assert all(b >= a for a, b in zip(seen, seen[1:]))
+    # Every ensemble method ends at 1 (the stage-based estimates stop short of it).
+    for method in ("eemd", "ceemdan", "iceemdan", "beemdan"):
+        ends = []
+        gd.decompose(x[:1000], method=method, ensemble=4, progress=ends.append)
+        assert ends[-1] == 1.0, method
 
 
 def test_fit_and_causal_predict_report_progress():

@@ -221,19 +221,15 @@ Decomposition Run(const Eigen::Ref<const Eigen::VectorXd>& x, const internal::Jo
     result.report.stop_reason = "input has fewer than 3 extrema: no IMF";
     return result;
   }
-  switch (options.method) {
-    case Method::kEmd:
-      return internal::RunEmd(x, options);
-    case Method::kEemd:
-      return internal::RunEemd(x, job);
-    case Method::kCeemdan:
-      return internal::RunCeemdan(x, job);
-    case Method::kIceemdan:
-      return internal::RunIceemdan(x, job);
-    case Method::kBeemdan:
-      return internal::RunBeemdan(x, job);
-  }
-  throw UsageError("unknown decomposition method");
+  if (options.method == Method::kEmd) return internal::RunEmd(x, options);
+  Decomposition result = options.method == Method::kEemd       ? internal::RunEemd(x, job)
+                         : options.method == Method::kCeemdan  ? internal::RunCeemdan(x, job)
+                         : options.method == Method::kIceemdan ? internal::RunIceemdan(x, job)
+                                                               : internal::RunBeemdan(x, job);
+  // The stages' reports estimate the share done from a guess at the number of stages, so stop
+  // short of it; the end is said once it is reached.
+  job.context.execution.Report(1.0, ToString(options.method));
+  return result;
 }
 
 }  // namespace
