@@ -91,6 +91,9 @@ def main(argv=None):
                         help="redo units already calibrated with the same settings")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     a = parser.parse_args(argv)
+    if not os.path.isfile(a.manifest):  # a usage error, as gyrodrift calibrate says it
+        print(f"error: {a.manifest}: no such file", file=sys.stderr)
+        return 2
     try:
         r = calibrate(a.manifest, a.output, scheduler=a.scheduler, workers=a.workers,
                       force=a.force)
