@@ -63,9 +63,12 @@ void RefuseEmptyValues(CLI::App& app) {
       "", "NOT_EMPTY");
   const CLI::Validator not_a_path(
       [](std::string& value) {
-        return value.empty() ? std::string("an empty value is not a path") : std::string();
+        if (value.empty()) return std::string("an empty value is not a path");
+        // Outputs are written whole and renamed into place: a stream cannot take them.
+        if (value == "-") return std::string("'-' (standard output) is not supported: name a file");
+        return std::string();
       },
-      "", "NOT_EMPTY_PATH");
+      "", "OUTPUT_PATH");
   for (CLI::App* sub : app.get_subcommands({})) {
     for (CLI::Option* option : sub->get_options()) {
       const std::string type = option->get_type_name();

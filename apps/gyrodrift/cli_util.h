@@ -88,7 +88,8 @@ std::string MadeUpRowsPredictionNote(const std::vector<bool>& logged);
 
 // Refuses an empty value for every numeric option and every --output of app's subcommands: CLI11
 // reads '' (an unset shell variable) as 0, which would set a reference temperature of 0 degC
-// without a word, and an empty output name would fail only after the work, as a file error.
+// without a word, and an empty output name would fail only after the work, as a file error. An
+// --output of '-' is refused too: it would be a file named '-', not standard output.
 void RefuseEmptyValues(CLI::App& app);
 
 // Declares a list flag: values comma-separated ("60,300,900"), space-separated or the flag

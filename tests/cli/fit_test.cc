@@ -417,6 +417,11 @@ TEST_F(FitCli, BadInputGivesOneLineErrorAndNoOutput) {
   EXPECT_EQ(unnamed.exit_code, 2) << unnamed.err;
   EXPECT_NE(unnamed.err.find("--output: an empty value is not a path"), std::string::npos)
       << unnamed.err;
+  const auto dash = Fit(ok, "-");
+  EXPECT_EQ(dash.exit_code, 2) << dash.err;
+  EXPECT_NE(dash.err.find("--output: '-' (standard output) is not supported: name a file"),
+            std::string::npos)
+      << dash.err;
   // A device would be replaced by the rename that places the file: refused before the work.
   const auto device = Fit(ok, "/dev/null");
   EXPECT_EQ(device.exit_code, 4) << device.err;
