@@ -192,6 +192,10 @@ class PyDriftModel {
   // The thermal sub-models' coefficients in physical units around `reference_temperature`, else
   // the model's reference temperature, else the calibration's means (as `gyrodrift fit` prints).
   py::list Coefficients(std::optional<double> reference_temperature) const {
+    // The range fit's reference_temperature takes (drift::FitSettings).
+    if (reference_temperature) {
+      RequireInRange("reference_temperature", *reference_temperature, -100.0, 200.0);
+    }
     const io::LoadedModel& l = Loaded();
     const std::vector<std::string> channels = tasks::SplitColumns(l.info.temperature_column);
     const std::optional<double> reference =

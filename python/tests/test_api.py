@@ -278,3 +278,13 @@ def test_a_model_pickles_as_its_file_and_checks_a_stated_rate():
         m.estimate(sim["temperature_c"], rate_hz=float("nan"))
     assert np.array_equal(m.compensate(sim["rate_dph"], sim["temperature_c"], rate_hz=1.005),
                           m.compensate(sim["rate_dph"], sim["temperature_c"]))
+
+
+def test_coefficients_take_the_reference_temperatures_fit_takes():
+    sim = gd.simulate(duration=3600, seed=7)
+    with pytest.warns(UserWarning):
+        m = gd.DriftModel().fit(sim["rate_dph"], sim["temperature_c"])
+    assert m.coefficients(reference_temperature=25.0)[0]["reference_c"] == [25.0]
+    for bad in (1e308, float("nan"), -273.0):
+        with pytest.raises(gd.UsageError, match="reference_temperature = .*must be in"):
+            m.coefficients(reference_temperature=bad)
