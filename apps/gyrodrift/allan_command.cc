@@ -66,7 +66,10 @@ std::string TermTable(const al::NoiseTerms& t, const std::string& source) {
       Num(t.critical_chi2));
   s += fmt::format("  curve minimum {} deg/h at tau {} s (B slope reading = minimum / 0.664)\n",
                    Num(t.min_dev_dph), Num(t.min_dev_tau_s));
-  if (!t.note.empty()) s += "note: " + t.note + " (--fit-tau-min, --fit-tau-max)\n";
+  // The range flags cure a misfit over enough points; few points need a longer record.
+  const bool misfit = t.chi2_per_dof > al::kMisfitNote && t.points_used > 5;
+  if (!t.note.empty())
+    s += "note: " + t.note + (misfit ? " (--fit-tau-min, --fit-tau-max)\n" : "\n");
   return s;
 }
 

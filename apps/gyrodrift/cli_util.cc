@@ -92,15 +92,18 @@ std::string ConversionMessage(const CLI::App& app, const CLI::ConversionError& e
     for (const CLI::Option* option : sub->get_options()) {
       if (!option->check_name(name)) continue;
       const std::string type = option->get_type_name();
-      if (type.rfind("INT", 0) != 0 && type.rfind("UINT", 0) != 0) {
-        return name + " = " + value + ": must be a number";
-      }
-      // "1e3" is a number CLI11 does not read as an integer: say which integer it is.
+      if (type.rfind("FLOAT", 0) == 0) return name + " = " + value + ": must be a number";
+      if (type.rfind("INT", 0) != 0 && type.rfind("UINT", 0) != 0) return what;  // on/off, text
+      // "1e3" is a number CLI11 does not read as an integer: say which integer it is. An integer
+      // written as one but refused is beyond the flag's type.
       double number = 0.0;
       const char* end = value.data() + value.size();
       const auto [ptr, ec] = std::from_chars(value.data(), end, number);
       const bool whole = ec == std::errc() && ptr == end && std::isfinite(number) &&
                          number == std::trunc(number) && std::abs(number) < 9.0e15;
+      const bool written_whole =
+          whole && value.find_first_not_of("+-0123456789") == std::string::npos;
+      if (written_whole) return name + " = " + value + ": out of range";
       return name + " = " + value + ": must be an integer" +
              (whole ? fmt::format(" (write {})", static_cast<long long>(number)) : "");
     }

@@ -94,8 +94,8 @@ void RefuseEmptyValues(CLI::App& app);
 
 // Declares a list flag: values comma-separated ("60,300,900"), space-separated or the flag
 // repeated, each converted as CLI11 converts a T. An empty item ("60,,300", "60,") is refused:
-// CLI11's own splitting (Option::delimiter) drops it without a word. The default shown in --help
-// is `values` as declared.
+// CLI11's own splitting (Option::delimiter) drops it without a word (its bracket form "[60,,300]"
+// still does, before this sees the value). The default shown in --help is `values` as declared.
 template <typename T>
 CLI::Option* AddListOption(CLI::App* cmd, const std::string& name, std::vector<T>* values,
                            const std::string& help) {
@@ -110,14 +110,18 @@ CLI::Option* AddListOption(CLI::App* cmd, const std::string& name, std::vector<T
             end = std::min(token.find(',', begin), token.size());
             const std::string item = token.substr(begin, end - begin);
             T value{};
+            if (token.empty()) throw CLI::ValidationError(name + ": an empty value is not a list");
             if (item.empty()) {
               throw CLI::ValidationError(name + " = " + token + ": an empty item in the list");
             }
             if (!CLI::detail::lexical_cast(item, value)) {
-              throw CLI::ValidationError(name + " = " + token + ": '" + item + "' is not " +
-                                         (std::is_floating_point_v<T> ? "a number"
-                                          : std::is_integral_v<T>     ? "an integer"
-                                                                      : "a value"));
+              std::string kind = "a value";
+              if constexpr (std::is_floating_point_v<T>) kind = "a number";
+              if constexpr (std::is_integral_v<T>) {
+                kind = "an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
+                       std::to_string(std::numeric_limits<T>::max()) + "]";
+              }
+              throw CLI::ValidationError(name + " = " + token + ": '" + item + "' is not " + kind);
             }
             values->push_back(std::move(value));
           }

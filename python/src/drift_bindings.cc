@@ -131,8 +131,10 @@ class PyDriftModel {
     }
     const std::vector<std::string> channels = Channels();
     if (t.cols() == static_cast<Eigen::Index>(channels.size())) WarnOfTemperatures(t, channels);
+    tasks::CompensateSettings timed = settings;  // a stated rate times the blocks, as --rate-hz
+    if (rate_hz) timed.rate_hz = *rate_hz;
     py::gil_scoped_release release;
-    return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, settings);
+    return tasks::CompensateAxis(Loaded(), y, t, record_starts, logged, truth, timed);
   }
 
   py::tuple Estimate(const Array& temperature_in, const std::vector<Eigen::Index>& record_starts,

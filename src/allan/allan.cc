@@ -307,8 +307,7 @@ std::string AllanResult::Summary() const {
   std::ostringstream s;
   s << ToString(options.deviation) << " of ";
   if (n_logged >= 0 && n_logged < n_samples) {
-    s << n_logged << " logged " << ToString(options.data_type) << " samples (" << n_samples
-      << " on the time grid)";
+    s << n_logged << " logged " << ToString(options.data_type) << " samples";
   } else {
     s << n_samples << " " << ToString(options.data_type) << " samples";
   }

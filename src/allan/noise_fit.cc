@@ -282,7 +282,8 @@ NoiseTerms IdentifyNoiseImpl(const Eigen::VectorXd& tau_s, const Eigen::VectorXd
   note.precision(4);
   if (n <= kTerms) {
     note << n << " points fitted: at most " << n - 1 << " term" << (n == 2 ? "" : "s")
-         << " can be told apart, and a term the model lacks moves the others; a longer record or "
+         << " can be told apart (chi2/dof " << out.chi2_per_dof
+         << " with those kept), and a term the model lacks moves the others; a longer record or "
             "more taus in the fitted range identify more";
   } else if (out.chi2_per_dof > kMisfitNote) {
     note << "the five-term model misses this curve's shape (chi2/dof " << out.chi2_per_dof

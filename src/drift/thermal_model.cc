@@ -91,6 +91,12 @@ std::vector<double> ThermalModelOptions::Grid(double duration_s) const {
   return grid;
 }
 
+double ThermalModelOptions::RunReachingLag(double lag_s) const {
+  const double steps =
+      std::ceil(taus_per_octave * std::log2(lag_s / state_order / shortest_tau_s) - 1e-9);
+  return shortest_tau_s * std::exp2(std::max(steps, 0.0) / taus_per_octave) / longest_tau_share;
+}
+
 Eigen::MatrixXd ThermalRegression::Regressors(
     const Eigen::Ref<const Eigen::MatrixXd>& temperatures_c,
     const std::vector<Eigen::Index>& record_starts) const {

@@ -183,15 +183,11 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
         "thermal states could lag the sensor by at most %.0f s (time constants up to %g of the "
         "run): a gyro whose coil lags its sensor by more needs a longer calibration run",
         longest_delay, options.longest_tau_share));
-    // The run whose grid first holds a time constant of kSlowLagS / order (the grid is in steps).
-    const double needed_tau = kSlowLagS / options.state_order;
-    const double steps =
-        std::ceil(options.taus_per_octave * std::log2(needed_tau / options.shortest_tau_s) - 1e-9);
-    const double grid_tau = options.shortest_tau_s * std::exp2(steps / options.taus_per_octave);
+    const double needed_s = options.RunReachingLag(kSlowLagS);
     advice.push_back(
-        Format("short run: %.3g h lets states lag by %.0f s at most; %.3g h reaches %.0f s",
-               report.duration_s / 3600.0, longest_delay,
-               grid_tau / options.longest_tau_share / 3600.0, options.state_order * grid_tau));
+        Format("short run: %.3g h lets states lag by %.0f s at most; %g h reaches %.0f s",
+               report.duration_s / 3600.0, longest_delay, std::ceil(needed_s / 36.0) / 100.0,
+               options.state_order * options.Grid(needed_s).back()));
   }
   double slowest = 0.0;
   for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);

@@ -108,11 +108,16 @@ void RequireDistinctAxes(const std::vector<LoadedModel>& axes) {
   for (size_t a = 0; a < axes.size(); ++a) {
     for (size_t b = 0; b < a; ++b) {
       if (axes[a].info.target_column != axes[b].info.target_column) continue;
-      throw UsageError(fmt::format(
-          "{} has the target column of axis {}: the export names its axes by it, and two gyros "
-          "logged alike would share their temperature channels by name; fit each gyro's axes "
-          "under their own column names, or export each gyro on its own with its own prefix",
-          AxisLabel(a, axes[a]), b));
+      for (const std::string& channel : SplitNames(axes[a].info.temperature_column)) {
+        const std::vector<std::string> other = SplitNames(axes[b].info.temperature_column);
+        if (std::find(other.begin(), other.end(), channel) == other.end()) continue;
+        throw UsageError(fmt::format(
+            "{} has the target and the temperature column '{}' of axis {}: two gyros logged "
+            "alike, whose channels the export would join by name, so that both read one sensor; "
+            "fit each gyro under its own column names, or export each on its own with its own "
+            "prefix",
+            AxisLabel(a, axes[a]), channel, b));
+      }
     }
   }
 }

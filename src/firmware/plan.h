@@ -87,9 +87,10 @@ struct Plan {
 std::vector<std::string> SplitNames(const std::string& names);
 // "axis 0 (rate_dph)", naming an axis in messages.
 std::string AxisLabel(size_t i, const LoadedModel& m);
-// UsageError when two of `axes` have one target column: the C header and the coefficients name
-// their axes by it, and two gyros logged alike (convert --instance all) would also share their
-// temperature channels by name, each driven by the first gyro's sensor.
+// UsageError when two of `axes` have one target column and a temperature column in common: two
+// gyros logged alike (convert --instance all), whose temperature channels the export joins by
+// name, so that both would read the first gyro's sensor. (Axes of one gyro share its sensor under
+// their own target names; nothing tells two gyros apart then.)
 void RequireDistinctAxes(const std::vector<LoadedModel>& axes);
 
 // The plan of `axes` (RequireExportable first).

@@ -189,10 +189,12 @@ class CsvTable::Parser {
                       "endings");
     }
     if (!carry_.empty()) Line(carry_);  // the last line has no newline
-    if (!have_header_ && skip_rows_ > 0 && line_number_ > 0) {
-      throw DataError(table_.source_ + ": skipping its first " + std::to_string(skip_rows_) +
-                      " lines leaves no header (the file has " + std::to_string(line_number_) +
-                      ")");
+    if (!have_header_ && skip_rows_ > 0 && line_number_ > 0 && line_number_ <= skip_rows_) {
+      throw DataError(
+          fmt::format("{}: skipping its first {} line{} leaves nothing to read (the "
+                      "file has {} line{})",
+                      table_.source_, skip_rows_, skip_rows_ == 1 ? "" : "s", line_number_,
+                      line_number_ == 1 ? "" : "s"));
     }
     if (!have_header_) throw DataError(table_.source_ + ": empty file (no header row)");
     if (table_.rows_ == 0 && !table_.skipped_lines_.empty()) {
@@ -309,7 +311,7 @@ class CsvTable::Parser {
 
   void Header(std::string_view line) {
     CsvTable& t = table_;
-    if (line.find('\0') != std::string_view::npos) {
+    if (names_.empty() && line.find('\0') != std::string_view::npos) {  // a header read
       throw DataError(t.source_ + ": line " + std::to_string(line_number_) +
                       " (the header) holds a NUL byte: not a text file");
     }

@@ -306,8 +306,15 @@ CompensateResult RunCompensate(const std::vector<io::LoadedModel>& axes, const T
     const Eigen::VectorXd y = table.Column(axis.info.target_column);
     const Eigen::MatrixXd temperature =
         ReadColumns(table, axis.info.temperature_column, "--temperature").values;
-    AxisCompensation c =
-        CompensateAxis(axis, y, temperature, log.record_starts, log.logged, truth, settings);
+    AxisCompensation c;
+    try {
+      c = CompensateAxis(axis, y, temperature, log.record_starts, log.logged, truth, settings);
+    } catch (const DataError& e) {
+      // The library sees arrays (y, temperature): the column and the log are named here, as
+      // fit names them.
+      throw DataError(fmt::format("compensating '{}' on '{}' ({}): {}", axis.info.target_column,
+                                  axis.info.temperature_column, log.path, e.what()));
+    }
     for (io::CsvColumn& column : c.Columns(suffixes[i])) r.columns.push_back(std::move(column));
     // One axis: its fields at the top level (the layout of one-axis models); several: "axes".
     if (axes.size() == 1) {

@@ -225,7 +225,8 @@ TEST_F(ExportCli, CoefficientsJsonAndRefusals) {
     test::ExpectCleanFailure(
         test::RunCli("export " + Quote(Dir() + "/two.json") + " " + Quote(Dir() + "/copy.json") +
                      " --format " + format + " -o " + Quote(Dir() + "/twice.h")),
-        2, "axis 1 (rate_dph) has the target column of axis 0", Dir() + "/twice.h", format);
+        2, "axis 1 (rate_dph) has the target and the temperature column 'temperature_c' of axis 0",
+        Dir() + "/twice.h", format);
   }
 }
 

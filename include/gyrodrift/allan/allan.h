@@ -133,7 +133,7 @@ struct AllanPoint {
 
 struct AllanResult {
   AllanOptions options;
-  Eigen::Index n_samples = 0;      // input samples (of a record with gaps, on its time grid)
+  Eigen::Index n_samples = 0;      // input samples (with gaps: the made-up and breaks too)
   Eigen::Index n_logged = -1;      // of them logged (ComputeWithGaps), -1: every one
   Eigen::Index n_phase = 0;        // angle (phase) points the estimators see (rate: n_samples + 1)
   std::vector<AllanPoint> points;  // increasing tau

@@ -94,6 +94,9 @@ TEST(NoiseFit, FewPointsOrAMisfitCurveAreTold) {
             1);
   EXPECT_NE(two.note.find("2 points fitted: at most 1 term can be told apart"), std::string::npos)
       << two.note;
+  // One term cannot follow both: the misfit is said beside the few points.
+  EXPECT_GT(two.chi2_per_dof, kMisfitNote);
+  EXPECT_NE(two.note.find("can be told apart (chi2/dof "), std::string::npos) << two.note;
   std::vector<double> octaves;
   for (double t = 0.01; t < 1e3; t *= 2) octaves.push_back(t);
   EXPECT_EQ(fit(octaves, qn).note, "");

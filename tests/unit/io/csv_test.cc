@@ -422,7 +422,10 @@ TEST(CsvCapture, AnEmptyResultSaysWhatEmptiedIt) {
     return std::string("read");
   };
   EXPECT_NE(message("a,b\n1,2\n", {.skip_rows = 5})
-                .find("skipping its first 5 lines leaves no header (the file has 2)"),
+                .find("skipping its first 5 lines leaves nothing to read (the file has 2 lines)"),
+            std::string::npos);
+  // Lines left after the skipped ones but all comments: the file is empty, not over-skipped.
+  EXPECT_NE(message("banner\n# only\n", {.skip_rows = 1}).find("empty file (no header row)"),
             std::string::npos);
   EXPECT_NE(message("a,b\nx,2\n1\n", {.bad_lines = BadLines::kSkip})
                 .find("every data row is bad (2 skipped as bad lines, the first at line 2)"),
@@ -431,6 +434,11 @@ TEST(CsvCapture, AnEmptyResultSaysWhatEmptiedIt) {
   EXPECT_NE(message(std::string("a,b\0c\n1,2\n", 10), {})
                 .find("line 1 (the header) holds a NUL byte: not a text file"),
             std::string::npos);
+  // Without a header the first line is data: a garbled first row of a serial capture is a bad
+  // line like any other.
+  EXPECT_EQ(
+      message(std::string("1\0,2\n3,4\n", 9), {.names = {"a", "b"}, .bad_lines = BadLines::kSkip}),
+      "read");
 }
 
 TEST(CsvCapture, BadOptionsAreRefused) {
