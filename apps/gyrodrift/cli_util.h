@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
@@ -106,11 +107,11 @@ CLI::Option* AddListOption(CLI::App* cmd, const std::string& name, std::vector<T
       [values, name](const std::vector<std::string>& tokens) {
         values->clear();
         for (const std::string& token : tokens) {
+          if (token.empty()) throw CLI::ValidationError(name + ": an empty value is not a list");
           for (size_t begin = 0, end = 0; begin <= token.size(); begin = end + 1) {
             end = std::min(token.find(',', begin), token.size());
             const std::string item = token.substr(begin, end - begin);
             T value{};
-            if (token.empty()) throw CLI::ValidationError(name + ": an empty value is not a list");
             if (item.empty()) {
               throw CLI::ValidationError(name + " = " + token + ": an empty item in the list");
             }
@@ -133,8 +134,9 @@ CLI::Option* AddListOption(CLI::App* cmd, const std::string& name, std::vector<T
   return option;
 }
 
-// The message of CLI11's "Could not convert: --flag = value" with what the flag takes ("--ensemble
-// = 1e3: must be an integer (1000)"); CLI11's own message when the flag is not found.
+// The message of CLI11's "Could not convert: --flag = value" with what a numeric flag takes
+// ("--ensemble = 1e3: must be an integer (write 1000)", "... = 99999999999: out of range");
+// CLI11's own message for other flags (on/off, text) and when the flag is not found.
 std::string ConversionMessage(const CLI::App& app, const CLI::ConversionError& error);
 
 // Binds `flag` to the names under which the library refers to what it sets (a
