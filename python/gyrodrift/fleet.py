@@ -54,6 +54,9 @@ def calibrate(manifest_path, output_dir, *, client=None, scheduler=None, workers
         os.makedirs(output_dir, exist_ok=True)
     except OSError as e:
         raise _gyrodrift.FileError(f"{output_dir}: cannot create the output folder ({e.strerror})")
+    if not os.access(output_dir, os.W_OK):  # else every unit would run, then fleet.csv fail
+        raise _gyrodrift.FileError(f"{os.path.join(output_dir, 'fleet.csv')}: cannot open for "
+                                   "writing (Permission denied)")
     cluster = None
     own_client = client is None
     if client is None:
