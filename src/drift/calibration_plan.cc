@@ -87,7 +87,7 @@ CalibrationPlan PlanCalibration(const PlanSettings& settings) {
     plan.warnings.push_back(Format(
         "a run of %.3g h lets the fit's thermal states lag by %.0f s at most; a coil that lags its "
         "sensor by more needs %g h or more",
-        t / 3600.0, delay, std::ceil(fit.RunReachingLag(internal::kSlowLagS) / 36.0) / 100.0));
+        t / 3600.0, delay, fit.HoursReachingLag(internal::kSlowLagS)));
   }
   plan.time_s.push_back(0.0);
   plan.temperature_c.push_back(mid);

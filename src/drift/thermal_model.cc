@@ -91,10 +91,12 @@ std::vector<double> ThermalModelOptions::Grid(double duration_s) const {
   return grid;
 }
 
-double ThermalModelOptions::RunReachingLag(double lag_s) const {
+double ThermalModelOptions::HoursReachingLag(double lag_s) const {
   const double steps =
       std::ceil(taus_per_octave * std::log2(lag_s / state_order / shortest_tau_s) - 1e-9);
-  return shortest_tau_s * std::exp2(std::max(steps, 0.0) / taus_per_octave) / longest_tau_share;
+  const double run_s =
+      shortest_tau_s * std::exp2(std::max(steps, 0.0) / taus_per_octave) / longest_tau_share;
+  return std::ceil(run_s / 36.0) / 100.0;
 }
 
 Eigen::MatrixXd ThermalRegression::Regressors(

@@ -183,11 +183,11 @@ void AddModelWarnings(const ThermalRegression& model, const ThermalModelOptions&
         "thermal states could lag the sensor by at most %.0f s (time constants up to %g of the "
         "run): a gyro whose coil lags its sensor by more needs a longer calibration run",
         longest_delay, options.longest_tau_share));
-    const double needed_s = options.RunReachingLag(kSlowLagS);
+    const double needed_h = options.HoursReachingLag(kSlowLagS);
     advice.push_back(
         Format("short run: %.3g h lets states lag by %.0f s at most; %g h reaches %.0f s",
-               report.duration_s / 3600.0, longest_delay, std::ceil(needed_s / 36.0) / 100.0,
-               options.state_order * options.Grid(needed_s).back()));
+               report.duration_s / 3600.0, longest_delay, needed_h,
+               options.state_order * options.Grid(needed_h * 3600.0).back()));
   }
   double slowest = 0.0;
   for (const ThermalState& s : model.states) slowest = std::max(slowest, s.tau_s);

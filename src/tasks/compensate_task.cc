@@ -224,20 +224,13 @@ void RequireModelColumns(const io::LoadedModel& loaded, const io::CsvTable& tabl
 void RequireModelRate(const std::vector<io::LoadedModel>& axes, const std::string& model_path,
                       const std::string& log_path, double log_hz, const std::string& how,
                       bool flags) {
-  if (how == "default") return;
   for (const io::LoadedModel& axis : axes) {
-    const double model_hz = axis.model.options.features.rate_hz;
-    const double ratio = log_hz / model_hz;
-    if (std::abs(ratio - 1.0) <= 0.01) continue;
-    throw DataError(fmt::format(
-        "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its thermal lags and "
-        "temperature rates would run {:.3g} times too {} (resample the log to {:g} Hz or fit the "
-        "model on a log at {:g} Hz{})",
-        log_path, log_hz, RateSourceText(how, flags), model_path, model_hz,
-        ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow", model_hz, log_hz,
-        how == "time_s"
-            ? fmt::format("; give {} if time_s is wrong", flags ? "--rate-hz" : "rate_hz")
-            : ""));
+    RequireRateOfModel(log_path, log_hz, how, flags, model_path,
+                       axis.model.options.features.rate_hz, [](double ratio) {
+                         return fmt::format(
+                             "its thermal lags and temperature rates would run {:.3g} times too {}",
+                             ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "fast" : "slow");
+                       });
   }
 }
 

@@ -29,17 +29,13 @@ void RequirePredictMode(const io::LoadedModel& loaded, const std::string& model_
 void RequirePredictRate(const io::LoadedModel& loaded, const std::string& model_path,
                         const std::string& log_path, double log_hz, const std::string& how,
                         bool flags) {
-  const double model_hz = loaded.model.options.features.rate_hz;
-  const double ratio = log_hz / model_hz;
-  if (how == "default" || std::abs(ratio - 1.0) <= 0.01) return;
-  throw DataError(fmt::format(
-      "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: its lags and windows, counted in "
-      "samples, would span {:.3g} times {} time than it learnt (resample the log to {:g} Hz or "
-      "fit a model on a log at {:g} Hz{})",
-      log_path, log_hz, RateSourceText(how, flags), model_path, model_hz,
-      ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "less" : "more", model_hz, log_hz,
-      how == "time_s" ? fmt::format("; give {} if time_s is wrong", flags ? "--rate-hz" : "rate_hz")
-                      : ""));
+  RequireRateOfModel(log_path, log_hz, how, flags, model_path,
+                     loaded.model.options.features.rate_hz, [](double ratio) {
+                       return fmt::format(
+                           "its lags and windows, counted in samples, would span {:.3g} times {} "
+                           "time than it learnt",
+                           ratio > 1.0 ? ratio : 1.0 / ratio, ratio > 1.0 ? "less" : "more");
+                     });
 }
 
 PredictResult RunPredict(const io::LoadedModel& loaded, const Eigen::VectorXd& y,

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "gyrodrift/common/check.h"
@@ -31,6 +32,20 @@ std::string RateSourceText(const std::string& how, bool flags) {
   return how == "given"    ? "given by " + rate
          : how == "time_s" ? "from the steps of time_s"
                            : "assumed: no " + rate + " and no time_s column";
+}
+
+void RequireRateOfModel(const std::string& log_path, double log_hz, const std::string& how,
+                        bool flags, const std::string& model_path, double model_hz,
+                        const std::function<std::string(double ratio)>& effect) {
+  const double ratio = log_hz / model_hz;
+  if (how == "default" || std::abs(ratio - 1.0) <= 0.01) return;
+  throw DataError(fmt::format(
+      "{} is sampled at {:g} Hz ({}), {} was fitted at {:g} Hz: {} (resample the log to {:g} Hz "
+      "or fit the model on a log at {:g} Hz{})",
+      log_path, log_hz, RateSourceText(how, flags), model_path, model_hz, effect(ratio), model_hz,
+      log_hz,
+      how == "time_s" ? fmt::format("; give {} if time_s is wrong", flags ? "--rate-hz" : "rate_hz")
+                      : ""));
 }
 
 std::vector<std::string> SplitColumns(const std::string& names) {

@@ -134,9 +134,10 @@ struct ThermalModelOptions {
   void Validate() const;  // throws OptionError naming the field
   // The candidate constants for a run of `duration_s` seconds.
   std::vector<double> Grid(double duration_s) const;
-  // The shortest run, s, whose Grid holds a state lagging by at least `lag_s` (order x tau): the
-  // grid goes in steps, so this is more than lag_s / (order x longest_tau_share) in general.
-  double RunReachingLag(double lag_s) const;
+  // The shortest run, h, rounded up to 0.01 h, whose Grid holds a state lagging by at least
+  // `lag_s` (order x tau): the grid goes in steps, so this is more than lag_s / (order x
+  // longest_tau_share) in general.
+  double HoursReachingLag(double lag_s) const;
   // Whether a run of `logged_s` seconds of logged samples tries the hysteresis term.
   bool TriesHysteresis(double logged_s) const;
 };

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,14 @@ bool SpeltAsFlags(const io::LogOptions& log);
 // Where io::ResolveSampleRate's rate came from (`how` "given", "time_s" or "default"), as the
 // user reads it beside the rate: "given by --rate-hz" (`flags`) or "given by rate_hz", ...
 std::string RateSourceText(const std::string& how, bool flags);
+
+// DataError naming the log and the model when the log's rate (`log_hz`, from `how`; "default", a
+// rate nobody stated, is not checked) is more than 1 % off the model's `model_hz`: `effect` says
+// what the model's sample-counted parts would do at ratio = log_hz / model_hz ("its lags would
+// run 10 times too fast"). The advice to give the rate is offered where time_s gave it.
+void RequireRateOfModel(const std::string& log_path, double log_hz, const std::string& how,
+                        bool flags, const std::string& model_path, double model_hz,
+                        const std::function<std::string(double ratio)>& effect);
 
 // The columns of `spec` ("a" or "a,b", names or 1-based indices): their names, the names joined by
 // commas, and the N x C matrix. Throws UsageError naming `option` (--target, target) for an
